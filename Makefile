@@ -1,0 +1,41 @@
+# Two commands do all the set-up on a fresh machine with Python 3.11 and make:
+#   make demo   creates .venv, installs scara-pin, runs the demo
+#   make test   creates .venv, installs scara-pin with its test extras, runs the whole suite
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+OUT ?= build
+
+.PHONY: demo test bench lint clean
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+
+$(VENV)/.installed: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install -q -e .
+	touch $@
+
+$(VENV)/.installed-test: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install -q -e '.[test]'
+	touch $@ $(VENV)/.installed
+
+demo: $(VENV)/.installed
+	@mkdir -p $(OUT)
+	$(BIN)/scara-pin urdf --robot default -o $(OUT)/scara.urdf
+	$(BIN)/scara-pin fk 0.1 0.2 0.05 0.3
+	$(BIN)/scara-pin jacobian 0.1 0.2 0.05 0.3
+
+test: $(VENV)/.installed-test
+	$(BIN)/python -m pytest -q
+
+bench: $(VENV)/.installed-test
+	$(BIN)/python benchmarks/bench_fk.py
+
+lint: $(VENV)/.installed-test
+	$(BIN)/python -m pip install -q ruff mypy
+	$(BIN)/ruff check scara_pin tests benchmarks
+	$(BIN)/mypy scara_pin
+
+clean:
+	rm -rf $(VENV) $(OUT) .pytest_cache

@@ -1,0 +1,56 @@
+"""scara-pin: exact kinematics, motion and pictures for 4-DOF Schoenflies robots (SCARA first).
+
+Describe a robot once (yaml parameters -> xacro -> URDF), load it into Pinocchio, and get forward
+kinematics and Jacobians from the model. Heavy optional packages (toppra, matplotlib, yourdfpy, meshcat)
+are imported only by the functions that need them.
+"""
+
+import logging
+
+from .description import (
+    JOINT_NAMES,
+    PARAMETER_NAMES,
+    JointLimits,
+    RobotParameters,
+    available_robots,
+    generate_urdf,
+    load_parameters,
+    urdf_dir,
+)
+from .errors import (
+    DescriptionError,
+    InfeasibleError,
+    InvalidInputError,
+    ParameterError,
+    ScaraError,
+    UnknownRobotError,
+    UrdfError,
+)
+from .model import Robot, load_robot, load_urdf, pose_from_placement
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "JOINT_NAMES",
+    "PARAMETER_NAMES",
+    "DescriptionError",
+    "InfeasibleError",
+    "InvalidInputError",
+    "JointLimits",
+    "ParameterError",
+    "Robot",
+    "RobotParameters",
+    "ScaraError",
+    "UnknownRobotError",
+    "UrdfError",
+    "__version__",
+    "available_robots",
+    "generate_urdf",
+    "load_parameters",
+    "load_robot",
+    "load_urdf",
+    "pose_from_placement",
+    "urdf_dir",
+]
+
+logging.getLogger(__name__).addHandler(logging.NullHandler())

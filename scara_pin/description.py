@@ -1,0 +1,352 @@
+"""Robot parameters (yaml) and the URDF generated from them with xacro.
+
+The yaml files under ``urdf/config/<robot>/`` are the single source of truth:
+
+- ``kinematics.yaml``: ``base_height``, ``d1``, ``l1``, ``d2``, ``l2``, ``d3`` and ``tool: {x, y, z, yaw}``;
+- ``joint_limits.yaml``: per joint ``lower``, ``upper``, ``velocity``, ``acceleration``, ``effort``;
+- ``physical_parameters.yaml``: per body (``base``, ``link1``, ``link2``, ``quill``, ``flange``) its
+  ``mass`` and ``radius`` (and ``length`` for the quill and the flange).
+
+Parameters are addressed by flat names (``l1``, ``tool_x``, ``joint2_velocity``, ``quill_mass``): the
+nested yaml keys joined by ``_``. Every value is validated here, BEFORE xacro runs, and reaches xacro
+only as the text ``repr(float(v))`` of a finite number: xacro evaluates ``${...}`` expressions in a
+sandbox that can be escaped, so no user-supplied text may ever reach it.
+
+Units are SI: [m], [rad], [kg], [rad/s] or [m/s], [rad/s^2] or [m/s^2], [N m] or [N]. The yaml files
+may write angles as ``!degrees 132`` (xacro's yaml tag), read here as radians, as xacro reads them.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import xml.dom.minidom
+from collections.abc import Mapping
+from dataclasses import InitVar, dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+
+from .errors import DescriptionError, ParameterError, UnknownRobotError
+
+__all__ = [
+    "JOINT_NAMES",
+    "PARAMETER_NAMES",
+    "JointLimits",
+    "RobotParameters",
+    "available_robots",
+    "generate_urdf",
+    "load_parameters",
+    "urdf_dir",
+]
+
+JOINT_NAMES: tuple[str, ...] = ("joint1", "joint2", "joint3", "joint4")
+"""The four joints, in URDF (and q) order."""
+
+_KINEMATICS = ("base_height", "d1", "l1", "d2", "l2", "d3", "tool_x", "tool_y", "tool_z", "tool_yaw")
+_LIMIT_FIELDS = ("lower", "upper", "velocity", "acceleration", "effort")
+_LIMITS = tuple(f"{j}_{f}" for j in JOINT_NAMES for f in _LIMIT_FIELDS)
+_PHYSICAL = (
+    "base_mass", "base_radius", "link1_mass", "link1_radius", "link2_mass", "link2_radius",
+    "quill_mass", "quill_radius", "quill_length", "flange_mass", "flange_radius", "flange_length",
+)  # fmt: skip
+_FILES: dict[str, tuple[str, ...]] = {
+    "kinematics.yaml": _KINEMATICS,
+    "joint_limits.yaml": _LIMITS,
+    "physical_parameters.yaml": _PHYSICAL,
+}
+PARAMETER_NAMES: tuple[str, ...] = _KINEMATICS + _LIMITS + _PHYSICAL
+"""Every parameter, by its flat name (the names ``--set key=value`` accepts)."""
+
+# Parameters that must be strictly positive: lengths of bodies, masses and the speed/force limits.
+_POSITIVE = frozenset(
+    {"l1", "l2"}
+    | {n for n in _PHYSICAL}
+    | {f"{j}_{f}" for j in JOINT_NAMES for f in ("velocity", "acceleration", "effort")}
+)
+# Acceleration limits have no URDF element; they stay in Python (yaml) and never reach xacro.
+_XACRO_ARGS = tuple(n for n in PARAMETER_NAMES if not n.endswith("_acceleration"))
+_NAME_RE = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+_PREFIX_RE = re.compile(r"[A-Za-z0-9_]*\Z")
+_ENTRY = "scara.urdf.xacro"
+
+
+def urdf_dir() -> Path:
+    """The folder of the description: ``scara.urdf.xacro``, the macro, ``inc/`` and ``config/``.
+
+    Installed from a wheel it lies inside the package (``scara_pin/urdf``); in a source checkout it is
+    the repository's top-level ``urdf/``.
+    """
+    here = Path(__file__).resolve().parent
+    for candidate in (here / "urdf", here.parent / "urdf"):
+        if (candidate / _ENTRY).is_file():
+            return candidate
+    raise DescriptionError(f"the robot description ({_ENTRY}) is missing from the installation at {here}")
+
+
+def available_robots() -> list[str]:
+    """Names of the shipped robot configurations, sorted."""
+    config = urdf_dir() / "config"
+    return sorted(p.name for p in config.iterdir() if (p / "kinematics.yaml").is_file())
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """Limits of the four joints, in q order, as float tuples.
+
+    Attributes:
+        lower: lower position limit [rad] or [m].
+        upper: upper position limit [rad] or [m].
+        velocity: velocity limit [rad/s] or [m/s].
+        acceleration: acceleration limit [rad/s^2] or [m/s^2].
+        effort: effort limit [N m] or [N].
+        validate: check the limits (finite, lower < upper, the rest > 0); ``False`` keeps a foreign
+            URDF's limits as written (they may be placeholders such as 0).
+    """
+
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    velocity: tuple[float, ...]
+    acceleration: tuple[float, ...]
+    effort: tuple[float, ...]
+    validate: InitVar[bool] = True
+
+    def __post_init__(self, validate: bool) -> None:
+        if not validate:  # limits read from a foreign URDF, kept as written
+            return
+        for name in _LIMIT_FIELDS:
+            values = getattr(self, name)
+            if len(values) != len(JOINT_NAMES):
+                raise ParameterError(name, values, f"must hold {len(JOINT_NAMES)} values")
+            for joint, value in zip(JOINT_NAMES, values):
+                _check_finite(f"{joint}_{name}", value)
+                if name not in ("lower", "upper") and value <= 0:
+                    raise ParameterError(f"{joint}_{name}", value, "must be > 0")
+        for joint, lo, hi in zip(JOINT_NAMES, self.lower, self.upper):
+            if not lo < hi:
+                raise ParameterError(f"{joint}_lower", lo, f"must be < {joint}_upper = {hi}")
+
+
+@dataclass(frozen=True)
+class RobotParameters:
+    """The validated parameters of one robot.
+
+    Attributes:
+        name: the robot's name (its config folder's name).
+        values: every parameter by flat name (see :data:`PARAMETER_NAMES`), SI units.
+        source: the config folder the values were read from.
+    """
+
+    name: str
+    values: Mapping[str, float]
+    source: Path | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        values = dict(self.values)
+        missing = [n for n in PARAMETER_NAMES if n not in values]
+        if missing:
+            raise ParameterError(missing[0], None, "is required (missing)")
+        for key, value in values.items():
+            if key not in PARAMETER_NAMES:
+                raise ParameterError(key, value, f"is not a parameter; known: {', '.join(PARAMETER_NAMES)}")
+            _check_finite(key, value)
+            if key in _POSITIVE and value <= 0:
+                raise ParameterError(key, value, "must be > 0")
+        column = values["base_height"] + values["d1"]
+        if column <= 0:
+            raise ParameterError("base_height + d1", column, "(the column from the floor to joint1) must be > 0")
+        object.__setattr__(self, "values", MappingProxyType({k: float(values[k]) for k in PARAMETER_NAMES}))
+        object.__setattr__(self, "limits", self._limits())
+
+    limits: JointLimits = field(init=False, compare=False)
+
+    def _limits(self) -> JointLimits:
+        v = self.values
+        return JointLimits(**{f: tuple(v[f"{j}_{f}"] for j in JOINT_NAMES) for f in _LIMIT_FIELDS})
+
+    def __getitem__(self, key: str) -> float:
+        return self.values[key]
+
+    def with_overrides(self, overrides: Mapping[str, object]) -> RobotParameters:
+        """A copy with some parameters replaced.
+
+        Args:
+            overrides: flat name -> number, or the text of a number (``"0.25"``); checked before use.
+
+        Raises:
+            ParameterError: an unknown name, a value that is not a finite number, or a broken rule.
+        """
+        values = dict(self.values)
+        for key, raw in overrides.items():
+            if key not in PARAMETER_NAMES:
+                raise ParameterError(key, raw, f"is not a parameter; known: {', '.join(PARAMETER_NAMES)}")
+            values[key] = _to_float(key, raw)
+        return RobotParameters(self.name, values, self.source)
+
+    def xacro_mappings(self, prefix: str = "") -> dict[str, str]:
+        """The xacro arguments: each value as ``repr(float(v))``, and the (checked) name prefix."""
+        if not _PREFIX_RE.match(prefix):
+            raise ParameterError("prefix", prefix, "may hold only letters, digits and '_'")
+        mappings = {n: repr(float(self.values[n])) for n in _XACRO_ARGS}
+        mappings["prefix"] = prefix
+        return mappings
+
+
+def _check_finite(name: str, value: object) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError(name, value, "must be a number")
+    if not math.isfinite(value):
+        raise ParameterError(name, value, "must be finite")
+
+
+def _to_float(name: str, raw: object) -> float:
+    """A finite float from a number or the text of one; anything else is refused."""
+    if isinstance(raw, str):
+        try:
+            value = float(raw.strip())
+        except ValueError:
+            raise ParameterError(name, raw, "must be a number") from None
+    elif isinstance(raw, bool) or not isinstance(raw, (int, float)):
+        raise ParameterError(name, raw, "must be a number")
+    else:
+        value = float(raw)
+    _check_finite(name, value)
+    return value
+
+
+def _yaml_loader() -> type:
+    """A safe yaml loader that also reads xacro's unit tags (``!degrees``, ``!millimeters``, ...)."""
+    import yaml
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    scales = {"!radians": 1.0, "!degrees": math.pi / 180.0, "!meters": 1.0, "!millimeters": 1e-3,
+              "!foot": 0.3048, "!inches": 0.0254}  # fmt: skip
+    for tag, scale in scales.items():
+
+        def construct(loader: yaml.SafeLoader, node: yaml.Node, scale: float = scale) -> float:
+            text = loader.construct_scalar(node)  # type: ignore[arg-type]
+            try:
+                return float(text) * scale
+            except ValueError:
+                raise ParameterError(f"{node.tag} value", text, "must be a number") from None
+
+        Loader.add_constructor(tag, construct)
+    return Loader
+
+
+def _flatten(tree: object, prefix: str, out: dict[str, object]) -> None:
+    if isinstance(tree, dict):
+        for key, value in tree.items():
+            _flatten(value, f"{prefix}_{key}" if prefix else str(key), out)
+    else:
+        out[prefix] = tree
+
+
+def _read_config(folder: Path) -> dict[str, float]:
+    import yaml
+
+    loader = _yaml_loader()
+    values: dict[str, float] = {}
+    for filename, expected in _FILES.items():
+        path = folder / filename
+        try:
+            tree = yaml.load(path.read_text(encoding="utf-8"), Loader=loader)  # noqa: S506 (safe loader)
+        except OSError as exc:
+            raise ParameterError(str(path), None, f"cannot be read ({exc.strerror})") from None
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            where = f" line {mark.line + 1}" if mark is not None else ""
+            raise ParameterError(f"{path}{where}", None, f"must be valid yaml ({exc})") from None
+        flat: dict[str, object] = {}
+        _flatten(tree if tree is not None else {}, "", flat)
+        for key, raw in flat.items():
+            if key not in expected:
+                raise ParameterError(f"{key} in {path}", raw, f"is not a parameter of {filename}")
+            try:
+                values[key] = _to_float(key, raw)
+            except ParameterError as exc:
+                raise ParameterError(f"{key} in {path}", raw, exc.rule) from None
+        for key in expected:
+            if key not in flat:
+                raise ParameterError(f"{key} in {path}", None, "is required (missing)")
+    return values
+
+
+def _config_folder(robot: str | Path) -> tuple[str, Path]:
+    """Resolve a robot name or a config folder path to (name, folder)."""
+    text = str(robot)
+    folder = Path(text)
+    if isinstance(robot, Path) or "/" in text or "\\" in text or folder.is_dir():
+        if (folder / "kinematics.yaml").is_file():
+            name = folder.resolve().name
+            return (name if _NAME_RE.match(name) else "scara"), folder
+        raise UnknownRobotError(text, available_robots())
+    if _NAME_RE.match(text):
+        folder = urdf_dir() / "config" / text
+        if (folder / "kinematics.yaml").is_file():
+            return text, folder
+    raise UnknownRobotError(text, available_robots())
+
+
+def load_parameters(
+    robot: str | Path | RobotParameters = "default", overrides: Mapping[str, object] | None = None
+) -> RobotParameters:
+    """Read and validate a robot's parameters.
+
+    Args:
+        robot: a shipped robot's name (see :func:`available_robots`), a config folder holding the three
+            yaml files, or parameters already loaded.
+        overrides: flat parameter name -> value (a number or its text), applied after reading.
+
+    Returns:
+        The validated parameters.
+
+    Raises:
+        UnknownRobotError: no such robot or folder.
+        ParameterError: a missing, unknown, non-finite or rule-breaking parameter.
+    """
+    if isinstance(robot, RobotParameters):
+        params = robot
+    else:
+        name, folder = _config_folder(robot)
+        params = RobotParameters(name, _read_config(folder), folder)
+    return params.with_overrides(overrides) if overrides else params
+
+
+def generate_urdf(
+    robot: str | Path | RobotParameters = "default",
+    overrides: Mapping[str, object] | None = None,
+    *,
+    prefix: str = "",
+) -> str:
+    """Expand ``urdf/scara.urdf.xacro`` for a robot and return the URDF text.
+
+    Args:
+        robot: as in :func:`load_parameters`.
+        overrides: as in :func:`load_parameters`.
+        prefix: prepended to every link and joint name (letters, digits and ``_`` only).
+
+    Returns:
+        The URDF document as a string.
+    """
+    import xacro
+
+    params = load_parameters(robot, overrides)
+    mappings = params.xacro_mappings(prefix)
+    entry = urdf_dir() / _ENTRY
+    try:
+        # xacro keeps (and mutates) the mappings dict it is given: hand it a copy.
+        doc = xacro.process_file(str(entry), mappings=dict(mappings))
+    except Exception as exc:  # xacro raises plain Exceptions too; all mean a broken template here
+        raise DescriptionError(f"xacro failed on {entry}: {exc}") from exc
+    doc.documentElement.setAttribute("name", params.name)
+    return _pretty(doc)
+
+
+def _pretty(doc: xml.dom.minidom.Document) -> str:
+    # drop xacro's banner (it names the absolute path of the template, which varies between installs)
+    for node in list(doc.childNodes):
+        if node.nodeType == node.COMMENT_NODE:
+            doc.removeChild(node)
+    return str(doc.toprettyxml(indent="  "))

@@ -1,0 +1,75 @@
+"""One exception tree for the whole package.
+
+Every error raised on purpose by scara_pin is a :class:`ScaraError`. Each subclass carries the data that
+explains it and an ``exit_code`` that the command line uses: 2 for invalid input, 3 for an infeasible
+request, 1 for an internal error (a bug, or a broken installation).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+__all__ = [
+    "DescriptionError",
+    "InfeasibleError",
+    "InvalidInputError",
+    "ParameterError",
+    "ScaraError",
+    "UnknownRobotError",
+    "UrdfError",
+]
+
+
+class ScaraError(Exception):
+    """Base class of the errors scara_pin raises on purpose."""
+
+    exit_code: ClassVar[int] = 1
+
+
+class InvalidInputError(ScaraError, ValueError):
+    """The caller gave something that cannot be used (exit code 2)."""
+
+    exit_code: ClassVar[int] = 2
+
+
+class ParameterError(InvalidInputError):
+    """A robot parameter or a numeric input breaks a rule.
+
+    Attributes:
+        name: the parameter, e.g. ``"l1"`` or ``"joint2_velocity"``.
+        value: the offending value, as given.
+        rule: the rule it breaks, e.g. ``"must be > 0"``.
+    """
+
+    def __init__(self, name: str, value: object, rule: str, unit: str = "") -> None:
+        self.name = name
+        self.value = value
+        self.rule = rule
+        shown = f"{value!r}" if isinstance(value, str) else f"{value}"
+        super().__init__(f"{name} is {shown}{(' ' + unit) if unit else ''}; it {rule}")
+
+
+class UnknownRobotError(InvalidInputError):
+    """No robot configuration of that name or path."""
+
+    def __init__(self, robot: str, available: list[str]) -> None:
+        self.robot = robot
+        self.available = available
+        super().__init__(
+            f"unknown robot {robot!r}: not a shipped robot ({', '.join(available)}) "
+            "nor a folder holding kinematics.yaml, joint_limits.yaml and physical_parameters.yaml"
+        )
+
+
+class UrdfError(InvalidInputError):
+    """A URDF that cannot be loaded, or that is not a usable robot."""
+
+
+class InfeasibleError(ScaraError):
+    """A valid request that the robot cannot carry out (exit code 3)."""
+
+    exit_code: ClassVar[int] = 3
+
+
+class DescriptionError(ScaraError):
+    """The packaged description templates failed to expand (a bug or a broken install; exit code 1)."""

@@ -1,0 +1,315 @@
+"""A SCARA loaded into Pinocchio: forward kinematics, frame placements and Jacobians.
+
+Conventions (used by every command of the package):
+
+- ``q`` holds the four joint values in URDF joint order, SI units ([rad], and [m] for the quill).
+- Poses are of ``tool0`` in the robot's ``base`` frame (the controller's reference frame). The yaw is
+  ``atan2(R[1, 0], R[0, 0])`` of that rotation: the heading of tool0's x axis in the base plane.
+- Pinocchio's world frame (``universe``) is the root link (``base_link``); Jacobians named after
+  Pinocchio's reference frames (``WORLD``, ``LOCAL``, ``LOCAL_WORLD_ALIGNED``) are exactly Pinocchio's.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import tempfile
+import xml.etree.ElementTree as ET
+from collections.abc import Mapping, Sequence
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
+from .errors import InvalidInputError, ParameterError, UrdfError
+
+__all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
+
+_REFERENCES: dict[str, pin.ReferenceFrame] = {
+    "world": pin.ReferenceFrame.WORLD,
+    "local": pin.ReferenceFrame.LOCAL,
+    "local_world_aligned": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+}
+
+
+def pose_from_placement(aMb: pin.SE3) -> np.ndarray:
+    """The (x, y, z, yaw) of a placement: its translation and ``atan2(R[1, 0], R[0, 0])`` [m, rad]."""
+    R = aMb.rotation
+    p = aMb.translation
+    return np.array([p[0], p[1], p[2], math.atan2(R[1, 0], R[0, 0])])
+
+
+def _parse_urdf(urdf: str, origin: str) -> pin.Model:
+    """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
+    try:
+        root = ET.fromstring(urdf)
+    except ET.ParseError as exc:
+        line, column = exc.position
+        raise UrdfError(f"{origin}: malformed XML at line {line}, column {column + 1}") from None
+    if root.tag != "robot":
+        raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
+    # urdfdom reports the reason on the C stderr and Pinocchio raises a generic ValueError: capture it.
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as captured:
+        os.dup2(captured.fileno(), 2)
+        try:
+            model = pin.buildModelFromXML(urdf)
+            failure = None
+        except (ValueError, RuntimeError) as exc:
+            failure = exc
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        captured.seek(0)
+        report = captured.read().decode(errors="replace")
+    if failure is not None:
+        reasons = [ln.split("Error:", 1)[1].strip() for ln in report.splitlines() if "Error:" in ln]
+        reason = "; ".join(reasons) if reasons else str(failure)
+        raise UrdfError(f"{origin}: not a valid URDF: {reason}")
+    if report.strip():
+        sys.stderr.write(report)
+    if model.nq == 0:
+        raise UrdfError(
+            f"{origin}: the URDF has no movable joint connected to its root link "
+            f"({model.nbodies - 1} bodies, nq = 0): the kinematic tree is empty or disconnected"
+        )
+    return model
+
+
+class Robot:
+    """A 4-joint SCARA in Pinocchio, with its frames and limits.
+
+    Attributes:
+        model: the Pinocchio model (``nq = nv = 4``).
+        data: its Pinocchio data (the methods below overwrite it).
+        urdf: the URDF text the model was built from.
+        name: the robot's name.
+        limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
+        parameters: the yaml parameters, when the robot was generated from them.
+        base_frame, tool_frame: names of the reference frame and of the tool frame.
+    """
+
+    model: pin.Model
+    data: pin.Data
+    urdf: str
+    name: str
+    limits: JointLimits
+    parameters: RobotParameters | None
+    base_frame: str
+    tool_frame: str
+
+    def __init__(
+        self,
+        urdf: str,
+        *,
+        acceleration: Sequence[float] | None = None,
+        parameters: RobotParameters | None = None,
+        base_frame: str = "base",
+        tool_frame: str = "tool0",
+        origin: str = "URDF",
+    ) -> None:
+        """Load URDF text.
+
+        Args:
+            urdf: the URDF document.
+            acceleration: acceleration limits per joint [rad/s^2 or m/s^2]; URDF has none. Without it
+                (a URDF file) they are NaN, meaning unknown: commands that need them ask for them.
+            parameters: the yaml parameters it was generated from, if any.
+            base_frame: the frame poses are expressed in; falls back to the root link if absent.
+            tool_frame: the tool frame (``tool0``).
+            origin: how to name the source in error messages (a file name).
+
+        Raises:
+            UrdfError: unreadable, invalid or disconnected URDF, or not a 4-joint robot.
+        """
+        model = _parse_urdf(urdf, origin)
+        if model.nq != len(JOINT_NAMES) or model.nv != len(JOINT_NAMES):
+            joints = ", ".join(f"{model.names[i]} (nq {model.joints[i].nq})" for i in range(1, model.njoints))
+            raise UrdfError(
+                f"{origin}: a SCARA has 4 single-DOF joints; this model has nq = {model.nq}, "
+                f"nv = {model.nv}: {joints}"
+            )
+        if not model.existFrame(tool_frame):
+            raise UrdfError(f"{origin}: no frame named {tool_frame!r}")
+        if not model.existFrame(base_frame):
+            base_frame = model.frames[1].name if len(model.frames) > 1 else "universe"
+        self.model = model
+        self.data = model.createData()
+        self.urdf = urdf
+        self.name = model.name
+        self.parameters = parameters
+        self.base_frame = base_frame
+        self.tool_frame = tool_frame
+        self.base_id = model.getFrameId(base_frame)
+        self.tool_id = model.getFrameId(tool_frame)
+        if parameters is not None:
+            self.limits = parameters.limits
+        else:  # a URDF file: record its limits as written (they may be placeholders; not checked here)
+            self.limits = JointLimits(
+                lower=tuple(float(v) for v in model.lowerPositionLimit),
+                upper=tuple(float(v) for v in model.upperPositionLimit),
+                velocity=tuple(float(v) for v in model.velocityLimit),
+                acceleration=tuple(math.nan for _ in JOINT_NAMES) if acceleration is None
+                else tuple(float(v) for v in acceleration),
+                effort=tuple(float(v) for v in model.effortLimit),
+                validate=False,
+            )
+        # base is fixed to the root: its placement never changes; keep its inverse for the fast path.
+        pin.framesForwardKinematics(model, self.data, pin.neutral(model))
+        self._baseMo = self.data.oMf[self.base_id].inverse()
+        self._Rbo = self._baseMo.rotation.copy()
+
+    # ----------------------------------------------------------------- construction helpers
+    @classmethod
+    def from_config(
+        cls,
+        robot: str | Path | RobotParameters = "default",
+        overrides: Mapping[str, object] | None = None,
+    ) -> Robot:
+        """Generate the URDF of a configured robot (see :mod:`scara_pin.description`) and load it."""
+        params = load_parameters(robot, overrides)
+        return cls(
+            generate_urdf(params),
+            parameters=params,
+            origin=f"robot {params.name!r}",
+        )
+
+    @classmethod
+    def from_file(cls, path: str | Path, **kwargs: Any) -> Robot:
+        """Load a URDF file (keyword arguments as for the constructor)."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise UrdfError(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+        return cls(text, origin=str(path), **kwargs)
+
+    # ----------------------------------------------------------------- geometry (lazy)
+    @cached_property
+    def visual_model(self) -> pin.GeometryModel:
+        """Visual geometry (primitives) of the URDF, built on first use."""
+        return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.VISUAL)
+
+    @cached_property
+    def collision_model(self) -> pin.GeometryModel:
+        """Collision geometry of the URDF, built on first use."""
+        return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.COLLISION)
+
+    # ----------------------------------------------------------------- input checks
+    def check_q(self, q: object) -> np.ndarray:
+        """Return ``q`` as a float array of 4 finite values, or raise :class:`ParameterError`."""
+        try:
+            arr = np.asarray(q, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError("q", q, "must be 4 numbers") from None
+        if arr.shape != (4,):
+            raise ParameterError("q", q, f"must be 4 numbers (got shape {arr.shape})")
+        if not math.isfinite(arr.dot(arr)):
+            for joint, value in zip(JOINT_NAMES, arr):
+                if not math.isfinite(value):
+                    raise ParameterError(joint, float(value), "must be finite")
+            raise ParameterError("q", q, "is too large to be a joint configuration")
+        return arr
+
+    def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:
+        """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
+        out = []
+        for i, joint in enumerate(JOINT_NAMES):
+            lo, hi = self.limits.lower[i], self.limits.upper[i]
+            if not lo - tol <= q[i] <= hi + tol:
+                out.append(f"{joint} = {q[i]:.9g} outside [{lo:.9g}, {hi:.9g}]")
+        return out
+
+    # ----------------------------------------------------------------- kinematics
+    def tool_placement(self, q: np.ndarray) -> pin.SE3:
+        """``baseMtool``: the placement of the tool frame in the base frame, at ``q``."""
+        q = self.check_q(q)
+        pin.forwardKinematics(self.model, self.data, q)
+        return self._baseMo * pin.updateFramePlacement(self.model, self.data, self.tool_id)
+
+    def tool_pose(self, q: np.ndarray) -> np.ndarray:
+        """(x, y, z, yaw) of the tool frame in the base frame [m, m, m, rad]."""
+        return pose_from_placement(self.tool_placement(q))
+
+    def frame_placement(self, q: np.ndarray, frame: str, relative_to: str | None = None) -> pin.SE3:
+        """Placement of any frame at ``q``, in the base frame (default) or in frame ``relative_to``.
+
+        ``relative_to="universe"`` gives Pinocchio's ``oMf``.
+        """
+        q = self.check_q(q)
+        fid = self._frame_id(frame)
+        ref = self.base_id if relative_to is None else self._frame_id(relative_to)
+        pin.framesForwardKinematics(self.model, self.data, q)
+        return self.data.oMf[ref].actInv(self.data.oMf[fid])
+
+    def frame_jacobian(
+        self, q: np.ndarray, frame: str | None = None, reference: str | pin.ReferenceFrame = "local_world_aligned"
+    ) -> np.ndarray:
+        """The 6 x 4 Jacobian of a frame (default: the tool), rows (v, omega), as Pinocchio defines it.
+
+        Args:
+            q: joint values.
+            frame: frame name; the tool frame by default.
+            reference: ``"world"``, ``"local"`` or ``"local_world_aligned"`` (or a pin.ReferenceFrame).
+        """
+        q = self.check_q(q)
+        fid = self.tool_id if frame is None else self._frame_id(frame)
+        if isinstance(reference, str):
+            if reference.lower() not in _REFERENCES:
+                raise InvalidInputError(f"reference {reference!r} must be one of {', '.join(_REFERENCES)}")
+            reference = _REFERENCES[reference.lower()]
+        return pin.computeFrameJacobian(self.model, self.data, q, fid, reference)
+
+    def task_jacobian(self, q: np.ndarray) -> np.ndarray:
+        """The 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame.
+
+        Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
+        base z axis, which equals d(yaw)/dt while the tool stays level).
+        """
+        q = self.check_q(q)
+        J = pin.computeFrameJacobian(self.model, self.data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED)
+        R = self._Rbo
+        out = np.empty((4, 4))
+        out[:3] = R @ J[:3]
+        out[3] = R[2] @ J[3:]
+        return out
+
+    def manipulability(self, q: np.ndarray) -> float:
+        """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4)."""
+        return float(abs(np.linalg.det(self.task_jacobian(q))))
+
+    def _frame_id(self, frame: str) -> int:
+        if not self.model.existFrame(frame):
+            names = ", ".join(f.name for f in self.model.frames)
+            raise InvalidInputError(f"no frame named {frame!r}; frames: {names}")
+        return int(self.model.getFrameId(frame))
+
+
+def load_robot(
+    robot: str | Path | RobotParameters = "default",
+    overrides: Mapping[str, object] | None = None,
+    *,
+    urdf: str | Path | None = None,
+) -> Robot:
+    """Load a robot: a configured one (name or config folder, with overrides) or a URDF file.
+
+    Args:
+        robot: shipped robot name, config folder, or parameters (ignored when ``urdf`` is given).
+        overrides: parameter overrides (flat names), for configured robots only.
+        urdf: path of a URDF file to load instead.
+    """
+    if urdf is not None:
+        if overrides:
+            raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file")
+        return Robot.from_file(urdf)
+    return Robot.from_config(robot, overrides)
+
+
+def load_urdf(path: str | Path) -> Robot:
+    """Load any SCARA URDF file into Pinocchio."""
+    return Robot.from_file(path)
