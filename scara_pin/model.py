@@ -19,13 +19,16 @@ import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
 
 from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
+
+if TYPE_CHECKING:
+    from .ik import IKResult, ScaraGeometry
 
 __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
 
@@ -199,6 +202,24 @@ class Robot:
     def collision_model(self) -> pin.GeometryModel:
         """Collision geometry of the URDF, built on first use."""
         return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.COLLISION)
+
+    # ----------------------------------------------------------------- inverse kinematics
+    @cached_property
+    def kinematics(self) -> ScaraGeometry:
+        """The SCARA geometry read from the model for the closed-form IK (extracted once, on first use).
+
+        Raises:
+            NotScaraError: the model is not SCARA-like (the reason names the joint).
+        """
+        from .ik import ScaraGeometry
+
+        return ScaraGeometry.from_robot(self)
+
+    def ik(self, target: Any, *, branch: str = "all", reference: Sequence[float] | None = None) -> IKResult:
+        """Closed-form IK: every solution inside the limits (see :func:`scara_pin.ik.solve`)."""
+        from .ik import solve
+
+        return solve(self.kinematics, target, branch=branch, reference=reference)
 
     # ----------------------------------------------------------------- input checks
     def check_q(self, q: object) -> np.ndarray:
