@@ -23,7 +23,7 @@ import sys
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from .errors import InfeasibleError, InvalidInputError, ParameterError, ScaraError
 
@@ -224,19 +224,191 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     return 0
 
 
+def _read_pose(texts: Sequence[str], units: Units, what: str = "target") -> list[float]:
+    if len(texts) != 4:
+        raise ParameterError(what, " ".join(texts), f"must be 4 values X Y Z YAW (got {len(texts)})")
+    return [_number(n, t) / sc for n, t, sc in zip(("x", "y", "z", "yaw"), texts, units.scale(_POSE_KINDS))]
+
+
+def _solutions_json(q_list: Sequence[Sequence[float]], branches: Sequence[str], units: Units) -> list[dict]:
+    scale = units.scale(_Q_KINDS)
+    return [{"q": _scaled(q, scale), "branch": b} for q, b in zip(q_list, branches)]
+
+
+def cmd_ik(args: argparse.Namespace) -> int:
+    """Inverse kinematics: every joint solution for a tool pose (closed form, or numeric)."""
+    units = Units(args.deg, args.mm)
+    robot = _load(args)
+    if args.input:
+        return _ik_batch(args, robot, units)
+    if args.input is None and args.output:
+        raise InvalidInputError("--output goes with --input (batch mode)")
+    target = _read_pose(args.target, units)
+    near = None
+    if args.near:
+        near = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(_Q_KINDS))])
+    numeric = args.numeric
+    if not numeric:
+        from .ik import NotScaraError
+
+        try:
+            robot.kinematics
+        except NotScaraError as exc:
+            log.warning("closed-form IK refused this robot (%s); using the numeric IK", exc)
+            numeric = True
+    if numeric:
+        status, message, qs, branches = _ik_numeric(robot, target, near)
+    else:
+        result = robot.ik(target, branch=args.branch, reference=near)
+        sols = result.branch(args.branch)
+        if near is not None and sols:
+            best = result.nearest(near, branch=args.branch)
+            sols = (best,) if best is not None else ()
+        status = result.status.name if sols or not result.success else "NO_SOLUTION_IN_BRANCH"
+        message = result.message if sols or not result.success else f"no {args.branch} solution"
+        qs, branches = [s.q for s in sols], [s.branch for s in sols]
+    scale = units.scale(_POSE_KINDS)
+    tgt = dict(zip(("x", "y", "z", "yaw"), _scaled(target, scale)))
+    code = 0 if status == "OK" else 3
+    if args.json:
+        print(json.dumps({"robot": robot.name, "target": tgt, "solutions": _solutions_json(qs, branches, units),
+                          "status": status, "message": message, "method": "numeric" if numeric else "closed-form",
+                          "units": {"length": units.length_name, "angle": units.angle_name}}))  # fmt: skip
+        return code
+    if code:
+        raise InfeasibleError(f"{status}: {message}")
+    print(f"robot     {robot.name}: {'numeric' if numeric else 'closed-form'} IK of {robot.tool_frame} in {robot.base_frame}")
+    print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS))}]")
+    print(f"units     q = [{', '.join(units.names(_Q_KINDS))}]")
+    for q, b in zip(qs, branches):
+        print(f"{b:<9} {_fmt(_scaled(q, units.scale(_Q_KINDS)))}")
+    return 0
+
+
+def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
+    from .ik import NotScaraError, branch_of
+    from .ik_numeric import solve_numeric
+
+    res = solve_numeric(robot, target, q0=near)
+    if not res.success:
+        return ("NO_CONVERGENCE", f"numeric IK did not reach the target (residual {res.residual:.3g} after "
+                f"{res.iterations} iterations from {res.starts} starts)", [], [])  # fmt: skip
+    try:
+        branch = branch_of(robot.kinematics, res.q)
+    except NotScaraError:
+        branch = "unknown"
+    return "OK", f"converged in {res.iterations} iterations (residual {res.residual:.3g})", [res.q], [branch]
+
+
+def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
+    """Stream a CSV of targets (x, y, z, yaw) through the vectorised closed form, in bounded memory."""
+    import csv
+
+    import numpy as np
+
+    from .ik import IKStatus, solve_batch
+
+    if args.target:
+        raise InvalidInputError("give either X Y Z YAW or --input FILE, not both")
+    if not args.output:
+        raise InvalidInputError("--input needs --output FILE")
+    branch = {"all": "nearest", "right": "right", "left": "left"}[args.branch]
+    reference = None
+    if args.near:
+        reference = [_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(_Q_KINDS))]
+    geo = robot.kinematics
+    in_path, out_path = Path(args.input), Path(args.output)
+    try:
+        handle = in_path.open(newline="", encoding="utf-8")
+    except OSError as exc:
+        raise InvalidInputError(f"cannot read {in_path}: {exc.strerror}") from None
+    total = failed = 0
+    pose_scale = np.array(units.scale(_POSE_KINDS))
+    q_scale = np.array(units.scale(_Q_KINDS))
+    show_progress = sys.stderr.isatty()
+    size = max(in_path.stat().st_size, 1)
+
+    def rows_out(writer: Any) -> None:
+        nonlocal total, failed
+        reader = csv.reader(handle)
+        header = next(reader, None)
+        if header is None or [h.strip().lower() for h in header[:4]] != ["x", "y", "z", "yaw"]:
+            raise InvalidInputError(f"{in_path}: the first row must be the header x,y,z,yaw")
+        writer.writerow(["x", "y", "z", "yaw", "q1", "q2", "q3", "q4", "branch", "status"])
+        chunk: list[list[float]] = []
+        line = 1
+        for row in reader:
+            line += 1
+            if not row or all(not c.strip() for c in row):
+                continue
+            if len(row) < 4:
+                raise InvalidInputError(f"{in_path} line {line}: expected 4 values x,y,z,yaw, got {len(row)}")
+            chunk.append([_number(f"{in_path.name} line {line} {n}", c) for n, c in zip("xyz", row[:3])]
+                         + [_number(f"{in_path.name} line {line} yaw", row[3])])  # fmt: skip
+            if len(chunk) == 65536:
+                flush(writer, chunk)
+                chunk = []
+                if show_progress:
+                    print(f"\r{total} targets ({100 * handle.tell() / size:.0f} %)", end="", file=sys.stderr)
+        flush(writer, chunk)
+        if show_progress:
+            print(f"\r{total} targets (100 %)", file=sys.stderr)
+
+    def flush(writer: Any, chunk: list[list[float]]) -> None:
+        nonlocal total, failed
+        if not chunk:
+            return
+        T = np.array(chunk) / pose_scale
+        res = solve_batch(geo, T, branch=branch, reference=reference)
+        names = [IKStatus(c).name for c in range(len(IKStatus))]
+        labels = {1: "right", -1: "left", 0: ""}
+        for t, q, b, st in zip(T * pose_scale, res.q * q_scale, res.branch, res.status):
+            writer.writerow([*(repr(float(v)) for v in t), *("" if math.isnan(v) else repr(float(v)) for v in q),
+                             labels[int(b)], names[int(st)]])  # fmt: skip
+        total += len(chunk)
+        failed += int((res.status != 0).sum())
+
+    with handle:
+        write_atomic_with(out_path, lambda f: rows_out(csv.writer(f)))
+    print(f"wrote {out_path}: {total} targets, {total - failed} solved, {failed} without solution", file=sys.stderr)
+    return 3 if failed else 0
+
+
+def cmd_validate_ik(args: argparse.Namespace) -> int:
+    """Cross-validate the closed-form IK against Pinocchio FK and the numeric IK."""
+    from .validate import validate_ik
+
+    if args.samples < 1:
+        raise ParameterError("--samples", args.samples, "must be >= 1")
+    robot = _load(args)
+    report = validate_ik(robot, args.samples, args.seed)
+    if args.json:
+        out = {k: v for k, v in vars(report).items()}
+        out["ok"] = report.ok
+        print(json.dumps(out))
+    else:
+        print(report.table())
+    return 0 if report.ok else 1
+
+
 # ---------------------------------------------------------------------------------------------- plumbing
 def write_atomic(path: Path, text: str) -> None:
     """Write a text file atomically: a temporary file in the same folder, then a rename.
 
     An error or Ctrl-C leaves either the old file or none, never a half-written one.
     """
+    write_atomic_with(path, lambda handle: handle.write(text))
+
+
+def write_atomic_with(path: Path, produce: Callable[[Any], object]) -> None:
+    """Let ``produce(handle)`` write a text file, atomically (temporary file, then rename)."""
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise InvalidInputError(f"cannot write {path}: folder {folder} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
+            produce(handle)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -295,6 +467,27 @@ def build_parser() -> argparse.ArgumentParser:
                    help="task (4 x 4, default) or a Pinocchio reference frame for the 6 x 4 frame Jacobian")  # fmt: skip
     p.add_argument("--frame", default=None, help="frame of the 6 x 4 Jacobian (default: tool0)")
     p.set_defaults(func=cmd_jacobian)
+
+    p = sub.add_parser("ik", help="inverse kinematics: every joint solution for a tool pose X Y Z YAW")
+    p.add_argument("target", nargs="*", metavar="X Y Z YAW", help="tool0 pose in the base frame")
+    p.add_argument("--branch", default="all", choices=["all", "left", "right"],
+                   help="elbow branch (right: elbow turns counterclockwise seen from above); default all")  # fmt: skip
+    p.add_argument("--near", nargs=4, metavar="Q", help="return only the solution nearest to this configuration")
+    p.add_argument("--numeric", action="store_true", help="use Pinocchio-based numeric IK instead of the closed form")
+    p.add_argument("--input", metavar="CSV", help="batch: targets with header x,y,z,yaw (one solution per row)")
+    p.add_argument("--output", metavar="CSV", help="batch: joints written here (atomically), with a status column")
+    p.add_argument("--deg", action="store_true", help="angles in degrees")
+    p.add_argument("--mm", action="store_true", help="lengths in millimetres")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_ik)
+
+    p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
+    p.add_argument("--samples", type=int, default=1000, help="configurations sampled within limits (default 1000)")
+    p.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_validate_ik)
     return parser
 
 
