@@ -19,6 +19,7 @@ import json
 import logging
 import math
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Callable, Sequence
@@ -46,6 +47,11 @@ class _UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        # negative numbers, e-notation included (-1e-3), are values, not options
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
     def error(self, message: str) -> NoReturn:
         raise _UsageError(message)
 
@@ -192,6 +198,8 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     q = _read_q(args, units)
     _check_limits(robot, q, args.strict)
     if args.reference == "task":
+        if args.frame is not None:
+            raise InvalidInputError("--frame goes with --reference world|local|local_world_aligned")
         J = robot.task_jacobian(q)
         rows = ["x", "y", "z", "yaw"]
         row_kinds: tuple[str, ...] = _POSE_KINDS
@@ -405,11 +413,19 @@ def write_atomic_with(path: Path, produce: Callable[[Any], object]) -> None:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise InvalidInputError(f"cannot write {path}: folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    if path.is_dir():
+        raise InvalidInputError(f"cannot write {path}: it is a folder")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise InvalidInputError(f"cannot write in {folder}: {exc.strerror}") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
             produce(handle)
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise InvalidInputError(f"cannot write {path}: {exc.strerror or exc}") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
@@ -508,10 +524,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         except _UsageError as exc:
             print(f"error: {exc} (see scara-pin --help)", file=sys.stderr)
             return 2
+        except SystemExit as exc:  # --help, --version
+            return exc.code if isinstance(exc.code, int) else 0
         log.setLevel(logging.DEBUG if args.verbose else logging.WARNING)
         func: Callable[[argparse.Namespace], int] | None = getattr(args, "func", None)
         if func is None:
-            parser.print_help(sys.stderr)
+            print("error: no command given (see scara-pin --help)", file=sys.stderr)
             return 2
         return func(args)
     except ScaraError as exc:

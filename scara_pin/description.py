@@ -19,6 +19,7 @@ may write angles as ``!degrees 132`` (xacro's yaml tag), read here as radians, a
 from __future__ import annotations
 
 import math
+import numbers
 import re
 import xml.dom.minidom
 from collections.abc import Mapping
@@ -144,7 +145,7 @@ class RobotParameters:
         values = dict(self.values)
         missing = [n for n in PARAMETER_NAMES if n not in values]
         if missing:
-            raise ParameterError(missing[0], None, "is required (missing)")
+            raise ParameterError(missing[0], ParameterError.NOTHING, "is required (missing)")
         for key, value in values.items():
             if key not in PARAMETER_NAMES:
                 raise ParameterError(key, value, f"is not a parameter; known: {', '.join(PARAMETER_NAMES)}")
@@ -192,7 +193,7 @@ class RobotParameters:
 
 
 def _check_finite(name: str, value: object) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ParameterError(name, value, "must be a number")
     if not math.isfinite(value):
         raise ParameterError(name, value, "must be finite")
@@ -205,7 +206,7 @@ def _to_float(name: str, raw: object) -> float:
             value = float(raw.strip())
         except ValueError:
             raise ParameterError(name, raw, "must be a number") from None
-    elif isinstance(raw, bool) or not isinstance(raw, (int, float)):
+    elif isinstance(raw, bool) or not isinstance(raw, numbers.Real):
         raise ParameterError(name, raw, "must be a number")
     else:
         value = float(raw)
@@ -224,12 +225,12 @@ def _yaml_loader() -> type:
               "!foot": 0.3048, "!inches": 0.0254}  # fmt: skip
     for tag, scale in scales.items():
 
-        def construct(loader: yaml.SafeLoader, node: yaml.Node, scale: float = scale) -> float:
+        def construct(loader: yaml.SafeLoader, node: yaml.Node, scale: float = scale) -> float | str:
             text = loader.construct_scalar(node)  # type: ignore[arg-type]
             try:
                 return float(text) * scale
-            except ValueError:
-                raise ParameterError(f"{node.tag} value", text, "must be a number") from None
+            except ValueError:  # left as text: the caller refuses it, naming the parameter and file
+                return f"{node.tag} {text}"
 
         Loader.add_constructor(tag, construct)
     return Loader
@@ -253,11 +254,11 @@ def _read_config(folder: Path) -> dict[str, float]:
         try:
             tree = yaml.load(path.read_text(encoding="utf-8"), Loader=loader)  # noqa: S506 (safe loader)
         except OSError as exc:
-            raise ParameterError(str(path), None, f"cannot be read ({exc.strerror})") from None
+            raise ParameterError(str(path), ParameterError.NOTHING, f"cannot be read ({exc.strerror})") from None
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f" line {mark.line + 1}" if mark is not None else ""
-            raise ParameterError(f"{path}{where}", None, f"must be valid yaml ({exc})") from None
+            raise ParameterError(f"{path}{where}", ParameterError.NOTHING, f"must be valid yaml ({exc})") from None
         flat: dict[str, object] = {}
         _flatten(tree if tree is not None else {}, "", flat)
         for key, raw in flat.items():
@@ -269,7 +270,7 @@ def _read_config(folder: Path) -> dict[str, float]:
                 raise ParameterError(f"{key} in {path}", raw, exc.rule) from None
         for key in expected:
             if key not in flat:
-                raise ParameterError(f"{key} in {path}", None, "is required (missing)")
+                raise ParameterError(f"{key} in {path}", ParameterError.NOTHING, "is required (missing)")
     return values
 
 
@@ -277,7 +278,8 @@ def _config_folder(robot: str | Path) -> tuple[str, Path]:
     """Resolve a robot name or a config folder path to (name, folder)."""
     text = str(robot)
     folder = Path(text)
-    if isinstance(robot, Path) or "/" in text or "\\" in text or folder.is_dir():
+    shipped = _NAME_RE.match(text) is not None and (urdf_dir() / "config" / text / "kinematics.yaml").is_file()
+    if not shipped and (isinstance(robot, Path) or "/" in text or "\\" in text or folder.is_dir()):
         if (folder / "kinematics.yaml").is_file():
             name = folder.resolve().name
             return (name if _NAME_RE.match(name) else "scara"), folder

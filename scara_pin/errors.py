@@ -41,10 +41,16 @@ class ParameterError(InvalidInputError):
         rule: the rule it breaks, e.g. ``"must be > 0"``.
     """
 
+    NOTHING: ClassVar[object] = object()
+    """Pass as ``value`` when there is no value to show (a missing key, an unreadable file)."""
+
     def __init__(self, name: str, value: object, rule: str, unit: str = "") -> None:
         self.name = name
         self.value = value
         self.rule = rule
+        if value is ParameterError.NOTHING:  # nothing to show: a missing or unreadable item
+            super().__init__(f"{name} {rule}")
+            return
         shown = f"{value!r}" if isinstance(value, str) else f"{value}"
         super().__init__(f"{name} is {shown}{(' ' + unit) if unit else ''}; it {rule}")
 

@@ -32,6 +32,9 @@ if TYPE_CHECKING:
 
 __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
 
+_Q_MAX = 1e6
+"""[rad or m] the largest joint value taken as a configuration (beyond it an angle has no precision)."""
+
 _REFERENCES: dict[str, pin.ReferenceFrame] = {
     "world": pin.ReferenceFrame.WORLD,
     "local": pin.ReferenceFrame.LOCAL,
@@ -225,16 +228,21 @@ class Robot:
     def check_q(self, q: object) -> np.ndarray:
         """Return ``q`` as a float array of 4 finite values, or raise :class:`ParameterError`."""
         try:
-            arr = np.asarray(q, dtype=float)
+            arr = np.asarray(q)
         except (TypeError, ValueError):
             raise ParameterError("q", q, "must be 4 numbers") from None
+        if arr.dtype != np.float64:
+            if arr.dtype.kind not in "fiu":  # strings, objects, booleans: refused, never converted
+                raise ParameterError("q", q, "must be 4 numbers")
+            arr = arr.astype(np.float64)
         if arr.shape != (4,):
             raise ParameterError("q", q, f"must be 4 numbers (got shape {arr.shape})")
-        if not math.isfinite(arr.dot(arr)):
-            for joint, value in zip(JOINT_NAMES, arr):
+        if not all(-_Q_MAX <= v <= _Q_MAX for v in arr.tolist()):  # NaN fails every comparison
+            for joint, value in zip(JOINT_NAMES, arr.tolist()):
                 if not math.isfinite(value):
-                    raise ParameterError(joint, float(value), "must be finite")
-            raise ParameterError("q", q, "is too large to be a joint configuration")
+                    raise ParameterError(joint, value, "must be finite")
+                if abs(value) > _Q_MAX:
+                    raise ParameterError(joint, value, f"must be within +/-{_Q_MAX:g} (rad or m)")
         return arr
 
     def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:

@@ -1,0 +1,294 @@
+"""The error tree (scara_pin.errors) and the errors of scara_pin.model: bad URDFs, bad q, bad frames."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from scara_pin import (
+    DescriptionError,
+    InfeasibleError,
+    InvalidInputError,
+    ParameterError,
+    Robot,
+    ScaraError,
+    UnknownRobotError,
+    UrdfError,
+    generate_urdf,
+    load_robot,
+    load_urdf,
+)
+
+JOINTS = ("joint1", "joint2", "joint3", "joint4")
+
+
+@pytest.fixture(scope="module")
+def robot() -> Robot:
+    return load_robot("default")
+
+
+# ------------------------------------------------------------------------------------ error tree
+@pytest.mark.parametrize(
+    ("cls", "code"),
+    [
+        (ScaraError, 1),
+        (InvalidInputError, 2),
+        (ParameterError, 2),
+        (UnknownRobotError, 2),
+        (UrdfError, 2),
+        (InfeasibleError, 3),
+        (DescriptionError, 1),
+    ],
+)
+def test_exit_codes(cls: type, code: int) -> None:
+    assert cls.exit_code == code
+    assert issubclass(cls, ScaraError)
+
+
+def test_hierarchy() -> None:
+    for cls in (ParameterError, UnknownRobotError, UrdfError):
+        assert issubclass(cls, InvalidInputError)
+    assert issubclass(InvalidInputError, ValueError)
+    assert not issubclass(InfeasibleError, InvalidInputError)
+    assert not issubclass(DescriptionError, InvalidInputError)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("l1", -1.0, "must be > 0"), "l1 is -1.0; it must be > 0"),
+        (("l1", "abc", "must be a number"), "l1 is 'abc'; it must be a number"),
+        (("joint2_velocity", 0.0, "must be > 0", "rad/s"), "joint2_velocity is 0.0 rad/s; it must be > 0"),
+        (("q", None, "is required"), "q is None; it is required"),
+    ],
+)
+def test_parameter_error_message(args: tuple, message: str) -> None:
+    err = ParameterError(*args)
+    assert str(err) == message
+    assert (err.name, err.value, err.rule) == args[:3]
+    assert err.exit_code == 2
+
+
+def test_unknown_robot_error_lists_the_robots() -> None:
+    err = UnknownRobotError("nope", ["default", "s1"])
+    assert "'nope'" in str(err) and "default, s1" in str(err)
+    assert err.robot == "nope" and err.available == ["default", "s1"]
+
+
+# ------------------------------------------------------------------------------------- bad URDFs
+def _link(name: str) -> str:
+    return f'<link name="{name}"/>'
+
+
+def _joint(name: str, parent: str, child: str, kind: str = "revolute") -> str:
+    limit = '<limit lower="-1" upper="1" velocity="1" effort="1"/>' if kind in ("revolute", "prismatic") else ""
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<axis xyz="0 0 1"/>{limit}</joint>'
+    )
+
+
+def _chain(kinds: list[str], extra: str = "", tool: bool = True) -> str:
+    links = ["base"] + [f"l{i}" for i in range(1, len(kinds) + 1)]
+    body = "".join(_link(n) for n in links)
+    body += "".join(_joint(f"joint{i}", links[i - 1], links[i], k) for i, k in enumerate(kinds, start=1))
+    if tool:
+        body += _link("tool0") + _joint("tool_fixed", links[-1], "tool0", "fixed")
+    return f'<robot name="r">{body}{extra}</robot>'
+
+
+# (text, substrings the message must hold)
+BAD_URDFS = {
+    "malformed": ('<robot name="r">\n  <link name="a">\n</robot>\n', ["malformed XML", "line 3", "column"]),
+    "not-xml": ("this is not xml", ["malformed XML", "line 1"]),
+    "empty": ("", ["malformed XML"]),
+    "root-not-robot": ('<sdf version="1.6"><model name="m"/></sdf>', ["<sdf>", "<robot>"]),
+    "missing-link": (
+        f'<robot name="r">{_link("a")}{_joint("j1", "a", "ghost_link")}</robot>',
+        ["not a valid URDF", "ghost_link"],
+    ),
+    "two-roots": (
+        f'<robot name="r">{_link("root_a")}{_link("root_b")}{_link("c")}{_joint("j1", "root_a", "c")}</robot>',
+        ["not a valid URDF", "root"],
+    ),
+    "duplicate-links": (
+        f'<robot name="r">{_link("dup_link")}{_link("dup_link")}{_link("b")}{_joint("j1", "dup_link", "b")}</robot>',
+        ["not a valid URDF", "dup_link"],
+    ),
+    "cycle": (
+        f'<robot name="r">{_link("a")}{_link("b")}{_joint("j1", "a", "b")}{_joint("j2", "b", "a")}</robot>',
+        ["not a valid URDF"],
+    ),
+    "lonely-link": (f'<robot name="r">{_link("alone")}</robot>', ["nq = 0"]),
+    "fixed-only": (_chain(["fixed", "fixed"]), ["nq = 0"]),
+    "three-joints": (_chain(["revolute", "revolute", "prismatic"]), ["nq = 3", "4 single-DOF"]),
+    "five-joints": (_chain(["revolute"] * 5), ["nq = 5"]),
+    "continuous-joint": (_chain(["revolute", "revolute", "prismatic", "continuous"]), ["nq = 5", "nv = 4"]),
+    "no-tool0": (_chain(["revolute", "revolute", "prismatic", "revolute"], tool=False), ["tool0"]),
+}
+
+
+@pytest.mark.parametrize("case", BAD_URDFS)
+def test_bad_urdf_text(case: str, capfd: pytest.CaptureFixture[str]) -> None:
+    text, needles = BAD_URDFS[case]
+    with pytest.raises(UrdfError) as info:
+        Robot(text)
+    message = str(info.value)
+    for needle in needles:
+        assert needle in message, (needle, message)
+    assert info.value.exit_code == 2
+    out, err = capfd.readouterr()
+    assert (out, err) == ("", ""), "urdfdom (or pinocchio) wrote to the real stdout/stderr"
+
+
+@pytest.mark.parametrize("case", BAD_URDFS)
+def test_bad_urdf_file(case: str, tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
+    text, needles = BAD_URDFS[case]
+    path = tmp_path / f"{case}.urdf"
+    path.write_text(text, encoding="utf-8")
+    loaders = (lambda: load_robot(urdf=path), lambda: load_robot("default", urdf=str(path)), lambda: load_urdf(path))
+    for loader in loaders:
+        with pytest.raises(UrdfError) as info:
+            loader()
+        message = str(info.value)
+        assert str(path) in message
+        for needle in needles:
+            assert needle in message, (needle, message)
+    out, err = capfd.readouterr()
+    assert (out, err) == ("", "")
+
+
+def test_malformed_xml_names_line_and_column() -> None:
+    text = '<robot name="r">\n  <link name="a"/>\n  <link name="b" <oops/>\n</robot>'
+    with pytest.raises(UrdfError, match=r"line 3, column \d+"):
+        Robot(text)
+
+
+@pytest.mark.parametrize("name", ["missing.urdf", "no/such/dir/x.urdf"])
+def test_urdf_file_that_does_not_exist(name: str, tmp_path: Path) -> None:
+    path = tmp_path / name
+    with pytest.raises(UrdfError) as info:
+        load_robot(urdf=path)
+    assert str(path) in str(info.value) and "cannot be read" in str(info.value)
+
+
+def test_urdf_path_is_a_directory(tmp_path: Path) -> None:
+    with pytest.raises(UrdfError, match="cannot be read"):
+        load_robot(urdf=tmp_path)
+
+
+def test_urdf_file_not_utf8(tmp_path: Path) -> None:
+    path = tmp_path / "latin1.urdf"
+    path.write_bytes(b'<robot name="r\xe9"/>')
+    with pytest.raises(UrdfError, match="cannot be read"):
+        load_robot(urdf=path)
+
+
+def test_overrides_with_urdf_file_are_refused(tmp_path: Path) -> None:
+    path = tmp_path / "scara.urdf"
+    path.write_text(generate_urdf("default"), encoding="utf-8")
+    with pytest.raises(InvalidInputError, match="overrides"):
+        load_robot(overrides={"l1": 0.3}, urdf=path)
+
+
+def test_good_urdf_file_loads_with_its_limits(tmp_path: Path, robot: Robot, capfd: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "scara.urdf"
+    path.write_text(generate_urdf("default"), encoding="utf-8")
+    from_file = load_robot(urdf=path)
+    assert from_file.model.nq == 4
+    assert from_file.limits.lower[0] == pytest.approx(math.radians(-132), abs=1e-15)
+    assert from_file.limits.upper[2] - from_file.limits.lower[2] == pytest.approx(0.150, abs=1e-15)
+    assert all(math.isnan(a) for a in from_file.limits.acceleration)  # URDF has no accelerations
+    q = np.array([0.4, -1.2, 0.07, 2.0])
+    assert from_file.tool_pose(q) == pytest.approx(robot.tool_pose(q), abs=1e-12)
+    assert capfd.readouterr() == ("", "")
+
+
+# ------------------------------------------------------------------------------------------ check_q
+@pytest.mark.parametrize("index", range(4))
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_check_q_non_finite_names_the_joint(robot: Robot, index: int, bad: float) -> None:
+    q = [0.1, 0.2, 0.03, 0.4]
+    q[index] = bad
+    with pytest.raises(ParameterError) as info:
+        robot.check_q(q)
+    assert info.value.name == JOINTS[index]
+    assert "finite" in info.value.rule
+
+
+@pytest.mark.parametrize(
+    "q",
+    [
+        [],
+        [0.1, 0.2, 0.3],
+        [0.1, 0.2, 0.3, 0.4, 0.5],
+        [[0.1, 0.2, 0.3, 0.4]],
+        np.zeros((2, 4)),
+        0.5,
+        None,
+        ["a", "b", "c", "d"],
+        ["0.1", "x", "0", "0"],
+        "abcd",
+        "0.1 0.2 0.3 0.4",
+        {"q1": 0.1},
+        [1j, 0, 0, 0],
+        [object(), 0, 0, 0],
+    ],
+    ids=repr,
+)
+def test_check_q_refuses(robot: Robot, q: object) -> None:
+    with pytest.raises(ParameterError) as info:
+        robot.check_q(q)
+    assert info.value.name == "q"
+
+
+def test_check_q_refuses_numeric_strings(robot: Robot) -> None:
+    with pytest.raises(ParameterError):
+        robot.check_q(["0.1", "0.2", "0.03", "0.4"])
+
+
+@pytest.mark.parametrize("method", ["tool_pose", "tool_placement", "task_jacobian", "frame_jacobian", "manipulability"])
+def test_kinematics_check_q(robot: Robot, method: str) -> None:
+    with pytest.raises(ParameterError):
+        getattr(robot, method)([0.0, math.nan, 0.0, 0.0])
+    with pytest.raises(ParameterError):
+        getattr(robot, method)([0.0, 0.0, 0.0])
+
+
+def test_check_q_accepts_four_numbers(robot: Robot) -> None:
+    q = robot.check_q((1, 2, 0, -3))
+    assert q.dtype == float and q.shape == (4,)
+    assert q.tolist() == [1.0, 2.0, 0.0, -3.0]
+
+
+# ------------------------------------------------------------------------------- frames, references
+@pytest.mark.parametrize("reference", ["bogus", "", "task", "world_aligned"])
+def test_frame_jacobian_bad_reference(robot: Robot, reference: str) -> None:
+    with pytest.raises(InvalidInputError) as info:
+        robot.frame_jacobian(np.zeros(4), reference=reference)
+    assert repr(reference) in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "reference", ["world", "WORLD", "local", "Local_World_Aligned", pin.ReferenceFrame.LOCAL_WORLD_ALIGNED]
+)
+def test_frame_jacobian_good_reference(robot: Robot, reference: object) -> None:
+    J = robot.frame_jacobian(np.array([0.1, 0.2, 0.03, 0.4]), reference=reference)
+    assert J.shape == (6, 4)
+    assert np.isfinite(J).all()
+
+
+def test_unknown_frame(robot: Robot) -> None:
+    q = np.zeros(4)
+    with pytest.raises(InvalidInputError, match="no_such_frame"):
+        robot.frame_jacobian(q, frame="no_such_frame")
+    with pytest.raises(InvalidInputError, match="no_such_frame"):
+        robot.frame_placement(q, "no_such_frame")
+    with pytest.raises(InvalidInputError, match="no_such_frame"):
+        robot.frame_placement(q, "tool0", relative_to="no_such_frame")
+    # the good names work
+    assert robot.frame_placement(q, "link2").translation[0] == pytest.approx(0.2, abs=1e-12)
