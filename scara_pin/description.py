@@ -21,11 +21,11 @@ from __future__ import annotations
 import math
 import numbers
 import re
-import xml.dom.minidom
 from collections.abc import Mapping
 from dataclasses import InitVar, dataclass, field
 from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 from .errors import DescriptionError, ParameterError, UnknownRobotError
 
@@ -218,7 +218,9 @@ def _yaml_loader() -> type:
     """A safe yaml loader that also reads xacro's unit tags (``!degrees``, ``!millimeters``, ...)."""
     import yaml
 
-    class Loader(yaml.SafeLoader):
+    base = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when available: ~10x faster
+
+    class Loader(base):  # type: ignore[valid-type, misc]
         pass
 
     scales = {"!radians": 1.0, "!degrees": math.pi / 180.0, "!meters": 1.0, "!millimeters": 1e-3,
@@ -346,7 +348,7 @@ def generate_urdf(
     return _pretty(doc)
 
 
-def _pretty(doc: xml.dom.minidom.Document) -> str:
+def _pretty(doc: Any) -> str:
     # drop xacro's banner (it names the absolute path of the template, which varies between installs)
     for node in list(doc.childNodes):
         if node.nodeType == node.COMMENT_NODE:

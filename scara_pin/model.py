@@ -14,8 +14,6 @@ from __future__ import annotations
 import math
 import os
 import sys
-import tempfile
-import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
@@ -35,6 +33,24 @@ __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
 _Q_MAX = 1e6
 """[rad or m] the largest joint value taken as a configuration (beyond it an angle has no precision)."""
 
+_F64 = np.dtype(np.float64)
+_FAST_Q2 = (0.5 * _Q_MAX) ** 2
+
+
+def _rerooted(model: pin.Model, baseMo: pin.SE3) -> pin.Model:
+    """A copy of ``model`` whose world frame is the frame at ``baseMo.inverse()`` (same joints and frames)."""
+    out = pin.Model(model)
+    for j in range(1, model.njoints):
+        if model.parents[j] == 0:
+            out.jointPlacements[j] = baseMo * model.jointPlacements[j]
+    for f in range(len(model.frames)):
+        frame = out.frames[f]
+        if frame.parentJoint == 0:
+            frame.placement = baseMo * model.frames[f].placement
+            out.frames[f] = frame
+    return out
+
+
 _REFERENCES: dict[str, pin.ReferenceFrame] = {
     "world": pin.ReferenceFrame.WORLD,
     "local": pin.ReferenceFrame.LOCAL,
@@ -51,6 +67,9 @@ def pose_from_placement(aMb: pin.SE3) -> np.ndarray:
 
 def _parse_urdf(urdf: str, origin: str) -> pin.Model:
     """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
+    import tempfile
+    import xml.etree.ElementTree as ET
+
     try:
         root = ET.fromstring(urdf)
     except ET.ParseError as exc:
@@ -167,8 +186,11 @@ class Robot:
             )
         # base is fixed to the root: its placement never changes; keep its inverse for the fast path.
         pin.framesForwardKinematics(model, self.data, pin.neutral(model))
-        self._baseMo = self.data.oMf[self.base_id].inverse()
-        self._Rbo = self._baseMo.rotation.copy()
+        # A private copy of the model re-rooted at the base frame: its oMf are placements in `base` and its
+        # LOCAL_WORLD_ALIGNED Jacobians are in base axes, so the hot paths need no extra products.
+        self._base_model = _rerooted(model, self.data.oMf[self.base_id].inverse())
+        self._base_data = self._base_model.createData()
+        self._rows = np.array([0, 1, 2, 5])  # x, y, z, wz of a 6-row Jacobian
 
     # ----------------------------------------------------------------- construction helpers
     @classmethod
@@ -255,11 +277,28 @@ class Robot:
         return out
 
     # ----------------------------------------------------------------- kinematics
+    def _valid_q(self, q: object) -> np.ndarray:
+        """``q`` itself when it is obviously valid (4 moderate float64 values), else ``check_q(q)``.
+
+        The cheap test only ever sends inputs on to the full check; it never lets a bad one through.
+        """
+        try:
+            a, b, c, d = q.tolist() if q.dtype is _F64 and q.ndim == 1 else ()  # type: ignore[attr-defined]
+            if a * a + b * b + c * c + d * d <= _FAST_Q2:  # NaN and inf fail this comparison
+                return q  # type: ignore[return-value]
+        except (AttributeError, TypeError, ValueError):
+            pass
+        return self.check_q(q)
+
     def tool_placement(self, q: np.ndarray) -> pin.SE3:
-        """``baseMtool``: the placement of the tool frame in the base frame, at ``q``."""
-        q = self.check_q(q)
-        pin.forwardKinematics(self.model, self.data, q)
-        return self._baseMo * pin.updateFramePlacement(self.model, self.data, self.tool_id)
+        """``baseMtool``: the placement of the tool frame in the base frame, at ``q``.
+
+        Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
+        """
+        q = self._valid_q(q)
+        model, data = self._base_model, self._base_data
+        pin.forwardKinematics(model, data, q)
+        return pin.updateFramePlacement(model, data, self.tool_id)
 
     def tool_pose(self, q: np.ndarray) -> np.ndarray:
         """(x, y, z, yaw) of the tool frame in the base frame [m, m, m, rad]."""
@@ -300,13 +339,9 @@ class Robot:
         Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
         base z axis, which equals d(yaw)/dt while the tool stays level).
         """
-        q = self.check_q(q)
-        J = pin.computeFrameJacobian(self.model, self.data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED)
-        R = self._Rbo
-        out = np.empty((4, 4))
-        out[:3] = R @ J[:3]
-        out[3] = R[2] @ J[3:]
-        return out
+        q = self._valid_q(q)
+        J = pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED)
+        return J.take(self._rows, 0)
 
     def manipulability(self, q: np.ndarray) -> float:
         """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4)."""
