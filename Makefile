@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= build
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test bench bench-ik lint clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -32,10 +32,17 @@ test: $(VENV)/.installed-test
 bench: $(VENV)/.installed-test
 	$(BIN)/python benchmarks/bench_fk.py
 
+# roboticstoolbox-python is a benchmark-only dependency: it goes into its own environment
+RTB_VENV ?= .venv-bench
+bench-ik: $(VENV)/.installed-test
+	test -x $(RTB_VENV)/bin/python || $(PYTHON) -m venv $(RTB_VENV)
+	$(RTB_VENV)/bin/python -m pip install -q roboticstoolbox-python -e .
+	$(RTB_VENV)/bin/python benchmarks/bench_ik.py
+
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q ruff mypy
 	$(BIN)/ruff check scara_pin tests benchmarks
 	$(BIN)/mypy scara_pin
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache
