@@ -269,11 +269,14 @@ def cmd_ik(args: argparse.Namespace) -> int:
     else:
         result = robot.ik(target, branch=args.branch, reference=near)
         sols = result.branch(args.branch)
+        message = result.message
         if near is not None and sols:
             best = result.nearest(near, branch=args.branch)
+            message = f"the nearest of {len(sols)} solution(s) to --near"
             sols = (best,) if best is not None else ()
         status = result.status.name if sols or not result.success else "NO_SOLUTION_IN_BRANCH"
-        message = result.message if sols or not result.success else f"no {args.branch} solution"
+        if result.success and not sols:
+            message = f"no {args.branch} solution ({len(result.solutions)} of the other branch)"
         qs, branches = [s.q for s in sols], [s.branch for s in sols]
     scale = units.scale(_POSE_KINDS)
     tgt = dict(zip(("x", "y", "z", "yaw"), _scaled(target, scale)))
