@@ -25,6 +25,9 @@ demo: $(VENV)/.installed
 	$(BIN)/scara-pin urdf --robot default -o $(OUT)/scara.urdf
 	$(BIN)/scara-pin fk 0.1 0.2 0.05 0.3
 	$(BIN)/scara-pin jacobian 0.1 0.2 0.05 0.3
+	$(BIN)/scara-pin ik 0.3 0.1 -0.1 0.5
+	$(BIN)/scara-pin traj --robot s1 --deg --from 0 0 0 0 --to 90 60 0.05 -180 --duration 5 \
+	    --out $(OUT)/s1_traj.csv --plot $(OUT)/s1_traj.png
 
 test: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -q

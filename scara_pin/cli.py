@@ -402,6 +402,143 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
     return 0 if report.ok else 1
 
 
+def _joint_arg(robot: Robot, texts: Sequence[str], units: Units, what: str) -> np.ndarray:
+    q = robot.check_q([_number(f"{what} {n}", t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(_Q_KINDS))])
+    outside = robot.outside_limits(q, tol=1e-12)
+    if outside:
+        raise InfeasibleError(f"{what} is outside the joint limits: " + "; ".join(outside))
+    return q
+
+
+def _pose_to_q(robot: Robot, pose: Sequence[float], near: np.ndarray, what: str) -> np.ndarray:
+    result = robot.ik(pose)
+    if not result.success:
+        raise InfeasibleError(f"{what} {list(pose)}: {result.status.name}: {result.message}")
+    best = result.nearest(near)
+    assert best is not None  # success means at least one solution
+    return best.q
+
+
+def cmd_traj(args: argparse.Namespace) -> int:
+    """A trajectory between configurations or poses: quintic, time-optimal, or a straight tool line."""
+    import numpy as np
+
+    from . import trajectory as tr
+
+    logging.getLogger("toppra").setLevel(logging.WARNING)
+    units = Units(args.deg, args.mm)
+    robot = _load(args)
+    if (args.from_q is None) == (args.from_pose is None):
+        raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
+    if (args.to_q is None) == (args.to_pose is None):
+        raise InvalidInputError("give the end as either --to Q1 Q2 Q3 Q4 or --to-pose X Y Z YAW")
+    if args.duration is not None and args.optimal:
+        raise InvalidInputError("--duration and --optimal exclude each other")
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise ParameterError("--duration", args.duration, "must be a finite number > 0", "s")
+    if not (math.isfinite(args.rate) and args.rate > 0):
+        raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
+    vias = [_joint_arg(robot, v, units, f"--via #{i + 1}") for i, v in enumerate(args.via or [])]
+    mid = (np.asarray(robot.limits.lower) + np.asarray(robot.limits.upper)) / 2
+    pose_from = _read_pose(args.from_pose, units, "--from-pose") if args.from_pose else None
+    pose_to = _read_pose(args.to_pose, units, "--to-pose") if args.to_pose else None
+    q_from = _joint_arg(robot, args.from_q, units, "--from") if args.from_q else None
+    q_to = _joint_arg(robot, args.to_q, units, "--to") if args.to_q else None
+    tool_speed = None
+    if args.tool_speed is not None:
+        tool_speed = _number("--tool-speed", str(args.tool_speed)) / units.length
+    if args.linear:
+        poses = [pose_from if q_from is None else tr.joint_pose(robot, q_from)]
+        poses += [tr.joint_pose(robot, v) for v in vias]
+        poses.append(pose_to if q_to is None else tr.joint_pose(robot, q_to))
+        path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
+        if args.duration is not None:
+            traj, method = tr.timed(path, args.duration), "straight line, quintic time law"
+        else:
+            from .timing import time_optimal
+
+            traj = time_optimal(robot, path, tool_speed=tool_speed, torque=args.torque)
+            method = "straight line, time-optimal (TOPP-RA)"
+    else:
+        if q_from is None:
+            q_from = _pose_to_q(robot, pose_from, mid, "--from-pose")  # type: ignore[arg-type]
+        if q_to is None:
+            q_to = _pose_to_q(robot, pose_to, vias[-1] if vias else q_from, "--to-pose")  # type: ignore[arg-type]
+        waypoints = [q_from, *vias, q_to]
+        lim = robot.limits
+        if args.duration is not None:
+            if vias:
+                traj, method = tr.timed(tr.joint_path(robot, waypoints), args.duration), "joint spline, quintic law"
+            else:
+                traj, method = tr.quintic(q_from, q_to, args.duration), "joint quintic (jtraj)"
+        elif not vias and tool_speed is None and not args.torque:
+            traj, method = tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), "joint line, time-optimal"
+        else:
+            from .timing import time_optimal
+
+            traj = time_optimal(robot, waypoints, tool_speed=tool_speed, torque=args.torque)
+            method = "joint path, time-optimal (TOPP-RA)"
+    from .timing import limit_ratios
+
+    ratios = limit_ratios(robot, traj, rate=1000.0, tool_speed=tool_speed, torque=args.torque)
+    if ratios.worst > 1 + 1e-6:
+        message = (f"the trajectory exceeds a limit: worst ratio {ratios.worst:.6g} (velocity "
+                   f"{ratios.velocity:.6g}, acceleration {ratios.acceleration:.6g}); a longer --duration, or "
+                   "--optimal, respects them")  # fmt: skip
+        if args.strict:
+            raise InfeasibleError(message)
+        log.warning(message)
+    outputs: dict[str, str] = {}
+    if args.out:
+        out = Path(args.out)
+        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
+        outputs["trajectory"] = str(out)
+    if args.setpoints:
+        motor = None
+        if args.gear or args.steps_per_rev or args.screw_lead is not None:
+            if not (args.gear and args.steps_per_rev and args.screw_lead is not None):
+                raise InvalidInputError("motor steps need --gear G1..G4, --steps-per-rev S1..S4 and --screw-lead L")
+            motor = tr.MotorUnits.from_drive(
+                [_number("--gear", g) for g in args.gear],
+                [_number("--steps-per-rev", v) for v in args.steps_per_rev],
+                _number("--screw-lead", args.screw_lead) / units.length,
+                prismatic=robot.kinematics.prismatic,
+            )
+        delays = [_number("--delays", d) for d in args.delays] if args.delays else None
+        sp = traj.setpoints(args.setpoint_rate or args.rate, delays=delays, motor=motor)
+        write_atomic(Path(args.setpoints), sp.csv_text())
+        outputs["setpoints"] = args.setpoints
+    if args.plot:
+        from .plots import plot_trajectory
+
+        plot_trajectory(traj, args.plot, robot=robot)
+        outputs["plot"] = args.plot
+    summary = {
+        "robot": robot.name,
+        "method": method,
+        "duration": traj.duration,
+        "q_from": traj.q_start.tolist(),
+        "q_to": traj.q_end.tolist(),
+        "limit_ratios": {"velocity": ratios.velocity, "acceleration": ratios.acceleration,
+                         "tool_speed": ratios.tool_speed, "torque": ratios.torque},  # fmt: skip
+        "outputs": outputs,
+        "units": {"length": "m", "angle": "rad", "time": "s"},
+    }
+    if args.json:
+        if not args.out:
+            summary["samples"] = traj.resample(args.rate).to_dict()
+        print(json.dumps(summary))
+        return 0
+    print(f"robot     {robot.name}: {method}")
+    print(f"duration  {traj.duration:.9g} s")
+    print(f"from      {_fmt(traj.q_start)}  [SI]")
+    print(f"to        {_fmt(traj.q_end)}  [SI]")
+    print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} (sampled at 1 kHz)")
+    for kind, where in outputs.items():
+        print(f"wrote     {kind}: {where}")
+    return 0
+
+
 # ---------------------------------------------------------------------------------------------- plumbing
 def write_atomic(path: Path, text: str) -> None:
     """Write a text file atomically: a temporary file in the same folder, then a rename.
@@ -500,6 +637,36 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_robot_options(p)
     p.set_defaults(func=cmd_ik)
+
+    p = sub.add_parser("traj", help="trajectory: quintic, time-optimal (TOPP-RA) or straight tool line; export, plot")
+    g = p.add_argument_group("endpoints (joint values in URDF order, or tool poses X Y Z YAW)")
+    g.add_argument("--from", dest="from_q", nargs=4, metavar="Q", help="start configuration")
+    g.add_argument("--to", dest="to_q", nargs=4, metavar="Q", help="end configuration")
+    g.add_argument("--from-pose", nargs=4, metavar="P", help="start pose (IK: the solution nearest mid-range)")
+    g.add_argument("--to-pose", nargs=4, metavar="P", help="end pose (IK: the solution nearest the previous point)")
+    g.add_argument("--via", nargs=4, action="append", metavar="Q", help="via configuration (repeatable)")
+    g = p.add_argument_group("timing")
+    g.add_argument("--duration", type=float, metavar="T", help="quintic time law over T seconds (checked against the limits)")
+    g.add_argument("--optimal", action="store_true", help="time-optimal under the joint limits (the default)")
+    g.add_argument("--linear", action="store_true", help="straight tool line (S4), one elbow branch, J4 continuous")
+    g.add_argument("--tool-speed", type=float, metavar="V", help="also limit the tool speed [m/s, or mm/s with --mm]")
+    g.add_argument("--torque", action="store_true", help="also respect the effort limits (RNEA, URDF inertias)")
+    g.add_argument("--strict", action="store_true", help="refuse (exit 3) a --duration that exceeds a limit")
+    g = p.add_argument_group("outputs (files in SI units)")
+    g.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out and --json (default 1000)")
+    g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
+    g.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time with limits, and the tool path")
+    g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
+    g.add_argument("--setpoint-rate", type=float, metavar="HZ", help="setpoint rate (default: --rate)")
+    g.add_argument("--delays", nargs=4, metavar="S", help="per-axis command latency [s], compensated")
+    g.add_argument("--gear", nargs=4, metavar="G", help="gear ratios (motor turns per joint/screw turn)")
+    g.add_argument("--steps-per-rev", nargs=4, metavar="N", help="motor steps per motor turn")
+    g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")
+    p.add_argument("--deg", action="store_true", help="angles in degrees (inputs)")
+    p.add_argument("--mm", action="store_true", help="lengths in millimetres (inputs)")
+    p.add_argument("--json", action="store_true", help="print one JSON object (with the samples unless --out)")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_traj)
 
     p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
     p.add_argument("--samples", type=int, default=1000, help="configurations sampled within limits (default 1000)")
