@@ -1,0 +1,880 @@
+"""Exact plan-view workspace of a SCARA under any J1/J2 limits, and the nearest edge along a ray.
+
+The region. With theta = phi1 + beta1 (heading of arm 1) and gamma the elbow angle (angle from arm 1 to
+arm 2, see :mod:`scara_pin.ik`), the wrist axis point (the J4 axis) is
+
+    W(theta, gamma) = A1 + l1 e(theta) + l2 e(theta + gamma),     e(a) = (cos a, sin a),
+
+and the joint limits make (theta, gamma) a rectangle [t_lo, t_hi] x [g_lo, g_hi]. The reachable region is
+the image of that rectangle. It is compact and connected (the image of a connected set), so it has one
+outer loop and possibly holes; it never comes in two pieces. Its boundary lies in the images of
+
+- the rectangle's J1 edges (theta = t_lo or t_hi, gamma sweeping): arcs of radius l2 centred on the elbow
+  positions A1 + l1 e(theta);
+- its J2 edges (gamma = g_lo or g_hi, theta sweeping): arcs centred on A1 of radius
+  r(gamma) = sqrt(l1^2 + l2^2 + 2 l1 l2 cos gamma), at angles theta + psi(gamma),
+  psi = atan2(l2 sin gamma, l1 + l2 cos gamma);
+- the singular lines (det dW/d(theta, gamma) = l1 l2 sin gamma = 0): gamma = 0 (stretched, r = l1 + l2) and
+  gamma = pi (folded, r = |l1 - l2|), when the elbow range contains them (mod 2 pi).
+
+A J1 range of 2 pi or more (or infinite limits) leaves only circles about A1 (an annulus, no side arcs);
+an elbow range of 2 pi or more makes the J1 edges whole circles. The candidate arcs are split at all their
+mutual intersections, taken from the joint parameters where they are known (an elbow circle meets the
+shoulder circle of elbow angle g at (theta, +/-g); g = 0 and pi are tangencies, where the general
+circle-circle formula would lose half the digits); a piece is kept when exactly one side of its midpoint
+(offset radially by ``SIDE_OFFSET`` times l1 + l2, or a quarter of the distance to the nearest other
+candidate circle if that is less) is in the exact set (:meth:`Workspace.contains` with tol = 0), and
+labelled with the joint limit that produces it. The kept pieces are merged and chained into loops
+oriented with the region on the left (outer loop counterclockwise, holes clockwise); the area is exact by
+Green's theorem over the arcs: for an arc of centre c, radius R from angle a to b (signed), the integral
+of x dy - y dx is R^2 (b - a) + R [c_x (sin b - sin a) - c_y (cos b - cos a)].
+
+:meth:`Workspace.contains` is the closed-form IK's test (independent of the arcs): r = |W - A1| gives
+|gamma| by the half-angle law of cosines; each elbow sign gives gamma and theta, and the point is inside
+when gamma and theta each have a 2 pi-equivalent within the limits (tolerance ``LIMIT_TOL`` = 1e-10 rad
+on the joints and ``REACH_TOL`` = 1e-10 m on the reach, the IK's own).
+
+Which point. The region is that of the wrist axis point. The shipped robots have no plan-view tool offset,
+so it is also the tool point's. With a tool offset t from the wrist axis, the tool point is
+W + R(alpha) t with alpha = yaw - yaw0 (:mod:`scara_pin.ik`); at a FIXED yaw, with J4 free to take any
+turn (a J4 range of at least 2 pi, so that J4 never cuts the region), the tool point region is the wrist
+region translated by R(yaw - yaw0) t: pass ``yaw`` to :func:`workspace` to get it. Without a yaw (or with
+J4 limited to less than a turn) only the wrist axis region is defined here.
+
+Vertical: z = z0 + s3 q3 with q3 in the J3 stroke gives ``z_range``; the region is the same at every z.
+
+Ray query (digest S5). From a start point inside the region along a direction (plan view, or with a
+vertical component: the J3 stroke then stops the ray too), the ray start + u d (|d| = 1, u >= 0) meets
+each boundary arc's circle where |s + u d - c| = R; an intersection counts when its angle on the circle lies
+within the arc (a tolerance of ``EDGE_TOL`` m along the arc). The nearest one with u > ``EDGE_TOL`` is
+the edge. Documented edge cases:
+
+- a start outside the region (beyond the joint tolerances) or outside the z stroke raises
+  :class:`OutsideWorkspaceError`;
+- a start on the edge (within ``EDGE_TOL`` = 1e-9 m of a boundary arc or a stroke end): when the
+  direction points out of the region across that arc, the answer is the start itself at distance 0;
+  otherwise that arc is ignored and the answer is the next edge along the ray. At a corner, the answer is
+  0 as soon as the direction points out across either arc (conservative at a reflex corner);
+- a ray that only grazes a boundary arc (tangent) stops there (conservative: the jog stops on the edge).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .errors import InvalidInputError, ParameterError
+from .ik import LIMIT_TOL, ScaraGeometry
+
+if TYPE_CHECKING:
+    from .model import Robot
+
+__all__ = [
+    "EDGE_TOL",
+    "SIDE_OFFSET",
+    "Arc",
+    "Limit",
+    "OutsideWorkspaceError",
+    "RayBatch",
+    "RayHit",
+    "Workspace",
+    "plot_workspace",
+    "workspace",
+]
+
+EDGE_TOL = 1e-9
+"""[m] a ray start this close to the edge is on it; arc ranges are widened by this much for ray hits."""
+SIDE_OFFSET = 1e-7
+"""[-] radial offset (times l1 + l2) of the two side points that decide whether an arc piece is boundary."""
+_MERGE_TOL = 1e-12
+"""[-] (times l1 + l2) two candidate circles closer than this are the same circle."""
+_CHAIN_TOL = 1e-7
+"""[-] (times l1 + l2) arc ends closer than this are joined into a loop."""
+
+_TWO_PI = 2.0 * math.pi
+
+
+class OutsideWorkspaceError(InvalidInputError):
+    """A ray start (or another point that must be reachable) is outside the workspace.
+
+    Attributes:
+        point: the offending point [m].
+        reason: why it is outside (which joint or stroke rule it breaks).
+    """
+
+    def __init__(self, point: Sequence[float], reason: str) -> None:
+        self.point = tuple(float(v) for v in point)
+        self.reason = reason
+        shown = ", ".join(f"{v:.9g}" for v in self.point)
+        super().__init__(f"start point ({shown}) is outside the workspace: {reason}")
+
+
+class Limit(enum.Enum):
+    """Which joint limit (or singular pose) makes a boundary arc or stops a ray.
+
+    ``J1_LOWER``: J1 at its lower limit with J2 sweeping; ``J2_UPPER``: J2 at its upper limit with J1
+    sweeping; ``OUTER``: the arm stretched (elbow angle 0) with J1 sweeping; ``FOLDED``: the arm folded
+    (elbow angle pi) with J1 sweeping; ``J3_LOWER``/``J3_UPPER``: the ends of the vertical stroke (rays only).
+    Lower/upper refer to the joint value q (not to the angle in the plane, which a -z axis reverses).
+    """
+
+    OUTER = "outer"
+    FOLDED = "folded"
+    J1_LOWER = "joint1_lower"
+    J1_UPPER = "joint1_upper"
+    J2_LOWER = "joint2_lower"
+    J2_UPPER = "joint2_upper"
+    J3_LOWER = "joint3_lower"
+    J3_UPPER = "joint3_upper"
+
+
+# label priority when two candidate arcs lie on the same circle (a J2 limit at exactly 0 is the outer arc)
+_PRIORITY = {Limit.OUTER: 0, Limit.FOLDED: 1, Limit.J2_LOWER: 2, Limit.J2_UPPER: 3, Limit.J1_LOWER: 4,
+             Limit.J1_UPPER: 5}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Arc:
+    """One boundary arc: the points center + radius e(a) for a from ``start`` counterclockwise by ``sweep``.
+
+    Attributes:
+        center: (x, y) [m].
+        radius: [m], > 0.
+        start: start angle [rad], in [0, 2 pi).
+        sweep: counterclockwise extent [rad], in (0, 2 pi] (2 pi: a whole circle).
+        limit: the joint limit that produces it.
+        description: a sentence naming the joints and values, e.g. "joint1 at its upper limit 132 deg,
+            joint2 sweeping".
+        region_inside: True when the region lies on the centre's side of the arc (convex side outward);
+            the loops traverse such an arc counterclockwise, the others clockwise.
+    """
+
+    center: tuple[float, float]
+    radius: float
+    start: float
+    sweep: float
+    limit: Limit
+    description: str
+    region_inside: bool
+
+    @property
+    def end(self) -> float:
+        """End angle [rad] (start + sweep, may exceed 2 pi)."""
+        return self.start + self.sweep
+
+    def point(self, angle: float) -> tuple[float, float]:
+        """The point of the circle at ``angle`` [rad]."""
+        return (self.center[0] + self.radius * math.cos(angle), self.center[1] + self.radius * math.sin(angle))
+
+    def points(self, n: int) -> np.ndarray:
+        """(n, 2) points evenly spaced along the arc, both ends included."""
+        a = self.start + np.linspace(0.0, self.sweep, n)
+        return np.column_stack((self.center[0] + self.radius * np.cos(a), self.center[1] + self.radius * np.sin(a)))
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready description."""
+        return {
+            "center": list(self.center),
+            "radius": self.radius,
+            "start_angle": self.start,
+            "end_angle": self.end,
+            "limit": self.limit.value,
+            "description": self.description,
+            "region_inside": self.region_inside,
+        }
+
+
+@dataclass(frozen=True)
+class RayHit:
+    """The edge met along a ray.
+
+    Attributes:
+        point: the edge point, (x, y) or (x, y, z) as the start was given [m].
+        distance: the distance from the start along the (unit) direction [m]; 0 when the start is on the
+            edge and the direction leaves the region there.
+        limit: what stops the ray.
+        arc: index of the stopping arc in ``Workspace.arcs``, or -1 for the J3 stroke.
+        description: the stopping arc's (or stroke end's) description.
+    """
+
+    point: tuple[float, ...]
+    distance: float
+    limit: Limit
+    arc: int
+    description: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready description."""
+        return {"point": list(self.point), "distance": self.distance, "limit": self.limit.value,
+                "arc": self.arc, "description": self.description}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RayBatch:
+    """Answers of :meth:`Workspace.ray_batch` for N rays.
+
+    Attributes:
+        points: (N, 2) or (N, 3) edge points [m].
+        distance: (N,) distances [m].
+        arc: (N,) index of the stopping arc, -1 for the J3 stroke.
+        limit: (N,) :class:`Limit` values as strings (``Limit(value)`` gives the enum).
+    """
+
+    points: np.ndarray
+    distance: np.ndarray
+    arc: np.ndarray
+    limit: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Params:
+    """The plain numbers of the region (angles in the plane, not joint values)."""
+
+    a1: tuple[float, float]
+    l1: float
+    l2: float
+    t_lo: float
+    t_hi: float
+    t_full: bool
+    g_lo: float
+    g_hi: float
+    g_full: bool
+
+
+def _turn_ok(v: np.ndarray, lo: float, hi: float, full: bool, tol: float) -> np.ndarray:
+    """Whether v + 2 pi k lies in [lo - tol, hi + tol] for some integer k (elementwise)."""
+    if full:
+        return np.ones(np.shape(v), dtype=bool)
+    return v + np.ceil((lo - tol - v) / _TWO_PI) * _TWO_PI <= hi + tol
+
+
+def _contains_xy(p: _Params, x: np.ndarray, y: np.ndarray, tol: float = LIMIT_TOL) -> np.ndarray:
+    """The closed-form IK's reachability test of wrist points (module docstring); tol [rad] and [m]."""
+    l1, l2 = p.l1, p.l2
+    l12, d12 = l1 + l2, abs(l1 - l2)
+    dx, dy = x - p.a1[0], y - p.a1[1]
+    r = np.hypot(dx, dy)
+    outer = np.maximum(l12 - r, 0.0) * (l12 + r)
+    inner = np.maximum(r - d12, 0.0) * (r + d12)
+    g0 = 2.0 * np.arctan2(np.sqrt(outer), np.sqrt(inner))
+    heading = np.arctan2(dy, dx)
+    free = r < 1e-15  # l1 = l2 and the wrist on the shoulder axis: the shoulder angle is free
+    inside = np.zeros(np.shape(r), dtype=bool)
+    for sign in (1.0, -1.0):
+        g = sign * g0
+        ok_g = _turn_ok(g, p.g_lo, p.g_hi, p.g_full, tol)
+        theta = heading - np.arctan2(l2 * np.sin(g), l1 + l2 * np.cos(g))
+        ok_t = _turn_ok(theta, p.t_lo, p.t_hi, p.t_full, tol) | free
+        inside |= ok_g & ok_t
+    return inside & (r <= l12 + tol) & (r >= d12 - tol)
+
+
+def _circle_intersections(c1: tuple[float, float], r1: float, c2: tuple[float, float], r2: float) -> list[float]:
+    """Angles on circle 1 of its intersections with circle 2 (a tangency gives the same angle twice)."""
+    dx, dy = c2[0] - c1[0], c2[1] - c1[1]
+    d = math.hypot(dx, dy)
+    eps = 1e-13 * max(r1, r2)
+    if d < 1e-15 or d > r1 + r2 + eps or d < abs(r1 - r2) - eps:
+        return []
+    base = math.atan2(dy, dx)
+    c = (d * d + r1 * r1 - r2 * r2) / (2.0 * d * r1)
+    h = math.acos(min(1.0, max(-1.0, c)))
+    return [base - h, base + h]
+
+
+def _intersections(p: _Params, a: _Candidate, b: _Candidate) -> list[float]:
+    """Angles on a's circle of its intersections with b's, from the joint parameters where they are known.
+
+    An elbow circle (heading theta) meets the shoulder circle of elbow angle g at the configurations
+    (theta, +g) and (theta, -g): angles theta +/- g on the elbow circle, theta +/- psi(g) on the shoulder
+    circle; g = 0 and g = pi are the tangencies with the outer and folded circles, exact here where the
+    general formula would lose half the digits. Two shoulder circles are concentric; two elbow circles
+    (the two J1 limits) meet where the general formula says.
+    """
+    (ka, va), (kb, vb) = a.circle, b.circle
+    if ka == "shoulder" and kb == "shoulder":
+        return []
+    if ka == "elbow" and kb == "elbow":
+        return _circle_intersections(a.center, a.radius, b.center, b.radius)
+    if ka == "elbow":
+        return [va + vb, va - vb]
+    psi = math.atan2(p.l2 * math.sin(va), p.l1 + p.l2 * math.cos(va))
+    return [vb + psi, vb - psi]
+
+
+@dataclass
+class _Candidate:
+    center: tuple[float, float]
+    radius: float
+    start: float
+    sweep: float  # 2 pi: whole circle
+    limit: Limit
+    description: str
+    # ("elbow", theta): radius l2 about the elbow at heading theta; ("shoulder", |gamma|): r(gamma) about A1
+    circle: tuple[str, float]
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """The exact plan-view region of the wrist axis point (or, with ``yaw``, the tool point at that yaw).
+
+    Attributes:
+        geometry: the SCARA geometry (limits included) it was built from.
+        arcs: the boundary arcs.
+        loops: each closed loop as indices into ``arcs`` in traversal order (region on the left: the outer
+            loop counterclockwise, holes clockwise).
+        area: [m^2], exact (Green's theorem over the arcs).
+        r_min, r_max: smallest and largest distance of the wrist axis from the shoulder axis [m].
+        z_range: (z_min, z_max) of the tool from the J3 stroke [m].
+        offset: translation of the region from the wrist region: (0, 0), or R(yaw - yaw0) t with ``yaw``.
+        yaw: the fixed tool yaw the region is for, or None (wrist axis point) [rad].
+    """
+
+    geometry: ScaraGeometry
+    arcs: tuple[Arc, ...]
+    loops: tuple[tuple[int, ...], ...]
+    area: float
+    r_min: float
+    r_max: float
+    z_range: tuple[float, float]
+    offset: tuple[float, float] = (0.0, 0.0)
+    yaw: float | None = None
+    _p: _Params = field(init=False, repr=False, compare=False)
+    _z_limits: tuple[Limit, Limit] = field(init=False, repr=False, compare=False)
+    _arc_arrays: tuple[np.ndarray, ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # derived once (the workspace is frozen): the plain numbers of the test and the arcs as arrays
+        geo = self.geometry
+        object.__setattr__(self, "_p", _params(geo))
+        up = geo.signs[geo.prismatic] > 0  # the top of the stroke is J3's upper limit
+        z_limits = (Limit.J3_LOWER, Limit.J3_UPPER) if up else (Limit.J3_UPPER, Limit.J3_LOWER)
+        object.__setattr__(self, "_z_limits", z_limits)
+        rows = [(a.center[0], a.center[1], a.radius, a.start, a.sweep, 1.0 if a.region_inside else -1.0)
+                for a in self.arcs]  # fmt: skip
+        object.__setattr__(self, "_arc_arrays", tuple(np.array(col, dtype=float) for col in zip(*rows, strict=True))
+                           if rows else tuple(np.zeros(0) for _ in range(6)))  # fmt: skip
+
+    # --------------------------------------------------------------------------------- membership
+    def contains(self, points: Sequence[float] | np.ndarray, *, tol: float = LIMIT_TOL) -> bool | np.ndarray:
+        """Whether plan points (x, y) are reachable (the closed-form IK's test).
+
+        Args:
+            points: one point (2,) or an (N, 2) array [m]; a third column (z) is ignored.
+            tol: how far outside a joint limit [rad] or a reach circle [m] still counts as inside; the
+                default is the IK's (``LIMIT_TOL`` = ``REACH_TOL`` = 1e-10); 0 for the exact set.
+
+        Returns:
+            a bool for one point, an (N,) bool array for N points.
+        """
+        P = np.asarray(points, dtype=float)
+        one = P.ndim == 1
+        P = np.atleast_2d(P)
+        if P.shape[1] < 2:
+            raise ParameterError("points", f"array of shape {np.shape(points)}", "must be (2,) or (N, 2)")
+        out = _contains_xy(self._p, P[:, 0] - self.offset[0], P[:, 1] - self.offset[1], tol)
+        return bool(out[0]) if one else out
+
+    def contains_by_arcs(self, points: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Point-in-region from the boundary arcs alone (even-odd crossings of a ray towards +x), (N,) bool.
+
+        An independent route to :meth:`contains` (used to check the arcs); points on the boundary may go
+        either way.
+        """
+        P = np.atleast_2d(np.asarray(points, dtype=float))
+        x, y = P[:, 0], P[:, 1]
+        count = np.zeros(len(P), dtype=np.int64)
+        for arc in self.arcs:
+            cx, cy, R = arc.center[0], arc.center[1], arc.radius
+            h2 = R * R - (y - cy) ** 2
+            ok = h2 > 0
+            h = np.sqrt(np.where(ok, h2, 0.0))
+            for sx in (1.0, -1.0):
+                xi = cx + sx * h
+                ang = np.arctan2(y - cy, xi - cx)
+                within = np.mod(ang - arc.start, _TWO_PI) <= arc.sweep
+                count += (ok & (xi > x) & within).astype(np.int64)
+        return count % 2 == 1
+
+    def distance_to_boundary(self, points: Sequence[float] | np.ndarray) -> np.ndarray:
+        """(N,) distance from plan points to the nearest boundary arc [m]."""
+        P = np.atleast_2d(np.asarray(points, dtype=float))
+        best = np.full(len(P), np.inf)
+        for arc in self.arcs:
+            dx, dy = P[:, 0] - arc.center[0], P[:, 1] - arc.center[1]
+            within = np.mod(np.arctan2(dy, dx) - arc.start, _TWO_PI) <= arc.sweep
+            (x0, y0), (x1, y1) = arc.point(arc.start), arc.point(arc.end)
+            to_ends = np.minimum(np.hypot(P[:, 0] - x0, P[:, 1] - y0), np.hypot(P[:, 0] - x1, P[:, 1] - y1))
+            best = np.minimum(best, np.where(within, np.abs(np.hypot(dx, dy) - arc.radius), to_ends))
+        return best
+
+    # --------------------------------------------------------------------------------- rays
+    def ray(self, start: Sequence[float], direction: Sequence[float]) -> RayHit:
+        """The nearest edge along a ray (see the module docstring for starts on the edge).
+
+        Args:
+            start: (x, y) or (x, y, z) inside the region [m].
+            direction: (dx, dy) or (dx, dy, dz), not zero; normalised here. With a z component the J3
+                stroke stops the ray too, and the distance is measured in 3D.
+
+        Returns:
+            RayHit.
+
+        Raises:
+            OutsideWorkspaceError: the start is outside the region or the stroke.
+            ParameterError: malformed or zero direction, or shapes that do not match.
+        """
+        s = np.asarray(start, dtype=float)
+        d = np.asarray(direction, dtype=float)
+        if s.shape not in ((2,), (3,)) or d.shape != s.shape:
+            raise ParameterError("ray start and direction", f"shapes {s.shape} and {d.shape}",
+                                 "must both be (2,) (x, y) or both (3,) (x, y, z)")  # fmt: skip
+        batch = self.ray_batch(s[None, :], d[None, :])
+        k = int(batch.arc[0])
+        limit = Limit(batch.limit[0])
+        desc = self.arcs[k].description if k >= 0 else self._z_description(limit)
+        return RayHit(tuple(float(v) for v in batch.points[0]), float(batch.distance[0]), limit, k, desc)
+
+    def ray_batch(self, starts: np.ndarray, directions: np.ndarray) -> RayBatch:
+        """:meth:`ray` for N rays at once, vectorised with numpy.
+
+        Args:
+            starts: (N, 2) or (N, 3) start points [m].
+            directions: the same shape; each row not zero.
+
+        Raises:
+            OutsideWorkspaceError: some start is outside (the first such one is named).
+            ParameterError: malformed input.
+        """
+        S = np.asarray(starts, dtype=float)
+        D = np.asarray(directions, dtype=float)
+        if S.ndim != 2 or S.shape[1] not in (2, 3) or D.shape != S.shape:
+            raise ParameterError("ray starts and directions", f"shapes {S.shape} and {D.shape}",
+                                 "must both be (N, 2) or both (N, 3)")  # fmt: skip
+        if not (np.isfinite(S).all() and np.isfinite(D).all()):
+            raise ParameterError("ray starts and directions", "non-finite values", "must be finite")
+        norm = np.sqrt((D * D).sum(axis=1))
+        if (norm == 0).any():
+            i = int(np.argmax(norm == 0))
+            raise ParameterError("ray direction", D[i].tolist(), "must not be zero")
+        D = D / norm[:, None]
+        inside = self.contains(S[:, :2])
+        if not inside.all():
+            i = int(np.argmin(inside))
+            raise OutsideWorkspaceError(S[i], self._why_outside(S[i, :2]))
+        n = len(S)
+        best = np.full(n, np.inf)
+        which = np.full(n, -2, dtype=np.int64)
+        sx, sy = S[:, 0], S[:, 1]
+        dx, dy = D[:, 0], D[:, 1]
+        plan = np.hypot(dx, dy)  # |d_xy|: u = w / |d_xy| with w the plan distance
+        moving = plan > 1e-150
+        plan_safe = np.where(moving, plan, 1.0)
+        ex, ey = dx / plan_safe, dy / plan_safe  # unit plan direction
+        cx_all, cy_all, R_all, st_all, sw_all, sgn_all = self._arc_arrays
+        for k in range(len(self.arcs)):
+            cx, cy, R, st, sw, sgn = cx_all[k], cy_all[k], R_all[k], st_all[k], sw_all[k], sgn_all[k]
+            ox, oy = sx - cx, sy - cy
+            # w^2 + 2 b w + c = 0 with b = o.e, c = |o|^2 - R^2 and b^2 - c = R^2 - p^2, p = |o x e| the
+            # miss distance: both factored so that grazing rays and starts near the circle keep their digits
+            b = ox * ex + oy * ey
+            rho = np.hypot(ox, oy)
+            c = (rho - R) * (rho + R)
+            miss = np.abs(ox * ey - oy * ex)
+            disc = (R - miss) * (R + miss)
+            hit = moving & (disc >= 0.0)
+            root = np.sqrt(np.where(hit, disc, 0.0))
+            qq = -(b + np.copysign(root, b))  # stable roots: qq and c / qq
+            qq_safe = np.where(qq == 0.0, 1.0, qq)
+            u1 = qq / plan_safe
+            u2 = np.where(qq == 0.0, 0.0, c / qq_safe) / plan_safe
+            tol_ang = EDGE_TOL / R
+            for u in (u1, u2):
+                hx, hy = ox + u * dx, oy + u * dy
+                rel = np.mod(np.arctan2(hy, hx) - st, _TWO_PI)
+                on_arc = hit & ((rel <= sw + tol_ang) | (rel >= _TWO_PI - tol_ang))
+                ahead = on_arc & (u > EDGE_TOL) & (u < best)
+                best = np.where(ahead, u, best)
+                which = np.where(ahead, k, which)
+            # a start on the edge (within EDGE_TOL of this arc): stop at 0 when the direction leaves the
+            # region across the arc (a tangent direction leaves across an arc with the region inside only)
+            rel = np.mod(np.arctan2(oy, ox) - st, _TWO_PI)
+            on_edge = (np.abs(np.hypot(ox, oy) - R) <= EDGE_TOL) & ((rel <= sw + tol_ang) | (rel >= _TWO_PI - tol_ang))
+            leaving = on_edge & (sgn * (ox * dx + oy * dy + sgn * 1e-12 * R) > 0.0)
+            best = np.where(leaving, 0.0, best)
+            which = np.where(leaving, k, which)
+        if S.shape[1] == 3:
+            z_lo, z_hi = self.z_range
+            z = S[:, 2]
+            if ((z < z_lo - EDGE_TOL) | (z > z_hi + EDGE_TOL)).any():
+                i = int(np.argmax((z < z_lo - EDGE_TOL) | (z > z_hi + EDGE_TOL)))
+                raise OutsideWorkspaceError(S[i], f"z = {z[i]:.9g} m is outside the J3 stroke "
+                                                  f"[{z_lo:.9g}, {z_hi:.9g}] m")  # fmt: skip
+            dz = D[:, 2]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                uz = np.where(dz > 0, (z_hi - z) / dz, np.where(dz < 0, (z_lo - z) / dz, np.inf))
+            uz = np.maximum(uz, 0.0)
+            zstop = uz < best
+            best = np.where(zstop, uz, best)
+            which = np.where(zstop, np.where(dz > 0, -1, -3), which)  # -1: upper end, -3: lower end
+        if not np.isfinite(best).all():  # cannot happen for a bounded region and a nonzero direction
+            i = int(np.argmax(~np.isfinite(best)))
+            raise InvalidInputError(f"the ray from {S[i].tolist()} along {D[i].tolist()} meets no edge")
+        points = S + best[:, None] * D
+        kinds = np.array([a.limit.value for a in self.arcs] + [self._z_limits[0].value, self._z_limits[1].value])
+        limit = kinds[np.where(which >= 0, which, np.where(which == -1, len(self.arcs) + 1, len(self.arcs)))]
+        return RayBatch(points, best, np.where(which >= 0, which, -1), limit)
+
+    def _z_description(self, limit: Limit) -> str:
+        name = self.geometry.names[self.geometry.prismatic]
+        at_top = limit is self._z_limits[1]
+        z = self.z_range[1] if at_top else self.z_range[0]
+        side = "upper" if limit is Limit.J3_UPPER else "lower"
+        return f"{name} at the {side} end of its stroke ({'top' if at_top else 'bottom'}: z = {z:.6g} m)"
+
+    def _why_outside(self, xy: np.ndarray) -> str:
+        p = self._p
+        r = math.hypot(xy[0] - self.offset[0] - p.a1[0], xy[1] - self.offset[1] - p.a1[1])
+        if r > p.l1 + p.l2:
+            return f"r = {r:.9g} m from the shoulder axis is beyond the reach l1 + l2 = {p.l1 + p.l2:.9g} m"
+        if r < self.r_min:
+            return f"r = {r:.9g} m from the shoulder axis is inside the inner limit r_min = {self.r_min:.9g} m"
+        g = self.geometry
+        return (f"no {g.names[g.revolute[0]]}/{g.names[g.revolute[1]]} values within their limits reach it "
+                f"(r = {r:.9g} m is within [{self.r_min:.9g}, {self.r_max:.9g}] m)")  # fmt: skip
+
+    # --------------------------------------------------------------------------------- export
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready description (arcs, loops, area, radii, z range)."""
+        return {
+            "point": "wrist axis" if self.yaw is None else f"tool point at yaw {self.yaw:.9g} rad",
+            "offset": list(self.offset),
+            "area": self.area,
+            "r_min": self.r_min,
+            "r_max": self.r_max,
+            "z_range": list(self.z_range),
+            "arcs": [a.to_dict() for a in self.arcs],
+            "loops": [list(loop) for loop in self.loops],
+        }
+
+
+# ------------------------------------------------------------------------------------------ building
+def workspace(
+    robot: Robot | ScaraGeometry,
+    *,
+    lower: Sequence[float] | None = None,
+    upper: Sequence[float] | None = None,
+    yaw: float | None = None,
+) -> Workspace:
+    """Build the exact workspace of a robot.
+
+    Args:
+        robot: a :class:`~scara_pin.model.Robot` or its :class:`~scara_pin.ik.ScaraGeometry`.
+        lower, upper: joint limits in q order replacing the model's (e.g. a software range) [rad, m].
+        yaw: a fixed tool yaw [rad]: the region is then the tool point's at that yaw (needs J4 to span at
+            least 2 pi when the tool is offset from the wrist axis). None: the wrist axis point.
+
+    Returns:
+        Workspace.
+
+    Raises:
+        ParameterError: limits that are not ordered or not numbers, J1 or J2 limits that leave no range,
+            or a yaw with J4 limited to less than a turn and a tool offset.
+    """
+    geo = robot if isinstance(robot, ScaraGeometry) else robot.kinematics
+    if lower is not None or upper is not None:
+        lo = tuple(float(v) for v in (geo.lower if lower is None else lower))
+        hi = tuple(float(v) for v in (geo.upper if upper is None else upper))
+        if len(lo) != len(geo.lower) or len(hi) != len(geo.upper):
+            raise ParameterError("joint limits", f"{len(lo)} and {len(hi)} values", f"must have {len(geo.lower)}")
+        geo = replace(geo, lower=lo, upper=hi)
+    for i, name in enumerate(geo.names):
+        if math.isnan(geo.lower[i]) or math.isnan(geo.upper[i]) or geo.lower[i] > geo.upper[i]:
+            limits = (geo.lower[i], geo.upper[i])
+            raise ParameterError(f"limits of {name}", limits, "must be numbers with lower <= upper")
+    for i in geo.revolute[:2]:
+        if not geo.upper[i] > geo.lower[i]:
+            limits = (geo.lower[i], geo.upper[i])
+            raise ParameterError(f"limits of {geo.names[i]}", limits, "must span a range (else the region has no area)")
+    offset = (0.0, 0.0)
+    if yaw is not None and not math.isfinite(yaw):
+        raise ParameterError("yaw", yaw, "must be a finite number", "rad")
+    if yaw is not None and math.hypot(*geo.tool) > 0.0:
+        rc = geo.revolute[2]
+        if not geo.upper[rc] - geo.lower[rc] >= _TWO_PI:
+            raise ParameterError(
+                f"range of {geo.names[rc]}", geo.upper[rc] - geo.lower[rc],
+                "must span at least 2 pi for a fixed-yaw tool point region (the J4 limit would cut it)", "rad",
+            )  # fmt: skip
+        al = float(yaw) - geo.yaw0
+        tx, ty = geo.tool
+        offset = (math.cos(al) * tx - math.sin(al) * ty, math.sin(al) * tx + math.cos(al) * ty)
+    p = _params(geo)
+    arcs = _boundary(geo, p)
+    if offset != (0.0, 0.0):
+        arcs = [replace(a, center=(a.center[0] + offset[0], a.center[1] + offset[1])) for a in arcs]
+    loops = _chain(arcs, p.l1 + p.l2)
+    area = 0.0
+    for a in arcs:
+        s = 1.0 if a.region_inside else -1.0
+        cx, cy, R = a.center[0], a.center[1], a.radius
+        b, e = a.start, a.end
+        green = R * R * a.sweep + R * (cx * (math.sin(e) - math.sin(b)) - cy * (math.cos(e) - math.cos(b)))
+        area += 0.5 * s * green
+    # (radius_range() needs finite elbow limits; a full elbow turn reaches every radius of the annulus)
+    r_min, r_max = (abs(p.l1 - p.l2), p.l1 + p.l2) if p.g_full else geo.radius_range()
+    ip = geo.prismatic
+    zs = sorted((geo.z0 + geo.signs[ip] * geo.lower[ip], geo.z0 + geo.signs[ip] * geo.upper[ip]))
+    return Workspace(geo, tuple(arcs), loops, area, r_min, r_max, (zs[0], zs[1]), offset, yaw)
+
+
+def _params(geo: ScaraGeometry) -> _Params:
+    ra, rb = geo.revolute[0], geo.revolute[1]
+    t = sorted((geo.signs[ra] * geo.lower[ra] + geo.beta1, geo.signs[ra] * geo.upper[ra] + geo.beta1))
+    g = sorted((geo.elbow_angle(geo.lower[rb]), geo.elbow_angle(geo.upper[rb])))
+    t_full = not (math.isfinite(t[0]) and math.isfinite(t[1]) and t[1] - t[0] < _TWO_PI)
+    g_full = not (math.isfinite(g[0]) and math.isfinite(g[1]) and g[1] - g[0] < _TWO_PI)
+    return _Params(geo.a1, geo.l1, geo.l2, t[0], t[1], t_full, g[0], g[1], g_full)
+
+
+def _deg(v: float) -> str:
+    return f"{math.degrees(v):.6g} deg"
+
+
+def _candidates(geo: ScaraGeometry, p: _Params) -> list[_Candidate]:
+    """Every arc that may carry boundary: rectangle edges and singular circles (module docstring)."""
+    ra, rb = geo.revolute[0], geo.revolute[1]
+    n1, n2 = geo.names[ra], geo.names[rb]
+    l1, l2, a1 = p.l1, p.l2, p.a1
+    out: list[_Candidate] = []
+    t_sweep = _TWO_PI if p.t_full else p.t_hi - p.t_lo
+    t_start = 0.0 if p.t_full else p.t_lo
+
+    def reaches(angle: float) -> bool:
+        return p.g_full or angle + math.ceil((p.g_lo - angle) / _TWO_PI) * _TWO_PI <= p.g_hi
+
+    def radius(g: float) -> float:
+        return math.sqrt(max(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * math.cos(g), 0.0))
+
+    # J1 edges: J1 at a limit, J2 sweeping: radius l2 about the elbow
+    if not p.t_full:
+        for t, lower_q in ((p.t_lo, geo.signs[ra] > 0), (p.t_hi, geo.signs[ra] < 0)):
+            q = geo.lower[ra] if lower_q else geo.upper[ra]
+            lim = Limit.J1_LOWER if lower_q else Limit.J1_UPPER
+            c = (a1[0] + l1 * math.cos(t), a1[1] + l1 * math.sin(t))
+            sw = _TWO_PI if p.g_full else p.g_hi - p.g_lo
+            st = 0.0 if p.g_full else t + p.g_lo
+            if sw > 0.0:
+                text = f"{n1} at its {'lower' if lower_q else 'upper'} limit {_deg(q)}, {n2} sweeping"
+                out.append(_Candidate(c, l2, st, sw, lim, text, ("elbow", t)))
+    # J2 edges: J2 at a limit, J1 sweeping: radius r(g) about the shoulder
+    if not p.g_full:
+        for g, lower_q in ((p.g_lo, geo.signs[rb] > 0), (p.g_hi, geo.signs[rb] < 0)):
+            R = radius(g)
+            if R <= 1e-12 * (l1 + l2):
+                continue
+            q = geo.lower[rb] if lower_q else geo.upper[rb]
+            lim = Limit.J2_LOWER if lower_q else Limit.J2_UPPER
+            psi = math.atan2(l2 * math.sin(g), l1 + l2 * math.cos(g))
+            if t_sweep > 0.0:
+                text = f"{n2} at its {'lower' if lower_q else 'upper'} limit {_deg(q)}, {n1} sweeping"
+                out.append(_Candidate(a1, R, t_start + (0.0 if p.t_full else psi), t_sweep, lim, text,
+                                      ("shoulder", abs(math.remainder(g, _TWO_PI)))))  # fmt: skip
+    # singular circles
+    if reaches(0.0) and t_sweep > 0.0:
+        text = f"outer: arm stretched ({n2} at elbow angle 0), {n1} sweeping"
+        out.append(_Candidate(a1, l1 + l2, t_start, t_sweep, Limit.OUTER, text, ("shoulder", 0.0)))
+    if reaches(math.pi) and abs(l1 - l2) > 1e-12 * (l1 + l2) and t_sweep > 0.0:
+        psi = 0.0 if l1 > l2 else math.pi
+        text = f"inner: arm folded ({n2} at elbow angle 180 deg), {n1} sweeping"
+        start = t_start + (0.0 if p.t_full else psi)
+        out.append(_Candidate(a1, abs(l1 - l2), start, t_sweep, Limit.FOLDED, text, ("shoulder", math.pi)))
+    return out
+
+
+def _boundary(geo: ScaraGeometry, p: _Params) -> list[Arc]:
+    """Split the candidates at their intersections, keep the boundary pieces, merge them (module docstring)."""
+    scale = p.l1 + p.l2
+    cands = _candidates(geo, p)
+    # group candidates lying on the same circle
+    groups: list[list[_Candidate]] = []
+    for c in cands:
+        for grp in groups:
+            g0 = grp[0]
+            if (math.hypot(c.center[0] - g0.center[0], c.center[1] - g0.center[1]) < _MERGE_TOL * scale
+                    and abs(c.radius - g0.radius) < _MERGE_TOL * scale):  # fmt: skip
+                grp.append(c)
+                break
+        else:
+            groups.append([c])
+    arcs: list[Arc] = []
+    delta = SIDE_OFFSET * scale
+    for gi, grp in enumerate(groups):
+        center, R = grp[0].center, grp[0].radius
+        bps: list[float] = []
+        for c in grp:
+            if c.sweep < _TWO_PI:
+                bps += [c.start % _TWO_PI, (c.start + c.sweep) % _TWO_PI]
+        for gj, other in enumerate(groups):
+            if gj != gi:
+                bps += [a % _TWO_PI for a in _intersections(p, grp[0], other[0])]
+        bps.sort()
+        uniq: list[float] = []
+        for b in bps:
+            if not uniq or b - uniq[-1] > 1e-13:
+                uniq.append(b)
+        if len(uniq) > 1 and uniq[0] + _TWO_PI - uniq[-1] <= 1e-13:
+            uniq.pop()
+        if not uniq:
+            pieces = [(0.0, _TWO_PI)]
+        else:
+            pieces = [(uniq[i], uniq[i + 1]) for i in range(len(uniq) - 1)] + [(uniq[-1], uniq[0] + _TWO_PI)]
+        kept: list[tuple[float, float, _Candidate, bool]] = []
+        for s, e in pieces:
+            m = 0.5 * (s + e)
+            covering = [c for c in grp if c.sweep >= _TWO_PI or (m - c.start) % _TWO_PI < c.sweep]
+            if not covering:
+                continue
+            cm, sm = math.cos(m), math.sin(m)
+            # side points closer to this circle than to any other candidate circle (nearly coincident
+            # circles: a J2 limit just off 0 or pi), tested on the exact set (tol = 0)
+            px, py = center[0] + R * cm, center[1] + R * sm
+            gap = min((abs(math.hypot(px - o[0].center[0], py - o[0].center[1]) - o[0].radius)
+                       for gj, o in enumerate(groups) if gj != gi), default=math.inf)  # fmt: skip
+            d = min(delta, 0.25 * gap) if gap > 0.0 else delta
+            xs = np.array([center[0] + (R - d) * cm, center[0] + (R + d) * cm])
+            ys = np.array([center[1] + (R - d) * sm, center[1] + (R + d) * sm])
+            in_in, in_out = _contains_xy(p, xs, ys, 0.0)
+            if bool(in_in) == bool(in_out):
+                continue
+            # keep the previous piece's label while its candidate still covers (fewer, longer arcs)
+            prev = kept[-1][2] if kept and abs(kept[-1][1] - s) < 1e-13 and kept[-1][3] == bool(in_in) else None
+            best = prev if prev in covering else min(covering, key=lambda c: _PRIORITY[c.limit])
+            kept.append((s, e, best, bool(in_in)))
+        # merge neighbours with the same label and side (cyclically)
+        merged: list[list[Any]] = []
+        for s, e, c, side in kept:
+            if merged and abs(merged[-1][1] - s) < 1e-13 and merged[-1][2] is c and merged[-1][3] == side:
+                merged[-1][1] = e
+            else:
+                merged.append([s, e, c, side])
+        if len(merged) > 1:
+            first, last = merged[0], merged[-1]
+            if abs(last[1] - (first[0] + _TWO_PI)) < 1e-13 and last[2] is first[2] and last[3] == first[3]:
+                first[0] = last[0]
+                first[1] = first[1] + _TWO_PI if first[1] < last[0] else first[1]
+                merged.pop()
+        for s, e, c, side in merged:
+            sweep = min(e - s, _TWO_PI)
+            start = 0.0 if sweep >= _TWO_PI else s % _TWO_PI
+            arcs.append(Arc(center, R, start, sweep, c.limit, c.description, side))
+    return arcs
+
+
+def _chain(arcs: list[Arc], scale: float) -> tuple[tuple[int, ...], ...]:
+    """Order the arcs into closed loops, each arc traversed with the region on its left."""
+
+    def ends(i: int) -> tuple[tuple[float, float], tuple[float, float]]:
+        a = arcs[i]
+        p0, p1 = a.point(a.start), a.point(a.end)
+        return (p0, p1) if a.region_inside else (p1, p0)
+
+    unused = set(range(len(arcs)))
+    loops: list[tuple[int, ...]] = []
+    while unused:
+        first = min(unused)
+        unused.discard(first)
+        loop = [first]
+        if arcs[first].sweep < _TWO_PI:
+            head = ends(first)[0]
+            tail = ends(first)[1]
+            while math.dist(tail, head) > _CHAIN_TOL * scale:
+                nxt = min(unused, key=lambda j: math.dist(ends(j)[0], tail), default=None)
+                if nxt is None or math.dist(ends(nxt)[0], tail) > _CHAIN_TOL * scale:
+                    break  # an open chain: reported as it is (should not happen)
+                unused.discard(nxt)
+                loop.append(nxt)
+                tail = ends(nxt)[1]
+        loops.append(tuple(loop))
+    return tuple(loops)
+
+
+# ------------------------------------------------------------------------------------------ picture
+def plot_workspace(
+    ws: Workspace,
+    path: str,
+    q: Sequence[float] | None = None,
+    ray: tuple[Sequence[float], Sequence[float]] | None = None,
+) -> None:
+    """Draw the region to a PNG: filled, arcs coloured by their limit, the arm at ``q``, a ray and its hit.
+
+    Args:
+        ws: the workspace.
+        path: output file (.png).
+        q: a joint configuration (q order) to draw the arm at; default the limits' midpoints (finite ones).
+        ray: (start, direction) of a ray to draw with its edge point.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.path import Path as MPath
+    from matplotlib.patches import PathPatch
+
+    colours = {Limit.OUTER: "tab:blue", Limit.FOLDED: "tab:purple", Limit.J1_LOWER: "tab:red",
+               Limit.J1_UPPER: "tab:orange", Limit.J2_LOWER: "tab:green", Limit.J2_UPPER: "tab:olive"}  # fmt: skip
+    fig, ax = plt.subplots(figsize=(7, 7))
+    verts: list[np.ndarray] = []
+    codes: list[int] = []
+    for loop in ws.loops:
+        pts = []
+        for i in loop:
+            a = ws.arcs[i]
+            seg = a.points(max(8, int(a.sweep * 90)))
+            pts.append(seg if a.region_inside else seg[::-1])
+        v = np.vstack(pts)
+        verts.append(v)
+        codes += [MPath.MOVETO] + [MPath.LINETO] * (len(v) - 2) + [MPath.CLOSEPOLY]
+    if verts:
+        ax.add_patch(PathPatch(MPath(np.vstack(verts), codes), facecolor="lightsteelblue", alpha=0.5, lw=0))
+    seen: set[Limit] = set()
+    for a in ws.arcs:
+        pts = a.points(max(8, int(a.sweep * 90)))
+        ax.plot(pts[:, 0], pts[:, 1], color=colours[a.limit], lw=2.0,
+                label=a.description if a.limit not in seen else None)  # fmt: skip
+        seen.add(a.limit)
+    geo = ws.geometry
+    if q is None:
+        q = [0.5 * (lo + hi) if math.isfinite(lo + hi) else 0.0 for lo, hi in zip(geo.lower, geo.upper)]
+    ra, rb = geo.revolute[0], geo.revolute[1]
+    theta = geo.signs[ra] * q[ra] + geo.beta1
+    gamma = geo.elbow_angle(q[rb])
+    a1 = np.array(geo.a1)
+    elbow = a1 + geo.l1 * np.array([math.cos(theta), math.sin(theta)])
+    wrist = elbow + geo.l2 * np.array([math.cos(theta + gamma), math.sin(theta + gamma)])
+    arm = np.vstack((a1, elbow, wrist))
+    ax.plot(arm[:, 0], arm[:, 1], "-o", color="black", lw=3, ms=6, label="arm")
+    if ws.offset != (0.0, 0.0):  # the tool point at the region's yaw
+        tool = wrist + np.array(ws.offset)
+        ax.plot([wrist[0], tool[0]], [wrist[1], tool[1]], "-", color="dimgray", lw=2, label="tool offset")
+    if ray is not None:
+        start, direction = ray
+        hit = ws.ray(start[:2], direction[:2])
+        ax.plot([start[0], hit.point[0]], [start[1], hit.point[1]], "--", color="crimson", lw=1.5,
+                label=f"ray: {hit.distance:.4g} m to {hit.limit.value}")  # fmt: skip
+        ax.plot(*hit.point[:2], "x", color="crimson", ms=10, mew=2)
+        ax.plot(start[0], start[1], "o", color="crimson", ms=5)
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.grid(alpha=0.3)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(f"workspace: area {ws.area:.5g} m$^2$, r in [{ws.r_min:.4g}, {ws.r_max:.4g}] m")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=7, framealpha=0.8)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
