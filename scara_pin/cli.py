@@ -539,6 +539,98 @@ def cmd_traj(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_workspace(args: argparse.Namespace) -> int:
+    """The exact reachable region (arcs, area, radii), a ray query to its edge, and a picture."""
+    from .workspace import plot_workspace, workspace
+
+    units = Units(False, args.mm)
+    L = units.length
+    robot = _load(args)
+    ws = workspace(robot)
+    hit = None
+    if args.ray:
+        start = [_number(n, t) / L for n, t in zip(("x", "y"), args.ray[:2])]
+        direction = [_number(n, t) for n, t in zip(("dx", "dy"), args.ray[2:])]
+        if (args.z is None) != (args.dz is None):
+            raise InvalidInputError("--z and --dz go together (a 3-D ray also meets the J3 stroke)")
+        if args.z is not None:
+            start.append(_number("--z", args.z) / L)
+            direction.append(_number("--dz", args.dz))
+        hit = ws.ray(start, direction)
+    elif args.z is not None or args.dz is not None:
+        raise InvalidInputError("--z/--dz go with --ray")
+    if args.plot:
+        ray = None if hit is None else (start[:2], direction[:2])
+        plot_workspace(ws, args.plot, ray=ray)
+    if args.json:
+        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}}
+        if hit is not None:
+            out["ray"] = {"start": start, "direction": direction, **hit.to_dict()}
+        else:
+            out["workspace"] = ws.to_dict()
+        if args.plot:
+            out["plot"] = args.plot
+        print(json.dumps(out))
+        return 0
+    if hit is not None:
+        print(f"robot     {robot.name}: ray from {_fmt([v * L for v in start])} [{units.length_name}] along {_fmt(direction)}")
+        print(f"edge      {_fmt([v * L for v in hit.point])} [{units.length_name}]")
+        print(f"distance  {hit.distance * L:.9g} {units.length_name}")
+        print(f"stopped by {hit.description} [{hit.limit.value}]")
+    else:
+        z0, z1 = ws.z_range
+        print(f"robot     {robot.name}: reachable region of the wrist axis (= tool point without tool offset)")
+        print(f"area      {ws.area * L * L:.9g} {units.length_name}^2")
+        print(f"radius    {ws.r_min * L:.9g} .. {ws.r_max * L:.9g} {units.length_name} (from the J1 axis)")
+        print(f"z         {z0 * L:.9g} .. {z1 * L:.9g} {units.length_name} (J3 stroke)")
+        print(f"boundary  {len(ws.loops)} loop(s) of {len(ws.arcs)} arcs (centre, radius, start..end angle, limit):")
+        for i, arc in enumerate(ws.arcs):
+            cx, cy = (v * L for v in arc.center)
+            print(f"  {i:>2}  ({cx: .6g}, {cy: .6g})  r {arc.radius * L:.6g}  "
+                  f"{math.degrees(arc.start):8.3f}..{math.degrees(arc.end):8.3f} deg  {arc.description}")  # fmt: skip
+    if args.plot:
+        print(f"wrote     {args.plot}")
+    return 0
+
+
+def cmd_jog(args: argparse.Namespace) -> int:
+    """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge."""
+    from .jog import jog_to_edge
+
+    units = Units(args.deg, args.mm)
+    robot = _load(args)
+    q0 = _joint_arg(robot, args.from_q, units, "--from")
+    direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
+    if len(direction) not in (2, 3):
+        raise ParameterError("--direction", " ".join(args.direction), "must be DX DY or DX DY DZ")
+    margin = _number("--margin", args.margin) / units.length
+    jog = jog_to_edge(robot, q0, direction, margin=margin)
+    traj = jog.trajectory
+    if args.out:
+        out = Path(args.out)
+        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
+    if args.plot:
+        from .plots import plot_trajectory
+
+        plot_trajectory(traj, args.plot, robot=robot)
+    if args.json:
+        print(json.dumps({"robot": robot.name, "hit": jog.hit.to_dict(), "start_pose": jog.start_pose.tolist(),
+                          "end_pose": jog.end_pose.tolist(), "distance": jog.distance, "duration": traj.duration,
+                          "q_end": traj.q_end.tolist(), "limit_ratio": jog.ratio,
+                          "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
+        return 0
+    L = units.length
+    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}")
+    print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]")
+    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)")
+    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]")
+    print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)")
+    for what in (args.out, args.plot):
+        if what:
+            print(f"wrote     {what}")
+    return 0
+
+
 # ---------------------------------------------------------------------------------------------- plumbing
 def write_atomic(path: Path, text: str) -> None:
     """Write a text file atomically: a temporary file in the same folder, then a rename.
@@ -667,6 +759,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object (with the samples unless --out)")
     _add_robot_options(p)
     p.set_defaults(func=cmd_traj)
+
+    p = sub.add_parser("workspace", help="exact reachable region (arcs, area, radii); --ray: the edge along a ray")
+    p.add_argument("--ray", nargs=4, metavar=("X", "Y", "DX", "DY"), help="start inside the region and plan direction")
+    p.add_argument("--z", metavar="Z", help="with --ray: start height (a 3-D ray also meets the J3 stroke)")
+    p.add_argument("--dz", metavar="DZ", help="with --ray: vertical direction component")
+    p.add_argument("--plot", metavar="PNG", help="picture of the region (arcs coloured by limit; the ray)")
+    p.add_argument("--mm", action="store_true", help="lengths in millimetres")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_workspace)
+
+    p = sub.add_parser("jog", help="jog to the edge: straight tool move ending at rest on the workspace edge")
+    p.add_argument("--from", dest="from_q", nargs=4, metavar="Q", required=True, help="current configuration")
+    p.add_argument("--direction", nargs="+", metavar="D", required=True, help="DX DY (plan) or DX DY DZ")
+    p.add_argument("--margin", default="0", metavar="M", help="stop this far before the edge [m or mm] (default 0)")
+    p.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out (default 1000)")
+    p.add_argument("--out", metavar="FILE", help="samples as CSV (or JSON for *.json), atomically")
+    p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
+    p.add_argument("--deg", action="store_true", help="angles in degrees (inputs)")
+    p.add_argument("--mm", action="store_true", help="lengths in millimetres (inputs)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_jog)
 
     p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
     p.add_argument("--samples", type=int, default=1000, help="configurations sampled within limits (default 1000)")
