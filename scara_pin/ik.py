@@ -39,7 +39,7 @@ import enum
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -74,6 +74,14 @@ PARALLEL_TOL = 1e-6
 """[rad] the largest angle between a joint axis and the base z axis for a SCARA."""
 
 _TWO_PI = 2.0 * math.pi
+_PI = math.pi
+_BRANCHES = ("all", "left", "right")
+# bound once for the per-target hot path of solve()
+_atan2, _sin, _cos, _sqrt, _hypot = math.atan2, math.sin, math.cos, math.sqrt, math.hypot
+_ceil, _isfinite = math.ceil, math.isfinite
+_array = np.array
+_F64 = np.dtype(np.float64)
+_new = object.__new__
 
 
 class NotScaraError(UrdfError):
@@ -91,6 +99,9 @@ class IKStatus(enum.IntEnum):
     J3_STROKE = 5
     J4_LIMIT = 6
     NOT_A_YAW_POSE = 7
+
+
+_OK = IKStatus.OK
 
 
 @dataclass(frozen=True)
@@ -201,12 +212,43 @@ class ScaraGeometry:
     l2: float = field(init=False)
     beta1: float = field(init=False)
     beta2: float = field(init=False)
+    _radius: tuple[float, float] | None = field(init=False, repr=False, compare=False)
+    _fast: tuple[Any, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "l1", math.hypot(*self.u1))
         object.__setattr__(self, "l2", math.hypot(*self.u2))
         object.__setattr__(self, "beta1", math.atan2(self.u1[1], self.u1[0]))
         object.__setattr__(self, "beta2", math.atan2(self.u2[1], self.u2[0]))
+        # Everything the solvers need that does not depend on the target, computed once (the geometry is
+        # frozen). Limits that make radius_range() fail (infinite) leave it to fail where it did: in solve.
+        try:
+            radius: tuple[float, float] | None = self._radius_range()
+        except (ArithmeticError, TypeError, ValueError):
+            radius = None
+        object.__setattr__(self, "_radius", radius)
+        ra, rb, rc = self.revolute
+        ip = self.prismatic
+        s, lo, hi = self.signs, self.lower, self.upper
+        tol = LIMIT_TOL
+        l1, l2 = self.l1, self.l2
+        # J4 always has a 2 pi-equivalent inside its limits when they span more than a turn (with margin)
+        wrist_any_turn = math.isfinite(lo[rc]) and math.isfinite(hi[rc]) and hi[rc] - lo[rc] >= _TWO_PI + 1e-9
+        layout = 1 if (ra, rb, rc, ip) == (0, 1, 3, 2) else 0  # 1: q = (shoulder, elbow, prismatic, wrist)
+        # at most one 2 pi-equivalent inside a range shorter than a turn (with margin): no list needed
+        one_a = hi[ra] - lo[ra] + 2 * tol < _TWO_PI - 1e-9
+        one_b = hi[rb] - lo[rb] + 2 * tol < _TWO_PI - 1e-9
+        inner_min = math.nan if radius is None else radius[0] - REACH_TOL
+        fast = (
+            ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip],
+            lo[ra], hi[ra], lo[rb], hi[rb], lo[rc], hi[rc], lo[ip], hi[ip],
+            lo[ra] - tol, hi[ra] + tol, lo[rb] - tol, hi[rb] + tol, lo[rc] - tol, hi[rc] + tol,
+            lo[ip] - tol, hi[ip] + tol,
+            self.z0, self.yaw0, self.a1[0], self.a1[1], self.tool[0], self.tool[1],
+            l1, l2, self.beta1, self.beta2, l1 + l2 + REACH_TOL, l1 + l2, abs(l1 - l2),
+            wrist_any_turn, layout, one_a, one_b, inner_min, self.tool == (0.0, 0.0),
+        )  # fmt: skip
+        object.__setattr__(self, "_fast", fast)
 
     # ---------------------------------------------------------------------------------------- reading
     @classmethod
@@ -296,6 +338,11 @@ class ScaraGeometry:
         r(gamma) = sqrt(l1^2 + l2^2 + 2 l1 l2 cos gamma) falls as |gamma| grows to pi, so r_min comes from
         the allowed gamma nearest to pi (mod 2 pi) and r_max from the one nearest to 0.
         """
+        if self._radius is not None:
+            return self._radius
+        return self._radius_range()
+
+    def _radius_range(self) -> tuple[float, float]:
         e = self.revolute[1]
         g_lo, g_hi = sorted((self.elbow_angle(self.lower[e]), self.elbow_angle(self.upper[e])))
 
@@ -335,14 +382,6 @@ def _turns(value: float, lo: float, hi: float) -> list[float]:
     return out
 
 
-def _elbow(geo: ScaraGeometry, r: float) -> float:
-    """The elbow angle gamma in [0, pi] for a wrist radius r (clamped to the reachable annulus)."""
-    l1, l2 = geo.l1, geo.l2
-    outer = max(l1 + l2 - r, 0.0) * (l1 + l2 + r)
-    inner = max(r - abs(l1 - l2), 0.0) * (r + abs(l1 - l2))
-    return 2.0 * math.atan2(math.sqrt(outer), math.sqrt(inner))
-
-
 def solve(
     geo: ScaraGeometry,
     target: Sequence[float] | np.ndarray | pin.SE3,
@@ -362,92 +401,192 @@ def solve(
     Returns:
         IKResult: all solutions (sorted: right before left, then by q), or the status and its reason.
     """
-    if branch not in ("all", "left", "right"):
+    # Hot path: plain floats and the math module; numpy only for the arrays the result holds. Every
+    # expression below is the one of the straightforward formulation (same operations, same order), so
+    # the results are the same to the last bit; only the bookkeeping around them is leaner.
+    if branch not in _BRANCHES:
         raise InvalidInputError(f"branch {branch!r} must be 'all', 'left' or 'right'")
-    x, y, z, alpha, tilt = _target(geo, target)
-    pose = np.array([x, y, z, _wrap(alpha + geo.yaw0)])
-    if tilt > YAW_POSE_TOL:
-        return IKResult(pose, (), IKStatus.NOT_A_YAW_POSE,
-                        f"the target tilts the tool by {math.degrees(tilt):.6g} deg (roll/pitch); "
-                        "a SCARA can only turn it about the vertical axis")  # fmt: skip
-    ra, rb, rc = geo.revolute
-    ip = geo.prismatic
-    s = geo.signs
-    lo, hi = geo.lower, geo.upper
+    (ra, rb, rc, ip, s_a, s_b, s_c, s_p,
+     lo_a, hi_a, lo_b, hi_b, lo_c, hi_c, lo_p, hi_p,
+     lt_a, ht_a, lt_b, ht_b, lt_c, ht_c, lt_p, ht_p,
+     z0, yaw0, a1x, a1y, tx, ty,
+     l1, l2, beta1, beta2, reach, l12, d12,
+     wrist_any_turn, layout, one_a, one_b, inner_min, tool_on_axis) = geo._fast  # fmt: skip
+    # a 4-vector of finite floats is read without numpy; anything else goes through _target
+    plain = False
+    kind = type(target)
+    if kind is np.ndarray:
+        if target.shape == (4,) and target.dtype is _F64:  # type: ignore[union-attr]
+            x, y, z, yaw = target.tolist()  # type: ignore[union-attr]
+            plain = _isfinite(x + y + z + yaw)  # else: _target names the culprit
+    elif (kind is tuple or kind is list) and len(target) == 4:  # type: ignore[arg-type]
+        x, y, z, yaw = target  # type: ignore[misc]
+        plain = (type(x) is float and type(y) is float and type(z) is float and type(yaw) is float
+                 and _isfinite(x + y + z + yaw))  # fmt: skip
+    if plain:
+        alpha = yaw - yaw0
+    else:
+        x, y, z, alpha, tilt = _target(geo, target)
+        if tilt > YAW_POSE_TOL:
+            return _result(_array([x, y, z, _wrap(alpha + yaw0)]), (), IKStatus.NOT_A_YAW_POSE,
+                           f"the target tilts the tool by {math.degrees(tilt):.6g} deg (roll/pitch); "
+                           "a SCARA can only turn it about the vertical axis")  # fmt: skip
+    pose = _array((x, y, z, (alpha + yaw0 + _PI) % _TWO_PI - _PI))
     # vertical joint
-    qp = (z - geo.z0) / s[ip]
-    if not lo[ip] - LIMIT_TOL <= qp <= hi[ip] + LIMIT_TOL:
-        return IKResult(pose, (), IKStatus.J3_STROKE,
-                        f"z = {z:.9g} m needs {geo.names[ip]} = {qp:.9g} m, outside its stroke "
-                        f"[{lo[ip]:.9g}, {hi[ip]:.9g}] m")  # fmt: skip
-    qp = min(max(qp, lo[ip]), hi[ip])
+    qp = (z - z0) / s_p
+    if not lt_p <= qp <= ht_p:
+        return _result(pose, (), IKStatus.J3_STROKE,
+                       f"z = {z:.9g} m needs {geo.names[ip]} = {qp:.9g} m, outside its stroke "
+                       f"[{lo_p:.9g}, {hi_p:.9g}] m")  # fmt: skip
+    m = lo_p if lo_p > qp else qp  # min(max(qp, lo), hi)
+    qp = hi_p if hi_p < m else m
     # wrist point and reach
-    ca, sa = math.cos(alpha), math.sin(alpha)
-    tx, ty = geo.tool
-    wx = x - (ca * tx - sa * ty) - geo.a1[0]
-    wy = y - (sa * tx + ca * ty) - geo.a1[1]
-    r = math.hypot(wx, wy)
-    l1, l2 = geo.l1, geo.l2
-    if r > l1 + l2 + REACH_TOL:
-        return IKResult(pose, (), IKStatus.OUT_OF_REACH,
-                        f"the wrist axis would be {r:.9g} m from the shoulder axis, beyond the reach "
-                        f"l1 + l2 = {l1 + l2:.9g} m")  # fmt: skip
-    r_min, r_max = geo.radius_range()
-    if r < r_min - REACH_TOL:
-        limited = r_min > abs(l1 - l2) + REACH_TOL
-        why = (f"the inner limit r_min = {r_min:.9g} m set by {geo.names[rb]}'s limits "
-               f"[{math.degrees(lo[rb]):.6g}, {math.degrees(hi[rb]):.6g}] deg" if limited
-               else f"|l1 - l2| = {abs(l1 - l2):.9g} m")  # fmt: skip
-        return IKResult(pose, (), IKStatus.INSIDE_INNER_LIMIT,
-                        f"the wrist axis would be {r:.9g} m from the shoulder axis, inside {why}")  # fmt: skip
-    gamma = _elbow(geo, r)
-    singular = gamma < 1e-12 or math.pi - gamma < 1e-12
-    elbows = [(gamma, "right"), (-gamma, "left")] if not singular else [
-        (gamma, "right" if gamma < 1.0 else "left")]  # fmt: skip
-    solutions: list[IKSolution] = []
-    failures: list[tuple[IKStatus, str]] = []
+    if tool_on_axis and x and y:  # x - (+/-0.0) = x exactly unless x is a zero (whose sign would change)
+        wx = x - a1x
+        wy = y - a1y
+    else:
+        ca, sa = _cos(alpha), _sin(alpha)
+        wx = x - (ca * tx - sa * ty) - a1x
+        wy = y - (sa * tx + ca * ty) - a1y
+    r = _hypot(wx, wy)
+    if r > reach:
+        return _result(pose, (), IKStatus.OUT_OF_REACH,
+                       f"the wrist axis would be {r:.9g} m from the shoulder axis, beyond the reach "
+                       f"l1 + l2 = {l1 + l2:.9g} m")  # fmt: skip
+    if r < inner_min:
+        return _inside_inner_limit(geo, pose, r, geo.radius_range()[0])
+    if inner_min != inner_min:  # NaN: radius_range() fails (infinite limits); let it raise here, as it did
+        r_min = geo.radius_range()[0]
+        if r < r_min - REACH_TOL:
+            return _inside_inner_limit(geo, pose, r, r_min)
+    # elbow angle gamma in [0, pi], by the half-angle form (see the module docstring)
+    outer = l12 - r
+    if 0.0 > outer:
+        outer = 0.0
+    outer *= l12 + r
+    inner = r - d12
+    if 0.0 > inner:
+        inner = 0.0
+    inner *= r + d12
+    gamma = 2.0 * _atan2(_sqrt(outer), _sqrt(inner))
+    singular = gamma < 1e-12 or _PI - gamma < 1e-12
     phi_ref = None
     if reference is not None:
-        phi_ref = s[ra] * float(reference[ra])
-    for g, label in elbows:
+        phi_ref = s_a * float(reference[ra])
+    if r > 0.0:
+        # atan2(wy, wx) - atan2(l2 sin g, l1 + l2 cos g) for g = +gamma and g = -gamma (atan2 and sin are
+        # odd: the second term changes sign)
+        heading = _atan2(wy, wx)
+        lean = _atan2(l2 * _sin(gamma), l1 + l2 * _cos(gamma))
+    else:  # l1 = l2 and the wrist on the shoulder axis: the shoulder is free
+        heading = (phi_ref if phi_ref is not None else 0.0) + beta1
+        lean = 0.0
+    if singular:
+        elbows: tuple[tuple[float, float, str], ...] = ((gamma, heading - lean, "right" if gamma < 1.0 else "left"),)
+    else:
+        elbows = ((gamma, heading - lean, "right"), (-gamma, heading + lean, "left"))
+    solutions: list[IKSolution] = []
+    failures: list[tuple[IKStatus, str]] = []
+    for g, theta1, label in elbows:
         if not (branch == "all" or label == branch or singular):
             continue
-        if r > 0.0:
-            theta1 = math.atan2(wy, wx) - math.atan2(l2 * math.sin(g), l1 + l2 * math.cos(g))
-        else:  # l1 = l2 and the wrist on the shoulder axis: the shoulder is free
-            theta1 = (phi_ref if phi_ref is not None else 0.0) + geo.beta1
-        phi1 = theta1 - geo.beta1
-        phi2 = g + geo.beta1 - geo.beta2
-        phi4 = alpha - phi1 - phi2
-        q_a = _turns(s[ra] * phi1, lo[ra], hi[ra])
-        q_b = _turns(s[rb] * phi2, lo[rb], hi[rb])
-        q_c = _turns(s[rc] * phi4, lo[rc], hi[rc])
+        phi1 = theta1 - beta1
+        phi2 = g + beta1 - beta2
+        # every 2 pi-equivalent inside the limits (as _turns), shoulder and elbow
+        va = s_a * phi1
+        v = va + _ceil((lt_a - va) / _TWO_PI) * _TWO_PI
+        if one_a:
+            if v <= ht_a:
+                m = lo_a if lo_a > v else v
+                q_a: Sequence[float] = (hi_a if hi_a < m else m,)
+            else:
+                q_a = ()
+        else:
+            q_a = []
+            while v <= ht_a:
+                m = lo_a if lo_a > v else v
+                q_a.append(hi_a if hi_a < m else m)
+                v += _TWO_PI
+        vb = s_b * phi2
+        v = vb + _ceil((lt_b - vb) / _TWO_PI) * _TWO_PI
+        if one_b:
+            if v <= ht_b:
+                m = lo_b if lo_b > v else v
+                q_b: Sequence[float] = (hi_b if hi_b < m else m,)
+            else:
+                q_b = ()
+        else:
+            q_b = []
+            while v <= ht_b:
+                m = lo_b if lo_b > v else v
+                q_b.append(hi_b if hi_b < m else m)
+                v += _TWO_PI
         if not q_b:
-            failures.append((IKStatus.J2_LIMIT, f"{label}: {geo.names[rb]} = {_wrap(s[rb] * phi2):.9g} rad (+2 pi k) "
-                             f"outside [{lo[rb]:.9g}, {hi[rb]:.9g}]"))  # fmt: skip
+            failures.append((IKStatus.J2_LIMIT, f"{label}: {geo.names[rb]} = {_wrap(vb):.9g} rad (+2 pi k) "
+                             f"outside [{lo_b:.9g}, {hi_b:.9g}]"))  # fmt: skip
             continue
         if not q_a:
-            failures.append((IKStatus.J1_LIMIT, f"{label}: {geo.names[ra]} = {_wrap(s[ra] * phi1):.9g} rad (+2 pi k) "
-                             f"outside [{lo[ra]:.9g}, {hi[ra]:.9g}]"))  # fmt: skip
+            failures.append((IKStatus.J1_LIMIT, f"{label}: {geo.names[ra]} = {_wrap(va):.9g} rad (+2 pi k) "
+                             f"outside [{lo_a:.9g}, {hi_a:.9g}]"))  # fmt: skip
             continue
-        if not q_c:
-            failures.append((IKStatus.J4_LIMIT, f"{label}: {geo.names[rc]} = {_wrap(s[rc] * phi4):.9g} rad (+2 pi k) "
-                             f"outside [{lo[rc]:.9g}, {hi[rc]:.9g}]"))  # fmt: skip
-            continue
-        for va in q_a:
-            for vb in q_b:
+        if not wrist_any_turn:
+            phi4 = alpha - phi1 - phi2
+            if not _turns(s_c * phi4, lo_c, hi_c):
+                failures.append((IKStatus.J4_LIMIT, f"{label}: {geo.names[rc]} = {_wrap(s_c * phi4):.9g} rad "
+                                 f"(+2 pi k) outside [{lo_c:.9g}, {hi_c:.9g}]"))  # fmt: skip
+                continue
+        for qa in q_a:
+            for qb in q_b:
                 # the wrist takes up whatever turns the shoulder and elbow add, to keep alpha
-                for vc in _turns(s[rc] * (alpha - s[ra] * va - s[rb] * vb), lo[rc], hi[rc]):
-                    q = np.empty(4)
-                    q[ra], q[rb], q[rc], q[ip] = va, vb, vc, qp
-                    solutions.append(IKSolution(q, label, singular))
+                vc = s_c * (alpha - s_a * qa - s_b * qb)
+                v = vc + _ceil((lt_c - vc) / _TWO_PI) * _TWO_PI
+                while v <= ht_c:
+                    m = lo_c if lo_c > v else v
+                    qc = hi_c if hi_c < m else m
+                    v += _TWO_PI
+                    if layout:
+                        q = _array((qa, qb, qp, qc))
+                    else:
+                        q = np.empty(4)
+                        q[ra], q[rb], q[rc], q[ip] = qa, qb, qc, qp
+                    # IKSolution(q, label, singular) without the frozen dataclass' __init__ (3 x
+                    # object.__setattr__): the same object, built in half the time
+                    sol = _new(IKSolution)
+                    d = sol.__dict__
+                    d["q"] = q
+                    d["branch"] = label
+                    d["singular"] = singular
+                    solutions.append(sol)
     if solutions:
-        return IKResult(pose, tuple(solutions), IKStatus.OK, f"{len(solutions)} solution(s)")
+        return _result(pose, tuple(solutions), _OK, f"{len(solutions)} solution(s)")
     if not failures:  # the requested branch was not tried: cannot happen for 'all'
-        return IKResult(pose, (), IKStatus.J2_LIMIT, f"no {branch} solution")
+        return _result(pose, (), IKStatus.J2_LIMIT, f"no {branch} solution")
     order = (IKStatus.J2_LIMIT, IKStatus.J1_LIMIT, IKStatus.J4_LIMIT)  # the later the stage, the closer
     status = max((f[0] for f in failures), key=order.index)
-    return IKResult(pose, (), status, "no solution inside the joint limits: " + "; ".join(f[1] for f in failures))
+    return _result(pose, (), status, "no solution inside the joint limits: " + "; ".join(f[1] for f in failures))
+
+
+def _result(target: np.ndarray, solutions: tuple[IKSolution, ...], status: IKStatus, message: str) -> IKResult:
+    """IKResult(target, solutions, status, message), without the frozen dataclass' __init__."""
+    res = _new(IKResult)
+    d = res.__dict__
+    d["target"] = target
+    d["solutions"] = solutions
+    d["status"] = status
+    d["message"] = message
+    return res
+
+
+def _inside_inner_limit(geo: ScaraGeometry, pose: np.ndarray, r: float, r_min: float) -> IKResult:
+    l1, l2 = geo.l1, geo.l2
+    rb = geo.revolute[1]
+    lo, hi = geo.lower, geo.upper
+    limited = r_min > abs(l1 - l2) + REACH_TOL
+    why = (f"the inner limit r_min = {r_min:.9g} m set by {geo.names[rb]}'s limits "
+           f"[{math.degrees(lo[rb]):.6g}, {math.degrees(hi[rb]):.6g}] deg" if limited
+           else f"|l1 - l2| = {abs(l1 - l2):.9g} m")  # fmt: skip
+    return _result(pose, (), IKStatus.INSIDE_INNER_LIMIT,
+                   f"the wrist axis would be {r:.9g} m from the shoulder axis, inside {why}")  # fmt: skip
 
 
 def _target(geo: ScaraGeometry, target: object) -> tuple[float, float, float, float, float]:
@@ -468,6 +607,27 @@ def _target(geo: ScaraGeometry, target: object) -> tuple[float, float, float, fl
     E = R @ geo.R0.T  # a pure yaw of the tool's zero-pose rotation: E = Rz(alpha)
     tilt = math.atan2(math.hypot(E[0, 2], E[1, 2]), E[2, 2])
     return float(M[0, 3]), float(M[1, 3]), float(M[2, 3]), math.atan2(E[1, 0], E[0, 0]), tilt
+
+
+_BATCH_ROWS = 16384
+"""Rows per block of :func:`solve_batch`: its work arrays stay in the cache, and the Python cost of the
+(about 100) array operations per block is spread over enough rows."""
+
+# Per row, the failures of a branch as the bits of a small code, in the order of precedence of `solve`'s
+# checks (a higher bit wins): 0 J4, 1 J1, 2 J2, 3 inside the inner limit, 4 out of reach, 5 J3 stroke.
+_BIT_STATUS = (IKStatus.J4_LIMIT, IKStatus.J1_LIMIT, IKStatus.J2_LIMIT, IKStatus.INSIDE_INNER_LIMIT,
+               IKStatus.OUT_OF_REACH, IKStatus.J3_STROKE)  # fmt: skip
+_CODE_STATUS = np.array([0] + [int(_BIT_STATUS[c.bit_length() - 1]) for c in range(1, 64)], dtype=np.int64)
+"""Status of a failure code (the highest bit set)."""
+_CODE_NAN = np.where(np.arange(64) == 0, 1.0, np.nan)
+"""1 where a code is a solution, NaN where it is not (a factor that turns q into NaN rows)."""
+_CODE_INF = np.where(np.arange(64) == 0, 0.0, np.inf)
+"""0 where a code is a solution, +inf where it is not (added to a distance)."""
+_STAGE = np.zeros(len(IKStatus), dtype=np.int64)
+_STAGE[[IKStatus.OK, IKStatus.J2_LIMIT, IKStatus.J1_LIMIT, IKStatus.J4_LIMIT]] = [9, 1, 2, 3]
+_CODE_STAGE = _STAGE[_CODE_STATUS]
+"""How far `solve` gets with a code: OK, then J4 after J1 after J2 (other failures: 0)."""
+_INV_TWO_PI = 1.0 / _TWO_PI
 
 
 def solve_batch(
@@ -500,67 +660,310 @@ def solve_batch(
     lo = np.asarray(geo.lower)
     hi = np.asarray(geo.upper)
     ref = (lo + hi) / 2 if reference is None else np.broadcast_to(np.asarray(reference, dtype=float), T.shape)
-    if branch == "nearest":
-        right = _batch_branch(geo, T, 1.0, ref, lo, hi)
-        left = _batch_branch(geo, T, -1.0, ref, lo, hi)
-        dr = np.where(right.status == 0, ((right.q - ref) ** 2).sum(axis=1), np.inf)
-        dl = np.where(left.status == 0, ((left.q - ref) ** 2).sum(axis=1), np.inf)
-        use_left = (dl < dr)[:, None]
-        # neither branch solves: report the one that got further (J4 after J1 after J2, as `solve` does)
-        stage = np.zeros(len(IKStatus), dtype=np.int64)
-        stage[[IKStatus.OK, IKStatus.J2_LIMIT, IKStatus.J1_LIMIT, IKStatus.J4_LIMIT]] = [9, 1, 2, 3]
-        status = np.where(stage[left.status] > stage[right.status], left.status, right.status)
-        return BatchIKResult(np.where(use_left, left.q, right.q), status,
-                             np.where(status == 0, np.where(use_left[:, 0], left.branch, right.branch), 0))  # fmt: skip
-    return _batch_branch(geo, T, 1.0 if branch == "right" else -1.0, ref, lo, hi)
-
-
-def _batch_turn(value: np.ndarray, lo: float, hi: float, ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per element, value + 2 pi k inside [lo, hi] nearest to ref; and whether one exists."""
-    k_min = np.ceil((lo - LIMIT_TOL - value) / _TWO_PI)
-    k_max = np.floor((hi + LIMIT_TOL - value) / _TWO_PI)
-    k = np.clip(np.round((ref - value) / _TWO_PI), k_min, k_max)
-    return np.clip(value + k * _TWO_PI, lo, hi), k_min <= k_max
-
-
-def _batch_branch(
-    geo: ScaraGeometry, T: np.ndarray, sign: float, ref: np.ndarray, lo: np.ndarray, hi: np.ndarray
-) -> BatchIKResult:
-    ra, rb, rc = geo.revolute
-    ip = geo.prismatic
-    s = geo.signs
-    l1, l2 = geo.l1, geo.l2
     n = T.shape[0]
-    status = np.zeros(n, dtype=np.int64)
-    alpha = T[:, 3] - geo.yaw0
+    q = np.empty((n, 4))
+    status = np.empty(n, dtype=np.int64)
+    sign = np.empty(n, dtype=np.int64)
+    if n == 0:
+        return BatchIKResult(q, status, sign)
+    # one reference for every row (the default, a (4,) reference or a broadcast one): four numbers
+    row_refs = ref.ndim == 2 and ref.strides[0] != 0
+    const_ref = None if row_refs else [float(v) for v in (ref if ref.ndim == 1 else ref[0])]
+    work = _BatchWork(geo, min(n, _BATCH_ROWS), branch, const_ref)
+    for start in range(0, n, _BATCH_ROWS):
+        stop = min(start + _BATCH_ROWS, n)
+        refs = const_ref if const_ref is not None else list(ref[start:stop].T)
+        work.block(T[start:stop], refs, q[start:stop], status[start:stop], sign[start:stop])
+    return BatchIKResult(q, status, sign)
+
+
+class _BatchWork:
+    """The closed form of :func:`solve` for arrays, one block of rows at a time, for one call.
+
+    Every operation writes into a preallocated array (``out=``) of the block's length: nothing is
+    allocated per block and the data stays in the cache. Changes of formulation, all exact identities:
+
+    - the reach: o = l12^2 - r^2 and i = r^2 - d12^2 (l12 = l1 + l2, d12 = |l1 - l2|) from r^2, without
+      the square root, except on the rows near the stretched or folded arm (o or i below 1e-6 l1 l2,
+      gamma or pi - gamma below about 1e-3) where `solve`'s (l12 - r)(l12 + r) of r = hypot(wx, wy) is
+      used, so that the ill-conditioned elbow angle there is computed from the same numbers;
+    - the elbow: tan(gamma / 2) = sqrt(o / i), so tan gamma = 2 sqrt(o i) / (i - o), ONE atan2; and
+      (l1 + l2 cos gamma, l2 sin gamma) is, up to the positive factor (i + o), (a, b) with
+      a = l12 i + (l1 - l2) o and b = 2 l2 sqrt(o i): no cos/sin of gamma;
+    - the shoulder: atan2(wy, wx) - atan2(b, a) is the argument of (wx + j wy)(a - j b), ONE atan2:
+      theta1 = atan2(wy a - wx b, wx a + wy b) (mod 2 pi, which the choice of turn absorbs), except
+      where the wrist is within 1e-3 l2 of the shoulder axis (only possible when l1 ~ l2; theta1 is free
+      at r = 0), where the two-atan2 form of `solve` gives the value, as there;
+    - the turn nearest to the reference: with one reference for all rows, when every turn inside the
+      limits is within pi of it, that turn is the nearest one (k = round((ref - v) / 2 pi)) and there
+      is no clipping of k to do (see ``_turn``);
+    - the statuses: the failures of a row as the bits of a small code, read through lookup tables.
+    """
+
+    def __init__(self, geo: ScaraGeometry, rows: int, branch: str, const_ref: list[float] | None) -> None:
+        self.geo = geo
+        self.rows = rows
+        self.branch = branch
+        ra, rb, rc = geo.revolute
+        ip = geo.prismatic
+        l1, l2 = geo.l1, geo.l2
+        self.r_min = geo.radius_range()[0]
+        # reach (squared), and the rows that take the exact route (see the class docstring)
+        self.reach2 = (l1 + l2 + REACH_TOL) ** 2
+        self.inner2 = (self.r_min - REACH_TOL) ** 2 if self.r_min - REACH_TOL > 0.0 else -1.0
+        self.l12_2 = (l1 + l2) ** 2
+        self.d12_2 = (l1 - l2) ** 2
+        self.delicate = 1e-6 * l1 * l2
+        self.axis_rows = abs(l1 - l2) < 1e-3 * l2  # the wrist can come near the shoulder axis
+        both = branch == "nearest"
+        self._f = np.empty((28 if both else 22, rows))
+        self._u = np.empty((12, rows), dtype=np.uint8)
+        self._p = np.empty((4, rows), dtype=np.intp)
+        self._q = np.empty((2 if both else 1, 4, rows))
+        self._zeros = np.zeros(rows)
+        self._views = self._make_views(rows)
+        lo, hi = geo.lower, geo.upper
+        s = geo.signs
+        self.sa, self.sb, self.sc, self.sp = s[ra], s[rb], s[rc], s[ip]
+        # per revolute joint: (index, limits, widened limits, mode of the turn choice; see _turn)
+        self.joints = []
+        for j in (ra, rb, rc):
+            mode = "clip"
+            if const_ref is not None:
+                ref, margin = const_ref[j], 1e-9
+                if lo[j] + margin <= ref - math.pi and ref + math.pi <= hi[j] - margin:
+                    mode = "inside"  # the turn nearest to ref is always inside the limits
+                elif lo[j] <= ref <= hi[j] and max(ref - lo[j], hi[j] - ref) + LIMIT_TOL < math.pi - margin:
+                    mode = "unique"  # no other turn than the nearest can be inside the limits
+            self.joints.append((j, lo[j], hi[j], lo[j] - LIMIT_TOL, hi[j] + LIMIT_TOL, mode))
+
+    def _make_views(self, m: int) -> tuple[Any, ...]:
+        return (list(self._f[:, :m]), list(self._u[:, :m]), list(self._p[:, :m]),
+                [a[:, :m] for a in self._q], self._zeros[:m])  # fmt: skip
+
+    def block(self, T: np.ndarray, refs: list[Any], q_out: np.ndarray, st_out: np.ndarray, sg_out: np.ndarray) -> None:
+        """Solve the rows T (at most ``rows``) into q_out, st_out and sg_out."""
+        geo = self.geo
+        m = T.shape[0]
+        f, u, p, qs, zeros = self._views if m == self.rows else self._make_views(m)
+        x, y, z, yaw = T[:, 0], T[:, 1], T[:, 2], T[:, 3]
+        l1, l2 = geo.l1, geo.l2
+        ip = geo.prismatic
+        t = f[5]
+        # ------------------------------------------------------------------ shared by both branches
+        alpha = yaw if geo.yaw0 == 0.0 else np.subtract(yaw, geo.yaw0, out=f[0])
+        tx, ty = geo.tool
+        a1x, a1y = geo.a1
+        if tx == 0.0 and ty == 0.0:
+            wx = x if a1x == 0.0 else np.subtract(x, a1x, out=f[1])
+            wy = y if a1y == 0.0 else np.subtract(y, a1y, out=f[2])
+        else:
+            ca = np.cos(alpha, out=f[3])
+            sa = np.sin(alpha, out=f[4])
+            wx = np.multiply(ca, tx, out=f[1])  # x - (ca tx - sa ty) - a1x
+            np.subtract(wx, np.multiply(sa, ty, out=t), out=wx)
+            np.subtract(x, wx, out=wx)
+            if a1x != 0.0:
+                np.subtract(wx, a1x, out=wx)
+            wy = np.multiply(sa, tx, out=f[2])  # y - (sa tx + ca ty) - a1y
+            np.add(wy, np.multiply(ca, ty, out=t), out=wy)
+            np.subtract(y, wy, out=wy)
+            if a1y != 0.0:
+                np.subtract(wy, a1y, out=wy)
+        r2 = np.multiply(wx, wx, out=f[6])
+        np.add(r2, np.multiply(wy, wy, out=t), out=r2)
+        o = np.subtract(self.l12_2, r2, out=f[7])
+        np.maximum(o, zeros, out=o)
+        i = np.subtract(r2, self.d12_2, out=f[8])
+        np.maximum(i, zeros, out=i)
+        # vertical joint (into the q rows of the branches)
+        Q0 = qs[0]
+        qp = np.subtract(z, geo.z0, out=Q0[ip])
+        if self.sp < 0:
+            np.negative(qp, out=qp)
+        # the shared failure bits, built Horner-fashion (2 c + bit): J3 stroke, out of reach, inside
+        code0, bit = u[0], u[1]
+        np.less(qp, geo.lower[ip] - LIMIT_TOL, out=code0.view(bool))
+        np.bitwise_or(code0, np.greater(qp, geo.upper[ip] + LIMIT_TOL, out=bit.view(bool)), out=code0)
+        np.add(code0, code0, out=code0)
+        np.bitwise_or(code0, np.greater(r2, self.reach2, out=bit.view(bool)), out=code0)
+        np.add(code0, code0, out=code0)
+        np.bitwise_or(code0, np.less(r2, self.inner2, out=bit.view(bool)), out=code0)
+        np.clip(qp, geo.lower[ip], geo.upper[ip], out=qp)
+        # rows near the stretched or folded arm: r, o, i (and their bits) as `solve` computes them
+        near = np.less(o, self.delicate, out=u[2].view(bool))
+        np.bitwise_or(near, np.less(i, self.delicate, out=bit.view(bool)), out=near)
+        axis = None
+        if near.any():
+            rows = np.flatnonzero(near)
+            r = np.hypot(wx[rows], wy[rows])
+            l12, d12 = l1 + l2, abs(l1 - l2)
+            o[rows] = np.maximum(l12 - r, 0.0) * (l12 + r)
+            i[rows] = np.maximum(r - d12, 0.0) * (r + d12)
+            code0[rows] = (code0[rows] & 4) | (r > l12 + REACH_TOL) << 1 | (r < self.r_min - REACH_TOL)
+            if self.axis_rows:
+                close = r < 1e-3 * l2
+                if close.any():
+                    axis = rows[close]
+        # elbow and the shoulder's products
+        root = np.multiply(o, i, out=f[10])  # 2 sqrt(o i)
+        np.multiply(root, 4.0, out=root)
+        np.sqrt(root, out=root)
+        gamma = np.arctan2(root, np.subtract(i, o, out=t), out=f[11])  # in [0, pi]
+        a = np.multiply(i, l1 + l2, out=f[12])
+        if l1 != l2:
+            np.add(a, np.multiply(o, l1 - l2, out=t), out=a)
+        bb = np.multiply(root, l2, out=f[13])
+        prods = (np.multiply(wy, a, out=f[14]), np.multiply(wx, bb, out=f[15]),
+                 np.multiply(wx, a, out=f[16]), np.multiply(wy, bb, out=f[17]))  # fmt: skip
+        shared = (alpha, prods, gamma, axis, code0)
+        if self.branch != "nearest":
+            sgn = 1 if self.branch == "right" else -1
+            code = self._branch(sgn, shared, refs, T, f[18:22], u[3:7], Q0, p[0])
+            np.take(_CODE_STATUS, code, out=st_out)
+            np.multiply(np.equal(code, 0, out=bit.view(bool)), sgn, out=sg_out)
+            np.multiply(Q0, np.take(_CODE_NAN, code, out=t), out=q_out.T)
+        else:
+            Qr, Ql = qs
+            np.copyto(Ql[ip], Qr[ip])
+            code_r = self._branch(1, shared, refs, T, f[18:22], u[3:7], Qr, p[0])
+            code_l = self._branch(-1, shared, refs, T, f[22:26], u[7:11], Ql, p[1])
+            # per row the solution nearest to the reference (squared distance; +inf without a solution)
+            dr, dl = f[26], f[27]
+            for dist, Qb, code in ((dr, Qr, code_r), (dl, Ql, code_l)):
+                np.take(_CODE_INF, code, out=dist)
+                for j in range(4):
+                    d = np.subtract(Qb[j], refs[j], out=t)
+                    np.add(dist, np.multiply(d, d, out=d), out=dist)
+            use_left = np.less(dl, dr, out=u[11].view(bool))
+            np.copyto(Qr, Ql, where=use_left)
+            # neither branch solves: report the one that got further (J4 after J1 after J2, as `solve` does)
+            further = np.greater(np.take(_CODE_STAGE, code_l, out=p[2]), np.take(_CODE_STAGE, code_r, out=p[3]),
+                                 out=bit.view(bool))  # fmt: skip
+            np.copyto(code_r, code_l, where=further)
+            np.take(_CODE_STATUS, code_r, out=st_out)
+            # branch: -1 where the left one is used, +1 for the right one, 0 without a solution
+            np.multiply(use_left, -2, out=sg_out)
+            np.add(sg_out, 1, out=sg_out)
+            np.multiply(sg_out, np.equal(code_r, 0, out=bit.view(bool)), out=sg_out)
+            np.multiply(Qr, np.take(_CODE_NAN, code_r, out=t), out=q_out.T)
+        # rows with a NaN or an infinity (rare): OUT_OF_REACH, NaN; found through the sum of the block
+        if not _isfinite(float(np.add.reduce(T, axis=None))):
+            bad = ~np.isfinite(T).all(axis=1)
+            st_out[bad] = IKStatus.OUT_OF_REACH
+            sg_out[bad] = 0
+            q_out[bad] = np.nan
+
+    def _branch(self, sgn: int, shared: tuple[Any, ...], refs: list[Any], T: np.ndarray, f: list[np.ndarray],
+                u: list[np.ndarray], Q: np.ndarray, code: np.ndarray) -> np.ndarray:  # fmt: skip
+        """One elbow branch: its joint values into Q (4, m), its failure code per row into ``code``.
+
+        The joint values are the 2 pi-equivalents nearest to the reference; the code is described at
+        ``_CODE_STATUS``.
+        """
+        geo = self.geo
+        alpha, (wya, wxb, wxa, wyb), gamma, axis, code0 = shared
+        ja, jb, jc = self.joints
+        t1, t2 = f[0], f[1]
+        # shoulder: theta1 = atan2(wy a -+ wx b, wx a +- wy b); phi1 = theta1 - beta1
+        if sgn > 0:
+            np.subtract(wya, wxb, out=t1)
+            np.add(wxa, wyb, out=t2)
+        else:
+            np.add(wya, wxb, out=t1)
+            np.subtract(wxa, wyb, out=t2)
+        va = np.arctan2(t1, t2, out=f[2])
+        if axis is not None:
+            va[axis] = _two_atan2_shoulder(geo, sgn, T[axis].T, gamma[axis])
+        if geo.beta1 != 0.0:
+            np.subtract(va, geo.beta1, out=va)
+        if self.sa < 0:
+            np.negative(va, out=va)
+        # elbow: phi2 = +-gamma + beta1 - beta2
+        vb = gamma if sgn * self.sb > 0 else np.negative(gamma, out=f[3])
+        if geo.beta1 != geo.beta2:
+            vb = np.add(vb, self.sb * (geo.beta1 - geo.beta2), out=f[3])
+        bad_a, bad_b, bad_c, scratch = (v.view(bool) for v in u)
+        shoulder_fails = _turn(va, ja, refs, Q, bad_a, scratch, t1, t2)
+        elbow_fails = _turn(vb, jb, refs, Q, bad_b, scratch, t1, t2)
+        # wrist: s_c (alpha - s_a q_a - s_b q_b)
+        vc = f[3]
+        (np.subtract if self.sa > 0 else np.add)(alpha, Q[ja[0]], out=vc)
+        (np.subtract if self.sb > 0 else np.add)(vc, Q[jb[0]], out=vc)
+        if self.sc < 0:
+            np.negative(vc, out=vc)
+        wrist_fails = _turn(vc, jc, refs, Q, bad_c, scratch, t1, t2)
+        # the code, Horner-fashion: ((2 code0 + J2) 2 + J1) 2 + J4
+        c8 = u[3]
+        np.add(code0, code0, out=c8)
+        if elbow_fails:
+            np.bitwise_or(c8, u[1], out=c8)
+        np.add(c8, c8, out=c8)
+        if shoulder_fails:
+            np.bitwise_or(c8, u[0], out=c8)
+        np.add(c8, c8, out=c8)
+        if wrist_fails:
+            np.bitwise_or(c8, u[2], out=c8)
+        np.copyto(code, c8)
+        return code
+
+
+def _turn(value: np.ndarray, joint: tuple[Any, ...], refs: list[Any], Q: np.ndarray, bad: np.ndarray,
+          scratch: np.ndarray, k_min: np.ndarray, k_max: np.ndarray) -> bool:  # fmt: skip
+    """Per element, value + 2 pi k inside [lo, hi] nearest to the reference, into Q[j]; ``bad`` where none.
+
+    Returns whether ``bad`` was written (a turn always exists in mode "inside").
+
+    Mode "clip" (the general case): k = clip(round((ref - value) / 2 pi), k_min, k_max) with k_min, k_max
+    the first and last turn inside the limits widened by LIMIT_TOL, then the result clipped onto the
+    limits. With one reference for all rows, when every turn inside the widened limits lies within pi
+    of it (mode "unique"), that turn is the nearest one: k = round((ref - value) / 2 pi) needs no clipping,
+    and there is none exactly when that turn is outside the widened limits; when moreover the nearest turn
+    is always inside (mode "inside": [ref - pi, ref + pi] within the limits), there is nothing to check.
+    """
+    j, lo, hi, lo_tol, hi_tol, mode = joint
+    ref = refs[j]
+    out = Q[j]
+    if mode == "clip":
+        np.subtract(lo_tol, value, out=k_min)
+        np.divide(k_min, _TWO_PI, out=k_min)
+        np.ceil(k_min, out=k_min)
+        np.subtract(hi_tol, value, out=k_max)
+        np.divide(k_max, _TWO_PI, out=k_max)
+        np.floor(k_max, out=k_max)
+        np.greater(k_min, k_max, out=bad)
+        np.subtract(ref, value, out=out)
+        np.divide(out, _TWO_PI, out=out)
+        np.rint(out, out=out)
+        np.maximum(out, k_min, out=out)
+        np.minimum(out, k_max, out=out)
+        np.multiply(out, _TWO_PI, out=out)
+        np.add(value, out, out=out)
+        np.clip(out, lo, hi, out=out)
+        return True
+    np.subtract(ref, value, out=out)
+    np.multiply(out, _INV_TWO_PI, out=out)
+    np.rint(out, out=out)
+    np.multiply(out, _TWO_PI, out=out)
+    np.add(value, out, out=out)
+    if mode == "inside":
+        return False
+    np.less(out, lo_tol, out=bad)
+    np.bitwise_or(bad, np.greater(out, hi_tol, out=scratch), out=bad)
+    np.clip(out, lo, hi, out=out)
+    return True
+
+
+def _two_atan2_shoulder(geo: ScaraGeometry, sgn: float, X: np.ndarray, gamma: np.ndarray) -> np.ndarray:
+    """Shoulder angles of a few rows X (x, y, z, yaw), computed as `solve` does.
+
+    theta1 = atan2(wy, wx) - atan2(l2 sin g, l1 + l2 cos g), with the wrist point and its signed zeros as
+    in `solve` (atan2(+-0, +-0) picks the shoulder angle at r = 0).
+    """
+    alpha = X[3] - geo.yaw0
     ca, sa = np.cos(alpha), np.sin(alpha)
     tx, ty = geo.tool
-    wx = T[:, 0] - (ca * tx - sa * ty) - geo.a1[0]
-    wy = T[:, 1] - (sa * tx + ca * ty) - geo.a1[1]
-    r = np.hypot(wx, wy)
-    outer = np.maximum(l1 + l2 - r, 0.0) * (l1 + l2 + r)
-    inner = np.maximum(r - abs(l1 - l2), 0.0) * (r + abs(l1 - l2))
-    gamma = sign * 2.0 * np.arctan2(np.sqrt(outer), np.sqrt(inner))
-    theta1 = np.arctan2(wy, wx) - np.arctan2(l2 * np.sin(gamma), l1 + l2 * np.cos(gamma))
-    phi1 = theta1 - geo.beta1
-    phi2 = gamma + (geo.beta1 - geo.beta2)
-    q = np.empty((n, 4))
-    qa, ok_a = _batch_turn(s[ra] * phi1, lo[ra], hi[ra], ref[..., ra])
-    qb, ok_b = _batch_turn(s[rb] * phi2, lo[rb], hi[rb], ref[..., rb])
-    qc, ok_c = _batch_turn(s[rc] * (alpha - s[ra] * qa - s[rb] * qb), lo[rc], hi[rc], ref[..., rc])
-    qp = (T[:, 2] - geo.z0) / s[ip]
-    ok_p = (qp >= lo[ip] - LIMIT_TOL) & (qp <= hi[ip] + LIMIT_TOL)
-    q[:, ra], q[:, rb], q[:, rc], q[:, ip] = qa, qb, qc, np.clip(qp, lo[ip], hi[ip])
-    r_min, _ = geo.radius_range()
-    # the same precedence as the scalar solver (later assignments win)
-    status[~ok_c] = IKStatus.J4_LIMIT
-    status[~ok_a] = IKStatus.J1_LIMIT
-    status[~ok_b] = IKStatus.J2_LIMIT
-    status[r < r_min - REACH_TOL] = IKStatus.INSIDE_INNER_LIMIT
-    status[r > l1 + l2 + REACH_TOL] = IKStatus.OUT_OF_REACH
-    status[~ok_p] = IKStatus.J3_STROKE
-    status[~np.isfinite(T).all(axis=1)] = IKStatus.OUT_OF_REACH
-    bad = status != 0
-    q[bad] = np.nan
-    branch = np.where(bad, 0, int(sign))
-    return BatchIKResult(q, status, branch)
+    wx = X[0] - (ca * tx - sa * ty) - geo.a1[0]
+    wy = X[1] - (sa * tx + ca * ty) - geo.a1[1]
+    g = sgn * gamma
+    return np.arctan2(wy, wx) - np.arctan2(geo.l2 * np.sin(g), geo.l1 + geo.l2 * np.cos(g))

@@ -9,6 +9,13 @@ with J the task Jacobian from ``pin.computeFrameJacobian`` (LOCAL_WORLD_ALIGNED,
 frame), lambda adapted Levenberg-Marquardt style, and q projected into the joint limits after every step
 (revolute joints first try the 2 pi-equivalent inside the limits). When a start stalls it restarts from
 the mirrored elbow, then from seeded random configurations inside the limits.
+
+The damping follows Nielsen's rule (Madsen, Nielsen, Tingleff, "Methods for non-linear least squares
+problems", 2004): after an accepted step lambda^2 is scaled by max(1/3, 1 - (2 rho - 1)^3), rho the ratio
+of the actual to the predicted decrease of |e|^2 / 2; after a rejected one it is multiplied by 2, 4, 8, ...
+A start stalls when lambda reaches 1e3, or when it keeps sliding along a joint limit (six accepted steps
+in a row clipped by the projection, which cut the residual by less than half). A converged start is
+polished by undamped Gauss-Newton steps to full precision.
 """
 
 from __future__ import annotations
@@ -17,9 +24,10 @@ import enum
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from .errors import ParameterError
 
@@ -29,6 +37,17 @@ if TYPE_CHECKING:
 __all__ = ["NumericIKOptions", "NumericIKReason", "NumericIKResult", "solve_numeric"]
 
 _TWO_PI = 2.0 * math.pi
+_PI = math.pi
+_atan2, _sqrt = math.atan2, math.sqrt
+_array = np.array
+_fk, _frame = pin.forwardKinematics, pin.updateFramePlacement
+_jac, _LWA = pin.computeFrameJacobian, pin.LOCAL_WORLD_ALIGNED
+_POLISHED = 1e-9
+"""[rad, m] a Gauss-Newton step this small ends the polish: the next one would be ~its square."""
+_STALL_WINDOW = 6
+"""A start that ends its last this-many accepted steps against a joint limit ..."""
+_STALL_RATIO = 0.5
+"""... having cut the residual by less than this factor over them is stalled: it slides along the limit."""
 
 
 class NumericIKReason(enum.Enum):
@@ -88,6 +107,9 @@ class NumericIKResult:
     starts: int
 
 
+_DEFAULTS = NumericIKOptions()
+
+
 def _error(robot: Robot, q: np.ndarray, target: np.ndarray) -> np.ndarray:
     pose = robot.tool_pose(q)
     e = target - pose
@@ -117,27 +139,36 @@ def solve_numeric(
     Args:
         robot: the loaded robot.
         target: (x, y, z, yaw).
-        q0: the first start (default: the middle of the joint ranges).
+        q0: the first start (default: the middle of the joint ranges, the elbow turned off the
+            stretched/folded singularity to half-way to its upper limit).
         options: :class:`NumericIKOptions`.
 
     Returns:
         NumericIKResult with the best q found; ``success`` tells whether it reaches the target.
     """
-    opts = options or NumericIKOptions()
+    opts = options or _DEFAULTS
     tgt = np.asarray(target, dtype=float)
     if tgt.shape != (4,) or not np.isfinite(tgt).all():
         raise ParameterError("target", tgt.tolist(), "must be 4 finite numbers (x, y, z, yaw)")
     lo = np.asarray(robot.limits.lower)
     hi = np.asarray(robot.limits.upper)
-    revolute = np.array([robot.model.joints[j].shortname().startswith("JointModelR") for j in range(1, 5)])
-    elbow = int(np.flatnonzero(revolute)[1]) if revolute.sum() >= 2 else None
+    joints = robot.model.joints
+    revolute = [joints[j].shortname().startswith("JointModelR") for j in range(1, 5)]
+    turning = [i for i in range(4) if revolute[i]]
+    elbow = turning[1] if len(turning) >= 2 else None
     start = (lo + hi) / 2 if q0 is None else robot.check_q(q0)
     if elbow is not None and abs(math.sin(start[elbow])) < 1e-3:
-        # a stretched or folded start has a rank-deficient Jacobian: step off the singularity
+        # a stretched or folded start has a rank-deficient Jacobian: step off the singularity; the
+        # default start goes half-way to the upper limit (a well-conditioned elbow: fewer restarts),
+        # a given one only by 0.1 rad
         start = start.copy()
-        start[elbow] += 0.1 if start[elbow] + 0.1 <= hi[elbow] else -0.1
-    rng = np.random.default_rng(opts.seed)
-    best_q, best_res = _project(start, lo, hi, revolute), math.inf
+        if q0 is None:
+            start[elbow] = (start[elbow] + hi[elbow]) / 2
+        else:
+            start[elbow] += 0.1 if start[elbow] + 0.1 <= hi[elbow] else -0.1
+    task = _Task(robot, tgt, lo, hi, revolute, opts)
+    rng = None  # the random restarts' generator, made when the first one is needed
+    best_q, best_res = task.project(start), math.inf
     total = 0
     starts = 0
     candidates: list[np.ndarray] = [start]
@@ -145,9 +176,11 @@ def solve_numeric(
         if candidates:
             q = candidates.pop(0)
         else:
+            if rng is None:
+                rng = np.random.default_rng(opts.seed)
             q = rng.uniform(lo, hi)
         starts += 1
-        q, res, its = _descend(robot, _project(q, lo, hi, revolute), tgt, lo, hi, revolute, opts)
+        q, res, its = task.descend(task.project(q))
         total += its
         if res < best_res:
             best_q, best_res = q, res
@@ -162,68 +195,229 @@ def solve_numeric(
     return NumericIKResult(best_q, False, total, best_res, NumericIKReason.MAX_ITERATIONS, starts)
 
 
-def _descend(
-    robot: Robot,
-    q: np.ndarray,
-    target: np.ndarray,
-    lo: np.ndarray,
-    hi: np.ndarray,
-    revolute: np.ndarray,
-    opts: NumericIKOptions,
-) -> tuple[np.ndarray, float, int]:
-    """One damped least-squares descent; returns (q, residual, iterations)."""
-    lam = opts.damping
-    e = _error(robot, q, target)
-    res = float(np.linalg.norm(e))
-    eye = np.eye(4)
-    for it in range(1, opts.max_iterations + 1):
-        if res <= opts.tol:
-            return _polish(robot, q, e, res, target, lo, hi, revolute, it - 1)
-        J = robot.task_jacobian(q)
-        JtJ = J.T @ J
-        dq = np.linalg.solve(JtJ + lam * lam * eye, J.T @ e)
-        q_new = _project(q + dq, lo, hi, revolute)
-        e_new = _error(robot, q_new, target)
-        res_new = float(np.linalg.norm(e_new))
-        if res_new < res:
-            q, e, res = q_new, e_new, res_new
-            lam = max(lam / 10.0, 1e-12)
-        else:
-            lam = min(lam * 10.0, 1e3)
-            if lam >= 1e3:  # stalled (a limit or a singularity in the way)
-                return q, res, it
-    return q, res, opts.max_iterations
+class _Task:
+    """One target's damped least squares, on plain floats; Pinocchio only for FK and the Jacobian.
 
-
-def _polish(
-    robot: Robot,
-    q: np.ndarray,
-    e: np.ndarray,
-    res: float,
-    target: np.ndarray,
-    lo: np.ndarray,
-    hi: np.ndarray,
-    revolute: np.ndarray,
-    its: int,
-) -> tuple[np.ndarray, float, int]:
-    """Undamped Gauss-Newton steps while they still reduce the residual (to full precision).
-
-    Near the stretched/folded singularity the joint error is the residual divided by sin(gamma): a
-    residual at the tolerance is not yet a joint solution at full precision.
+    Works on the robot's private model re-rooted at the base frame (its ``oMf`` are placements in
+    ``base``, its LOCAL_WORLD_ALIGNED Jacobians are in base axes), with the tool frame id: no input
+    re-validation per iteration (q stays a float64 4-vector inside the limits), no 4 x 4 numpy algebra
+    (the normal equations are formed and solved by hand), and the Jacobian and J^T J, J^T e are reused
+    while a rejected step leaves q unchanged.
     """
-    for _ in range(4):
-        if res == 0.0:
-            break
-        J = robot.task_jacobian(q)
-        try:
-            dq = np.linalg.solve(J, e)
-        except np.linalg.LinAlgError:
-            break
-        q_new = _project(q + dq, lo, hi, revolute)
-        e_new = _error(robot, q_new, target)
-        res_new = float(np.linalg.norm(e_new))
-        its += 1
-        if not res_new < res:
-            break
-        q, e, res = q_new, e_new, res_new
-    return q, res, its
+
+    def __init__(self, robot: Robot, target: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: list[bool],
+                 opts: NumericIKOptions) -> None:  # fmt: skip
+        self.robot = robot
+        self.model = getattr(robot, "_base_model", None)
+        self.data = getattr(robot, "_base_data", None)
+        self.tool = robot.tool_id
+        self.x, self.y, self.z, self.yaw = target.tolist()
+        self.target = target
+        lo_, hi_ = lo.tolist(), hi.tolist()
+        self.joints = list(zip(range(4), lo_, hi_, revolute, strict=True))
+        self.box = (lo_[0], hi_[0], lo_[1], hi_[1], lo_[2], hi_[2], lo_[3], hi_[3])
+        self.opts = opts
+
+    # ------------------------------------------------------------------ kinematics
+    def error(self, q: np.ndarray) -> tuple[list[float], float]:
+        """Return e = target - (x, y, z, yaw) at q (yaw wrapped to [-pi, pi)) and |e|."""
+        model = self.model
+        if model is None:  # a Robot without the re-rooted model: its public methods
+            e = _error(self.robot, q, self.target).tolist()
+            return e, math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3])
+        data = self.data
+        _fk(model, data, q)
+        r0, r1, r2, _ = _frame(model, data, self.tool).homogeneous.tolist()
+        ex, ey, ez = self.x - r0[3], self.y - r1[3], self.z - r2[3]
+        ew = (self.yaw - _atan2(r1[0], r0[0]) + _PI) % _TWO_PI - _PI
+        return [ex, ey, ez, ew], _sqrt(ex * ex + ey * ey + ez * ez + ew * ew)
+
+    def jacobian(self, q: np.ndarray) -> list[list[float]]:
+        """Return the rows (x, y, z, yaw) of the 4 x 4 task Jacobian at q, in base axes."""
+        if self.model is None:
+            return self.robot.task_jacobian(q).tolist()
+        J = _jac(self.model, self.data, q, self.tool, _LWA).tolist()
+        return [J[0], J[1], J[2], J[5]]
+
+    def project(self, q: np.ndarray) -> np.ndarray:
+        """Into the limits: revolute joints by a 2 pi turn when that lands inside, then clipping."""
+        return self.clip(q.tolist())[0]
+
+    def clip(self, v: list[float]) -> tuple[np.ndarray, bool]:
+        """:meth:`project` of plain values; also whether a joint was clipped onto a limit."""
+        lo0, hi0, lo1, hi1, lo2, hi2, lo3, hi3 = self.box
+        a, b, c, d = v
+        if lo0 <= a <= hi0 and lo1 <= b <= hi1 and lo2 <= c <= hi2 and lo3 <= d <= hi3:
+            return _array(v), False
+        clipped = False
+        for i, lo, hi, revolute in self.joints:
+            x = v[i]
+            if x < lo or x > hi:
+                if revolute:
+                    k = math.ceil((lo - x) / _TWO_PI)
+                    if x + k * _TWO_PI <= hi:
+                        x += k * _TWO_PI
+                if x < lo:
+                    x, clipped = lo, True
+                elif x > hi:
+                    x, clipped = hi, True
+                v[i] = x
+        return _array(v), clipped
+
+    # ------------------------------------------------------------------ one start
+    def descend(self, q: np.ndarray) -> tuple[np.ndarray, float, int]:
+        """One damped least-squares descent; returns (q, residual, iterations)."""
+        opts = self.opts
+        tol = opts.tol
+        mu = opts.damping * opts.damping
+        nu = 2.0
+        error, jacobian, clip = self.error, self.jacobian, self.clip
+        e, res = error(q)
+        normal: Any = None  # (J, J^T J, J^T e) at the current q
+        history = [res]  # residuals after the accepted steps
+        limited = 0  # how many of the last accepted steps ended against a joint limit
+        for it in range(1, opts.max_iterations + 1):
+            if res <= tol:
+                return self.polish(q, e, res, it - 1, normal)
+            if normal is None:
+                J = jacobian(q)
+                normal = (J, _gram(J), _transposed_times(J, e))
+            g = normal[2]
+            d0, d1, d2, d3 = _damped_solve(normal[1], mu, g)
+            q0, q1, q2, q3 = q.tolist()
+            q_new, clipped = clip([q0 + d0, q1 + d1, q2 + d2, q3 + d3])
+            e_new, res_new = error(q_new)
+            if res_new < res:
+                # gain ratio: actual / predicted decrease of |e|^2 / 2 (Nielsen's update of mu)
+                pred = 0.5 * (d0 * (mu * d0 + g[0]) + d1 * (mu * d1 + g[1])
+                              + d2 * (mu * d2 + g[2]) + d3 * (mu * d3 + g[3]))  # fmt: skip
+                rho = 0.5 * (res * res - res_new * res_new) / pred if pred > 0.0 else 1.0
+                q, e, res = q_new, e_new, res_new
+                normal = None
+                mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-24)
+                nu = 2.0
+                history.append(res)
+                limited = limited + 1 if clipped else 0
+                if limited >= _STALL_WINDOW and res > _STALL_RATIO * history[-1 - _STALL_WINDOW]:
+                    return q, res, it  # sliding along a limit, slowly: another start does better
+            else:
+                mu = min(mu * nu, 1e6)
+                nu *= 2.0
+                if mu >= 1e6:  # stalled (a limit or a singularity in the way)
+                    return q, res, it
+        return q, res, opts.max_iterations
+
+    def polish(self, q: np.ndarray, e: list[float], res: float, its: int, normal: Any) -> tuple[np.ndarray, float, int]:
+        """Undamped Gauss-Newton steps while they still reduce the residual (to full precision).
+
+        Near the stretched/folded singularity the joint error is the residual divided by sin(gamma): a
+        residual at the tolerance is not yet a joint solution at full precision.
+        """
+        for _ in range(4):
+            if res == 0.0:
+                break
+            J = normal[0] if normal is not None else self.jacobian(q)
+            normal = None
+            dq = _solve4([row[:] for row in J], e)
+            if dq is None:
+                break
+            a, b, c, d = q.tolist()
+            q_new = self.clip([a + dq[0], b + dq[1], c + dq[2], d + dq[3]])[0]
+            e_new, res_new = self.error(q_new)
+            its += 1
+            if not res_new < res:
+                break
+            q, e, res = q_new, e_new, res_new
+            if max(abs(dq[0]), abs(dq[1]), abs(dq[2]), abs(dq[3])) <= _POLISHED:
+                break  # quadratic convergence: the next step would be below rounding
+        return q, res, its
+
+
+def _gram(J: list[list[float]]) -> list[float]:
+    """Return the 10 entries g00, g01, g02, g03, g11, g12, g13, g22, g23, g33 of J^T J (J given by rows)."""
+    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3) = J
+    return [a0 * a0 + b0 * b0 + c0 * c0 + d0 * d0, a0 * a1 + b0 * b1 + c0 * c1 + d0 * d1,
+            a0 * a2 + b0 * b2 + c0 * c2 + d0 * d2, a0 * a3 + b0 * b3 + c0 * c3 + d0 * d3,
+            a1 * a1 + b1 * b1 + c1 * c1 + d1 * d1, a1 * a2 + b1 * b2 + c1 * c2 + d1 * d2,
+            a1 * a3 + b1 * b3 + c1 * c3 + d1 * d3, a2 * a2 + b2 * b2 + c2 * c2 + d2 * d2,
+            a2 * a3 + b2 * b3 + c2 * c3 + d2 * d3, a3 * a3 + b3 * b3 + c3 * c3 + d3 * d3]  # fmt: skip
+
+
+def _transposed_times(J: list[list[float]], e: list[float]) -> list[float]:
+    """J^T e (J given by rows)."""
+    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3) = J
+    e0, e1, e2, e3 = e
+    return [a0 * e0 + b0 * e1 + c0 * e2 + d0 * e3, a1 * e0 + b1 * e1 + c1 * e2 + d1 * e3,
+            a2 * e0 + b2 * e1 + c2 * e2 + d2 * e3, a3 * e0 + b3 * e1 + c3 * e2 + d3 * e3]  # fmt: skip
+
+
+def _damped_solve(G: list[float], l2: float, g: list[float]) -> list[float]:
+    """Solve (J^T J + l2 I) x = g, J^T J given by ``_gram``.
+
+    By Cholesky when the matrix is numerically positive definite (always, but for a rank-deficient J with a
+    tiny l2), by Gaussian elimination otherwise.
+    """
+    g00, g01, g02, g03, g11, g12, g13, g22, g23, g33 = G
+    d0 = g00 + l2
+    if d0 > 0.0:
+        l00 = math.sqrt(d0)
+        l10, l20, l30 = g01 / l00, g02 / l00, g03 / l00
+        d1 = g11 + l2 - l10 * l10
+        if d1 > 0.0:
+            l11 = math.sqrt(d1)
+            l21 = (g12 - l20 * l10) / l11
+            l31 = (g13 - l30 * l10) / l11
+            d2 = g22 + l2 - l20 * l20 - l21 * l21
+            if d2 > 0.0:
+                l22 = math.sqrt(d2)
+                l32 = (g23 - l30 * l20 - l31 * l21) / l22
+                d3 = g33 + l2 - l30 * l30 - l31 * l31 - l32 * l32
+                if d3 > 0.0:
+                    l33 = math.sqrt(d3)
+                    y0 = g[0] / l00
+                    y1 = (g[1] - l10 * y0) / l11
+                    y2 = (g[2] - l20 * y0 - l21 * y1) / l22
+                    y3 = (g[3] - l30 * y0 - l31 * y1 - l32 * y2) / l33
+                    x3 = y3 / l33
+                    x2 = (y2 - l32 * x3) / l22
+                    x1 = (y1 - l21 * x2 - l31 * x3) / l11
+                    return [(y0 - l10 * x1 - l20 * x2 - l30 * x3) / l00, x1, x2, x3]
+    A = [[g00 + l2, g01, g02, g03], [g01, g11 + l2, g12, g13], [g02, g12, g22 + l2, g23], [g03, g13, g23, g33 + l2]]
+    x = _solve4(A, g)
+    return x if x is not None else [0.0, 0.0, 0.0, 0.0]  # exactly singular: no step (it is rejected)
+
+
+def _solve4(A: list[list[float]], b: list[float]) -> list[float] | None:
+    """Solve A x = b for a 4 x 4 A (rows; overwritten); ``None`` when A is singular.
+
+    Gaussian elimination with partial pivoting (the algorithm of LAPACK's gesv); singular means a pivot is
+    exactly zero, as for ``np.linalg.solve``.
+    """
+    b = list(b)
+    for k in range(4):
+        p = k
+        for i in range(k + 1, 4):
+            if abs(A[i][k]) > abs(A[p][k]):
+                p = i
+        if A[p][k] == 0.0:
+            return None
+        if p != k:
+            A[k], A[p] = A[p], A[k]
+            b[k], b[p] = b[p], b[k]
+        rk = A[k]
+        pivot = rk[k]
+        for i in range(k + 1, 4):
+            ri = A[i]
+            f = ri[k] / pivot
+            if f != 0.0:
+                for j in range(k + 1, 4):
+                    ri[j] -= f * rk[j]
+                b[i] -= f * b[k]
+    x = [0.0] * 4
+    for k in range(3, -1, -1):
+        s = b[k]
+        rk = A[k]
+        for j in range(k + 1, 4):
+            s -= rk[j] * x[j]
+        x[k] = s / rk[k]
+    return x
