@@ -68,6 +68,11 @@ REACH_TOL = 1e-10
 """[m] a target this close outside a reach circle is solved on it (absorbs rounding)."""
 LIMIT_TOL = 1e-10
 """[rad or m] a joint value this close outside a limit is clamped onto it."""
+SNAP_TOL = 8 * 2.0**-52
+"""A wrist radius within SNAP_TOL (l1 + l2) of the stretched or folded circle, a few rounding errors, is
+taken as on it: the sampled q = 0 elbow then comes back exactly, not as two branches 3e-8 rad apart."""
+FREE_R = 1e-12
+"""[m] a wrist this close to the shoulder axis (possible when l1 = l2) leaves the shoulder angle free."""
 YAW_POSE_TOL = 1e-9
 """[rad] the largest tilt of a target rotation still taken as a pure yaw."""
 PARALLEL_TOL = 1e-6
@@ -460,12 +465,13 @@ def solve(
         if r < r_min - REACH_TOL:
             return _inside_inner_limit(geo, pose, r, r_min)
     # elbow angle gamma in [0, pi], by the half-angle form (see the module docstring)
+    snap = SNAP_TOL * l12
     outer = l12 - r
-    if 0.0 > outer:
+    if snap > outer:
         outer = 0.0
     outer *= l12 + r
     inner = r - d12
-    if 0.0 > inner:
+    if snap > inner:
         inner = 0.0
     inner *= r + d12
     gamma = 2.0 * _atan2(_sqrt(outer), _sqrt(inner))
@@ -473,13 +479,13 @@ def solve(
     phi_ref = None
     if reference is not None:
         phi_ref = s_a * float(reference[ra])
-    if r > 0.0:
+    if r > FREE_R:
         # atan2(wy, wx) - atan2(l2 sin g, l1 + l2 cos g) for g = +gamma and g = -gamma (atan2 and sin are
         # odd: the second term changes sign)
         heading = _atan2(wy, wx)
         lean = _atan2(l2 * _sin(gamma), l1 + l2 * _cos(gamma))
     else:  # l1 = l2 and the wrist on the shoulder axis: the shoulder is free
-        heading = (phi_ref if phi_ref is not None else 0.0) + beta1
+        heading = _free_shoulder(geo, alpha, gamma + beta1 - beta2, phi_ref) + beta1
         lean = 0.0
     if singular:
         elbows: tuple[tuple[float, float, str], ...] = ((gamma, heading - lean, "right" if gamma < 1.0 else "left"),)
@@ -564,6 +570,33 @@ def solve(
     order = (IKStatus.J2_LIMIT, IKStatus.J1_LIMIT, IKStatus.J4_LIMIT)  # the later the stage, the closer
     status = max((f[0] for f in failures), key=order.index)
     return _result(pose, (), status, "no solution inside the joint limits: " + "; ".join(f[1] for f in failures))
+
+
+def _free_shoulder(geo: ScaraGeometry, alpha: float, phi2: float, phi_ref: float | None) -> float:
+    """phi1 for a free shoulder (wrist on its axis): inside the J1 limits, with a J4 turn inside the J4
+    limits when there is one, and nearest to the reference (``phi_ref``, else 0) among those values."""
+    ra, _, rc = geo.revolute
+    s_a, s_c = geo.signs[ra], geo.signs[rc]
+    want = s_a * (phi_ref if phi_ref is not None else 0.0)  # in q1 units
+    lo_a, hi_a = geo.lower[ra], geo.upper[ra]
+    lo_c, hi_c = geo.lower[rc], geo.upper[rc]
+    if hi_c - lo_c >= _TWO_PI:  # any q1 has a wrist turn inside its limits
+        return s_a * min(max(want, lo_a), hi_a)
+    # q4 = s_c (alpha - phi2 - s_a q1) + 2 pi k in [lo_c, hi_c]  <=>  q1 in an interval shifted by 2 pi k
+    c = alpha - phi2
+    ends = sorted((s_a * (c - s_c * lo_c), s_a * (c - s_c * hi_c)))
+    best = None
+    k0 = math.floor((lo_a - ends[1]) / _TWO_PI)
+    k1 = math.ceil((hi_a - ends[0]) / _TWO_PI)
+    for k in range(k0, k1 + 1):
+        a, b = max(ends[0] + k * _TWO_PI, lo_a), min(ends[1] + k * _TWO_PI, hi_a)
+        if a <= b:
+            v = min(max(want, a), b)
+            if best is None or abs(v - want) < abs(best - want):
+                best = v
+    if best is None:  # no turn fits the wrist: keep J1 nearest the reference; J4_LIMIT follows
+        best = min(max(want, lo_a), hi_a)
+    return s_a * best
 
 
 def _result(target: np.ndarray, solutions: tuple[IKSolution, ...], status: IKStatus, message: str) -> IKResult:
@@ -791,6 +824,7 @@ class _BatchWork:
         np.bitwise_or(code0, np.less(r2, self.inner2, out=bit.view(bool)), out=code0)
         np.clip(qp, geo.lower[ip], geo.upper[ip], out=qp)
         # rows near the stretched or folded arm: r, o, i (and their bits) as `solve` computes them
+        free: Sequence[int] = ()
         near = np.less(o, self.delicate, out=u[2].view(bool))
         np.bitwise_or(near, np.less(i, self.delicate, out=bit.view(bool)), out=near)
         axis = None
@@ -798,13 +832,16 @@ class _BatchWork:
             rows = np.flatnonzero(near)
             r = np.hypot(wx[rows], wy[rows])
             l12, d12 = l1 + l2, abs(l1 - l2)
-            o[rows] = np.maximum(l12 - r, 0.0) * (l12 + r)
-            i[rows] = np.maximum(r - d12, 0.0) * (r + d12)
+            snap = SNAP_TOL * l12
+            o_lin, i_lin = l12 - r, r - d12
+            o[rows] = np.where(o_lin < snap, 0.0, o_lin) * (l12 + r)
+            i[rows] = np.where(i_lin < snap, 0.0, i_lin) * (r + d12)
             code0[rows] = (code0[rows] & 4) | (r > l12 + REACH_TOL) << 1 | (r < self.r_min - REACH_TOL)
             if self.axis_rows:
                 close = r < 1e-3 * l2
                 if close.any():
                     axis = rows[close]
+                free = rows[r <= FREE_R]
         # elbow and the shoulder's products
         root = np.multiply(o, i, out=f[10])  # 2 sqrt(o i)
         np.multiply(root, 4.0, out=root)
@@ -847,12 +884,32 @@ class _BatchWork:
             np.add(sg_out, 1, out=sg_out)
             np.multiply(sg_out, np.equal(code_r, 0, out=bit.view(bool)), out=sg_out)
             np.multiply(Qr, np.take(_CODE_NAN, code_r, out=t), out=q_out.T)
+        # wrist on the shoulder axis (l1 = l2): the shoulder is free; these rare rows take the scalar route,
+        # which picks J1 (and J4) as `solve` does, nearest to the row's reference
+        for row in free:
+            self._free_row(T[row], [float(refs[j][row]) if np.ndim(refs[j]) else float(refs[j]) for j in range(4)],
+                           row, q_out, st_out, sg_out)  # fmt: skip
         # rows with a NaN or an infinity (rare): OUT_OF_REACH, NaN; found through the sum of the block
         if not _isfinite(float(np.add.reduce(T, axis=None))):
             bad = ~np.isfinite(T).all(axis=1)
             st_out[bad] = IKStatus.OUT_OF_REACH
             sg_out[bad] = 0
             q_out[bad] = np.nan
+
+    def _free_row(self, target: np.ndarray, ref: list[float], row: int, q_out: np.ndarray, st_out: np.ndarray,
+                  sg_out: np.ndarray) -> None:  # fmt: skip
+        """One row with a free shoulder, through `solve` (the nearest solution of the branch to ``ref``)."""
+        res = solve(self.geo, target, reference=ref)
+        want = "all" if self.branch == "nearest" else self.branch
+        best = res.nearest(ref, branch=want) if res.success else None
+        if best is None:
+            q_out[row] = np.nan
+            st_out[row] = res.status if not res.success else IKStatus.J2_LIMIT
+            sg_out[row] = 0
+            return
+        q_out[row] = best.q
+        st_out[row] = IKStatus.OK
+        sg_out[row] = (1 if best.branch == "right" else -1) if want == "all" else (1 if want == "right" else -1)
 
     def _branch(self, sgn: int, shared: tuple[Any, ...], refs: list[Any], T: np.ndarray, f: list[np.ndarray],
                 u: list[np.ndarray], Q: np.ndarray, code: np.ndarray) -> np.ndarray:  # fmt: skip

@@ -747,15 +747,6 @@ def test_stretched_targets_on_and_just_outside_the_circle(default: Robot) -> Non
         assert far.status is IKStatus.OUT_OF_REACH
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG (precision at the stretched singularity): FK of q with q2 = 0 often lands 1 ulp INSIDE the "
-    "outer circle (r = l1 + l2 - 5.6e-17); REACH_TOL only absorbs rounding outside it, so solve returns two "
-    "non-singular elbows q2 = +/-3.33e-8 per turn instead of one singular solution, and the sampled q is "
-    "3.3e-8 (> 1e-9) from every solution. E.g. default robot, q = (-1.9, 0, 0, 0), "
-    "target (-0.12931582674540135, -0.3785200350749658, -0.04999999999999999, -1.9): 4 solutions, "
-    "q2 = +/-3.332000937312528e-08; expected 2 singular solutions (q4 = 0 and 2 pi) containing q.",
-)
 def test_stretched_targets_from_fk_have_one_solution_per_turn(default: Robot) -> None:
     geo = default.kinematics
     lo, hi = limits(default)
@@ -822,14 +813,6 @@ def test_wrist_on_the_shoulder_axis_uses_the_reference() -> None:
             assert pose_error(robot, s.q, target) <= POSE_TOL
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG: r = 0 with l1 = l2 (J1 free) fails with J1_LIMIT when q1 = 0 (no reference) or the "
-    "reference's q1 lies outside J1's limits, although any q1 inside the limits solves. E.g. default robot "
-    "with joint2 +/-190 deg and joint1 [0.5, 2.0] rad, target (0, 0, -0.05, 0.3): got J1_LIMIT "
-    "'joint1 = 0 rad (+2 pi k) outside [0.5, 2]'; expected OK with q1 in [0.5, 2.0]. Default limits and "
-    "reference q1 = 3.0: got J1_LIMIT too. (solve_batch solves the first case: statuses disagree.)",
-)
 @pytest.mark.parametrize(
     ("overrides", "reference"),
     [({"joint1_lower": 0.5, "joint1_upper": 2.0}, None), ({}, [3.0, 0.0, 0.0, 0.0])],
@@ -846,15 +829,6 @@ def test_wrist_on_the_shoulder_axis_with_j1_limits(overrides: dict[str, float], 
         assert pose_error(robot, s.q, target) <= POSE_TOL
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG: the free-J1 case is detected by the exact test r > 0.0; with a tool offset the wrist of a "
-    "target 'on the shoulder axis' is ~1e-17 m off it, so the reference is ignored and q1 follows the "
-    "rounding noise; for 14 of 61 yaws that q1 is outside J1's limits and the reachable target is refused. "
-    "E.g. default robot with joint2 +/-190 deg, tool_x = 0.02, tool_yaw = 0.2, reference (0.7, 0.5, 0, 0), "
-    "target (0.010806046117362791, 0.01682941969615793, -0.08, 1.2000000000000002): got J1_LIMIT "
-    "'left: joint1 = 2.67794504 rad (+2 pi k) outside [-2.30383461, 2.30383461]'; expected OK with q1 = 0.7.",
-)
 def test_wrist_on_the_shoulder_axis_up_to_rounding_uses_the_reference() -> None:
     robot = load_robot("default", {"joint2_lower": D(-190), "joint2_upper": D(190), "tool_x": 0.02, "tool_yaw": 0.2})
     geo = robot.kinematics
@@ -1016,20 +990,10 @@ def test_batch_agrees_with_scalar(name: str, n: int, hand_robots: dict[str, Robo
 def _hard_case_params() -> list[Any]:
     out = []
     for case in _hard_cases():
-        marks = []
-        if case["name"] == "wrist_on_shoulder_axis":
-            marks = [pytest.mark.xfail(strict=True, reason=BATCH_FREE_J1)]
-        out.append(pytest.param(case, id=case["name"], marks=marks))
+        out.append(pytest.param(case, id=case["name"]))
     return out
 
 
-BATCH_FREE_J1 = (
-    "BUG: at r = 0 with l1 = l2 (J1 free) solve_batch ignores the reference and returns q1 = -/+ pi/2 "
-    "(atan2(0, 0) - atan2(l2 sin(+/-pi), l1 + l2 cos(+/-pi))), not a scalar solution: default robot with "
-    "joint2 +/-190 deg, target (0, 0, -0.05, 0.3), branch right: batch q = (-1.5708, 3.1416, 0, -1.2708), "
-    "solve gives q1 = 0 (or the reference's q1). With joint1 [-0.5, 0.5] rad the statuses disagree: batch "
-    "J1_LIMIT, solve OK (q1 = 0 or 0.2 for reference q1 = 0.2); with joint1 [0.5, 2.0]: batch OK, solve J1_LIMIT."
-)
 
 
 @pytest.mark.parametrize("case", _hard_case_params())
@@ -1046,7 +1010,6 @@ def test_batch_agrees_with_scalar_on_the_hard_cases(case: dict[str, Any]) -> Non
             assert closest([s.q for s in res.branch(scalar_branch)], batch.q[0]) <= Q_TOL, (batch_branch, batch.q[0])
 
 
-@pytest.mark.xfail(strict=True, reason=BATCH_FREE_J1)
 def test_batch_free_j1_status_agrees_with_scalar() -> None:
     robot = load_robot("default", {"joint2_lower": D(-190), "joint2_upper": D(190), "joint1_lower": -0.5,
                                    "joint1_upper": 0.5})  # fmt: skip
