@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= build
 
-.PHONY: demo test bench bench-ik lint clean
+.PHONY: demo test browser bench bench-ik lint clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -28,8 +28,15 @@ demo: $(VENV)/.installed
 	$(BIN)/scara-pin ik 0.3 0.1 -0.1 0.5
 	$(BIN)/scara-pin traj --robot s1 --deg --from 0 0 0 0 --to 90 60 0.05 -180 --duration 5 \
 	    --out $(OUT)/s1_traj.csv --plot $(OUT)/s1_traj.png
+	$(BIN)/scara-pin view --robot s1 --traj $(OUT)/s1_traj.csv --workspace --html $(OUT)/s1_traj.html
+	$(BIN)/scara-pin workspace --plot $(OUT)/workspace.png
 
-test: $(VENV)/.installed-test
+# The browser tests drive Debian's chromium through Playwright's Python API (never `playwright install`).
+browser:
+	@command -v chromium >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq chromium >/dev/null) \
+	    || echo "warning: chromium could not be installed; the browser tests will be skipped (outside CI)"
+
+test: $(VENV)/.installed-test browser
 	$(BIN)/python -m pytest -q
 
 bench: $(VENV)/.installed-test

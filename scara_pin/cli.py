@@ -21,12 +21,12 @@ import math
 import os
 import re
 import sys
-import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from .errors import InfeasibleError, InvalidInputError, ParameterError, ScaraError
+from .files import write_atomic_with, write_text_atomic
 
 if TYPE_CHECKING:
     import numpy as np
@@ -631,36 +631,53 @@ def cmd_jog(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_view(args: argparse.Namespace) -> int:
+    """Show the robot in the browser (meshcat): a configuration, a trajectory, the workspace boundary."""
+    import numpy as np
+
+    from . import viz
+
+    units = Units(args.deg, args.mm)
+    robot = _load(args)
+    q = None
+    if args.q:
+        q = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.q, units.scale(_Q_KINDS))])
+        for item in robot.outside_limits(q):
+            log.warning("%s (shown anyway)", item)
+    times = qs = None
+    if args.traj:
+        times, qs = viz.read_trajectory_csv(args.traj)
+    polylines = None
+    if args.workspace:
+        from .workspace import workspace
+
+        ws = workspace(robot)
+        polylines = [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
+    if args.html:
+        viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines,
+                        title=f"scara-pin: {robot.name}")  # fmt: skip
+        print(f"wrote {args.html} (self-contained; open it from disk, no network needed)")
+        return 0
+    with viz.Viewer(robot, open=args.open) as viewer:
+        if polylines is not None:
+            viewer.draw_polylines(polylines)
+        if times is not None and qs is not None:
+            viewer.draw_tool_path(qs)
+            viewer.animate(times, qs, loop=True)
+        else:
+            viewer.display(q if q is not None else np.zeros(4))
+        print(f"meshcat viewer: {viewer.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
+        try:
+            viewer.serve()
+        except KeyboardInterrupt:
+            print("stopped", file=sys.stderr)
+    return 0
+
+
 # ---------------------------------------------------------------------------------------------- plumbing
 def write_atomic(path: Path, text: str) -> None:
-    """Write a text file atomically: a temporary file in the same folder, then a rename.
-
-    An error or Ctrl-C leaves either the old file or none, never a half-written one.
-    """
-    write_atomic_with(path, lambda handle: handle.write(text))
-
-
-def write_atomic_with(path: Path, produce: Callable[[Any], object]) -> None:
-    """Let ``produce(handle)`` write a text file, atomically (temporary file, then rename)."""
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise InvalidInputError(f"cannot write {path}: folder {folder} does not exist")
-    if path.is_dir():
-        raise InvalidInputError(f"cannot write {path}: it is a folder")
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    except OSError as exc:
-        raise InvalidInputError(f"cannot write in {folder}: {exc.strerror}") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
-            produce(handle)
-        os.replace(tmp, path)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise InvalidInputError(f"cannot write {path}: {exc.strerror or exc}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Write a text file atomically (see :mod:`scara_pin.files`)."""
+    write_text_atomic(path, text)
 
 
 def _add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True) -> None:
@@ -782,6 +799,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_robot_options(p)
     p.set_defaults(func=cmd_jog)
+
+    p = sub.add_parser("view", help="show the robot in the browser (meshcat); --html writes a standalone page")
+    p.add_argument("--q", nargs=4, metavar="Q", help="configuration to show (default: zero)")
+    p.add_argument("--traj", metavar="CSV", help="animate a trajectory (a `traj --out` CSV) and draw the tool path")
+    p.add_argument("--workspace", action="store_true", help="draw the workspace boundary on the floor")
+    p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")
+    p.add_argument("--open", action="store_true", help="open the page in the web browser")
+    p.add_argument("--deg", action="store_true", help="angles in degrees")
+    p.add_argument("--mm", action="store_true", help="lengths in millimetres")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_view)
 
     p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
     p.add_argument("--samples", type=int, default=1000, help="configurations sampled within limits (default 1000)")

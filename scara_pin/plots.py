@@ -15,7 +15,8 @@ import numpy as np
 
 from .description import JOINT_NAMES, JointLimits
 from .errors import ParameterError
-from .trajectory import Trajectory, atomic_output
+from .files import atomic_output
+from .trajectory import Trajectory
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

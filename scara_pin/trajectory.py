@@ -34,9 +34,7 @@ import json
 import logging
 import math
 import os
-import tempfile
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -46,6 +44,7 @@ import pinocchio as pin
 
 from .description import JOINT_NAMES
 from .errors import InfeasibleError, InvalidInputError, ParameterError
+from .files import write_text_atomic
 from .ik import IKStatus, branch_of, solve_batch
 
 if TYPE_CHECKING:
@@ -69,7 +68,6 @@ __all__ = [
     "TimeLaw",
     "Trajectory",
     "TrapezoidLaw",
-    "atomic_output",
     "cartesian_path",
     "joint_path",
     "joint_pose",
@@ -1084,13 +1082,13 @@ class Trajectory:
     def to_csv(self, path: str | os.PathLike[str], rate: float = 1000.0) -> Path:
         """Write the samples at ``rate`` [Hz] as CSV (:data:`CSV_HEADER`), atomically; return the path."""
         text = self.resample(rate).csv_text()
-        return _write_text(Path(path), text)
+        return write_text_atomic(Path(path), text)
 
     def to_json(self, path: str | os.PathLike[str], rate: float = 1000.0) -> Path:
         """Write the samples at ``rate`` [Hz] as JSON (see :meth:`Samples.to_dict`), atomically."""
         data = self.resample(rate).to_dict()
         data["rate"] = float(rate)
-        return _write_text(Path(path), json.dumps(data) + "\n")
+        return write_text_atomic(Path(path), json.dumps(data) + "\n")
 
     @classmethod
     def from_samples(cls, samples: Samples) -> Trajectory:
@@ -1126,47 +1124,6 @@ class Trajectory:
                 shifted[di] = self.sample(t + di)[0]
             q[:, i] = shifted[di][:, i]
         return Setpoints(rate, tuple(d.tolist()), t, q, None if motor is None else motor.counts(q))
-
-
-def _write_text(path: Path, text: str) -> Path:
-    with atomic_output(path) as tmp:
-        tmp.write_text(text, encoding="utf-8", newline="")
-    return path
-
-
-@contextmanager
-def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """Yield a temporary file next to ``path``; on success rename it onto ``path``, else delete it.
-
-    An error (or Ctrl-C) leaves the old file or none, never a partial one.
-
-    Raises:
-        InvalidInputError: the folder does not exist or cannot be written, or ``path`` is a folder.
-    """
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise InvalidInputError(f"cannot write {path}: folder {folder} does not exist")
-    if path.is_dir():
-        raise InvalidInputError(f"cannot write {path}: it is a folder")
-    try:
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    except OSError as exc:
-        raise InvalidInputError(f"cannot write in {folder}: {exc.strerror}") from None
-    os.close(fd)
-    tmp = Path(name)
-    try:
-        yield tmp
-        mask = os.umask(0o022)  # mkstemp makes the file private: give it the usual permissions
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise InvalidInputError(f"cannot write {path}: {exc.strerror or exc}") from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def load_trajectory(path: str | os.PathLike[str]) -> Trajectory:
@@ -1308,7 +1265,7 @@ class Setpoints:
 
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
         """Write :meth:`csv_text` atomically."""
-        return _write_text(Path(path), self.csv_text())
+        return write_text_atomic(Path(path), self.csv_text())
 
 
 # ---------------------------------------------------------------------------------------------- constructors

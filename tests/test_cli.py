@@ -488,26 +488,6 @@ def _fail_replace(*args, **kwargs):
     raise OSError(28, "No space left on device")
 
 
-class _HalfWriter:
-    """A file handle that writes half of the text and then fails, like a full disk."""
-
-    def __init__(self, handle, exc: BaseException) -> None:
-        self.handle = handle
-        self.exc = exc
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc_info):
-        self.handle.close()
-        return False
-
-    def write(self, text: str) -> int:
-        self.handle.write(text[: len(text) // 2])
-        self.handle.flush()
-        raise self.exc
-
-
 @pytest.mark.parametrize(
     ("failure", "code"),
     [("replace", 2), ("write", 2), ("interrupt", 130)],
@@ -521,8 +501,13 @@ def test_urdf_output_failure_keeps_the_old_file(
         monkeypatch.setattr(os, "replace", _fail_replace)
     else:
         exc = OSError(28, "No space left on device") if failure == "write" else KeyboardInterrupt()
-        real_fdopen = os.fdopen
-        monkeypatch.setattr(os, "fdopen", lambda fd, *a, **k: _HalfWriter(real_fdopen(fd, *a, **k), exc))
+        real_write_text = Path.write_text
+
+        def half_write(self: Path, text: str, *args: object, **kwargs: object) -> int:
+            real_write_text(self, text[: len(text) // 2], *args, **kwargs)  # type: ignore[arg-type]
+            raise exc
+
+        monkeypatch.setattr(Path, "write_text", half_write)
     rc, out, err = run(capsys, ["urdf", "-o", str(target)])
     monkeypatch.undo()
     assert rc == code

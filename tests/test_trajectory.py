@@ -19,6 +19,7 @@ import pytest
 
 from scara_pin import InfeasibleError, InvalidInputError, ParameterError, Robot
 from scara_pin.ik import IKStatus, branch_of
+from scara_pin.files import atomic_output
 from scara_pin.trajectory import (
     CSV_HEADER,
     JointLine,
@@ -26,7 +27,6 @@ from scara_pin.trajectory import (
     PathError,
     Samples,
     Trajectory,
-    atomic_output,
     cartesian_path,
     joint_path,
     joint_pose,

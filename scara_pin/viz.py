@@ -1,0 +1,914 @@
+"""See the robot in a browser: meshcat scenes of a configuration, a motion, tool paths, targets, workspaces.
+
+Two ways out, sharing one scene builder:
+
+- :class:`Viewer` starts a meshcat server (a child process bound to 127.0.0.1 only) or connects to a
+  running one, and updates the browser live: :meth:`Viewer.display`, :meth:`Viewer.animate` (the
+  browser plays the motion in real time), :meth:`Viewer.play` (Python steps it in real time),
+  :meth:`Viewer.draw_path`, :meth:`Viewer.draw_targets`, :meth:`Viewer.draw_polylines`.
+- :func:`export_html` writes ONE self-contained HTML file (meshcat's JavaScript, ~850 KB, and the scene,
+  animation included) that renders offline from ``file://``. It needs no server: the scene's commands are
+  recorded and replayed synchronously by the page (no ``fetch``, no network request at all).
+
+Frames: the scene's world is Pinocchio's ``universe`` (the root link). Points, poses and polylines given
+to the ``draw_*`` functions are in the robot's base frame (the package's convention, see
+:mod:`scara_pin.model`) and converted here. meshcat's three.js scene is Y-up; meshcat turns its root
+(``scene.rotateX(-pi/2)``) so that the scene's coordinates are z-up like Pinocchio's: a point (x, y, z)
+of the scene is at three.js world (x, z, -y).
+
+The server process is killed by :meth:`Viewer.close` (also on leaving a ``with`` block, and at interpreter
+exit through :mod:`atexit`), and it exits by itself when its parent dies, even by SIGKILL: it watches its
+stdin (a pipe from the parent, at end of file once the parent is gone) and its parent pid. (Linux's
+``PR_SET_PDEATHSIG`` is not used: it fires when the *thread* that started the child ends.)
+
+Known meshcat 0.3.2 behaviour designed around: after ``Visualizer.wait()`` the next command can hang
+forever, so nothing here waits for a browser (the server replays the scene to every browser that
+connects); every request to the server has a time limit instead of blocking forever.
+
+meshcat and Pinocchio's ``MeshcatVisualizer`` are imported inside the functions that need them; no
+solver module imports this one.
+"""
+
+from __future__ import annotations
+
+import atexit
+import base64
+import collections
+import html
+import logging
+import math
+import os
+import queue
+import subprocess
+import sys
+import threading
+import time
+import warnings
+import webbrowser
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import InvalidInputError, ScaraError
+
+if TYPE_CHECKING:
+    from .model import Robot
+
+__all__ = [
+    "ROBOT_NODE",
+    "Viewer",
+    "ViewerError",
+    "export_html",
+    "read_trajectory_csv",
+    "static_html",
+    "tool_path",
+]
+
+log = logging.getLogger(__name__)
+
+ROBOT_NODE = "robot"
+"""The robot's node under meshcat's root: visuals in ``/meshcat/robot/visuals/<geometry>``, the tool frame's
+triad in ``/meshcat/robot/frames/<tool frame>``."""
+
+_OVERLAYS = "overlays"
+_DEFAULT_FPS = 30
+_PATH_COLOR = 0x1E90FF  # dodger blue: the tool path
+_WORKSPACE_COLOR = 0x2E8B57  # sea green: the workspace boundary
+_SERVER_MARK = "scara-pin-meshcat-server"
+"""Argument that marks our meshcat server processes (tests find leftovers by it)."""
+
+
+class ViewerError(ScaraError):
+    """The viewer cannot work: meshcat missing, or its server failed to start or stopped answering."""
+
+
+# ------------------------------------------------------------------------------------------ lazy imports
+def _meshcat() -> Any:
+    """Import meshcat (and check Pinocchio's visualizer can use it), or raise :class:`ViewerError`."""
+    try:
+        with warnings.catch_warnings():  # meshcat 0.3.2 imports pyzmq's deprecated zmq.eventloop.ioloop
+            warnings.filterwarnings("ignore", message="zmq.eventloop.ioloop is deprecated", category=DeprecationWarning)
+            import meshcat
+            import meshcat.animation
+            import meshcat.geometry
+    except ImportError as exc:
+        raise ViewerError(
+            f"the browser viewer needs meshcat ({exc}); install it with: pip install 'meshcat>=0.3.2'"
+        ) from None
+    return meshcat
+
+
+def _pinocchio_visualizer() -> Any:
+    _meshcat()
+    from pinocchio.visualize import MeshcatVisualizer
+
+    return MeshcatVisualizer
+
+
+# ------------------------------------------------------------------------------------------ input checks
+def _points(name: str, value: object, dim: int) -> np.ndarray:
+    """``value`` as an (N, dim) float array of finite numbers, N >= 2, or raise InvalidInputError."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"{name} must be an array of points of {dim} numbers") from None
+    if arr.ndim != 2 or arr.shape[1] != dim or arr.shape[0] < 2:
+        raise InvalidInputError(f"{name} must be at least 2 points of {dim} numbers (got shape {arr.shape})")
+    if not np.isfinite(arr).all():
+        row = int(np.argwhere(~np.isfinite(arr))[0, 0])
+        raise InvalidInputError(f"{name}: point {row} is {arr[row].tolist()}; every value must be finite")
+    return arr
+
+
+def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.ndarray]:
+    """Check a sampled motion: (N,) strictly increasing finite times [s] and (N, 4) joint values."""
+    try:
+        t = np.array(times, dtype=float)
+        q = np.array(qs, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError("times and qs must be numbers: (N,) times [s] and (N, 4) joint values") from None
+    if t.ndim != 1 or t.shape[0] < 1:
+        raise InvalidInputError(f"times must be a 1-D array of at least one time [s] (got shape {t.shape})")
+    if q.shape != (t.shape[0], robot.model.nq):
+        raise InvalidInputError(
+            f"qs must have shape ({t.shape[0]}, {robot.model.nq}), one row per time (got {q.shape})"
+        )
+    if not np.isfinite(t).all():
+        raise InvalidInputError("times must be finite")
+    steps = np.diff(t)
+    if (steps <= 0).any():
+        k = int(np.argmax(steps <= 0))
+        raise InvalidInputError(f"times must increase strictly: t[{k + 1}] = {t[k + 1]!r} s after t[{k}] = {t[k]!r} s")
+    for row in q:
+        robot.check_q(row)
+    return t, q
+
+
+def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Read the times and joint values of a trajectory CSV (columns ``t,q1,q2,q3,q4``; others ignored).
+
+    Reads the files of :meth:`scara_pin.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``).
+    Blank lines and lines starting with ``#`` are skipped.
+
+    Returns:
+        ``(times, qs)``: (N,) times [s] and (N, 4) joint values [rad or m].
+
+    Raises:
+        InvalidInputError: unreadable file, missing columns, a bad number (the message gives the line).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InvalidInputError(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    lines = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1) if ln.strip() and not ln.startswith("#")]
+    if not lines:
+        raise InvalidInputError(f"{path}: empty file; expected a header with t,q1,q2,q3,q4")
+    header = [c.strip() for c in lines[0][1].split(",")]
+    wanted = ("t", "q1", "q2", "q3", "q4")
+    missing = [c for c in wanted if c not in header]
+    if missing:
+        raise InvalidInputError(f"{path}: the header has no column {', '.join(missing)} (header: {lines[0][1]})")
+    cols = [header.index(c) for c in wanted]
+    rows = []
+    for k, line in lines[1:]:
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise InvalidInputError(f"{path}, line {k}: {len(cells)} values, expected {len(header)}")
+        try:
+            rows.append([float(cells[c]) for c in cols])
+        except ValueError as exc:
+            raise InvalidInputError(f"{path}, line {k}: {exc}") from None
+    if not rows:
+        raise InvalidInputError(f"{path}: no samples after the header")
+    table = np.array(rows)
+    return table[:, 0], table[:, 1:]
+
+
+def tool_path(robot: Robot, qs: object) -> np.ndarray:
+    """(N, 3) positions of the tool frame in the base frame [m] along the joint values ``qs`` (N, 4)."""
+    q = np.array(qs, dtype=float)
+    if q.ndim != 2 or q.shape[1] != robot.model.nq:
+        raise InvalidInputError(f"qs must have shape (N, {robot.model.nq}) (got {q.shape})")
+    return np.array([robot.tool_placement(robot.check_q(row)).translation for row in q])
+
+
+# ------------------------------------------------------------------------------------------ recorded scene
+class _Recorder:
+    """The latest state of every scene node, as meshcat's server keeps it, to replay in a static page."""
+
+    def __init__(self) -> None:
+        self.objects: dict[str, bytes] = {}
+        self.properties: dict[str, list[bytes]] = collections.defaultdict(list)
+        self.transforms: dict[str, bytes] = {}
+        self.animation: bytes | None = None
+
+    def add(self, kind: str, path: str, packed: bytes) -> None:
+        path = path.rstrip("/")
+        if kind == "set_object":
+            self.objects.pop(path, None)  # re-inserted last: drawn after what it may depend on
+            self.objects[path] = packed
+            self.properties.pop(path, None)
+        elif kind == "set_property":
+            self.properties[path].append(packed)
+        elif kind == "set_transform":
+            self.transforms[path] = packed
+        elif kind == "set_animation":
+            self.animation = packed
+        elif kind == "delete":
+            for table in (self.objects, self.properties, self.transforms):
+                for key in [k for k in table if k == path or k.startswith(path + "/")]:
+                    del table[key]
+
+    def commands(self) -> list[bytes]:
+        """List the commands to replay, in an order that works.
+
+        Objects and their properties, then the properties of nodes without objects, then transforms, then
+        the animation.
+        """
+        out: list[bytes] = []
+        for path, packed in self.objects.items():
+            out.append(packed)
+            out.extend(self.properties.get(path, ()))
+        out.extend(p for path, props in self.properties.items() if path not in self.objects for p in props)
+        out.extend(self.transforms.values())
+        if self.animation is not None:
+            out.append(self.animation)
+        return out
+
+
+def _viewer_js() -> str:
+    meshcat = _meshcat()
+    js_path = Path(meshcat.__file__).parent / "viewer" / "dist" / "main.min.js"
+    try:
+        js = js_path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ViewerError(f"meshcat's viewer script {js_path} cannot be read ({exc.strerror})") from None
+    return js.replace("</script", "<\\/script")
+
+
+def _page(title: str, commands: list[bytes]) -> str:
+    """Make a self-contained HTML page: meshcat's viewer script and the scene's commands, replayed at load."""
+    encoded = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in commands)
+    return f"""<!DOCTYPE html>
+<html>
+<head>
+<meta charset="utf-8">
+<title>{html.escape(title)}</title>
+<style>
+body {{ margin: 0; }}
+#meshcat-pane {{ width: 100vw; height: 100vh; overflow: hidden; }}
+</style>
+</head>
+<body>
+<div id="meshcat-pane"></div>
+<script>
+{_viewer_js()}
+</script>
+<script>
+var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));
+(function () {{
+  // The scene, as msgpack commands (base64): decoded and applied synchronously, in order; no fetch.
+  var commands = [
+{encoded}
+  ];
+  function bytes(text) {{
+    var raw = atob(text), out = new Uint8Array(raw.length);
+    for (var i = 0; i < raw.length; i++) out[i] = raw.charCodeAt(i);
+    return out;
+  }}
+  for (var i = 0; i < commands.length; i++) viewer.handle_command_bytearray(bytes(commands[i]));
+  window.scaraSceneCommands = commands.length;
+}})();
+</script>
+</body>
+</html>
+"""
+
+
+# ------------------------------------------------------------------------------------------ server side
+_SERVER_SCRIPT = r"""
+import os, sys, threading, time
+parent = int(sys.argv[2])
+
+def _stdin_closed():  # the parent holds the other end of this pipe: EOF when it closes it or dies
+    try:
+        while sys.stdin.buffer.read(65536):
+            pass
+    finally:
+        os._exit(0)
+
+def _orphaned():  # a second guard: reparented (the parent died) -> exit
+    while True:
+        if os.getppid() != parent:
+            os._exit(0)
+        time.sleep(0.25)
+
+threading.Thread(target=_stdin_closed, daemon=True).start()
+threading.Thread(target=_orphaned, daemon=True).start()
+
+import tornado.web
+from meshcat.servers import zmqserver as z
+
+class _LoopbackApp(tornado.web.Application):
+    def listen(self, port, address=None, **kwargs):  # meshcat listens on every interface: loopback only
+        return super().listen(port, "127.0.0.1", **kwargs)
+
+class _Bridge(z.ZMQWebSocketBridge):
+    def make_app(self):
+        return _LoopbackApp([
+            (r"/static/(.*)", z.StaticFileHandlerNoCache, {"path": z.VIEWER_ROOT, "default_filename": z.VIEWER_HTML}),
+            (r"/", z.WebSocketHandler, {"bridge": self}),
+        ])
+
+bridge = _Bridge(host="127.0.0.1")
+print("zmq_url=" + bridge.zmq_url)
+print("web_url=" + bridge.web_url, flush=True)
+bridge.run()
+"""
+
+
+class _Server:
+    """A meshcat server in a child process, bound to 127.0.0.1, that dies with its parent."""
+
+    def __init__(self, timeout: float) -> None:
+        _meshcat()
+        cmd = [sys.executable, "-u", "-c", _SERVER_SCRIPT, _SERVER_MARK, str(os.getpid())]
+        try:
+            self.proc: subprocess.Popen[bytes] = subprocess.Popen(
+                cmd,
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,  # Ctrl-C in a terminal reaches us; we stop the server ourselves
+            )
+        except OSError as exc:
+            raise ViewerError(f"cannot start the meshcat server: {exc}") from None
+        self.output: collections.deque[str] = collections.deque(maxlen=50)
+        lines: queue.Queue[str | None] = queue.Queue()
+        self._reader = threading.Thread(target=self._read, args=(lines,), daemon=True, name="meshcat-server-output")
+        self._reader.start()
+        urls: dict[str, str] = {}
+        deadline = time.monotonic() + timeout
+        while len(urls) < 2:
+            try:
+                line = lines.get(timeout=max(0.0, deadline - time.monotonic()))
+            except queue.Empty:
+                line = None
+            if line is None:  # end of output or time out
+                self.close()
+                said = "\n".join(self.output) or "(nothing)"
+                raise ViewerError(f"the meshcat server did not start within {timeout:g} s; it said:\n{said}")
+            for key in ("zmq_url", "web_url"):
+                if line.startswith(key + "="):
+                    urls[key] = line.split("=", 1)[1]
+        self.zmq_url = urls["zmq_url"]
+        self.web_url = urls["web_url"]
+        log.info("meshcat server (pid %d) at %s", self.proc.pid, self.web_url)
+
+    def _read(self, lines: queue.Queue[str | None]) -> None:
+        """Drain the server's output (so it never blocks on a full pipe); pass lines until both URLs came."""
+        assert self.proc.stdout is not None
+        for raw in self.proc.stdout:
+            line = raw.decode(errors="replace").rstrip()
+            self.output.append(line)
+            lines.put(line)
+            log.debug("meshcat server: %s", line)
+        lines.put(None)
+
+    @property
+    def pid(self) -> int:
+        return self.proc.pid
+
+    def close(self) -> None:
+        """Stop the server: close its stdin (it exits), then SIGKILL if it has not within 2 s."""
+        proc = self.proc
+        if proc.poll() is None:
+            if proc.stdin is not None:
+                try:
+                    proc.stdin.close()
+                except OSError:
+                    pass
+            try:
+                proc.wait(timeout=2.0)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+        elif proc.stdin is not None:
+            proc.stdin.close()
+        self._reader.join(timeout=2.0)
+        if proc.stdout is not None:
+            proc.stdout.close()
+
+
+class _Window:
+    """meshcat's ``ViewerWindow`` role: send commands to a server (with a time limit) and record them.
+
+    Without ``zmq_url`` it only records (for :func:`static_html`).
+    """
+
+    def __init__(self, zmq_url: str | None = None, timeout: float = 10.0) -> None:
+        self.recorder = _Recorder()
+        self.zmq_url = zmq_url
+        self.web_url: str | None = None
+        self.timeout = timeout
+        self._socket: Any = None
+        if zmq_url is not None:
+            self._connect()
+            self.web_url = self._request([b"url"]).decode("utf-8")
+            # meshcat's own client reconnects after asking for the URL (its server's receiver needs it)
+            self._connect()
+
+    def _connect(self) -> None:
+        import zmq
+
+        self._close_socket()
+        sock: Any = zmq.Context.instance().socket(zmq.REQ)
+        sock.setsockopt(zmq.LINGER, 0)
+        sock.setsockopt(zmq.SNDTIMEO, int(self.timeout * 1000))
+        sock.connect(self.zmq_url)
+        self._socket = sock
+
+    def _close_socket(self) -> None:
+        if self._socket is not None:
+            self._socket.close(linger=0)
+            self._socket = None
+
+    def _request(self, frames: list[bytes]) -> bytes:
+        import zmq
+
+        if self._socket is None:
+            raise ViewerError(
+                f"not connected to the meshcat server at {self.zmq_url} (closed, or it stopped answering)"
+            )
+        try:
+            self._socket.send_multipart(frames)
+            if not self._socket.poll(int(self.timeout * 1000), zmq.POLLIN):
+                raise zmq.Again()
+            return bytes(self._socket.recv())
+        except zmq.ZMQError:
+            self._close_socket()  # a REQ socket without its answer is unusable
+            raise ViewerError(
+                f"the meshcat server at {self.zmq_url} did not answer within {self.timeout:g} s"
+            ) from None
+
+    def send(self, command: Any) -> None:
+        import umsgpack
+
+        data = command.lower()
+        packed = umsgpack.packb(data)
+        self.recorder.add(data["type"], data.get("path", ""), packed)
+        if self.zmq_url is not None:
+            answer = self._request([data["type"].encode("utf-8"), data.get("path", "").encode("utf-8"), packed])
+            if answer != b"ok":
+                raise ViewerError(f"the meshcat server refused {data['type']}: {answer.decode(errors='replace')}")
+
+    def get_scene(self) -> str:
+        return _page("scara-pin", self.recorder.commands())
+
+    def open(self) -> _Window:
+        if self.web_url is not None:
+            webbrowser.open(self.web_url, new=2)
+        return self
+
+    def wait(self) -> str:
+        raise ViewerError(
+            "waiting for a browser is not supported (with meshcat 0.3.2 the next command can hang forever); "
+            "the server replays the scene to every browser that connects"
+        )
+
+    def get_image(self) -> Any:
+        raise ViewerError("image capture is not supported by scara_pin.viz; take a screenshot of the page")
+
+    def close(self) -> None:
+        self._close_socket()
+
+
+# ------------------------------------------------------------------------------------------ the scene
+class _Scene:
+    """The robot and the overlays in a meshcat visualizer (live or recording)."""
+
+    def __init__(self, robot: Robot, window: _Window) -> None:
+        meshcat = _meshcat()
+        self.robot = robot
+        self.vis = meshcat.Visualizer(window=window)
+        viz = _pinocchio_visualizer()(robot.model, robot.collision_model, robot.visual_model)
+        viz.initViewer(viewer=self.vis)
+        viz.loadViewerModel(rootNodeName=ROBOT_NODE)
+        self.viz = viz
+        q0 = pin.neutral(robot.model)
+        data = robot.model.createData()
+        pin.framesForwardKinematics(robot.model, data, q0)
+        self.oMb: pin.SE3 = data.oMf[robot.base_id].copy()
+        # scene size [m]: the farthest frame from the root at the neutral configuration
+        self.size = max(0.05, max(float(np.linalg.norm(f.translation)) for f in data.oMf))
+        viz.displayFrames(True, frame_ids=[robot.tool_id], axis_length=0.25 * self.size, axis_width=2)
+        self._camera()
+        self.display(q0)
+
+    def _camera(self) -> None:
+        """Look at the root from the front right, from about 2 arm lengths (meshcat's default is 3 m away)."""
+        s = self.size
+        x, y, z = 1.0 * s, -1.3 * s, 1.0 * s  # scene (z-up) coordinates
+        # the camera lives in /Cameras/default/rotated, turned by +pi/2 about x: scene (x, y, z) -> (x, z, -y)
+        self.vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
+        # meshcat's world axes are 0.5 m long, larger than a small arm: the tool frame's triad shows the axes
+        self.vis["/Axes"].set_property("visible", False)
+
+    def display(self, q: object) -> None:
+        self.viz.display(self.robot.check_q(q))
+
+    def animation(self, times: np.ndarray, qs: np.ndarray, fps: int) -> Any:
+        """Build a meshcat animation of the motion, ``fps`` frames per second.
+
+        Joint values are interpolated linearly between the samples; three.js interpolates between frames.
+        """
+        meshcat = _meshcat()
+        if not (isinstance(fps, int) and 1 <= fps <= 1000):
+            raise InvalidInputError(f"fps is {fps!r}; it must be a whole number of frames per second in [1, 1000]")
+        duration = float(times[-1] - times[0])
+        n = int(math.floor(duration * fps + 1e-9))
+        frames = np.arange(n + 1, dtype=float)
+        if duration * fps - n > 1e-9:
+            frames = np.append(frames, duration * fps)
+        grid = times[0] + frames / fps
+        q = np.column_stack([np.interp(grid, times, qs[:, j]) for j in range(qs.shape[1])])
+        anim = meshcat.animation.Animation(default_framerate=fps)
+        live = self.viz.viewer
+        try:
+            for frame, row in zip(frames.tolist(), q, strict=True):
+                with anim.at_frame(self.vis, frame) as at:
+                    self.viz.viewer = at  # Pinocchio's display() writes transforms into the frame
+                    self.viz.display(row)
+        finally:
+            self.viz.viewer = live
+        return anim
+
+    def _world(self, points_base: np.ndarray) -> np.ndarray:
+        """(N, 3) base-frame points -> (N, 3) scene (universe) points."""
+        return points_base @ self.oMb.rotation.T + self.oMb.translation
+
+    def line(self, path: str, points_world: np.ndarray, color: int) -> None:
+        mg = _meshcat().geometry
+        geometry = mg.PointsGeometry(np.ascontiguousarray(points_world.T, dtype=np.float32))
+        self.vis[path].set_object(mg.Line(geometry, mg.LineBasicMaterial(color=color)))
+
+    def draw_path(self, points: object, name: str, color: int) -> None:
+        pts = _points("points", points, 3)
+        self.line(f"{_OVERLAYS}/{name}", self._world(pts), color)
+
+    def draw_targets(self, poses: object, name: str) -> None:
+        mg = _meshcat().geometry
+        arr = np.array(poses, dtype=float)
+        if arr.ndim == 1:
+            arr = arr[None, :]
+        if arr.ndim != 2 or arr.shape[1] != 4 or not np.isfinite(arr).all():
+            raise InvalidInputError(f"poses must be finite (x, y, z, yaw) rows [m, rad] (got shape {arr.shape})")
+        node = self.vis[f"{_OVERLAYS}/{name}"]
+        node.delete()
+        for i, (x, y, z, yaw) in enumerate(arr.tolist()):
+            bMt = pin.SE3(pin.utils.rotate("z", yaw), np.array([x, y, z]))
+            node[str(i)].set_object(mg.triad(0.15 * self.size))
+            node[str(i)].set_transform((self.oMb * bMt).homogeneous)
+
+    def draw_polylines(self, polylines: Iterable[object], name: str, z: float | None, color: int) -> None:
+        if isinstance(polylines, np.ndarray) and polylines.ndim == 2:
+            polylines = [polylines]
+        checked = [_points(f"polyline {i}", p, 2) for i, p in enumerate(polylines)]
+        # default height: the floor, z = 0 of the root link, expressed in the base frame
+        zb = -float(self.oMb.translation[2]) if z is None else float(z)
+        node = self.vis[f"{_OVERLAYS}/{name}"]
+        node.delete()
+        for i, xy in enumerate(checked):
+            pts = np.column_stack([xy, np.full(len(xy), zb)])
+            self.line(f"{_OVERLAYS}/{name}/{i}", self._world(pts), color)
+
+
+def _scene(
+    scene: _Scene,
+    q: object | None,
+    times: object | None,
+    qs: object | None,
+    polylines: Iterable[object] | None,
+    path_points: object | None,
+    targets: object | None,
+    *,
+    draw_tool_path: bool,
+    fps: int,
+    loop: bool,
+) -> None:
+    """Fill a scene with what :func:`static_html` and :func:`export_html` take."""
+    robot = scene.robot
+    if (times is None) != (qs is None):
+        raise InvalidInputError("times and qs go together: give both or neither")
+    if q is not None:
+        scene.display(q)
+    if polylines is not None:
+        scene.draw_polylines(polylines, "workspace", None, _WORKSPACE_COLOR)
+    if path_points is not None:
+        scene.draw_path(path_points, "path", _PATH_COLOR)
+    if targets is not None:
+        scene.draw_targets(targets, "targets")
+    if times is not None:
+        t, qq = _motion(robot, times, qs)
+        if q is None:
+            scene.display(qq[0])
+        if path_points is None and draw_tool_path and len(t) >= 2:
+            scene.draw_path(tool_path(robot, qq), "path", _PATH_COLOR)
+        if len(t) >= 2:
+            scene.vis.set_animation(scene.animation(t, qq, fps), play=True, repetitions=math.inf if loop else 1)
+
+
+def static_html(
+    robot: Robot,
+    q: object | None = None,
+    times: object | None = None,
+    qs: object | None = None,
+    polylines: Iterable[object] | None = None,
+    path_points: object | None = None,
+    targets: object | None = None,
+    *,
+    draw_tool_path: bool = True,
+    fps: int = _DEFAULT_FPS,
+    loop: bool = True,
+    title: str | None = None,
+) -> str:
+    """Make a self-contained HTML page of the robot (no server needed; arguments as :func:`export_html`)."""
+    window = _Window()
+    scene = _Scene(robot, window)
+    _scene(scene, q, times, qs, polylines, path_points, targets, draw_tool_path=draw_tool_path, fps=fps, loop=loop)
+    return _page(title or f"scara-pin: {robot.name}", window.recorder.commands())
+
+
+def export_html(
+    robot: Robot,
+    path: str | os.PathLike[str],
+    q: object | None = None,
+    times: object | None = None,
+    qs: object | None = None,
+    polylines: Iterable[object] | None = None,
+    path_points: object | None = None,
+    targets: object | None = None,
+    *,
+    draw_tool_path: bool = True,
+    fps: int = _DEFAULT_FPS,
+    loop: bool = True,
+    title: str | None = None,
+) -> Path:
+    """Write one self-contained HTML page of the robot, that renders offline from ``file://``; atomically.
+
+    The page holds meshcat's viewer script (~850 KB) and the scene; it makes no network request.
+
+    Args:
+        robot: the robot.
+        path: the file to write.
+        q: the configuration shown [rad or m] (default: the first sample of the motion, else neutral).
+        times: (N,) sample times of a motion [s], strictly increasing; with ``qs``.
+        qs: (N, 4) joint values at those times; the page plays the motion in real time (looping unless
+            ``loop=False``), with meshcat's play / pause / time controls under "Animations".
+        polylines: workspace boundary: (M, 2) arrays of (x, y) in the base frame [m], drawn on the floor.
+        path_points: (K, 3) points of a tool path in the base frame [m]; by default the path of the tool
+            along ``qs`` is drawn (``draw_tool_path=False`` turns that off).
+        targets: (P, 4) target poses (x, y, z, yaw) in the base frame [m, rad], drawn as small frames.
+        draw_tool_path: draw the path of the tool along ``qs`` when no ``path_points`` are given.
+        fps: animation frames per second (joint values are interpolated between samples).
+        loop: repeat the animation forever (else play it once and hold the last frame).
+        title: the page title.
+
+    Returns:
+        The path written.
+
+    Raises:
+        InvalidInputError: bad inputs, or the file cannot be written.
+        ViewerError: meshcat is not installed.
+    """
+    from .files import write_atomic_with
+
+    text = static_html(
+        robot, q, times, qs, polylines, path_points, targets,
+        draw_tool_path=draw_tool_path, fps=fps, loop=loop, title=title,
+    )  # fmt: skip
+    out = Path(path)
+    write_atomic_with(out, lambda handle: handle.write(text))
+    return out
+
+
+# ------------------------------------------------------------------------------------------ live viewer
+class Viewer:
+    """A live meshcat view of a robot in the browser, at :attr:`url`.
+
+    Starts its own meshcat server (a child process on 127.0.0.1) unless ``zmq_url`` names a running one.
+    Use it as a context manager, or call :meth:`close`; the server is also stopped at interpreter exit
+    and when this process dies.
+
+    Example::
+
+        with Viewer(robot) as viewer:
+            print(viewer.url)
+            viewer.display([0.1, 0.2, 0.05, 0.3])
+            viewer.animate(times, qs)
+
+    Attributes:
+        robot: the robot shown.
+    """
+
+    robot: Robot
+    DEFAULT_TIMEOUT: ClassVar[float] = 20.0
+
+    def __init__(
+        self,
+        robot: Robot,
+        open: bool = False,  # noqa: A002 - the name the command line uses (--open)
+        *,
+        zmq_url: str | None = None,
+        timeout: float = DEFAULT_TIMEOUT,
+    ) -> None:
+        """Start (or connect to) a meshcat server and load the robot into it.
+
+        Args:
+            robot: the robot to show.
+            open: open the page in the default web browser.
+            zmq_url: a running meshcat server's ZeroMQ address (``tcp://127.0.0.1:6000``); default: start one.
+            timeout: the longest wait for the server to start or to answer a command [s].
+
+        Raises:
+            ViewerError: meshcat is missing, or the server does not start or answer.
+        """
+        self.robot = robot
+        self._server: _Server | None = None
+        self._window: _Window | None = None
+        self._closed = False
+        atexit.register(self.close)
+        try:
+            if zmq_url is None:
+                self._server = _Server(timeout)
+                zmq_url = self._server.zmq_url
+            self._window = _Window(zmq_url, timeout)
+            self._scene = _Scene(robot, self._window)
+        except BaseException:
+            self.close()
+            raise
+        if open:
+            self._window.open()
+
+    # ----------------------------------------------------------------- properties
+    @property
+    def url(self) -> str:
+        """The page to open in a browser (``http://127.0.0.1:<port>/static/``)."""
+        assert self._window is not None and self._window.web_url is not None
+        return self._window.web_url
+
+    @property
+    def zmq_url(self) -> str:
+        """The server's ZeroMQ address (another :class:`Viewer` can connect to it)."""
+        assert self._window is not None and self._window.zmq_url is not None
+        return self._window.zmq_url
+
+    @property
+    def server_pid(self) -> int | None:
+        """Process id of the server this viewer started (None when it connected to a running one)."""
+        return None if self._server is None else self._server.pid
+
+    @property
+    def visualizer(self) -> Any:
+        """The underlying ``meshcat.Visualizer`` (for drawing anything else)."""
+        return self._scene.vis
+
+    # ----------------------------------------------------------------- drawing
+    def _live(self) -> _Scene:
+        if self._closed:
+            raise ViewerError("the viewer is closed")
+        return self._scene
+
+    def display(self, q: object) -> None:
+        """Show the robot at ``q`` [rad or m] (stops nothing: an animation playing keeps playing)."""
+        self._live().display(q)
+
+    def animate(
+        self, times: object, qs: object, *, fps: int = _DEFAULT_FPS, loop: bool = False, play: bool = True
+    ) -> None:
+        """Send the motion to the browser, which plays it in real time (play / pause / time controls).
+
+        Args:
+            times: (N,) strictly increasing sample times [s], N >= 2.
+            qs: (N, 4) joint values [rad or m].
+            fps: animation frames per second (joint values are interpolated linearly between samples).
+            loop: repeat forever (else play once and hold the last frame).
+            play: start playing at once (meshcat's time slider moves the robot only once the animation
+                has been played: press play, then pause).
+        """
+        scene = self._live()
+        t, q = _motion(self.robot, times, qs)
+        if len(t) < 2:
+            raise InvalidInputError("an animation needs at least 2 samples; use display() for one")
+        scene.vis.set_animation(scene.animation(t, q, fps), play=play, repetitions=math.inf if loop else 1)
+
+    def play(self, times: object, qs: object, *, speed: float = 1.0) -> None:
+        """Step the robot through the motion from Python, in real time (blocks until the end).
+
+        Samples whose time has passed while the previous one was sent are skipped, so the motion keeps
+        to the clock. ``speed`` > 1 plays faster.
+        """
+        if not (math.isfinite(speed) and speed > 0):
+            raise InvalidInputError(f"speed is {speed}; it must be > 0")
+        scene = self._live()
+        t, q = _motion(self.robot, times, qs)
+        start = time.monotonic()
+        k = 0
+        while k < len(t):
+            now = (time.monotonic() - start) * speed + t[0]
+            # the latest sample that is due
+            k_due = int(np.searchsorted(t, now, side="right")) - 1
+            if k_due >= k:
+                k = k_due
+                scene.display(q[k])
+                k += 1
+            if k < len(t):
+                time.sleep(max(0.0, (t[k] - t[0]) / speed - (time.monotonic() - start)))
+
+    def draw_path(self, points: object, *, name: str = "path", color: int = _PATH_COLOR) -> None:
+        """Draw a tool path: a line through (N, 3) points in the base frame [m]."""
+        self._live().draw_path(points, name, color)
+
+    def draw_tool_path(self, qs: object, *, name: str = "path", color: int = _PATH_COLOR) -> None:
+        """Draw the path of the tool frame along (N, 4) joint values."""
+        self._live().draw_path(tool_path(self.robot, qs), name, color)
+
+    def draw_targets(self, poses: object, *, name: str = "targets") -> None:
+        """Draw target poses (x, y, z, yaw) in the base frame [m, rad] as small frames (red x, green y, blue z)."""
+        self._live().draw_targets(poses, name)
+
+    def draw_polylines(
+        self,
+        polylines: Iterable[object],
+        *,
+        name: str = "workspace",
+        z: float | None = None,
+        color: int = _WORKSPACE_COLOR,
+    ) -> None:
+        """Draw polylines of (x, y) points in the base frame [m], e.g. a workspace boundary.
+
+        They lie on the floor (z = 0 of the root link) unless ``z`` gives a height in the base frame [m].
+        Drawing again under the same ``name`` replaces them.
+        """
+        self._live().draw_polylines(polylines, name, z, color)
+
+    def clear(self, name: str) -> None:
+        """Remove an overlay drawn under ``name`` ("path", "targets", "workspace", ...)."""
+        self._live().vis[f"{_OVERLAYS}/{name}"].delete()
+
+    # ----------------------------------------------------------------- export
+    def static_html(self, title: str | None = None) -> str:
+        """Return the current scene (animation included) as a self-contained HTML page."""
+        assert self._window is not None
+        self._live()
+        return _page(title or f"scara-pin: {self.robot.name}", self._window.recorder.commands())
+
+    def save_html(self, path: str | os.PathLike[str], title: str | None = None) -> Path:
+        """Write :meth:`static_html` to ``path``, atomically; return the path."""
+        from .files import write_atomic_with
+
+        text = self.static_html(title)
+        out = Path(path)
+        write_atomic_with(out, lambda handle: handle.write(text))
+        return out
+
+    # ----------------------------------------------------------------- life cycle
+    def serve(self, poll: float = 0.5) -> None:
+        """Block while the server runs (for a command that serves until Ctrl-C: KeyboardInterrupt passes).
+
+        Raises:
+            ViewerError: the server this viewer started stopped (it was killed).
+        """
+        self._live()
+        while True:
+            if self._server is not None and self._server.proc.poll() is not None:
+                code = self._server.proc.returncode
+                self.close()
+                raise ViewerError(f"the meshcat server stopped (exit status {code})")
+            time.sleep(poll)
+
+    def close(self) -> None:
+        """Disconnect and stop the server this viewer started (idempotent)."""
+        if self._closed:
+            return
+        self._closed = True
+        atexit.unregister(self.close)
+        if self._window is not None:
+            self._window.close()
+        if self._server is not None:
+            self._server.close()
+            log.info("meshcat server (pid %d) stopped", self._server.pid)
+
+    def __enter__(self) -> Viewer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        state = "closed" if self._closed else (self._window.web_url if self._window else "starting")
+        return f"<Viewer of {self.robot.name!r} at {state}>"
