@@ -3,7 +3,8 @@
 Conventions shared by every command:
 
 - SI units by default; ``--deg`` gives and prints angles in degrees, ``--mm`` lengths in millimetres.
-- Joint vectors are in URDF joint order (joint1..joint4); q3 grows as the quill moves down.
+- Joint vectors are in URDF joint order (joint1..joint4); q3 grows as the quill moves down. A palletizer's
+  q is (q1, q2, theta3, q4), four angles, theta3 the small arm's absolute angle (scara_pin.palletizer).
 - ``--json`` prints one JSON object on stdout.
 - Exit codes: 0 ok, 2 invalid input, 3 infeasible request (unreachable, limits), 1 internal error.
   Errors are one line on stderr starting with ``error:``; warnings start with ``warning:``.
@@ -64,6 +65,7 @@ class Units:
         self.length = 1000.0 if mm else 1.0
         self.angle_name = "deg" if deg else "rad"
         self.length_name = "mm" if mm else "m"
+        self.q: tuple[str, ...] = _Q_KINDS  # what each joint value measures; set per robot by _load
 
     def scale(self, kinds: Sequence[str]) -> list[float]:
         """Multipliers from SI for a sequence of quantity kinds ("angle" / "length")."""
@@ -94,10 +96,13 @@ def _parse_sets(items: Sequence[str] | None) -> dict[str, str]:
     return overrides
 
 
-def _load(args: argparse.Namespace) -> Robot:
+def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
     from .model import load_robot
 
-    return load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf)
+    robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf)
+    if units is not None and robot.kind == "palletizer":  # four angles (S2's q1, q2, theta3, q5)
+        units.q = ("angle",) * 4
+    return robot
 
 
 def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
@@ -105,7 +110,7 @@ def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
 
     if len(args.q) != 4:
         raise ParameterError("q", " ".join(args.q), f"must be 4 joint values (got {len(args.q)})")
-    scale = units.scale(_Q_KINDS)
+    scale = units.scale(units.q)
     return np.array([_number(n, t) / s for n, t, s in zip(_Q_NAMES, args.q, scale)])
 
 
@@ -154,14 +159,14 @@ def cmd_urdf(args: argparse.Namespace) -> int:
 def cmd_fk(args: argparse.Namespace) -> int:
     """Forward kinematics: the pose of tool0 in the base frame."""
     units = Units(args.deg, args.mm)
-    robot = _load(args)
+    robot = _load(args, units)
     q = _read_q(args, units)
     _check_limits(robot, q, args.strict)
     M = robot.tool_placement(q)
     from .model import pose_from_placement
 
     pose = pose_from_placement(M)
-    q_out = _scaled(q, units.scale(_Q_KINDS))
+    q_out = _scaled(q, units.scale(units.q))
     pos = [float(v) * units.length for v in pose[:3]]
     yaw = float(pose[3]) * units.angle
     matrix = M.homogeneous.copy()
@@ -180,7 +185,7 @@ def cmd_fk(args: argparse.Namespace) -> int:
         print(json.dumps(out))
         return 0
     print(f"robot     {robot.name}: {robot.tool_frame} in {robot.base_frame}")
-    print(f"q         {_fmt(q_out)}  [{', '.join(units.names(_Q_KINDS))}]")
+    print(f"q         {_fmt(q_out)}  [{', '.join(units.names(units.q))}]")
     print(f"position  {_fmt(pos)}  [{units.length_name}]")
     print(f"yaw       {yaw: .9g}  [{units.angle_name}]")
     print("matrix")
@@ -194,7 +199,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     import numpy as np
 
     units = Units(args.deg, args.mm)
-    robot = _load(args)
+    robot = _load(args, units)
     q = _read_q(args, units)
     _check_limits(robot, q, args.strict)
     if args.reference == "task":
@@ -208,12 +213,12 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         rows = ["vx", "vy", "vz", "wx", "wy", "wz"]
         row_kinds = ("length",) * 3 + ("angle",) * 3
     # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j)
-    J = J * np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(_Q_KINDS))[None, :]
+    J = J * np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
     w = robot.manipulability(q)
     if args.json:
         out = {
             "robot": robot.name,
-            "q": _scaled(q, units.scale(_Q_KINDS)),
+            "q": _scaled(q, units.scale(units.q)),
             "reference": args.reference,
             "frame": args.frame or robot.tool_frame,
             "rows": rows,
@@ -224,7 +229,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         print(json.dumps(out))
         return 0
     print(f"robot     {robot.name}: {args.reference} Jacobian of {args.frame or robot.tool_frame}")
-    print(f"q         {_fmt(_scaled(q, units.scale(_Q_KINDS)))}  [{', '.join(units.names(_Q_KINDS))}]")
+    print(f"q         {_fmt(_scaled(q, units.scale(units.q)))}  [{', '.join(units.names(units.q))}]")
     print("          " + "".join(f"{n:>16}" for n in ("d/dq1", "d/dq2", "d/dq3", "d/dq4")))
     for name, row in zip(rows, J):
         print(f"{name:<10}" + "".join(f"{v:16.9g}" for v in row))
@@ -239,14 +244,14 @@ def _read_pose(texts: Sequence[str], units: Units, what: str = "target") -> list
 
 
 def _solutions_json(q_list: Sequence[Sequence[float]], branches: Sequence[str], units: Units) -> list[dict]:
-    scale = units.scale(_Q_KINDS)
+    scale = units.scale(units.q)
     return [{"q": _scaled(q, scale), "branch": b} for q, b in zip(q_list, branches)]
 
 
 def cmd_ik(args: argparse.Namespace) -> int:
     """Inverse kinematics: every joint solution for a tool pose (closed form, or numeric)."""
     units = Units(args.deg, args.mm)
-    robot = _load(args)
+    robot = _load(args, units)
     if args.input:
         return _ik_batch(args, robot, units)
     if args.input is None and args.output:
@@ -254,9 +259,14 @@ def cmd_ik(args: argparse.Namespace) -> int:
     target = _read_pose(args.target, units)
     near = None
     if args.near:
-        near = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(_Q_KINDS))])
+        near = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(units.q))])
     numeric = args.numeric
-    if not numeric:
+    if robot.kind == "palletizer":
+        if args.branch in ("left", "right"):
+            raise InvalidInputError(f"--branch {args.branch} is a SCARA branch; a palletizer's are up and down")
+    elif args.branch in ("up", "down"):
+        raise InvalidInputError(f"--branch {args.branch} is a palletizer branch; a SCARA's are left and right")
+    if not numeric and robot.kind == "scara":
         from .ik import NotScaraError
 
         try:
@@ -290,14 +300,14 @@ def cmd_ik(args: argparse.Namespace) -> int:
         raise InfeasibleError(f"{status}: {message}")
     print(f"robot     {robot.name}: {'numeric' if numeric else 'closed-form'} IK of {robot.tool_frame} in {robot.base_frame}")
     print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS))}]")
-    print(f"units     q = [{', '.join(units.names(_Q_KINDS))}]")
+    print(f"units     q = [{', '.join(units.names(units.q))}]")
     for q, b in zip(qs, branches):
-        print(f"{b:<9} {_fmt(_scaled(q, units.scale(_Q_KINDS)))}")
+        print(f"{b:<9} {_fmt(_scaled(q, units.scale(units.q)))}")
     return 0
 
 
 def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
-    from .ik import NotScaraError, branch_of
+    from .ik import NotScaraError
     from .ik_numeric import solve_numeric
 
     res = solve_numeric(robot, target, q0=near)
@@ -305,7 +315,7 @@ def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) 
         return ("NO_CONVERGENCE", f"numeric IK did not reach the target (residual {res.residual:.3g} after "
                 f"{res.iterations} iterations from {res.starts} starts)", [], [])  # fmt: skip
     try:
-        branch = branch_of(robot.kinematics, res.q)
+        branch = robot.branch_of(res.q)
     except NotScaraError:
         branch = "unknown"
     return "OK", f"converged in {res.iterations} iterations (residual {res.residual:.3g})", [res.q], [branch]
@@ -326,7 +336,9 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     branch = {"all": "nearest", "right": "right", "left": "left"}[args.branch]
     reference = None
     if args.near:
-        reference = [_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(_Q_KINDS))]
+        reference = [_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(units.q))]
+    if robot.kind != "scara":
+        raise InvalidInputError(f"ik --input (batch) is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     geo = robot.kinematics
     in_path, out_path = Path(args.input), Path(args.output)
     try:
@@ -335,7 +347,7 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
         raise InvalidInputError(f"cannot read {in_path}: {exc.strerror}") from None
     total = failed = 0
     pose_scale = np.array(units.scale(_POSE_KINDS))
-    q_scale = np.array(units.scale(_Q_KINDS))
+    q_scale = np.array(units.scale(units.q))
     show_progress = sys.stderr.isatty()
     size = max(in_path.stat().st_size, 1)
 
@@ -403,7 +415,7 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
 
 
 def _joint_arg(robot: Robot, texts: Sequence[str], units: Units, what: str) -> np.ndarray:
-    q = robot.check_q([_number(f"{what} {n}", t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(_Q_KINDS))])
+    q = robot.check_q([_number(f"{what} {n}", t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))])
     outside = robot.outside_limits(q, tol=1e-12)
     if outside:
         raise InfeasibleError(f"{what} is outside the joint limits: " + "; ".join(outside))
@@ -427,7 +439,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units(args.deg, args.mm)
-    robot = _load(args)
+    robot = _load(args, units)
     if (args.from_q is None) == (args.from_pose is None):
         raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
     if (args.to_q is None) == (args.to_pose is None):
@@ -447,6 +459,11 @@ def cmd_traj(args: argparse.Namespace) -> int:
     tool_speed = None
     if args.tool_speed is not None:
         tool_speed = _number("--tool-speed", str(args.tool_speed)) / units.length
+    if args.linear and robot.kind != "scara":
+        raise InvalidInputError(f"traj --linear is SCARA-only for now; robot {robot.name!r} is a {robot.kind} "
+                                "(joint-space --duration and TOPP-RA timing work)")  # fmt: skip
+    if args.plot and robot.kind != "scara":
+        raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     if args.linear:
         poses = [pose_from if q_from is None else tr.joint_pose(robot, q_from)]
         poses += [tr.joint_pose(robot, v) for v in vias]
@@ -545,7 +562,9 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
     units = Units(False, args.mm)
     L = units.length
-    robot = _load(args)
+    robot = _load(args, units)
+    if robot.kind == "palletizer":
+        return _palletizer_workspace(args, robot, units)
     ws = workspace(robot)
     hit = None
     if args.ray:
@@ -593,12 +612,44 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     return 0
 
 
+def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) -> int:
+    """The palletizer's reach envelope of tool0 in its arm plane (r from the waist axis, z)."""
+    from .palletizer_workspace import arm_plane_envelope, plot_envelope
+
+    if args.ray or args.z is not None or args.dz is not None:
+        raise InvalidInputError("--ray/--z/--dz are SCARA-only for now; a palletizer gets its arm-plane envelope")
+    env = arm_plane_envelope(robot.palletizer)
+    if args.plot:
+        plot_envelope(env, args.plot)
+    if args.json:
+        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"},
+                               "envelope": env.to_dict()}  # fmt: skip
+        if args.plot:
+            out["plot"] = args.plot
+        print(json.dumps(out))
+        return 0
+    L, name = units.length, units.length_name
+    print(f"robot     {robot.name}: reach envelope of {robot.tool_frame} in the arm plane (r from the waist axis, z)")
+    print(f"area      {env.area * L * L:.9g} {name}^2")
+    print(f"r range   [{env.r_range[0] * L:.9g}, {env.r_range[1] * L:.9g}] {name}")
+    print(f"z range   [{env.z_range[0] * L:.9g}, {env.z_range[1] * L:.9g}] {name}")
+    print(f"arcs      {len(env.arcs)} (centre, radius [{name}], phi from the vertical [rad])")
+    for a in env.arcs:
+        print(f"  {a.limit:<13} centre {_fmt([v * L for v in a.center])} radius {a.radius * L:.9g} "
+              f"phi [{a.start:.9g}, {a.start + a.sweep:.9g}]")  # fmt: skip
+    if args.plot:
+        print(f"wrote     {args.plot}")
+    return 0
+
+
 def cmd_jog(args: argparse.Namespace) -> int:
     """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge."""
     from .jog import jog_to_edge
 
     units = Units(args.deg, args.mm)
-    robot = _load(args)
+    robot = _load(args, units)
+    if robot.kind != "scara":
+        raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     q0 = _joint_arg(robot, args.from_q, units, "--from")
     direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
     if len(direction) not in (2, 3):
@@ -638,10 +689,10 @@ def cmd_view(args: argparse.Namespace) -> int:
     from . import viz
 
     units = Units(args.deg, args.mm)
-    robot = _load(args)
+    robot = _load(args, units)
     q = None
     if args.q:
-        q = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.q, units.scale(_Q_KINDS))])
+        q = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.q, units.scale(units.q))])
         for item in robot.outside_limits(q):
             log.warning("%s (shown anyway)", item)
     times = qs = None
@@ -651,6 +702,8 @@ def cmd_view(args: argparse.Namespace) -> int:
     if args.workspace:
         from .workspace import workspace
 
+        if robot.kind != "scara":
+            raise InvalidInputError(f"view --workspace is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
         ws = workspace(robot)
         polylines = [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
     if args.html:
@@ -691,7 +744,8 @@ def _add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True) -> No
 
 
 def _add_q(p: argparse.ArgumentParser) -> None:
-    p.add_argument("q", nargs="*", metavar="Q", help="joint values q1 q2 q3 q4 (URDF order; q3 > 0 lowers the quill)")
+    p.add_argument("q", nargs="*", metavar="Q", help="joint values q1 q2 q3 q4 (URDF order; SCARA: q3 > 0 lowers the quill; "
+                   "palletizer: q1 q2 theta3 q4, theta3 the small arm's absolute angle)")
     p.add_argument("--deg", action="store_true", help="angles in degrees")
     p.add_argument("--mm", action="store_true", help="lengths in millimetres")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -735,8 +789,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("ik", help="inverse kinematics: every joint solution for a tool pose X Y Z YAW")
     p.add_argument("target", nargs="*", metavar="X Y Z YAW", help="tool0 pose in the base frame")
-    p.add_argument("--branch", default="all", choices=["all", "left", "right"],
-                   help="elbow branch (right: elbow turns counterclockwise seen from above); default all")  # fmt: skip
+    p.add_argument("--branch", default="all", choices=["all", "left", "right", "up", "down"],
+                   help="elbow branch: a SCARA's right (elbow turns counterclockwise seen from above) or left; "
+                   "a palletizer's up (sin q3 > 0, S2's q3) or down; default all")  # fmt: skip
     p.add_argument("--near", nargs=4, metavar="Q", help="return only the solution nearest to this configuration")
     p.add_argument("--numeric", action="store_true", help="use Pinocchio-based numeric IK instead of the closed form")
     p.add_argument("--input", metavar="CSV", help="batch: targets with header x,y,z,yaw (one solution per row)")

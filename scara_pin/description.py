@@ -1,11 +1,17 @@
 """Robot parameters (yaml) and the URDF generated from them with xacro.
 
-The yaml files under ``urdf/config/<robot>/`` are the single source of truth:
+Two kinds of robot are described: ``scara`` (the default) and ``palletizer`` (source S2's
+double-parallelogram arm). ``kinematics.yaml`` chooses the kind with a top-level ``kind:`` key
+(absent: ``scara``); each kind has its own parameter schema (:data:`SCHEMAS`) and entry xacro.
+
+The yaml files under ``urdf/config/<robot>/`` are the single source of truth. For a SCARA:
 
 - ``kinematics.yaml``: ``base_height``, ``d1``, ``l1``, ``d2``, ``l2``, ``d3`` and ``tool: {x, y, z, yaw}``;
 - ``joint_limits.yaml``: per joint ``lower``, ``upper``, ``velocity``, ``acceleration``, ``effort``;
 - ``physical_parameters.yaml``: per body (``base``, ``link1``, ``link2``, ``quill``, ``flange``) its
   ``mass`` and ``radius`` (and ``length`` for the quill and the flange).
+
+For a palletizer see ``urdf/config/palletizer/*.yaml`` and :data:`PALLETIZER_PARAMETER_NAMES`.
 
 Parameters are addressed by flat names (``l1``, ``tool_x``, ``joint2_velocity``, ``quill_mass``): the
 nested yaml keys joined by ``_``. Every value is validated here, BEFORE xacro runs, and reaches xacro
@@ -21,7 +27,7 @@ from __future__ import annotations
 import math
 import numbers
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import InitVar, dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -31,12 +37,15 @@ from .errors import DescriptionError, ParameterError, UnknownRobotError
 
 __all__ = [
     "JOINT_NAMES",
+    "PALLETIZER_PARAMETER_NAMES",
     "PARAMETER_NAMES",
+    "SCHEMAS",
     "JointLimits",
     "RobotParameters",
     "available_robots",
     "generate_urdf",
     "load_parameters",
+    "parameter_names",
     "urdf_dir",
 ]
 
@@ -64,8 +73,75 @@ _POSITIVE = frozenset(
     | {n for n in _PHYSICAL}
     | {f"{j}_{f}" for j in JOINT_NAMES for f in ("velocity", "acceleration", "effort")}
 )
-# Acceleration limits have no URDF element; they stay in Python (yaml) and never reach xacro.
-_XACRO_ARGS = tuple(n for n in PARAMETER_NAMES if not n.endswith("_acceleration"))
+
+# The palletizer (S2): lengths a1..a4, heights d1, d2, d5 (see config/palletizer/kinematics.yaml).
+_P_KINEMATICS = ("d1", "d2", "a1", "a2", "a3", "a4", "d5", "tool_yaw")
+_P_PHYSICAL = (
+    "base_mass", "base_radius", "turret_mass", "turret_radius", "big_arm_mass", "big_arm_radius",
+    "small_arm_mass", "small_arm_radius", "wrist_mass", "wrist_radius",
+    "flange_mass", "flange_radius", "flange_length",
+)  # fmt: skip
+PALLETIZER_PARAMETER_NAMES: tuple[str, ...] = _P_KINEMATICS + _LIMITS + _P_PHYSICAL
+"""Every parameter of a palletizer, by its flat name."""
+
+
+def _scara_rules(values: Mapping[str, float]) -> None:
+    column = values["base_height"] + values["d1"]
+    if column <= 0:
+        raise ParameterError("base_height + d1", column, "(the column from the floor to joint1) must be > 0")
+
+
+def _palletizer_rules(values: Mapping[str, float]) -> None:
+    # d1, d2 (the base's and the turret's heights, drawn as cylinders) are in the positive set
+    if values["a1"] < 0:
+        raise ParameterError("a1", values["a1"], "(the shoulder's offset from the waist axis) must be >= 0")
+
+
+@dataclass(frozen=True)
+class _Schema:
+    """The parameters of one kind of robot: per yaml file its flat names, the rules, the entry xacro."""
+
+    kind: str
+    files: Mapping[str, tuple[str, ...]]
+    positive: frozenset[str]
+    rules: Callable[[Mapping[str, float]], None]
+    entry: str
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(n for names in self.files.values() for n in names)
+
+    @property
+    def xacro_args(self) -> tuple[str, ...]:
+        return tuple(n for n in self.names if not n.endswith("_acceleration"))
+
+
+SCHEMAS: Mapping[str, _Schema] = MappingProxyType({
+    "scara": _Schema("scara", MappingProxyType(_FILES), _POSITIVE, _scara_rules, "scara.urdf.xacro"),
+    "palletizer": _Schema(
+        "palletizer",
+        MappingProxyType({"kinematics.yaml": _P_KINEMATICS, "joint_limits.yaml": _LIMITS,
+                          "physical_parameters.yaml": _P_PHYSICAL}),
+        frozenset({"a2", "a3", "d1", "d2"} | set(_P_PHYSICAL)
+                  | {f"{j}_{f}" for j in JOINT_NAMES for f in ("velocity", "acceleration", "effort")}),
+        _palletizer_rules,
+        "palletizer.urdf.xacro",
+    ),
+})  # fmt: skip
+"""Parameter schema per robot kind (the ``kind:`` key of kinematics.yaml; ``scara`` when absent)."""
+
+
+def parameter_names(kind: str = "scara") -> tuple[str, ...]:
+    """The flat parameter names of a robot kind (``"scara"`` or ``"palletizer"``)."""
+    return _schema(kind).names
+
+
+def _schema(kind: object) -> _Schema:
+    if not isinstance(kind, str) or kind not in SCHEMAS:
+        raise ParameterError("kind", kind, f"must be one of {', '.join(SCHEMAS)}")
+    return SCHEMAS[kind]
+
+
 _NAME_RE = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 _PREFIX_RE = re.compile(r"[A-Za-z0-9_]*\Z")
 _ENTRY = "scara.urdf.xacro"
@@ -133,29 +209,31 @@ class RobotParameters:
 
     Attributes:
         name: the robot's name (its config folder's name).
-        values: every parameter by flat name (see :data:`PARAMETER_NAMES`), SI units.
+        values: every parameter by flat name (see :func:`parameter_names` of ``kind``), SI units.
         source: the config folder the values were read from.
+        kind: ``"scara"`` or ``"palletizer"`` (see :data:`SCHEMAS`).
     """
 
     name: str
     values: Mapping[str, float]
     source: Path | None = field(default=None, compare=False)
+    kind: str = "scara"
 
     def __post_init__(self) -> None:
+        schema = _schema(self.kind)
+        names = schema.names
         values = dict(self.values)
-        missing = [n for n in PARAMETER_NAMES if n not in values]
+        missing = [n for n in names if n not in values]
         if missing:
             raise ParameterError(missing[0], ParameterError.NOTHING, "is required (missing)")
         for key, value in values.items():
-            if key not in PARAMETER_NAMES:
-                raise ParameterError(key, value, f"is not a parameter; known: {', '.join(PARAMETER_NAMES)}")
+            if key not in names:
+                raise ParameterError(key, value, f"is not a parameter; known: {', '.join(names)}")
             _check_finite(key, value)
-            if key in _POSITIVE and value <= 0:
+            if key in schema.positive and value <= 0:
                 raise ParameterError(key, value, "must be > 0")
-        column = values["base_height"] + values["d1"]
-        if column <= 0:
-            raise ParameterError("base_height + d1", column, "(the column from the floor to joint1) must be > 0")
-        object.__setattr__(self, "values", MappingProxyType({k: float(values[k]) for k in PARAMETER_NAMES}))
+        schema.rules(values)
+        object.__setattr__(self, "values", MappingProxyType({k: float(values[k]) for k in names}))
         object.__setattr__(self, "limits", self._limits())
 
     limits: JointLimits = field(init=False, compare=False)
@@ -176,18 +254,19 @@ class RobotParameters:
         Raises:
             ParameterError: an unknown name, a value that is not a finite number, or a broken rule.
         """
+        names = _schema(self.kind).names
         values = dict(self.values)
         for key, raw in overrides.items():
-            if key not in PARAMETER_NAMES:
-                raise ParameterError(key, raw, f"is not a parameter; known: {', '.join(PARAMETER_NAMES)}")
+            if key not in names:
+                raise ParameterError(key, raw, f"is not a parameter; known: {', '.join(names)}")
             values[key] = _to_float(key, raw)
-        return RobotParameters(self.name, values, self.source)
+        return RobotParameters(self.name, values, self.source, self.kind)
 
     def xacro_mappings(self, prefix: str = "") -> dict[str, str]:
         """The xacro arguments: each value as ``repr(float(v))``, and the (checked) name prefix."""
         if not _PREFIX_RE.match(prefix):
             raise ParameterError("prefix", prefix, "may hold only letters, digits and '_'")
-        mappings = {n: repr(float(self.values[n])) for n in _XACRO_ARGS}
+        mappings = {n: repr(float(self.values[n])) for n in _schema(self.kind).xacro_args}
         mappings["prefix"] = prefix
         return mappings
 
@@ -246,12 +325,14 @@ def _flatten(tree: object, prefix: str, out: dict[str, object]) -> None:
         out[prefix] = tree
 
 
-def _read_config(folder: Path) -> dict[str, float]:
+def _read_config(folder: Path) -> tuple[str, dict[str, float]]:
+    """(kind, flat values) of a config folder; the kind is the ``kind:`` key of kinematics.yaml."""
     import yaml
 
     loader = _yaml_loader()
     values: dict[str, float] = {}
-    for filename, expected in _FILES.items():
+    schema = SCHEMAS["scara"]
+    for filename in ("kinematics.yaml", "joint_limits.yaml", "physical_parameters.yaml"):
         path = folder / filename
         try:
             tree = yaml.load(path.read_text(encoding="utf-8"), Loader=loader)  # noqa: S506 (safe loader)
@@ -262,6 +343,14 @@ def _read_config(folder: Path) -> dict[str, float]:
             where = f" line {mark.line + 1}" if mark is not None else ""
             raise ParameterError(f"{path}{where}", ParameterError.NOTHING, f"must be valid yaml ({exc})") from None
         flat: dict[str, object] = {}
+        if filename == "kinematics.yaml" and isinstance(tree, dict) and "kind" in tree:
+            tree = dict(tree)
+            kind = tree.pop("kind")
+            try:
+                schema = _schema(kind)
+            except ParameterError as exc:
+                raise ParameterError(f"kind in {path}", kind, exc.rule) from None
+        expected = schema.files[filename]
         _flatten(tree if tree is not None else {}, "", flat)
         for key, raw in flat.items():
             if key not in expected:
@@ -273,7 +362,7 @@ def _read_config(folder: Path) -> dict[str, float]:
         for key in expected:
             if key not in flat:
                 raise ParameterError(f"{key} in {path}", ParameterError.NOTHING, "is required (missing)")
-    return values
+    return schema.kind, values
 
 
 def _config_folder(robot: str | Path) -> tuple[str, Path]:
@@ -314,7 +403,8 @@ def load_parameters(
         params = robot
     else:
         name, folder = _config_folder(robot)
-        params = RobotParameters(name, _read_config(folder), folder)
+        kind, values = _read_config(folder)
+        params = RobotParameters(name, values, folder, kind)
     return params.with_overrides(overrides) if overrides else params
 
 
@@ -324,7 +414,7 @@ def generate_urdf(
     *,
     prefix: str = "",
 ) -> str:
-    """Expand ``urdf/scara.urdf.xacro`` for a robot and return the URDF text.
+    """Expand the robot kind's entry xacro (``urdf/scara.urdf.xacro``, ``urdf/palletizer.urdf.xacro``).
 
     Args:
         robot: as in :func:`load_parameters`.
@@ -338,7 +428,7 @@ def generate_urdf(
 
     params = load_parameters(robot, overrides)
     mappings = params.xacro_mappings(prefix)
-    entry = urdf_dir() / _ENTRY
+    entry = urdf_dir() / _schema(params.kind).entry
     try:
         # xacro keeps (and mutates) the mappings dict it is given: hand it a copy.
         doc = xacro.process_file(str(entry), mappings=dict(mappings))

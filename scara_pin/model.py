@@ -1,8 +1,10 @@
-"""A SCARA loaded into Pinocchio: forward kinematics, frame placements and Jacobians.
+"""A 4-DOF robot (SCARA or palletizer) loaded into Pinocchio: FK, frame placements and Jacobians.
 
 Conventions (used by every command of the package):
 
 - ``q`` holds the four joint values in URDF joint order, SI units ([rad], and [m] for the quill).
+  Passive ``<mimic>`` joints (the palletizer's levelling joints) are loaded as Pinocchio mimic joints:
+  they follow their joint and are not in ``q``.
 - Poses are of ``tool0`` in the robot's ``base`` frame (the controller's reference frame). The yaw is
   ``atan2(R[1, 0], R[0, 0])`` of that rotation: the heading of tool0's x axis in the base plane.
 - Pinocchio's world frame (``universe``) is the root link (``base_link``); Jacobians named after
@@ -27,6 +29,7 @@ from .errors import InvalidInputError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
     from .ik import IKResult, ScaraGeometry
+    from .palletizer import PalletizerGeometry
 
 __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
 
@@ -77,13 +80,15 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
         raise UrdfError(f"{origin}: malformed XML at line {line}, column {column + 1}") from None
     if root.tag != "robot":
         raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
+    # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
+    mimic = root.find("joint/mimic") is not None
     # urdfdom reports the reason on the C stderr and Pinocchio raises a generic ValueError: capture it.
     sys.stderr.flush()
     saved = os.dup(2)
     with tempfile.TemporaryFile() as captured:
         os.dup2(captured.fileno(), 2)
         try:
-            model = pin.buildModelFromXML(urdf)
+            model = pin.buildModelFromXML(urdf, mimic=True) if mimic else pin.buildModelFromXML(urdf)
             failure = None
         except (ValueError, RuntimeError) as exc:
             failure = exc
@@ -107,7 +112,7 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
 
 
 class Robot:
-    """A 4-joint SCARA in Pinocchio, with its frames and limits.
+    """A 4-joint robot (SCARA or palletizer) in Pinocchio, with its frames and limits.
 
     Attributes:
         model: the Pinocchio model (``nq = nv = 4``).
@@ -116,6 +121,7 @@ class Robot:
         name: the robot's name.
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
+        kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file counts as a SCARA).
         base_frame, tool_frame: names of the reference frame and of the tool frame.
     """
 
@@ -125,6 +131,7 @@ class Robot:
     name: str
     limits: JointLimits
     parameters: RobotParameters | None
+    kind: str
     base_frame: str
     tool_frame: str
 
@@ -168,6 +175,7 @@ class Robot:
         self.urdf = urdf
         self.name = model.name
         self.parameters = parameters
+        self.kind = parameters.kind if parameters is not None else "scara"
         self.base_frame = base_frame
         self.tool_frame = tool_frame
         self.base_id = model.getFrameId(base_frame)
@@ -234,17 +242,49 @@ class Robot:
         """The SCARA geometry read from the model for the closed-form IK (extracted once, on first use).
 
         Raises:
-            NotScaraError: the model is not SCARA-like (the reason names the joint).
+            NotScaraError: the model is not SCARA-like (the reason names the joint), or is a palletizer.
         """
-        from .ik import ScaraGeometry
+        from .ik import NotScaraError, ScaraGeometry
 
+        if self.kind != "scara":
+            raise NotScaraError(f"robot {self.name!r} is a {self.kind}, not a SCARA: the SCARA closed form "
+                                "(and what is built on it) does not apply")  # fmt: skip
         return ScaraGeometry.from_robot(self)
 
+    @cached_property
+    def palletizer(self) -> PalletizerGeometry:
+        """The palletizer geometry for the geometric IK (see :mod:`scara_pin.palletizer`).
+
+        Raises:
+            NotPalletizerError: the robot is not a palletizer generated from palletizer parameters.
+        """
+        from .palletizer import PalletizerGeometry
+
+        return PalletizerGeometry.from_robot(self)
+
     def ik(self, target: Any, *, branch: str = "all", reference: Sequence[float] | None = None) -> IKResult:
-        """Closed-form IK: every solution inside the limits (see :func:`scara_pin.ik.solve`)."""
+        """Closed-form IK of the robot's kind: every solution inside the limits.
+
+        A SCARA: :func:`scara_pin.ik.solve` (branches right/left); a palletizer:
+        :func:`scara_pin.palletizer.solve` (branches up/down).
+        """
+        if self.kind == "palletizer":
+            from . import palletizer
+
+            return palletizer.solve(self.palletizer, target, branch=branch, reference=reference)
         from .ik import solve
 
         return solve(self.kinematics, target, branch=branch, reference=reference)
+
+    def branch_of(self, q: Sequence[float]) -> str:
+        """The IK branch of a configuration (SCARA: right/left; palletizer: up/down)."""
+        if self.kind == "palletizer":
+            from .palletizer import branch_of
+
+            return branch_of(q)
+        from .ik import branch_of as scara_branch_of
+
+        return scara_branch_of(self.kinematics, q)
 
     # ----------------------------------------------------------------- input checks
     def check_q(self, q: object) -> np.ndarray:
@@ -375,5 +415,5 @@ def load_robot(
 
 
 def load_urdf(path: str | Path) -> Robot:
-    """Load any SCARA URDF file into Pinocchio."""
+    """Load a 4-joint URDF file (a SCARA, or with ``<mimic>`` passive joints) into Pinocchio."""
     return Robot.from_file(path)

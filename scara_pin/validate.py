@@ -1,5 +1,8 @@
 """Cross-validation of the closed-form IK against Pinocchio (FK and numeric IK).
 
+The closed form is the robot kind's: the SCARA's (:func:`scara_pin.ik.solve`) or the palletizer's
+geometric IK (:func:`scara_pin.palletizer.solve`, on the coupled model with its mimic joints).
+
 For N configurations sampled inside the joint limits (seeded), with target = FK(q) from Pinocchio:
 
 1. every closed-form solution reproduces the target under Pinocchio FK to ``POSE_TOL`` (1e-9 m / rad);
@@ -16,7 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ik import branch_of, solve
+from . import palletizer
+from .ik import IKResult, branch_of, solve
 from .ik_numeric import solve_numeric
 from .model import Robot
 
@@ -91,7 +95,24 @@ def _pose_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
 
 def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: int = 10) -> ValidationReport:
     """Run the three checks on ``samples`` seeded configurations (see the module docstring)."""
-    geo = robot.kinematics
+    if robot.kind == "palletizer":
+        pgeo = robot.palletizer
+
+        def closed(target: np.ndarray) -> IKResult:
+            return palletizer.solve(pgeo, target)
+
+        def branch_at(q: np.ndarray) -> str:
+            return palletizer.branch_of(q)
+    else:
+        geo = robot.kinematics
+        scara_solve = solve  # looked up at call time: tests may replace it
+
+        def closed(target: np.ndarray) -> IKResult:
+            return scara_solve(geo, target)
+
+        def branch_at(q: np.ndarray) -> str:
+            return branch_of(geo, q)
+
     rng = np.random.default_rng(seed)
     lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
     report = ValidationReport(robot.name, samples, seed)
@@ -105,7 +126,7 @@ def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: 
         q = rng.uniform(lo, hi)
         target = robot.tool_pose(q)
         t0 = time.perf_counter()
-        result = solve(geo, target)
+        result = closed(target)
         t_closed += time.perf_counter() - t0
         report.solutions += len(result.solutions)
         for sol in result.solutions:
@@ -126,7 +147,7 @@ def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: 
             report.numeric_fail += 1
             fail(f"q = {q.tolist()}: numeric IK did not converge (residual {num.residual:.3g})")
             continue
-        branch = branch_of(geo, num.q)
+        branch = branch_at(num.q)
         twins = [s for s in result.solutions if s.matches(branch)]
         dist = min((float(np.abs(s.q - num.q).max()) for s in twins), default=math.inf)
         report.worst_numeric_distance = max(report.worst_numeric_distance, dist)

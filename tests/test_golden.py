@@ -25,7 +25,7 @@ import pytest
 from scara_pin import generate_urdf
 
 DATA = Path(__file__).resolve().parent / "data"
-GOLDEN_ROBOTS = ["default", "s1"]
+GOLDEN_ROBOTS = ["default", "s1", "palletizer"]
 ABS_TOL = 1e-12
 UPDATE_ENV = "SCARA_PIN_UPDATE_GOLDEN"
 
