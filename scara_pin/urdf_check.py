@@ -1,0 +1,638 @@
+"""Lint a third-party SCARA URDF: what is wrong, where (line numbers), and whether the toolkit can use it.
+
+:func:`check_urdf` reads the XML itself (expat, keeping each element's line), walks the kinematic tree
+at q = 0 with its own transforms (independent of Pinocchio), then loads the file with
+:class:`scara_pin.model.Robot` and reads the closed-form geometry, so that what it reports is what the
+other commands will do.
+
+Findings (``code``: severity):
+
+- structure, each one ``error`` (the file is unusable): ``malformed-xml``, ``root-not-robot``,
+  ``xacro-not-expanded``, ``missing-name``, ``duplicate-name``, ``missing-link``, ``two-parents``,
+  ``disconnected``, ``joint-type``, ``bad-number``, ``joint-count`` (a SCARA has 4 movable joints: the ROS
+  tutorial's 3-joint RRP arm is unusable here; it would need a wrist joint), ``not-serial``,
+  ``limit-missing``, ``limits-inverted`` (lower > upper), ``limits-empty`` (lower = upper),
+  ``not-loadable`` (Pinocchio or :class:`~scara_pin.model.Robot` refuses it; the reason is quoted);
+- ``warning`` (usable, but check it): ``continuous-joint`` (Pinocchio gives it nq = 2, cos/sin),
+  ``velocity-zero``, ``velocity-placeholder`` (100, 1000, 10000, or one value on every joint),
+  ``limits-implausible`` (revolute limits beyond +/-4 pi: degrees?; strokes beyond 5 m: millimetres?),
+  ``length-implausible`` (an origin offset beyond 10 m: millimetres?),
+  ``velocity-implausible`` (revolute outside 0.05..50 rad/s, prismatic outside 0.05..10 m/s; a
+  deg/s reading is offered), ``axis-flipped`` (a revolute axis along base -z: handled, q turns
+  clockwise), ``axis-tilted`` (more than 1e-6 rad from vertical, angle in degrees: the closed-form IK
+  refuses; only numeric IK applies), ``closed-form-refused`` (the closed form's own reason),
+  ``prismatic-position`` (not third in the chain, e.g. a lifting column first: supported),
+  ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an ``rpy`` value such as
+  3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle error times the
+  distance from that joint to the tool at q = 0; ``info`` below 1 micrometre);
+- ``info``: ``joints`` (types and order), ``axis-down`` (a quill whose q grows downward: the usual
+  convention), ``zero-pose-direction`` (the arm points along +y or elsewhere than +x at q = 0: handled
+  by the zero offsets), ``zero-pose-bent``, ``tool-frame`` (no ``tool0``: the chain's last link is used).
+
+Status: ``unusable`` if any error (exit code 2), else ``warnings`` if any warning (exit code 4), else
+``clean`` (exit code 0).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+from xml.etree.ElementTree import Element, TreeBuilder
+
+import numpy as np
+
+__all__ = [
+    "CheckReport",
+    "CheckStatus",
+    "Finding",
+    "JointInfo",
+    "Severity",
+    "check_urdf",
+    "check_urdf_file",
+]
+
+TILT_TOL = 1e-6
+"""[rad] an axis further than this from the base z axis is tilted (the closed-form IK refuses it)."""
+RPY_NEAR = 0.01
+"""[rad] an rpy value this close to a nonzero multiple of pi/2 (but not equal to it) is an approximation."""
+RPY_EXACT = 1e-12
+"""[rad] closer than this to k pi/2 is taken as exact (a float's repr of pi is 1.2e-16 away)."""
+REVOLUTE_RANGE = 4 * math.pi
+"""[rad] a revolute limit beyond two turns either way is implausible (degrees written as radians)."""
+PRISMATIC_RANGE = 5.0
+"""[m] a SCARA stroke limit beyond this is implausible (millimetres written as metres)."""
+OFFSET_RANGE = 10.0
+"""[m] a joint origin offset beyond this is implausible (millimetres written as metres)."""
+PLACEHOLDER_VELOCITIES = (100.0, 1000.0, 10000.0)
+REVOLUTE_VELOCITY = (0.05, 50.0)
+"""[rad/s] plausible range of a SCARA joint's velocity limit."""
+PRISMATIC_VELOCITY = (0.05, 10.0)
+"""[m/s] plausible range of a SCARA quill's velocity limit."""
+_MOVABLE = ("revolute", "continuous", "prismatic")
+_KNOWN = (*_MOVABLE, "fixed", "floating", "planar")
+
+
+class Severity(enum.Enum):
+    """How bad a finding is."""
+
+    INFO = "info"
+    WARNING = "warning"
+    ERROR = "error"
+
+
+class CheckStatus(enum.Enum):
+    """The verdict on a file, with the command line's exit code."""
+
+    CLEAN = "clean"
+    WARNINGS = "warnings"
+    UNUSABLE = "unusable"
+
+    @property
+    def exit_code(self) -> int:
+        """0 clean, 4 warnings, 2 unusable."""
+        return {"clean": 0, "warnings": 4, "unusable": 2}[self.value]
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One thing found in the file.
+
+    Attributes:
+        severity: info, warning or error.
+        code: a stable identifier (see the module docstring).
+        message: one sentence with the numbers.
+        line: the line in the file, when the finding belongs to an element.
+        joint: the joint concerned, if any.
+    """
+
+    severity: Severity
+    code: str
+    message: str
+    line: int | None = None
+    joint: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"severity": self.severity.value, "code": self.code, "message": self.message, "line": self.line,
+                "joint": self.joint}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """A joint as written: name, type, line, and (movable joints) its axis in the base frame at q = 0."""
+
+    name: str
+    type: str
+    line: int | None
+    parent: str
+    child: str
+    axis: tuple[float, float, float] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"name": self.name, "type": self.type, "line": self.line, "parent": self.parent,
+                "child": self.child, "axis": list(self.axis) if self.axis is not None else None}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """The findings on one file.
+
+    Attributes:
+        source: the file name (or ``"URDF"``).
+        findings: in the order found (structure, joints, geometry, loading).
+        joints: movable joints in chain order (empty when the structure is broken).
+        tool_frame: the frame taken as the tool (``tool0`` when present).
+    """
+
+    source: str
+    findings: tuple[Finding, ...]
+    joints: tuple[JointInfo, ...] = ()
+    tool_frame: str | None = None
+
+    @property
+    def status(self) -> CheckStatus:
+        """Unusable with any error, warnings with any warning, else clean."""
+        severities = {f.severity for f in self.findings}
+        if Severity.ERROR in severities:
+            return CheckStatus.UNUSABLE
+        if Severity.WARNING in severities:
+            return CheckStatus.WARNINGS
+        return CheckStatus.CLEAN
+
+    @property
+    def exit_code(self) -> int:
+        """0 clean, 4 warnings, 2 unusable."""
+        return self.status.exit_code
+
+    def codes(self, severity: Severity | None = None) -> list[str]:
+        """The finding codes (of one severity, or all)."""
+        return [f.code for f in self.findings if severity is None or f.severity is severity]
+
+    def find(self, code: str) -> list[Finding]:
+        """The findings with this code."""
+        return [f for f in self.findings if f.code == code]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: source, status, exit_code, tool_frame, joints, findings."""
+        return {
+            "source": self.source,
+            "status": self.status.value,
+            "exit_code": self.exit_code,
+            "tool_frame": self.tool_frame,
+            "joints": [j.to_dict() for j in self.joints],
+            "findings": [f.to_dict() for f in self.findings],
+        }
+
+    def to_json(self) -> str:
+        """The JSON document of :meth:`to_dict` (indented, one trailing newline)."""
+        import json
+
+        return json.dumps(self.to_dict(), indent=2) + "\n"
+
+    def format_text(self) -> str:
+        """One line per finding (``file:line: severity: message [code]``), then the status line."""
+        out = []
+        for f in self.findings:
+            where = f"{self.source}:{f.line}" if f.line is not None else self.source
+            out.append(f"{where}: {f.severity.value}: {f.message} [{f.code}]")
+        out.append(f"{self.source}: {self.status.value}")
+        return "\n".join(out)
+
+
+# ----------------------------------------------------------------------------------------------- parsing
+class _Unusable(Exception):
+    """Internal: stop the checks (the findings so far say why)."""
+
+
+def _parse(text: str) -> tuple[Element, dict[Element, int]]:
+    """An ElementTree of the text, with each element's line (expat's position of its start tag)."""
+    from xml.parsers import expat
+
+    builder = TreeBuilder()
+    lines: dict[Element, int] = {}
+    parser = expat.ParserCreate()
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        lines[builder.start(tag, attrs)] = parser.CurrentLineNumber
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = builder.end
+    parser.Parse(text, True)
+    return builder.close(), lines
+
+
+def _rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
+    """URDF: R = Rz(y) Ry(p) Rx(r)."""
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ])  # fmt: skip
+
+
+@dataclass
+class _Joint:
+    name: str
+    type: str
+    line: int | None
+    parent: str
+    child: str
+    xyz: tuple[float, ...] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, ...] = (0.0, 0.0, 0.0)
+    rpy_line: int | None = None
+    axis: tuple[float, ...] = (1.0, 0.0, 0.0)
+    limit: dict[str, str] | None = None
+    limit_line: int | None = None
+    world: np.ndarray = field(default_factory=lambda: np.eye(4))  # joint frame at q = 0 in the root
+
+
+class _Checker:
+    def __init__(self, text: str, source: str) -> None:
+        self.text = text
+        self.source = source
+        self.findings: list[Finding] = []
+        self.joints: dict[str, _Joint] = {}
+        self.chain: list[_Joint] = []
+        self.tool: str | None = None
+
+    def add(
+        self, severity: Severity, code: str, message: str, line: int | None = None, joint: str | None = None
+    ) -> None:
+        self.findings.append(Finding(severity, code, message, line, joint))
+
+    def error(self, code: str, message: str, line: int | None = None, joint: str | None = None) -> None:
+        self.add(Severity.ERROR, code, message, line, joint)
+
+    # ------------------------------------------------------------------------------------- structure
+    def _numbers(self, el: Element | None, attr: str, default: tuple[float, ...], where: str, line: int | None,
+                 joint: str) -> tuple[float, ...]:  # fmt: skip
+        if el is None or el.get(attr) is None:
+            return default
+        raw = el.get(attr, "")
+        try:
+            values = tuple(float(v) for v in raw.split())
+        except ValueError:
+            values = ()
+        if len(values) != len(default) or not all(math.isfinite(v) for v in values):
+            self.error("bad-number", f"{where} {attr}={raw!r} of joint {joint} must be {len(default)} finite numbers",
+                       line, joint)  # fmt: skip
+            return default
+        return values
+
+    def structure(self) -> None:
+        try:
+            root, lines = _parse(self.text)
+        except Exception as exc:  # expat.ExpatError (malformed), ValueError (encoding declarations)
+            line = getattr(exc, "lineno", None)
+            self.error("malformed-xml", f"malformed XML: {getattr(exc, 'args', [exc])[0]}", line)
+            raise _Unusable from None
+        if root.tag != "robot":
+            self.error("root-not-robot", f"the root element is <{root.tag}>, not <robot>", lines.get(root))
+            raise _Unusable
+        xacro = next((el for el in root.iter() if el.tag.startswith("xacro:")), None)
+        if xacro is not None:
+            self.error("xacro-not-expanded", f"<{xacro.tag}> found: this is a xacro file; expand it with xacro first",
+                       lines.get(xacro))  # fmt: skip
+            raise _Unusable
+        links: dict[str, int | None] = {}
+        for el in root.findall("link"):
+            name = el.get("name")
+            if not name:
+                self.error("missing-name", "a <link> has no name", lines.get(el))
+            elif name in links:
+                self.error("duplicate-name", f"link {name!r} is defined twice (first at line {links[name]})",
+                           lines.get(el))  # fmt: skip
+            else:
+                links[name] = lines.get(el)
+        for el in root.findall("joint"):
+            name, kind, line = el.get("name"), el.get("type"), lines.get(el)
+            if not name:
+                self.error("missing-name", "a <joint> has no name", line)
+                continue
+            if name in self.joints:
+                first = self.joints[name].line
+                self.error("duplicate-name", f"joint {name!r} is defined twice (first at line {first})",
+                           line, name)  # fmt: skip
+                continue
+            if kind not in _KNOWN:
+                self.error("joint-type", f"joint {name} has type {kind!r}: not a URDF joint type", line, name)
+                continue
+            if kind in ("floating", "planar"):
+                self.error("joint-type", f"joint {name} is {kind}: a SCARA has revolute and prismatic joints",
+                           line, name)  # fmt: skip
+                continue
+            parent_el, child_el = el.find("parent"), el.find("child")
+            ends = []
+            for role, sub in (("parent", parent_el), ("child", child_el)):
+                target = sub.get("link") if sub is not None else None
+                if not target or target not in links:
+                    shown = f"link {target!r}, which is not defined" if target else f"no <{role} link=...>"
+                    self.error("missing-link", f"joint {name}'s {role} is {shown}", line, name)
+                ends.append(target or "")
+            origin, axis, limit = el.find("origin"), el.find("axis"), el.find("limit")
+            j = _Joint(name, kind, line, ends[0], ends[1])
+            oline = lines.get(origin) if origin is not None else line
+            j.xyz = self._numbers(origin, "xyz", (0.0, 0.0, 0.0), "origin", oline, name)
+            j.rpy = self._numbers(origin, "rpy", (0.0, 0.0, 0.0), "origin", oline, name)
+            j.rpy_line = oline
+            j.axis = self._numbers(axis, "xyz", (1.0, 0.0, 0.0), "axis", lines.get(axis) if axis is not None else line,
+                                   name)  # fmt: skip
+            if kind in _MOVABLE and math.hypot(*j.axis) < 1e-12:
+                self.error("bad-number", f"joint {name}'s axis is the zero vector", line, name)
+            if limit is not None:
+                j.limit, j.limit_line = dict(limit.attrib), lines.get(limit)
+            self.joints[name] = j
+        if any(f.severity is Severity.ERROR for f in self.findings):
+            raise _Unusable
+        # the tree: one root, every link reached once
+        parent_of: dict[str, _Joint] = {}
+        for j in self.joints.values():
+            if j.child in parent_of:
+                other = parent_of[j.child].name
+                self.error("two-parents", f"link {j.child} is the child of joints {other} and {j.name}",
+                           j.line, j.name)  # fmt: skip
+            parent_of[j.child] = j
+        if any(f.severity is Severity.ERROR for f in self.findings):
+            raise _Unusable
+        roots = [name for name in links if name not in parent_of]
+        if len(roots) != 1:
+            shown = ", ".join(f"{r} (line {links[r]})" for r in roots) or "none (a cycle)"
+            self.error("disconnected", f"the tree must have one root link; this file has {len(roots)}: {shown}")
+            raise _Unusable
+        children: dict[str, list[_Joint]] = {}
+        for j in self.joints.values():
+            children.setdefault(j.parent, []).append(j)
+        self.root = roots[0]
+        # depth-first from the root, siblings in file order (a serial chain has one order); iterative
+        self.order: list[_Joint] = []
+        self.link_world: dict[str, np.ndarray] = {self.root: np.eye(4)}
+        stack = list(reversed(children.get(self.root, [])))
+        while stack:
+            j = stack.pop()
+            if j.child in self.link_world:  # reached twice: only through a cycle, reported below
+                continue
+            M = np.eye(4)
+            M[:3, :3] = _rpy_matrix(*j.rpy)
+            M[:3, 3] = j.xyz
+            j.world = self.link_world[j.parent] @ M
+            self.link_world[j.child] = j.world
+            self.order.append(j)
+            stack.extend(reversed(children.get(j.child, [])))
+        unreached = [n for n in links if n not in self.link_world]
+        if unreached:
+            self.error("disconnected", f"links not connected to the root {self.root}: {', '.join(unreached)} "
+                       "(a cycle)", links[unreached[0]])  # fmt: skip
+            raise _Unusable
+        self.links = links
+        self.parent_of = parent_of
+        self.children = children
+
+    # ------------------------------------------------------------------------------------- joints
+    def joint_rules(self) -> None:
+        movable = [j for j in self.order if j.type in _MOVABLE]
+        self.chain = movable
+        listing = ", ".join(f"{j.name} ({j.type}, line {j.line})" for j in movable[:12])
+        if len(movable) > 12:
+            listing += f", ... ({len(movable) - 12} more)"
+        self.add(Severity.INFO, "joints", f"{len(movable)} movable joints in chain order: {listing or 'none'}")
+        if len(movable) != 4:
+            self.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic); this file has "
+                       f"{len(movable)}: {listing or 'none'}")  # fmt: skip
+        for a, b in zip(movable, movable[1:]):
+            if not self._is_ancestor(a, b):
+                self.error("not-serial", f"joint {b.name} is not downstream of {a.name}: not a serial chain",
+                           b.line, b.name)  # fmt: skip
+        velocities: list[float] = []
+        first_limit_line = next((j.limit_line for j in movable if j.limit is not None), None)
+        for j in movable:
+            unit = "m/s" if j.type == "prismatic" else "rad/s"
+            if j.type == "continuous":
+                self.add(Severity.WARNING, "continuous-joint",
+                         f"joint {j.name} is continuous: Pinocchio gives it nq = 2 (cos, sin) and nv = 1, while "
+                         "scara-pin's q holds one value per joint (its angle); "
+                         + ("its <limit> lower/upper are ignored" if j.limit is not None else "it has no limits"),
+                         j.line, j.name)  # fmt: skip
+            lim = j.limit
+            if lim is None:
+                if j.type != "continuous":
+                    self.error("limit-missing", f"{j.type} joint {j.name} has no <limit>: urdfdom refuses it",
+                               j.line, j.name)  # fmt: skip
+                continue
+            for attr in ("velocity", "effort"):
+                if attr not in lim:
+                    self.error("limit-missing", f"joint {j.name}'s <limit> has no {attr}: urdfdom refuses it",
+                               j.limit_line, j.name)  # fmt: skip
+            if j.type != "continuous":
+                missing = [a for a in ("lower", "upper") if a not in lim]
+                if missing:
+                    self.error("limit-missing", f"joint {j.name}'s <limit> has no {' and '.join(missing)}: read as 0, "
+                               "the joint cannot move", j.limit_line, j.name)  # fmt: skip
+            nums = {}
+            for attr in ("lower", "upper", "velocity", "effort"):
+                if attr in lim:
+                    try:
+                        nums[attr] = float(lim[attr])
+                    except ValueError:
+                        nums[attr] = math.nan
+                    if not math.isfinite(nums[attr]):
+                        self.error("bad-number", f"joint {j.name}'s {attr} limit is {lim[attr]!r}: not a finite number",
+                                   j.limit_line, j.name)  # fmt: skip
+            lo, hi = nums.get("lower", 0.0), nums.get("upper", 0.0)
+            if j.type != "continuous" and "lower" in nums and "upper" in nums:
+                if lo > hi:
+                    self.error("limits-inverted", f"joint {j.name}: lower {lo:g} > upper {hi:g}", j.limit_line, j.name)
+                elif lo == hi:
+                    self.error("limits-empty", f"joint {j.name}: lower = upper = {lo:g}: the joint cannot move",
+                               j.limit_line, j.name)  # fmt: skip
+                if j.type == "revolute" and max(abs(lo), abs(hi)) > REVOLUTE_RANGE and math.isfinite(lo + hi):
+                    self.add(Severity.WARNING, "limits-implausible",
+                             f"joint {j.name}'s limits [{lo:g}, {hi:g}] rad are "
+                             f"{math.degrees(lo):.4g}..{math.degrees(hi):.4g} deg "
+                             f"({(hi - lo) / (2 * math.pi):.3g} turns): degrees written as radians?",
+                             j.limit_line, j.name)  # fmt: skip
+                elif j.type == "prismatic" and max(abs(lo), abs(hi)) > PRISMATIC_RANGE and math.isfinite(lo + hi):
+                    self.add(Severity.WARNING, "limits-implausible",
+                             f"joint {j.name}'s stroke [{lo:g}, {hi:g}] m is longer than {PRISMATIC_RANGE:g} m: "
+                             "millimetres written as metres?", j.limit_line, j.name)  # fmt: skip
+            v = nums.get("velocity", math.nan)
+            if not math.isfinite(v):
+                continue
+            velocities.append(v)
+            low, high = PRISMATIC_VELOCITY if j.type == "prismatic" else REVOLUTE_VELOCITY
+            if v == 0:
+                self.add(Severity.WARNING, "velocity-zero", f"joint {j.name}'s velocity limit is 0 {unit}: "
+                         "a placeholder; "
+                         "timing and trajectories need the real limit (> 0)", j.limit_line, j.name)  # fmt: skip
+            elif v in PLACEHOLDER_VELOCITIES:
+                self.add(Severity.WARNING, "velocity-placeholder", f"joint {j.name}'s velocity limit is {v:g} {unit}: "
+                         "a placeholder value", j.limit_line, j.name)  # fmt: skip
+            elif v < 0 or not low <= v <= high:
+                note = ""
+                as_deg = v * 180.0 / math.pi
+                if abs(as_deg - round(as_deg)) < 1e-6 * max(1.0, as_deg) and round(as_deg) != 0:
+                    note = f"; it is {round(as_deg):g} deg/s converted to rad: a unit error?"
+                self.add(Severity.WARNING, "velocity-implausible",
+                         f"joint {j.name}'s velocity limit {v:g} {unit} is outside {low:g}..{high:g} {unit}{note}",
+                         j.limit_line, j.name)  # fmt: skip
+        if len(velocities) >= 3 and len(set(velocities)) == 1 and velocities[0] != 0 \
+                and velocities[0] not in PLACEHOLDER_VELOCITIES:  # fmt: skip
+            self.add(Severity.WARNING, "velocity-placeholder",
+                     f"every joint has the velocity limit {velocities[0]:g} (rad/s and m/s alike): a placeholder?",
+                     first_limit_line)
+
+    def _is_ancestor(self, a: _Joint, b: _Joint) -> bool:
+        link = b.parent
+        while link in self.parent_of:
+            j = self.parent_of[link]
+            if j is a:
+                return True
+            link = j.parent
+        return False
+
+    # ------------------------------------------------------------------------------------- geometry
+    def geometry(self) -> None:
+        base = "base" if "base" in self.link_world else self.root
+        self.base = base
+        bMo = np.linalg.inv(self.link_world[base])
+        tool = "tool0" if "tool0" in self.link_world else None
+        if tool is None and self.chain:  # the deepest link below the last movable joint (first in file order)
+            level = [self.chain[-1].child]
+            while level:
+                tool = level[0]
+                level = [j.child for link in level for j in self.children.get(link, [])]
+            self.add(Severity.INFO, "tool-frame",
+                     f"no tool0 frame: {tool} (the chain's last link) is taken as the tool")
+        self.tool = tool
+        p_tool = (bMo @ self.link_world[tool])[:3, 3] if tool else np.zeros(3)
+        revolute: list[tuple[_Joint, np.ndarray]] = []
+        prismatic_at = [i for i, j in enumerate(self.chain) if j.type == "prismatic"]
+        self.axes: dict[str, tuple[float, float, float]] = {}
+        for j in self.chain:
+            M = bMo @ j.world
+            axis = M[:3, :3] @ (np.asarray(j.axis) / np.linalg.norm(j.axis))
+            self.axes[j.name] = (float(axis[0]), float(axis[1]), float(axis[2]))
+            tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
+            if tilt > TILT_TOL:
+                self.add(Severity.WARNING, "axis-tilted",
+                         f"joint {j.name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
+                         f"axis (more than {TILT_TOL:g} rad): the closed-form IK refuses it; only numeric IK applies",
+                         j.line, j.name)  # fmt: skip
+            elif axis[2] < 0:
+                if j.type == "prismatic":
+                    self.add(Severity.INFO, "axis-down", f"joint {j.name} (prismatic) moves along base -z: q grows "
+                             "downward (the usual quill convention)", j.line, j.name)  # fmt: skip
+                else:
+                    self.add(Severity.WARNING, "axis-flipped", f"joint {j.name}'s axis points along base -z: q turns "
+                             "clockwise seen from above (handled by the toolkit)", j.line, j.name)  # fmt: skip
+            if j.type != "prismatic":
+                revolute.append((j, M[:3, 3]))
+        if len(prismatic_at) == 1 and len(self.chain) == 4 and prismatic_at[0] != 2:
+            j = self.chain[prismatic_at[0]]
+            self.add(Severity.WARNING, "prismatic-position",
+                     f"the prismatic joint {j.name} is joint {prismatic_at[0] + 1} of 4, not the third "
+                     f"({'the whole arm lifts' if prismatic_at[0] == 0 else 'an unusual layout'}): supported",
+                     j.line, j.name)  # fmt: skip
+        if len(revolute) == 3:
+            (ja, pa), (_, pb), (_, pc) = revolute
+            u1, u2 = (pb - pa)[:2], (pc - pb)[:2]
+            if min(np.linalg.norm(u1), np.linalg.norm(u2)) > 1e-9:
+                heading = math.degrees(math.atan2(u1[1], u1[0]))
+                gamma = math.degrees(math.atan2(u1[0] * u2[1] - u1[1] * u2[0], u1 @ u2))
+                if abs(gamma) > 170.0:
+                    self.add(Severity.WARNING, "zero-pose-folded",
+                             f"at q = 0 the arm is folded: arm 2 turns {gamma:.4g} deg from arm 1 (the wrist is "
+                             f"{np.linalg.norm(pc[:2] - pa[:2]):.4g} m from the shoulder axis)", ja.line)  # fmt: skip
+                elif abs(gamma) > 1.0:
+                    self.add(Severity.INFO, "zero-pose-bent", f"at q = 0 arm 2 turns {gamma:.4g} deg from arm 1")
+                if abs(heading) > 1.0:
+                    names = {90: "+y", -90: "-y", 180: "-x", -180: "-x"}
+                    named = names.get(int(round(heading)), f"{heading:.4g} deg from +x")
+                    self.add(Severity.INFO, "zero-pose-direction",
+                             f"at q = 0 arm 1 points along {named} ({heading:.4g} deg from +x), not +x: the zero "
+                             "offset is handled by the toolkit", ja.line, ja.name)  # fmt: skip
+        # rpy values approximating a multiple of pi/2: the tool error at the zero pose; offsets in mm
+        for j in self.order:
+            if max(abs(v) for v in j.xyz) > OFFSET_RANGE:
+                self.add(Severity.WARNING, "length-implausible",
+                         f"joint {j.name}'s origin xyz {' '.join(f'{v:g}' for v in j.xyz)} is more than "
+                         f"{OFFSET_RANGE:g} m long: millimetres written as metres?", j.rpy_line, j.name)  # fmt: skip
+            for k, (axis_name, value) in enumerate(zip(("roll", "pitch", "yaw"), j.rpy)):
+                n = round(value / (math.pi / 2))
+                err = value - n * math.pi / 2
+                if n == 0 or not RPY_EXACT < abs(err) < RPY_NEAR:
+                    continue
+                exact = {1: "pi/2", -1: "-pi/2", 2: "pi", -2: "-pi"}.get(n, f"{n}*pi/2")
+                dist = float(np.linalg.norm(p_tool - (bMo @ j.world)[:3, 3])) if tool else 0.0
+                mm = abs(err) * dist * 1000.0
+                sev = Severity.WARNING if mm >= 1e-3 else Severity.INFO
+                self.add(sev, "rpy-approximate",
+                         f"joint {j.name}: rpy {axis_name} = {value!r} approximates {exact} "
+                         f"(error {abs(err):.3g} rad = "
+                         f"{math.degrees(abs(err)):.3g} deg); the tool is {dist:.4g} m from this joint at q = 0: about "
+                         f"{mm:.3g} mm of position error at full reach; write {exact} as {n * math.pi / 2!r}",
+                         j.rpy_line, j.name)  # fmt: skip
+
+    # ------------------------------------------------------------------------------------- loading
+    def load(self) -> None:
+        from .errors import UrdfError
+        from .ik import NotScaraError
+        from .model import Robot
+
+        try:
+            robot = Robot(self.text, origin=self.source, tool_frame=self.tool or "tool0")
+        except UrdfError as exc:
+            hint = ""
+            if any(j.type == "continuous" for j in self.chain) and "nq" in str(exc):
+                hint = " (continuous joints are not supported by Robot yet: write them as revolute with limits)"
+            self.error("not-loadable", f"the toolkit cannot load it: {exc}{hint}")
+            return
+        try:
+            robot.kinematics  # noqa: B018 - reading the geometry is the check
+        except NotScaraError as exc:
+            if not any(f.code == "axis-tilted" for f in self.findings):
+                self.add(Severity.WARNING, "closed-form-refused",
+                         f"the closed-form IK refuses it: {exc}; only numeric IK applies")
+
+    def run(self) -> CheckReport:
+        try:
+            self.structure()
+            self.joint_rules()
+            self.geometry()
+            if not any(f.severity is Severity.ERROR for f in self.findings):
+                self.load()
+        except _Unusable:
+            pass
+        joints = tuple(
+            JointInfo(j.name, j.type, j.line, j.parent, j.child, getattr(self, "axes", {}).get(j.name))
+            for j in self.chain
+        )
+        return CheckReport(self.source, tuple(self.findings), joints, self.tool)
+
+
+def check_urdf(text: str, *, origin: str = "URDF") -> CheckReport:
+    """Lint URDF text.
+
+    Args:
+        text: the URDF document.
+        origin: how to name the source in the report (a file name).
+
+    Returns:
+        The report; its ``status`` and ``exit_code`` give the verdict. Never raises for bad input.
+    """
+    return _Checker(text, origin).run()
+
+
+def check_urdf_file(path: str | Path) -> CheckReport:
+    """Lint a URDF file (an unreadable file gives an ``unreadable`` error finding, status unusable)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = getattr(exc, "strerror", None) or str(exc)
+        return CheckReport(str(path), (Finding(Severity.ERROR, "unreadable", f"cannot be read ({reason})"),))
+    return check_urdf(text, origin=str(path))
