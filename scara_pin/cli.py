@@ -6,7 +6,8 @@ Conventions shared by every command:
 - Joint vectors are in URDF joint order (joint1..joint4); q3 grows as the quill moves down. A palletizer's
   q is (q1, q2, theta3, q4), four angles, theta3 the small arm's absolute angle (scara_pin.palletizer).
 - ``--json`` prints one JSON object on stdout.
-- Exit codes: 0 ok, 2 invalid input, 3 infeasible request (unreachable, limits), 1 internal error.
+- Exit codes: 0 ok, 2 invalid input, 3 infeasible request (unreachable, limits), 1 internal error;
+  ``check`` also exits 4 when the URDF is usable but has warnings.
   Errors are one line on stderr starting with ``error:``; warnings start with ``warning:``.
 
 Heavy packages (toppra, matplotlib, yourdfpy, meshcat) are imported only inside the commands that need
@@ -144,16 +145,32 @@ def cmd_robots(args: argparse.Namespace) -> int:
 
 
 def cmd_urdf(args: argparse.Namespace) -> int:
-    """Write the generated URDF to stdout or, atomically, to a file."""
-    from .description import generate_urdf
+    """Write the generated URDF (of a configured robot, or of a D-H table) to stdout or, atomically, a file."""
+    if args.dh:
+        from .dh import dh_to_urdf
 
-    text = generate_urdf(args.robot, _parse_sets(args.set), prefix=args.prefix)
+        if args.set or args.prefix or args.robot != "default":
+            raise InvalidInputError("--dh takes the whole robot from the table: no --robot, --set or --prefix")
+        text = dh_to_urdf(Path(args.dh))
+    else:
+        from .description import generate_urdf
+
+        text = generate_urdf(args.robot, _parse_sets(args.set), prefix=args.prefix)
     if args.output in (None, "-"):
         sys.stdout.write(text)
     else:
         write_atomic(Path(args.output), text)
         print(f"wrote {args.output}", file=sys.stderr)
     return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable."""
+    from .urdf_check import check_urdf_file
+
+    report = check_urdf_file(args.file)
+    print(report.to_json() if args.json else report.format_text())
+    return int(report.exit_code)
 
 
 def cmd_fk(args: argparse.Namespace) -> int:
@@ -773,8 +790,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("urdf", help="write the generated URDF of a robot")
     p.add_argument("-o", "--output", metavar="FILE", help="output file (default: stdout); written atomically")
     p.add_argument("--prefix", default="", help="prefix for every link and joint name (letters, digits, _)")
+    p.add_argument("--dh", metavar="TABLE.yaml",
+                   help="build the URDF from a D-H table (standard or modified; see urdf/examples/)")  # fmt: skip
     _add_robot_options(p, urdf_file=False)
     p.set_defaults(func=cmd_urdf)
+
+    p = sub.add_parser("check", help="lint a third-party SCARA URDF: exit 0 clean, 4 warnings, 2 unusable")
+    p.add_argument("file", metavar="FILE.urdf", help="the URDF to check")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("fk", help="forward kinematics: pose of tool0 in the base frame")
     _add_q(p)
