@@ -270,7 +270,7 @@ class ScaraGeometry:
         tool_parent = model.frames[robot.tool_id].parentJoint
         if tool_parent != model.njoints - 1:
             raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint {names[-1]}")
-        q0 = np.zeros(model.nq)
+        q0 = pin.neutral(model)  # q = 0 (a continuous joint's (cos, sin) = (1, 0))
         pin.computeJointJacobians(model, data, q0)
         pin.updateFramePlacements(model, data)
         oMb = data.oMf[robot.base_id]
@@ -282,7 +282,8 @@ class ScaraGeometry:
         for j in range(1, model.njoints):
             jm = model.joints[j]
             name = model.names[j]
-            if jm.nq != 1 or jm.nv != 1:
+            continuous = jm.nq == 2 and jm.nv == 1 and robot.continuous[j - 1]
+            if (jm.nq != 1 and not continuous) or jm.nv != 1:
                 raise NotScaraError(f"joint {name} ({jm.shortname()}) has nq = {jm.nq}, nv = {jm.nv}; "
                                     "a SCARA's joints are single-DOF revolute or prismatic")  # fmt: skip
             col = pin.getJointJacobian(model, data, j, pin.LOCAL_WORLD_ALIGNED)[:, jm.idx_v]
@@ -328,9 +329,12 @@ class ScaraGeometry:
             z0=float(bMt.translation[2]),
             yaw0=math.atan2(R0[1, 0], R0[0, 0]),
             R0=R0,
-            lower=tuple(float(v) for v in model.lowerPositionLimit),
-            upper=tuple(float(v) for v in model.upperPositionLimit),
-        )
+            # continuous joints: the robot's one-turn range [-pi, pi] (see Robot); others: the model's limits
+            lower=tuple(robot.limits.lower[j - 1] if robot.continuous[j - 1]
+                        else float(model.lowerPositionLimit[model.joints[j].idx_q]) for j in range(1, 5)),
+            upper=tuple(robot.limits.upper[j - 1] if robot.continuous[j - 1]
+                        else float(model.upperPositionLimit[model.joints[j].idx_q]) for j in range(1, 5)),
+        )  # fmt: skip
 
     # ---------------------------------------------------------------------------------------- derived
     def elbow_angle(self, q_elbow: float) -> float:

@@ -208,8 +208,11 @@ class _Task:
     def __init__(self, robot: Robot, target: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: list[bool],
                  opts: NumericIKOptions) -> None:  # fmt: skip
         self.robot = robot
-        self.model = getattr(robot, "_base_model", None)
-        self.data = getattr(robot, "_base_data", None)
+        # continuous joints (Pinocchio's q holds their cos, sin): through the robot's public methods, which
+        # convert q; the joint values themselves stay angles, wrapped into [-pi, pi] by the projection
+        plain = not getattr(robot, "has_continuous", False)
+        self.model = getattr(robot, "_base_model", None) if plain else None
+        self.data = getattr(robot, "_base_data", None) if plain else None
         self.tool = robot.tool_id
         self.x, self.y, self.z, self.yaw = target.tolist()
         self.target = target

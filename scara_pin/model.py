@@ -4,7 +4,9 @@ Conventions (used by every command of the package):
 
 - ``q`` holds the four joint values in URDF joint order, SI units ([rad], and [m] for the quill).
   Passive ``<mimic>`` joints (the palletizer's levelling joints) are loaded as Pinocchio mimic joints:
-  they follow their joint and are not in ``q``.
+  they follow their joint and are not in ``q``. A URDF ``continuous`` joint (Pinocchio: nq = 2, its
+  (cos q, sin q)) is one angle in ``q`` too: no position limit (any finite q), IK solutions presented in
+  [-pi, pi]; :meth:`Robot.to_pinocchio_q` / :meth:`Robot.from_pinocchio_q` convert for raw Pinocchio calls.
 - Poses are of ``tool0`` in the robot's ``base`` frame (the controller's reference frame). The yaw is
   ``atan2(R[1, 0], R[0, 0])`` of that rotation: the heading of tool0's x axis in the base plane.
 - Pinocchio's world frame (``universe``) is the root link (``base_link``); Jacobians named after
@@ -111,17 +113,52 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
     return model
 
 
+_CONTINUOUS = frozenset(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"))
+"""Pinocchio's continuous (unbounded revolute) joints: nq = 2 (cos, sin), nv = 1."""
+
+
+def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
+    """Per joint of q (nv = 1 each; passive mimic joints, nv = 0, skipped): whether it is continuous.
+
+    Raises:
+        UrdfError: not 4 single-DOF joints (nv = 4, each nq = 1, or nq = 2 for a continuous joint).
+    """
+    out = []
+    ok = model.nv == len(JOINT_NAMES)
+    for j in range(1, model.njoints):
+        jm = model.joints[j]
+        if jm.nv == 0 and jm.nq == 0:  # a mimic joint: follows its joint, not in q
+            continue
+        cont = jm.nq == 2 and jm.nv == 1 and jm.shortname() in _CONTINUOUS
+        ok = ok and (cont or (jm.nq == 1 and jm.nv == 1))
+        out.append(cont)
+    if not ok or len(out) != len(JOINT_NAMES) or model.nq != len(JOINT_NAMES) + sum(out):
+        joints = ", ".join(f"{model.names[i]} (nq {model.joints[i].nq})" for i in range(1, model.njoints))
+        raise UrdfError(
+            f"{origin}: a SCARA has 4 single-DOF joints; this model has nq = {model.nq}, "
+            f"nv = {model.nv}: {joints}"
+        )
+    return tuple(out)
+
+
 class Robot:
     """A 4-joint robot (SCARA or palletizer) in Pinocchio, with its frames and limits.
 
+    Continuous joints (URDF ``continuous``; Pinocchio stores them as (cos q, sin q), nq = 2) are accepted:
+    users still see ``q`` as 4 values; :meth:`to_pinocchio_q` / :meth:`from_pinocchio_q` convert. Such a joint
+    has no position limit: any finite value is a configuration (FK, Jacobians; ``outside_limits`` never
+    names it), and ``limits.lower/upper`` are -pi/pi for it, the one-turn range IK solutions are presented
+    in. Its velocity and effort limits are the URDF's ``<limit>`` values as Pinocchio reads them.
+
     Attributes:
-        model: the Pinocchio model (``nq = nv = 4``).
+        model: the Pinocchio model (``nv = 4``; ``nq = 4`` plus one per continuous joint).
         data: its Pinocchio data (the methods below overwrite it).
         urdf: the URDF text the model was built from.
         name: the robot's name.
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
         kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file counts as a SCARA).
+        continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
         base_frame, tool_frame: names of the reference frame and of the tool frame.
     """
 
@@ -132,6 +169,8 @@ class Robot:
     limits: JointLimits
     parameters: RobotParameters | None
     kind: str
+    continuous: tuple[bool, ...]
+    has_continuous: bool
     base_frame: str
     tool_frame: str
 
@@ -160,12 +199,7 @@ class Robot:
             UrdfError: unreadable, invalid or disconnected URDF, or not a 4-joint robot.
         """
         model = _parse_urdf(urdf, origin)
-        if model.nq != len(JOINT_NAMES) or model.nv != len(JOINT_NAMES):
-            joints = ", ".join(f"{model.names[i]} (nq {model.joints[i].nq})" for i in range(1, model.njoints))
-            raise UrdfError(
-                f"{origin}: a SCARA has 4 single-DOF joints; this model has nq = {model.nq}, "
-                f"nv = {model.nv}: {joints}"
-            )
+        continuous = _continuous_joints(model, origin)
         if not model.existFrame(tool_frame):
             raise UrdfError(f"{origin}: no frame named {tool_frame!r}")
         if not model.existFrame(base_frame):
@@ -183,9 +217,12 @@ class Robot:
         if parameters is not None:
             self.limits = parameters.limits
         else:  # a URDF file: record its limits as written (they may be placeholders; not checked here)
+            # per joint in q order; a continuous joint has no position limit: [-pi, pi] (one turn) is the
+            # range its IK solutions are presented in (Pinocchio's cos/sin bounds of +/-1.01 mean nothing here)
+            iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
             self.limits = JointLimits(
-                lower=tuple(float(v) for v in model.lowerPositionLimit),
-                upper=tuple(float(v) for v in model.upperPositionLimit),
+                lower=tuple(-math.pi if c else float(model.lowerPositionLimit[i]) for i, c in zip(iq, continuous)),
+                upper=tuple(math.pi if c else float(model.upperPositionLimit[i]) for i, c in zip(iq, continuous)),
                 velocity=tuple(float(v) for v in model.velocityLimit),
                 acceleration=tuple(math.nan for _ in JOINT_NAMES) if acceleration is None
                 else tuple(float(v) for v in acceleration),
@@ -199,6 +236,18 @@ class Robot:
         self._base_model = _rerooted(model, self.data.oMf[self.base_id].inverse())
         self._base_data = self._base_model.createData()
         self._rows = np.array([0, 1, 2, 5])  # x, y, z, wz of a 6-row Jacobian
+        self.continuous = continuous
+        self.has_continuous = any(continuous)
+        if self.has_continuous:
+            # (index in q, index in Pinocchio's q, continuous?) per joint; the hot paths convert q on the way
+            # in. Robots without continuous joints keep Robot._pin_q (= _valid_q): no extra cost, not even an
+            # instance attribute that would slow the method lookups of every Robot in the process.
+            iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
+            self._q_map = tuple(zip(range(len(JOINT_NAMES)), iq, continuous))
+            if type(self) is Robot:
+                self.__class__ = _ContinuousRobot
+            else:  # a user's subclass: keep it, convert through an instance attribute
+                self._pin_q = self._valid_pin_q  # type: ignore[method-assign]
 
     # ----------------------------------------------------------------- construction helpers
     @classmethod
@@ -311,6 +360,8 @@ class Robot:
         """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
         out = []
         for i, joint in enumerate(JOINT_NAMES):
+            if self.continuous[i]:  # no position limit
+                continue
             lo, hi = self.limits.lower[i], self.limits.upper[i]
             if not lo - tol <= q[i] <= hi + tol:
                 out.append(f"{joint} = {q[i]:.9g} outside [{lo:.9g}, {hi:.9g}]")
@@ -330,12 +381,61 @@ class Robot:
             pass
         return self.check_q(q)
 
+    _pin_q = _valid_q
+    """``q`` as Pinocchio takes it, checked (the fast path first). A robot with continuous joints is given the
+    class :class:`_ContinuousRobot`, whose ``_pin_q`` is :meth:`_valid_pin_q`: robots without continuous
+    joints pay nothing for the conversion."""
+
+    def _valid_pin_q(self, q: object) -> np.ndarray:
+        """:meth:`_valid_q` then the conversion to Pinocchio's q (continuous joints as cos, sin)."""
+        q = self._valid_q(q)
+        out = [0.0] * self.model.nq
+        for i, iq, cont in self._q_map:
+            v = float(q[i])
+            if cont:
+                out[iq] = math.cos(v)
+                out[iq + 1] = math.sin(v)
+            else:
+                out[iq] = v
+        return np.array(out)
+
+    def to_pinocchio_q(self, q: object) -> np.ndarray:
+        """The user's 4 joint values (checked) as Pinocchio's configuration vector (``model.nq`` values).
+
+        A continuous joint's angle q becomes (cos q, sin q); other joints are copied. Without continuous
+        joints this is :meth:`check_q`.
+        """
+        if not self.has_continuous:
+            return self.check_q(q)
+        return self._valid_pin_q(self.check_q(q))
+
+    def from_pinocchio_q(self, q_pin: object) -> np.ndarray:
+        """Pinocchio's configuration vector (``model.nq`` values) as the user's 4 joint values.
+
+        A continuous joint's (cos, sin) becomes ``atan2(sin, cos)``, in [-pi, pi].
+
+        Raises:
+            ParameterError: not ``model.nq`` finite numbers.
+        """
+        try:
+            arr = np.asarray(q_pin, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError("q_pin", q_pin, f"must be {self.model.nq} numbers") from None
+        if arr.shape != (self.model.nq,) or not np.isfinite(arr).all():
+            raise ParameterError("q_pin", q_pin, f"must be {self.model.nq} finite numbers")
+        if not self.has_continuous:
+            return arr.copy()
+        out = np.empty(len(JOINT_NAMES))
+        for i, iq, cont in self._q_map:
+            out[i] = math.atan2(arr[iq + 1], arr[iq]) if cont else arr[iq]
+        return out
+
     def tool_placement(self, q: np.ndarray) -> pin.SE3:
         """``baseMtool``: the placement of the tool frame in the base frame, at ``q``.
 
         Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
         """
-        q = self._valid_q(q)
+        q = self._pin_q(q)
         model, data = self._base_model, self._base_data
         pin.forwardKinematics(model, data, q)
         return pin.updateFramePlacement(model, data, self.tool_id)
@@ -349,7 +449,7 @@ class Robot:
 
         ``relative_to="universe"`` gives Pinocchio's ``oMf``.
         """
-        q = self.check_q(q)
+        q = self.to_pinocchio_q(q)
         fid = self._frame_id(frame)
         ref = self.base_id if relative_to is None else self._frame_id(relative_to)
         pin.framesForwardKinematics(self.model, self.data, q)
@@ -365,7 +465,7 @@ class Robot:
             frame: frame name; the tool frame by default.
             reference: ``"world"``, ``"local"`` or ``"local_world_aligned"`` (or a pin.ReferenceFrame).
         """
-        q = self.check_q(q)
+        q = self.to_pinocchio_q(q)
         fid = self.tool_id if frame is None else self._frame_id(frame)
         if isinstance(reference, str):
             if reference.lower() not in _REFERENCES:
@@ -379,7 +479,7 @@ class Robot:
         Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
         base z axis, which equals d(yaw)/dt while the tool stays level).
         """
-        q = self._valid_q(q)
+        q = self._pin_q(q)
         J = pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED)
         return J.take(self._rows, 0)
 
@@ -392,6 +492,38 @@ class Robot:
             names = ", ".join(f.name for f in self.model.frames)
             raise InvalidInputError(f"no frame named {frame!r}; frames: {names}")
         return int(self.model.getFrameId(frame))
+
+
+class _ContinuousRobot(Robot):
+    """A :class:`Robot` with continuous joints (``Robot(...)`` gives such an instance this class): its hot
+    paths (``tool_placement``, ``task_jacobian``) convert q to Pinocchio's (cos, sin) on the way in."""
+
+    _pin_q = Robot._valid_pin_q
+
+    def ik(self, target: Any, *, branch: str = "all", reference: Sequence[float] | None = None) -> IKResult:
+        """:meth:`Robot.ik`, each solution listed once: a continuous joint's range [-pi, pi] has the same
+        joint position at both ends, so a solution found at -pi and at +pi is kept once (the first found,
+        or the one nearer to ``reference`` when given)."""
+        import dataclasses
+
+        result = super().ik(target, branch=branch, reference=reference)
+        if len(result.solutions) < 2:
+            return result
+        ref = None if reference is None else np.asarray(reference, dtype=float)
+        cont = self.continuous
+        keep: list[Any] = []
+        for s in result.solutions:
+            for k, t in enumerate(keep):
+                if all(abs(math.remainder(a - b, 2 * math.pi) if c else a - b) <= 1e-9
+                       for a, b, c in zip(s.q.tolist(), t.q.tolist(), cont)):  # fmt: skip
+                    if ref is not None and float(np.sum((s.q - ref) ** 2)) < float(np.sum((t.q - ref) ** 2)):
+                        keep[k] = s
+                    break
+            else:
+                keep.append(s)
+        if len(keep) == len(result.solutions):
+            return result
+        return dataclasses.replace(result, solutions=tuple(keep))
 
 
 def load_robot(

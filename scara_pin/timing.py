@@ -295,6 +295,8 @@ def _tool_rows(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
 def _rnea(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
     model = robot.model
     data = model.createData()
+    if getattr(robot, "has_continuous", False):  # Pinocchio takes a continuous joint's (cos, sin)
+        return np.array([pin.rnea(model, data, robot.to_pinocchio_q(q[k]), v[k], a[k]) for k in range(len(q))])
     return np.array([pin.rnea(model, data, q[k], v[k], a[k]) for k in range(len(q))])
 
 

@@ -347,6 +347,8 @@ class _Kinematics:
         self.model = robot.model
         self.data = robot.model.createData()
         self.tool_id = robot.tool_id
+        # continuous joints: Pinocchio takes their (cos, sin); v stays the 4 joint rates
+        self.to_pin = robot.to_pinocchio_q if getattr(robot, "has_continuous", False) else None
         pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
         self.Rbo = self.data.oMf[robot.base_id].rotation.T.copy()  # base axes from world axes
 
@@ -358,10 +360,14 @@ class _Kinematics:
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """The 4 x 4 task Jacobian at q."""
+        if self.to_pin is not None:
+            q = self.to_pin(q)
         return self._task(pin.computeFrameJacobian(self.model, self.data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED))
 
     def jacobian_rate(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """dJ/dt of the task Jacobian when the joints move at v (Pinocchio's time variation)."""
+        if self.to_pin is not None:
+            q = self.to_pin(q)
         pin.computeJointJacobiansTimeVariation(self.model, self.data, q, v)
         pin.updateFramePlacements(self.model, self.data)
         dJ = pin.getFrameJacobianTimeVariation(self.model, self.data, self.tool_id, pin.LOCAL_WORLD_ALIGNED)

@@ -414,7 +414,8 @@ class _Checker:
             if j.type == "continuous":
                 self.add(Severity.WARNING, "continuous-joint",
                          f"joint {j.name} is continuous: Pinocchio gives it nq = 2 (cos, sin) and nv = 1, while "
-                         "scara-pin's q holds one value per joint (its angle); "
+                         "scara-pin's q holds one value per joint (its angle: converted to cos, sin for Pinocchio; "
+                         "no position limit, IK solutions presented in [-pi, pi]); "
                          + ("its <limit> lower/upper are ignored" if j.limit is not None else "it has no limits"),
                          j.line, j.name)  # fmt: skip
             lim = j.limit
@@ -586,10 +587,7 @@ class _Checker:
         try:
             robot = Robot(self.text, origin=self.source, tool_frame=self.tool or "tool0")
         except UrdfError as exc:
-            hint = ""
-            if any(j.type == "continuous" for j in self.chain) and "nq" in str(exc):
-                hint = " (continuous joints are not supported by Robot yet: write them as revolute with limits)"
-            self.error("not-loadable", f"the toolkit cannot load it: {exc}{hint}")
+            self.error("not-loadable", f"the toolkit cannot load it: {exc}")
             return
         try:
             robot.kinematics  # noqa: B018 - reading the geometry is the check

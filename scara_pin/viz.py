@@ -132,9 +132,9 @@ def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.nda
         raise InvalidInputError("times and qs must be numbers: (N,) times [s] and (N, 4) joint values") from None
     if t.ndim != 1 or t.shape[0] < 1:
         raise InvalidInputError(f"times must be a 1-D array of at least one time [s] (got shape {t.shape})")
-    if q.shape != (t.shape[0], robot.model.nq):
+    if q.shape != (t.shape[0], 4):
         raise InvalidInputError(
-            f"qs must have shape ({t.shape[0]}, {robot.model.nq}), one row per time (got {q.shape})"
+            f"qs must have shape ({t.shape[0]}, 4), one row per time (got {q.shape})"
         )
     if not np.isfinite(t).all():
         raise InvalidInputError("times must be finite")
@@ -191,8 +191,8 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.nd
 def tool_path(robot: Robot, qs: object) -> np.ndarray:
     """(N, 3) positions of the tool frame in the base frame [m] along the joint values ``qs`` (N, 4)."""
     q = np.array(qs, dtype=float)
-    if q.ndim != 2 or q.shape[1] != robot.model.nq:
-        raise InvalidInputError(f"qs must have shape (N, {robot.model.nq}) (got {q.shape})")
+    if q.ndim != 2 or q.shape[1] != 4:
+        raise InvalidInputError(f"qs must have shape (N, 4) (got {q.shape})")
     return np.array([robot.tool_placement(robot.check_q(row)).translation for row in q])
 
 
@@ -507,7 +507,7 @@ class _Scene:
         self.size = max(0.05, max(float(np.linalg.norm(f.translation)) for f in data.oMf))
         viz.displayFrames(True, frame_ids=[robot.tool_id], axis_length=0.25 * self.size, axis_width=2)
         self._camera()
-        self.display(q0)
+        self.display(robot.from_pinocchio_q(q0))  # q = 0 (Pinocchio's neutral, as the user's 4 values)
 
     def _camera(self) -> None:
         """Look at the root from the front right, from about 2 arm lengths (meshcat's default is 3 m away)."""
@@ -519,7 +519,7 @@ class _Scene:
         self.vis["/Axes"].set_property("visible", False)
 
     def display(self, q: object) -> None:
-        self.viz.display(self.robot.check_q(q))
+        self.viz.display(self.robot.to_pinocchio_q(q))  # continuous joints: their (cos, sin)
 
     def animation(self, times: np.ndarray, qs: np.ndarray, fps: int) -> Any:
         """Build a meshcat animation of the motion, ``fps`` frames per second.
@@ -542,7 +542,7 @@ class _Scene:
             for frame, row in zip(frames.tolist(), q, strict=True):
                 with anim.at_frame(self.vis, frame) as at:
                     self.viz.viewer = at  # Pinocchio's display() writes transforms into the frame
-                    self.viz.display(row)
+                    self.viz.display(self.robot.to_pinocchio_q(row))
         finally:
             self.viz.viewer = live
         return anim

@@ -471,9 +471,8 @@ TWO_PRISMATIC = _robot("two_prismatic", [_link(n) for n in ("base_link", "a", "b
 
 @pytest.mark.parametrize(
     ("urdf", "needles"),
-    [(RRP_ROS_TUTORIAL, ["nq = 3", "j1", "j2", "j3"]), (FIVE_JOINTS, ["nq = 5", "j5"]),
-     (CONTINUOUS_J4, ["j4", "nq 2"])],
-    ids=["3_joints_ros_rrp", "5_joints", "continuous_j4"],
+    [(RRP_ROS_TUTORIAL, ["nq = 3", "j1", "j2", "j3"]), (FIVE_JOINTS, ["nq = 5", "j5"])],
+    ids=["3_joints_ros_rrp", "5_joints"],  # a continuous joint (nq = 2) is accepted: tests/test_continuous.py
 )  # fmt: skip
 def test_not_four_single_dof_joints_is_refused(urdf: str, needles: list[str]) -> None:
     with pytest.raises(UrdfError) as info:
@@ -482,6 +481,23 @@ def test_not_four_single_dof_joints_is_refused(urdf: str, needles: list[str]) ->
     assert "fixture.urdf" in msg
     for needle in needles:
         assert needle in msg, msg
+
+
+def test_continuous_j4_is_accepted_and_matches_the_closed_form() -> None:
+    """A continuous J4 (Pinocchio: nq = 2, cos/sin) loads with a 4-value q; FK is the fixture's closed form
+    (1e-12) at any angle, and the closed-form IK presents J4 in [-pi, pi] (more in tests/test_continuous.py)."""
+    robot = Robot(CONTINUOUS_J4, origin="fixture.urdf")
+    assert robot.model.nq == 5 and robot.continuous == (False, False, False, True)
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        q = np.array([rng.uniform(D(-132), D(132)), rng.uniform(D(-150), D(150)), rng.uniform(-0.15, 0.0),
+                      rng.uniform(-3 * math.pi, 3 * math.pi)])  # fmt: skip
+        e = robot.tool_pose(q) - yk400xe_y_fk(q)
+        e[3] = wrap(e[3])
+        assert np.abs(e).max() <= TOL_FK, q
+        sols = robot.ik(robot.tool_pose(q)).solutions
+        assert sols and all(-math.pi <= s.q[3] <= math.pi for s in sols)
+        assert any(np.abs(s.q[:3] - q[:3]).max() <= Q_TOL and abs(wrap(s.q[3] - q[3])) <= Q_TOL for s in sols)
 
 
 def test_two_prismatic_joints_is_not_a_scara() -> None:
