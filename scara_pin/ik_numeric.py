@@ -71,7 +71,7 @@ class NumericIKOptions:
 
     tol: float = 1e-12
     max_iterations: int = 60
-    restarts: int = 20
+    restarts: int = 40
     damping: float = 1e-3
     seed: int = 0
 
@@ -152,8 +152,9 @@ def solve_numeric(
         raise ParameterError("target", tgt.tolist(), "must be 4 finite numbers (x, y, z, yaw)")
     lo = np.asarray(robot.limits.lower)
     hi = np.asarray(robot.limits.upper)
-    joints = robot.model.joints
-    revolute = [joints[j].shortname().startswith("JointModelR") for j in range(1, 5)]
+    # the actuated joints in q order (mimic joints, nv = 0, follow others and are not in q)
+    actuated = [jm for jm in robot.model.joints[1:] if jm.nv > 0]
+    revolute = [jm.shortname().startswith("JointModelR") for jm in actuated]
     turning = [i for i in range(4) if revolute[i]]
     elbow = turning[1] if len(turning) >= 2 else None
     start = (lo + hi) / 2 if q0 is None else robot.check_q(q0)

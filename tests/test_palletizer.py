@@ -559,3 +559,17 @@ def test_cli_workspace(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> No
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     rc, out, err = run(capsys, ["workspace", "--robot", "palletizer", "--ray", "1", "0", "1", "0"])
     assert rc == 2 and "SCARA-only" in err
+
+
+def test_numeric_ik_sees_the_four_actuated_joints_of_the_coupled_model() -> None:
+    """The mimic (levelling) joints are not in q: the numeric IK must turn the flange (joint4) by 2 pi
+    turns like any revolute joint, not treat it as a non-revolute joint."""
+    from scara_pin.ik_numeric import solve_numeric
+
+    robot = load_robot("palletizer")
+    q = np.array([0.4, 0.3, 1.6, 2.0])
+    target = robot.tool_pose(q)
+    target[3] += 2 * math.pi  # the same yaw one turn later: reachable only through a 2 pi-equivalent
+    res = solve_numeric(robot, target)
+    assert res.success and res.residual < 1e-9
+    assert robot.outside_limits(res.q) == []
