@@ -287,7 +287,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
         from .ik import NotScaraError
 
         try:
-            robot.kinematics
+            _ = robot.kinematics  # extracted on first use: refused here if the model is not SCARA-like
         except NotScaraError as exc:
             log.warning("closed-form IK refused this robot (%s); using the numeric IK", exc)
             numeric = True
@@ -315,7 +315,8 @@ def cmd_ik(args: argparse.Namespace) -> int:
         return code
     if code:
         raise InfeasibleError(f"{status}: {message}")
-    print(f"robot     {robot.name}: {'numeric' if numeric else 'closed-form'} IK of {robot.tool_frame} in {robot.base_frame}")
+    method = "numeric" if numeric else "closed-form"
+    print(f"robot     {robot.name}: {method} IK of {robot.tool_frame} in {robot.base_frame}")
     print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS))}]")
     print(f"units     q = [{', '.join(units.names(units.q))}]")
     for q, b in zip(qs, branches):
@@ -609,7 +610,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         print(json.dumps(out))
         return 0
     if hit is not None:
-        print(f"robot     {robot.name}: ray from {_fmt([v * L for v in start])} [{units.length_name}] along {_fmt(direction)}")
+        origin = _fmt([v * L for v in start])
+        print(f"robot     {robot.name}: ray from {origin} [{units.length_name}] along {_fmt(direction)}")
         print(f"edge      {_fmt([v * L for v in hit.point])} [{units.length_name}]")
         print(f"distance  {hit.distance * L:.9g} {units.length_name}")
         print(f"stopped by {hit.description} [{hit.limit.value}]")
@@ -750,10 +752,25 @@ def write_atomic(path: Path, text: str) -> None:
     write_text_atomic(path, text)
 
 
+def _add_units(
+    p: argparse.ArgumentParser, *, deg: bool = True, mm: bool = True, json_help: str | None = "print one JSON object",
+    inputs: bool = False,
+) -> None:
+    """The shared unit and output switches: --deg, --mm (human units) and --json."""
+    scope = " (inputs)" if inputs else ""
+    if deg:
+        p.add_argument("--deg", action="store_true", help=f"angles in degrees{scope}")
+    if mm:
+        p.add_argument("--mm", action="store_true", help=f"lengths in millimetres{scope}")
+    if json_help is not None:
+        p.add_argument("--json", action="store_true", help=json_help)
+
+
 def _add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True) -> None:
     g = p.add_argument_group("robot")
     g.add_argument("--robot", default="default", metavar="NAME|CONFIG_DIR",
-                   help="shipped robot name (see `scara-pin robots`) or a folder of yaml files (default: default)")  # fmt: skip
+                   help="shipped robot name (see `scara-pin robots`) or a folder of yaml files "
+                   "(default: default)")  # fmt: skip
     g.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="override a parameter, SI units (e.g. --set l1=0.25); repeatable")  # fmt: skip
     if urdf_file:
@@ -761,11 +778,10 @@ def _add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True) -> No
 
 
 def _add_q(p: argparse.ArgumentParser) -> None:
-    p.add_argument("q", nargs="*", metavar="Q", help="joint values q1 q2 q3 q4 (URDF order; SCARA: q3 > 0 lowers the quill; "
-                   "palletizer: q1 q2 theta3 q4, theta3 the small arm's absolute angle)")
-    p.add_argument("--deg", action="store_true", help="angles in degrees")
-    p.add_argument("--mm", action="store_true", help="lengths in millimetres")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("q", nargs="*", metavar="Q",
+                   help="joint values q1 q2 q3 q4 (URDF order; SCARA: q3 > 0 lowers the quill; "
+                   "palletizer: q1 q2 theta3 q4, theta3 the small arm's absolute angle)")  # fmt: skip
+    _add_units(p)
     p.add_argument("--strict", action="store_true", help="refuse (exit 3) a q outside the joint limits")
     _add_robot_options(p)
 
@@ -807,7 +823,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("jacobian", help="task Jacobian d(x, y, z, yaw)/dq (or a 6 x 4 frame Jacobian)")
     _add_q(p)
     p.add_argument("--reference", default="task", choices=["task", "world", "local", "local_world_aligned"],
-                   help="task (4 x 4, default) or a Pinocchio reference frame for the 6 x 4 frame Jacobian")  # fmt: skip
+                   help="task (4 x 4, default) or a Pinocchio reference frame for the 6 x 4 Jacobian")  # fmt: skip
     p.add_argument("--frame", default=None, help="frame of the 6 x 4 Jacobian (default: tool0)")
     p.set_defaults(func=cmd_jacobian)
 
@@ -820,9 +836,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--numeric", action="store_true", help="use Pinocchio-based numeric IK instead of the closed form")
     p.add_argument("--input", metavar="CSV", help="batch: targets with header x,y,z,yaw (one solution per row)")
     p.add_argument("--output", metavar="CSV", help="batch: joints written here (atomically), with a status column")
-    p.add_argument("--deg", action="store_true", help="angles in degrees")
-    p.add_argument("--mm", action="store_true", help="lengths in millimetres")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_units(p)
     _add_robot_options(p)
     p.set_defaults(func=cmd_ik)
 
@@ -834,14 +848,16 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--to-pose", nargs=4, metavar="P", help="end pose (IK: the solution nearest the previous point)")
     g.add_argument("--via", nargs=4, action="append", metavar="Q", help="via configuration (repeatable)")
     g = p.add_argument_group("timing")
-    g.add_argument("--duration", type=float, metavar="T", help="quintic time law over T seconds (checked against the limits)")
+    g.add_argument("--duration", type=float, metavar="T",
+                   help="quintic time law over T seconds (checked against the limits)")  # fmt: skip
     g.add_argument("--optimal", action="store_true", help="time-optimal under the joint limits (the default)")
     g.add_argument("--linear", action="store_true", help="straight tool line (S4), one elbow branch, J4 continuous")
     g.add_argument("--tool-speed", type=float, metavar="V", help="also limit the tool speed [m/s, or mm/s with --mm]")
     g.add_argument("--torque", action="store_true", help="also respect the effort limits (RNEA, URDF inertias)")
     g.add_argument("--strict", action="store_true", help="refuse (exit 3) a --duration that exceeds a limit")
     g = p.add_argument_group("outputs (files in SI units)")
-    g.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out and --json (default 1000)")
+    g.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
+                   help="sampling rate of --out and --json (default 1000)")  # fmt: skip
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
     g.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time with limits, and the tool path")
     g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
@@ -850,9 +866,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--gear", nargs=4, metavar="G", help="gear ratios (motor turns per joint/screw turn)")
     g.add_argument("--steps-per-rev", nargs=4, metavar="N", help="motor steps per motor turn")
     g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")
-    p.add_argument("--deg", action="store_true", help="angles in degrees (inputs)")
-    p.add_argument("--mm", action="store_true", help="lengths in millimetres (inputs)")
-    p.add_argument("--json", action="store_true", help="print one JSON object (with the samples unless --out)")
+    _add_units(p, inputs=True, json_help="print one JSON object (with the samples unless --out)")
     _add_robot_options(p)
     p.set_defaults(func=cmd_traj)
 
@@ -861,8 +875,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--z", metavar="Z", help="with --ray: start height (a 3-D ray also meets the J3 stroke)")
     p.add_argument("--dz", metavar="DZ", help="with --ray: vertical direction component")
     p.add_argument("--plot", metavar="PNG", help="picture of the region (arcs coloured by limit; the ray)")
-    p.add_argument("--mm", action="store_true", help="lengths in millimetres")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_units(p, deg=False)
     _add_robot_options(p)
     p.set_defaults(func=cmd_workspace)
 
@@ -873,9 +886,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out (default 1000)")
     p.add_argument("--out", metavar="FILE", help="samples as CSV (or JSON for *.json), atomically")
     p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
-    p.add_argument("--deg", action="store_true", help="angles in degrees (inputs)")
-    p.add_argument("--mm", action="store_true", help="lengths in millimetres (inputs)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_units(p, inputs=True)
     _add_robot_options(p)
     p.set_defaults(func=cmd_jog)
 
@@ -885,8 +896,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workspace", action="store_true", help="draw the workspace boundary on the floor")
     p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
-    p.add_argument("--deg", action="store_true", help="angles in degrees")
-    p.add_argument("--mm", action="store_true", help="lengths in millimetres")
+    _add_units(p, json_help=None)
     _add_robot_options(p)
     p.set_defaults(func=cmd_view)
 

@@ -338,7 +338,7 @@ class ScaraGeometry:
 
     # ---------------------------------------------------------------------------------------- derived
     def elbow_angle(self, q_elbow: float) -> float:
-        """gamma (angle from arm 1 to arm 2, counterclockwise from above) at an elbow joint value."""
+        """Gamma (angle from arm 1 to arm 2, counterclockwise from above) at an elbow joint value."""
         return self.signs[self.revolute[1]] * q_elbow + self.beta2 - self.beta1
 
     def radius_range(self) -> tuple[float, float]:
@@ -376,7 +376,7 @@ def branch_of(geo: ScaraGeometry, q: Sequence[float]) -> str:
 
 
 def _wrap(a: float) -> float:
-    """a wrapped to [-pi, pi)."""
+    """A wrapped to [-pi, pi)."""
     return (a + math.pi) % _TWO_PI - math.pi
 
 
@@ -578,7 +578,8 @@ def solve(
 
 def _free_shoulder(geo: ScaraGeometry, alpha: float, phi2: float, phi_ref: float | None) -> float:
     """phi1 for a free shoulder (wrist on its axis): inside the J1 limits, with a J4 turn inside the J4
-    limits when there is one, and nearest to the reference (``phi_ref``, else 0) among those values."""
+    limits when there is one, and nearest to the reference (``phi_ref``, else 0) among those values.
+    """
     ra, _, rc = geo.revolute
     s_a, s_c = geo.signs[ra], geo.signs[rc]
     want = s_a * (phi_ref if phi_ref is not None else 0.0)  # in q1 units

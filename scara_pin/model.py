@@ -496,14 +496,16 @@ class Robot:
 
 class _ContinuousRobot(Robot):
     """A :class:`Robot` with continuous joints (``Robot(...)`` gives such an instance this class): its hot
-    paths (``tool_placement``, ``task_jacobian``) convert q to Pinocchio's (cos, sin) on the way in."""
+    paths (``tool_placement``, ``task_jacobian``) convert q to Pinocchio's (cos, sin) on the way in.
+    """
 
     _pin_q = Robot._valid_pin_q
 
     def ik(self, target: Any, *, branch: str = "all", reference: Sequence[float] | None = None) -> IKResult:
         """:meth:`Robot.ik`, each solution listed once: a continuous joint's range [-pi, pi] has the same
         joint position at both ends, so a solution found at -pi and at +pi is kept once (the first found,
-        or the one nearer to ``reference`` when given)."""
+        or the one nearer to ``reference`` when given).
+        """
         import dataclasses
 
         result = super().ik(target, branch=branch, reference=reference)

@@ -277,7 +277,7 @@ class _ToppraPath:
 
 
 def _grid(path: GeometricPath, n: int) -> np.ndarray:
-    """n uniform segments on [0, 1] plus the path's knots (uniform points too close to a knot dropped)."""
+    """N uniform segments on [0, 1] plus the path's knots (uniform points too close to a knot dropped)."""
     knots = np.unique(np.clip(path.knots(), 0.0, 1.0))
     uniform = np.linspace(0.0, 1.0, n + 1)
     gap = 1e-3 / n
@@ -402,7 +402,7 @@ def _time_segment(
 
 
 def _precomputed_constraint(a: np.ndarray, b: np.ndarray, c: np.ndarray, F: np.ndarray, g: np.ndarray) -> Any:
-    """toppra's canonical linear constraint a u + b x + c = v, F v <= g, with our own coefficients."""
+    """Toppra's canonical linear constraint a u + b x + c = v, F v <= g, with our own coefficients."""
     from toppra.constraint import DiscretizationType, LinearConstraint
 
     class _Precomputed(LinearConstraint):  # type: ignore[misc]
@@ -462,7 +462,8 @@ def _diagnose(
 def _check_times(law: ProfileLaw, opts: TimingOptions, sub: bool, t_start: float | None) -> np.ndarray:
     """Local times to check: the grid points; with ``sub``, check_subdivisions points per segment; with
     ``t_start`` (the segment's start in the whole trajectory), the trajectory's check_rate grid k / rate
-    (the promise) that falls in this segment."""
+    (the promise) that falls in this segment.
+    """
     parts = [law.t]
     if sub:
         M = opts.check_subdivisions
@@ -521,7 +522,7 @@ def _check(
 
 
 def _polynomial_extremes(path: GeometricPath, law: ProfileLaw) -> tuple[np.ndarray, np.ndarray]:
-    """qd and qdd at every interior extremum of qd or qdd, per joint, for a path cubic between grid points.
+    """Qd and qdd at every interior extremum of qd or qdd, per joint, for a path cubic between grid points.
 
     On grid segment i (inside one cubic piece, the knots being grid points) ``x = sd^2`` is linear in s
     and ``qdd_j(s) = q'_j(s) u_i + q''_j(s) x(s)`` is a quadratic in s: its extremum is at its vertex,

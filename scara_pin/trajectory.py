@@ -195,7 +195,7 @@ class GeometricPath(abc.ABC):
         return np.array([0.0, 1.0])
 
     def __call__(self, s: float | np.ndarray, order: int = 0) -> np.ndarray:
-        """q (order 0), q' (1) or q'' (2) at ``s``: (4,) for a scalar, (n, 4) for an array."""
+        """Q (order 0), q' (1) or q'' (2) at ``s``: (4,) for a scalar, (n, 4) for an array."""
         arr = np.asarray(s, dtype=float)
         out = self.evaluate(np.atleast_1d(arr).ravel(), order)[order]
         return out[0] if arr.ndim == 0 else out

@@ -823,8 +823,8 @@ def plot_workspace(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.path import Path as MPath
     from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as MPath
 
     colours = {Limit.OUTER: "tab:blue", Limit.FOLDED: "tab:purple", Limit.J1_LOWER: "tab:red",
                Limit.J1_UPPER: "tab:orange", Limit.J2_LOWER: "tab:green", Limit.J2_UPPER: "tab:olive"}  # fmt: skip

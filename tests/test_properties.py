@@ -9,13 +9,11 @@
 from __future__ import annotations
 
 import math
-import resource
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -16,8 +16,8 @@ import pinocchio as pin
 import pytest
 
 from scara_pin import JointLimits, ParameterError, Robot, load_robot
-from scara_pin.trajectory import JointLine, PathError, cartesian_path, joint_path
 from scara_pin.timing import TimingError, TimingOptions, limit_ratios, parameterize, time_optimal
+from scara_pin.trajectory import JointLine, PathError, cartesian_path, joint_path
 
 PROMISE = 1e-6  # relative: the most any limit may be exceeded at the samples
 

@@ -18,15 +18,14 @@ import numpy as np
 import pytest
 
 from scara_pin import InfeasibleError, InvalidInputError, ParameterError, Robot
-from scara_pin.ik import IKStatus, branch_of
 from scara_pin.files import atomic_output
+from scara_pin.ik import IKStatus, branch_of
 from scara_pin.trajectory import (
     CSV_HEADER,
     JointLine,
     MotorUnits,
     PathError,
     Samples,
-    Trajectory,
     cartesian_path,
     joint_path,
     joint_pose,
