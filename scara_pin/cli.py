@@ -33,6 +33,7 @@ from .files import write_atomic_with, write_text_atomic
 if TYPE_CHECKING:
     import numpy as np
 
+    from ._typing import ArrayLike
     from .model import Robot
 
 __all__ = ["main"]
@@ -123,11 +124,11 @@ def _check_limits(robot: Robot, q: np.ndarray, strict: bool) -> None:
         log.warning("%s (computed anyway; --strict refuses)", item)
 
 
-def _fmt(values: Sequence[float]) -> str:
+def _fmt(values: ArrayLike) -> str:
     return "[" + ", ".join(f"{v: .9g}" for v in values) + "]"
 
 
-def _scaled(values: Sequence[float], scale: Sequence[float]) -> list[float]:
+def _scaled(values: ArrayLike, scale: Sequence[float]) -> list[float]:
     return [float(v) * s for v, s in zip(values, scale)]
 
 
@@ -260,7 +261,7 @@ def _read_pose(texts: Sequence[str], units: Units, what: str = "target") -> list
     return [_number(n, t) / sc for n, t, sc in zip(("x", "y", "z", "yaw"), texts, units.scale(_POSE_KINDS))]
 
 
-def _solutions_json(q_list: Sequence[Sequence[float]], branches: Sequence[str], units: Units) -> list[dict]:
+def _solutions_json(q_list: Sequence[ArrayLike], branches: Sequence[str], units: Units) -> list[dict]:
     scale = units.scale(units.q)
     return [{"q": _scaled(q, scale), "branch": b} for q, b in zip(q_list, branches)]
 
@@ -440,7 +441,7 @@ def _joint_arg(robot: Robot, texts: Sequence[str], units: Units, what: str) -> n
     return q
 
 
-def _pose_to_q(robot: Robot, pose: Sequence[float], near: np.ndarray, what: str) -> np.ndarray:
+def _pose_to_q(robot: Robot, pose: ArrayLike, near: np.ndarray, what: str) -> np.ndarray:
     result = robot.ik(pose)
     if not result.success:
         raise InfeasibleError(f"{what} {list(pose)}: {result.status.name}: {result.message}")
@@ -483,9 +484,13 @@ def cmd_traj(args: argparse.Namespace) -> int:
     if args.plot and robot.kind != "scara":
         raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     if args.linear:
-        poses = [pose_from if q_from is None else tr.joint_pose(robot, q_from)]
+        first = pose_from if q_from is None else tr.joint_pose(robot, q_from)
+        assert first is not None  # --from or --from-pose, checked above
+        poses = [first]
         poses += [tr.joint_pose(robot, v) for v in vias]
-        poses.append(pose_to if q_to is None else tr.joint_pose(robot, q_to))
+        last = pose_to if q_to is None else tr.joint_pose(robot, q_to)
+        assert last is not None  # --to or --to-pose, checked above
+        poses.append(last)
         path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
         if args.duration is not None:
             traj, method = tr.timed(path, args.duration), "straight line, quintic time law"

@@ -240,7 +240,9 @@ class RobotParameters:
 
     def _limits(self) -> JointLimits:
         v = self.values
-        return JointLimits(**{f: tuple(v[f"{j}_{f}"] for j in JOINT_NAMES) for f in _LIMIT_FIELDS})
+        columns = (tuple(v[f"{j}_{f}"] for j in JOINT_NAMES) for f in _LIMIT_FIELDS)
+        lower, upper, velocity, acceleration, effort = columns
+        return JointLimits(lower, upper, velocity, acceleration, effort)
 
     def __getitem__(self, key: str) -> float:
         return self.values[key]

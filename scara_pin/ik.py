@@ -39,7 +39,7 @@ import enum
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 import pinocchio as pin
@@ -47,7 +47,9 @@ import pinocchio as pin
 from .errors import InvalidInputError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
+    from ._typing import ArrayLike
     from .model import Robot
+    from .palletizer import PalletizerIKStatus
 
 __all__ = [
     "LIMIT_TOL",
@@ -135,13 +137,13 @@ class IKResult:
     Attributes:
         target: (x, y, z, yaw) of the tool frame in the base frame [m, rad].
         solutions: all solutions inside the joint limits (empty when ``status`` is not OK).
-        status: :class:`IKStatus`.
+        status: :class:`IKStatus` (:class:`~scara_pin.palletizer.PalletizerIKStatus` for a palletizer).
         message: a sentence with the numbers behind the status.
     """
 
     target: np.ndarray
     solutions: tuple[IKSolution, ...]
-    status: IKStatus
+    status: IKStatus | PalletizerIKStatus
     message: str
 
     @property
@@ -154,7 +156,7 @@ class IKResult:
         return tuple(s for s in self.solutions if s.matches(branch))
 
     def nearest(
-        self, reference: Sequence[float], weights: Sequence[float] | None = None, branch: str = "all"
+        self, reference: ArrayLike, weights: ArrayLike | None = None, branch: str = "all"
     ) -> IKSolution | None:
         """The solution nearest to ``reference`` in weighted joint space (sum of w_i (q_i - ref_i)^2).
 
@@ -337,8 +339,14 @@ class ScaraGeometry:
         )  # fmt: skip
 
     # ---------------------------------------------------------------------------------------- derived
-    def elbow_angle(self, q_elbow: float) -> float:
-        """Gamma (angle from arm 1 to arm 2, counterclockwise from above) at an elbow joint value."""
+    @overload
+    def elbow_angle(self, q_elbow: float) -> float: ...
+
+    @overload
+    def elbow_angle(self, q_elbow: np.ndarray) -> np.ndarray: ...
+
+    def elbow_angle(self, q_elbow: float | np.ndarray) -> float | np.ndarray:
+        """Gamma (angle from arm 1 to arm 2, counterclockwise from above) at an elbow joint value (or array)."""
         return self.signs[self.revolute[1]] * q_elbow + self.beta2 - self.beta1
 
     def radius_range(self) -> tuple[float, float]:
@@ -367,7 +375,7 @@ class ScaraGeometry:
         return r_min, r_max
 
 
-def branch_of(geo: ScaraGeometry, q: Sequence[float]) -> str:
+def branch_of(geo: ScaraGeometry, q: ArrayLike) -> str:
     """The branch (``"right"``/``"left"``) of a configuration: the sign of sin(gamma); ``right`` at gamma = 0."""
     g = _wrap(geo.elbow_angle(float(q[geo.revolute[1]])))
     if abs(g) < 1e-12:
@@ -393,10 +401,10 @@ def _turns(value: float, lo: float, hi: float) -> list[float]:
 
 def solve(
     geo: ScaraGeometry,
-    target: Sequence[float] | np.ndarray | pin.SE3,
+    target: ArrayLike | pin.SE3,
     *,
     branch: str = "all",
-    reference: Sequence[float] | None = None,
+    reference: ArrayLike | None = None,
 ) -> IKResult:
     """Every joint configuration inside the limits that puts the tool at ``target``.
 
@@ -577,8 +585,10 @@ def solve(
 
 
 def _free_shoulder(geo: ScaraGeometry, alpha: float, phi2: float, phi_ref: float | None) -> float:
-    """phi1 for a free shoulder (wrist on its axis): inside the J1 limits, with a J4 turn inside the J4
-    limits when there is one, and nearest to the reference (``phi_ref``, else 0) among those values.
+    """phi1 for a free shoulder (wrist on its axis).
+
+    It is inside the J1 limits, with a J4 turn inside the J4 limits when there is one, and nearest to the
+    reference (``phi_ref``, else 0) among those values.
     """
     ra, _, rc = geo.revolute
     s_a, s_c = geo.signs[ra], geo.signs[rc]
@@ -673,7 +683,7 @@ def solve_batch(
     targets: np.ndarray,
     *,
     branch: str = "right",
-    reference: np.ndarray | Sequence[float] | None = None,
+    reference: ArrayLike | None = None,
 ) -> BatchIKResult:
     """The closed form vectorised over N targets (no Python loop per target).
 

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -32,6 +31,7 @@ import pinocchio as pin
 from .errors import ParameterError
 
 if TYPE_CHECKING:
+    from ._typing import ArrayLike
     from .model import Robot
 
 __all__ = ["NumericIKOptions", "NumericIKReason", "NumericIKResult", "solve_numeric"]
@@ -130,8 +130,8 @@ def _project(q: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: np.ndarray
 
 def solve_numeric(
     robot: Robot,
-    target: Sequence[float],
-    q0: Sequence[float] | None = None,
+    target: ArrayLike,
+    q0: ArrayLike | None = None,
     options: NumericIKOptions | None = None,
 ) -> NumericIKResult:
     """Solve for (x, y, z, yaw) of the tool in the base frame [m, rad] by damped least squares.

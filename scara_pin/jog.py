@@ -1,5 +1,7 @@
-"""Jog to the edge (S5's teach-pendant use): a straight tool move along a direction that ends exactly on
-the workspace edge (or a margin before it), at rest, planned before moving.
+"""Jog to the edge (S5's teach-pendant use).
+
+A straight tool move along a direction that ends exactly on the workspace edge (or a margin before it),
+at rest, planned before moving.
 
 The edge is found with the exact workspace (:meth:`scara_pin.workspace.Workspace.ray`); the move is a
 straight Cartesian line (:func:`scara_pin.trajectory.cartesian_path`: one elbow branch, J4 continuous,
@@ -12,11 +14,11 @@ found in one step from a trial run and then verified.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from ._typing import ArrayLike
 from .errors import InfeasibleError, ParameterError
 from .model import Robot
 from .trajectory import Trajectory, cartesian_path, joint_pose, timed
@@ -50,8 +52,8 @@ class JogResult:
 
 def jog_to_edge(
     robot: Robot,
-    q0: Sequence[float],
-    direction: Sequence[float],
+    q0: ArrayLike,
+    direction: ArrayLike,
     *,
     margin: float = 0.0,
     ws: Workspace | None = None,

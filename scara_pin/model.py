@@ -30,6 +30,7 @@ from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urd
 from .errors import InvalidInputError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
+    from ._typing import ArrayLike
     from .ik import IKResult, ScaraGeometry
     from .palletizer import PalletizerGeometry
 
@@ -311,7 +312,7 @@ class Robot:
 
         return PalletizerGeometry.from_robot(self)
 
-    def ik(self, target: Any, *, branch: str = "all", reference: Sequence[float] | None = None) -> IKResult:
+    def ik(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None) -> IKResult:
         """Closed-form IK of the robot's kind: every solution inside the limits.
 
         A SCARA: :func:`scara_pin.ik.solve` (branches right/left); a palletizer:
@@ -325,7 +326,7 @@ class Robot:
 
         return solve(self.kinematics, target, branch=branch, reference=reference)
 
-    def branch_of(self, q: Sequence[float]) -> str:
+    def branch_of(self, q: ArrayLike) -> str:
         """The IK branch of a configuration (SCARA: right/left; palletizer: up/down)."""
         if self.kind == "palletizer":
             from .palletizer import branch_of
@@ -368,15 +369,16 @@ class Robot:
         return out
 
     # ----------------------------------------------------------------- kinematics
-    def _valid_q(self, q: object) -> np.ndarray:
+    def _valid_q(self, q: Any) -> np.ndarray:
         """``q`` itself when it is obviously valid (4 moderate float64 values), else ``check_q(q)``.
 
         The cheap test only ever sends inputs on to the full check; it never lets a bad one through.
         """
         try:
-            a, b, c, d = q.tolist() if q.dtype is _F64 and q.ndim == 1 else ()  # type: ignore[attr-defined]
-            if a * a + b * b + c * c + d * d <= _FAST_Q2:  # NaN and inf fail this comparison
-                return q  # type: ignore[return-value]
+            if q.dtype is _F64 and q.ndim == 1:
+                a, b, c, d = q.tolist()
+                if a * a + b * b + c * c + d * d <= _FAST_Q2:  # NaN and inf fail this comparison
+                    return q
         except (AttributeError, TypeError, ValueError):
             pass
         return self.check_q(q)
@@ -495,16 +497,18 @@ class Robot:
 
 
 class _ContinuousRobot(Robot):
-    """A :class:`Robot` with continuous joints (``Robot(...)`` gives such an instance this class): its hot
-    paths (``tool_placement``, ``task_jacobian``) convert q to Pinocchio's (cos, sin) on the way in.
+    """A :class:`Robot` with continuous joints (``Robot(...)`` gives such an instance this class).
+
+    Its hot paths (``tool_placement``, ``task_jacobian``) convert q to Pinocchio's (cos, sin) on the way in.
     """
 
     _pin_q = Robot._valid_pin_q
 
-    def ik(self, target: Any, *, branch: str = "all", reference: Sequence[float] | None = None) -> IKResult:
-        """:meth:`Robot.ik`, each solution listed once: a continuous joint's range [-pi, pi] has the same
-        joint position at both ends, so a solution found at -pi and at +pi is kept once (the first found,
-        or the one nearer to ``reference`` when given).
+    def ik(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None) -> IKResult:
+        """:meth:`Robot.ik`, each solution listed once.
+
+        A continuous joint's range [-pi, pi] has the same joint position at both ends, so a solution found
+        at -pi and at +pi is kept once (the first found, or the one nearer to ``reference`` when given).
         """
         import dataclasses
 

@@ -48,6 +48,7 @@ from .errors import InvalidInputError, ParameterError, UrdfError
 from .ik import LIMIT_TOL, REACH_TOL, YAW_POSE_TOL, IKResult, IKSolution
 
 if TYPE_CHECKING:
+    from ._typing import ArrayLike
     from .model import Robot
 
 __all__ = [
@@ -175,7 +176,7 @@ def wrist_pitch(q: Sequence[float]) -> float:
     return -float(_four("q", q)[2])
 
 
-def _four(name: str, values: Sequence[float]) -> np.ndarray:
+def _four(name: str, values: ArrayLike) -> np.ndarray:
     a = np.asarray(values, dtype=float)
     if a.shape != (4,) or not np.isfinite(a).all():
         raise ParameterError(name, np.asarray(values).tolist(), "must be 4 finite numbers")
@@ -191,7 +192,7 @@ def forward(geo: PalletizerGeometry, q: Sequence[float]) -> np.ndarray:
     return np.array([r * math.cos(q1), r * math.sin(q1), z, q1 + q4 + geo.tool_yaw])
 
 
-def branch_of(q: Sequence[float]) -> str:
+def branch_of(q: ArrayLike) -> str:
     """``"up"`` when sin(q3) >= 0 (q3 = theta3 - q2, S2's small-arm angle), else ``"down"``."""
     a = _four("q", q)
     return "up" if math.sin(a[2] - a[1]) >= 0.0 else "down"
@@ -227,10 +228,10 @@ def _target(geo: PalletizerGeometry, target: object) -> tuple[np.ndarray, float]
 
 def solve(
     geo: PalletizerGeometry,
-    target: Sequence[float] | np.ndarray | pin.SE3,
+    target: ArrayLike | pin.SE3,
     *,
     branch: str = "all",
-    reference: Sequence[float] | None = None,
+    reference: ArrayLike | None = None,
 ) -> PalletizerIKResult:
     """Every configuration ``q`` (motor side) inside the limits that puts tool0 at ``target``.
 

@@ -40,8 +40,10 @@ def plot_trajectory(
     title: str | None = None,
     dpi: int = 120,
 ) -> Path:
-    """Write a PNG: q, qd, qdd of the four joints against time (one panel each), limits dashed, and,
-    given the robot, the tool path in the base x-y plane with the reach circles.
+    """Write a PNG: q, qd, qdd of the four joints against time, and the tool path given the robot.
+
+    One panel per joint, limits dashed, and, given the robot, the tool path in the base x-y plane with the
+    reach circles.
 
     Limits (``limits``, default ``robot.limits``) are dashed lines in each joint's colour; the legend
     gives their values, and a limit far outside the plotted values (more than 2.5 times the largest)

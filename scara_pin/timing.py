@@ -61,6 +61,7 @@ from .trajectory import (
 )
 
 if TYPE_CHECKING:
+    from ._typing import ArrayLike
     from .model import Robot
 
 __all__ = [
@@ -203,7 +204,7 @@ def _limits(robot: Robot, limits: JointLimits | None, tool_speed: float | None, 
 
 def time_optimal(
     robot: Robot,
-    path: GeometricPath | CartesianPath | Sequence[Sequence[float]] | np.ndarray,
+    path: GeometricPath | CartesianPath | Sequence[ArrayLike] | np.ndarray,
     *,
     tool_speed: float | None = None,
     torque: bool = False,
@@ -216,7 +217,7 @@ def time_optimal(
 
 def parameterize(
     robot: Robot,
-    path: GeometricPath | CartesianPath | Sequence[Sequence[float]] | np.ndarray,
+    path: GeometricPath | CartesianPath | Sequence[ArrayLike] | np.ndarray,
     *,
     tool_speed: float | None = None,
     torque: bool = False,
@@ -460,9 +461,11 @@ def _diagnose(
 
 # ---------------------------------------------------------------------------------------------- verification
 def _check_times(law: ProfileLaw, opts: TimingOptions, sub: bool, t_start: float | None) -> np.ndarray:
-    """Local times to check: the grid points; with ``sub``, check_subdivisions points per segment; with
-    ``t_start`` (the segment's start in the whole trajectory), the trajectory's check_rate grid k / rate
-    (the promise) that falls in this segment.
+    """Local times to check.
+
+    The grid points; with ``sub``, check_subdivisions points per segment; with ``t_start`` (the segment's
+    start in the whole trajectory), the trajectory's check_rate grid k / rate (the promise) that falls in
+    this segment.
     """
     parts = [law.t]
     if sub:

@@ -48,7 +48,9 @@ from .files import write_text_atomic
 from .ik import IKStatus, branch_of, solve_batch
 
 if TYPE_CHECKING:
+    from ._typing import ArrayLike
     from .model import Robot
+    from .palletizer import PalletizerIKStatus
 
 __all__ = [
     "CSV_HEADER",
@@ -114,7 +116,7 @@ class PathError(InfeasibleError):
         segment: int = 0,
         pose: np.ndarray | None = None,
         q: np.ndarray | None = None,
-        status: IKStatus | None = None,
+        status: IKStatus | PalletizerIKStatus | None = None,
     ) -> None:
         self.s = float(s)
         self.segment = segment
@@ -167,7 +169,7 @@ def _rows(name: str, value: object) -> np.ndarray:
     return arr
 
 
-def _limit_vector(name: str, values: Sequence[float], unit: str) -> np.ndarray:
+def _limit_vector(name: str, values: ArrayLike, unit: str) -> np.ndarray:
     """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0."""
     arr = np.array(values, dtype=float)
     if arr.shape != (4,):
@@ -285,7 +287,7 @@ class JointSpline(GeometricPath):
         return tuple(out[: order + 1])
 
 
-def joint_path(robot: Robot, waypoints: Sequence[Sequence[float]] | np.ndarray) -> JointLine | JointSpline:
+def joint_path(robot: Robot, waypoints: Sequence[ArrayLike] | np.ndarray) -> JointLine | JointSpline:
     """The path through joint waypoints: a :class:`JointLine` for two, else a :class:`JointSpline`.
 
     Consecutive equal waypoints are merged. The spline's knots weight each joint by 1 / vmax. The path
@@ -466,11 +468,13 @@ class CartesianPath:
         return self.segments[-1].q_ref[-1].copy()
 
 
-def joint_pose(robot: Robot, q: Sequence[float] | np.ndarray) -> np.ndarray:
-    """The tool pose (x, y, z, yaw) at q with the yaw UNWRAPPED as the joints turn: yaw0 plus the signed
-    revolute angles, equal to FK's yaw modulo 2 pi. A line between two such poses turns the tool the way
-    the joints go (through +/-pi if they do), so ``cartesian_path(robot, [joint_pose(robot, qa),
-    joint_pose(robot, qb)], start=qa, end=qb)`` ends at qb whenever the line stays feasible.
+def joint_pose(robot: Robot, q: ArrayLike) -> np.ndarray:
+    """The tool pose (x, y, z, yaw) at q with the yaw UNWRAPPED as the joints turn.
+
+    The yaw is yaw0 plus the signed revolute angles, equal to FK's yaw modulo 2 pi. A line between two
+    such poses turns the tool the way the joints go (through +/-pi if they do), so
+    ``cartesian_path(robot, [joint_pose(robot, qa), joint_pose(robot, qb)], start=qa, end=qb)`` ends at qb
+    whenever the line stays feasible.
     """
     q = robot.check_q(q)
     geo = robot.kinematics
@@ -488,10 +492,10 @@ def _elbow_sin(robot: Robot, q: np.ndarray) -> np.ndarray:
 
 def cartesian_path(
     robot: Robot,
-    poses: Sequence[Sequence[float]] | np.ndarray,
+    poses: Sequence[ArrayLike] | np.ndarray,
     *,
-    start: Sequence[float] | np.ndarray | None = None,
-    end: Sequence[float] | np.ndarray | None = None,
+    start: ArrayLike | None = None,
+    end: ArrayLike | None = None,
     branch: str | None = None,
     n: int | None = None,
     max_step: float | None = None,
@@ -583,7 +587,7 @@ def cartesian_path(
 
 def _ik_step(
     robot: Robot, branch: str, pose: np.ndarray, q_prev: np.ndarray
-) -> tuple[np.ndarray | None, str, IKStatus | None]:
+) -> tuple[np.ndarray | None, str, IKStatus | PalletizerIKStatus | None]:
     """The branch solution at ``pose`` nearest ``q_prev``, or None with the reason and the IK status."""
     res = robot.ik(pose, branch=branch)
     sol = res.nearest(q_prev, branch=branch) if res.success else None
@@ -1207,8 +1211,10 @@ class MotorUnits:
         screw_lead: float,
         prismatic: int = 2,
     ) -> MotorUnits:
-        """From the drive train: revolute ``gear * steps_per_rev / (2 pi)`` [steps/rad]; the prismatic
-        joint ``gear * steps_per_rev / lead`` [steps/m], ``lead`` the screw's travel per turn [m].
+        """From the drive train.
+
+        Revolute joints ``gear * steps_per_rev / (2 pi)`` [steps/rad]; the prismatic joint
+        ``gear * steps_per_rev / lead`` [steps/m], ``lead`` the screw's travel per turn [m].
 
         Args:
             gear_ratio: motor turns per joint turn (per screw turn for the prismatic joint).
@@ -1275,23 +1281,24 @@ class Setpoints:
 
 
 # ---------------------------------------------------------------------------------------------- constructors
-def quintic(q0: Sequence[float], q1: Sequence[float], duration: float) -> Trajectory:
+def quintic(q0: ArrayLike, q1: ArrayLike, duration: float) -> Trajectory:
     """``jtraj``: q0 to q1 in ``duration`` with a quintic, zero velocity and acceleration at both ends.
 
     Each joint: ``q0 + (q1 - q0) (10 x^3 - 15 x^4 + 6 x^5)``, x = t / T; peak velocity
     ``1.875 dq / T`` at T / 2, peak acceleration ``(10 / sqrt(3)) dq / T^2`` at x = 1/2 -/+ sqrt(3)/6.
 
     Args:
-        q0, q1: start and end [rad, m].
+        q0: start [rad, m].
+        q1: end [rad, m].
         duration: T [s] > 0.
     """
-    return Trajectory((Motion(JointLine(q0, q1), QuinticLaw(duration)),))
+    return Trajectory((Motion(JointLine(_vector("q0", q0), _vector("q1", q1)), QuinticLaw(duration)),))
 
 
 def _line_rates(
-    q0: Sequence[float], q1: Sequence[float], velocity: Sequence[float], acceleration: Sequence[float]
+    q0: ArrayLike, q1: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> tuple[JointLine, float, float]:
-    line = JointLine(q0, q1)
+    line = JointLine(_vector("q0", q0), _vector("q1", q1))
     v = _limit_vector("velocity", velocity, "rad/s or m/s")
     a = _limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
     dq = np.abs(line.q1 - line.q0)
@@ -1304,12 +1311,14 @@ def _line_rates(
 
 
 def quintic_min_duration(
-    q0: Sequence[float], q1: Sequence[float], velocity: Sequence[float], acceleration: Sequence[float]
+    q0: ArrayLike, q1: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> float:
-    """The shortest duration of :func:`quintic` within the limits: the peaks 1.875 |dq| / T and
-    (10 / sqrt(3)) |dq| / T^2 reach a limit: T = max_i max(1.875 |dq_i| / v_i, sqrt(10 / sqrt(3) |dq_i| / a_i)).
+    """The shortest duration of :func:`quintic` within the limits.
+
+    The peaks 1.875 |dq| / T and (10 / sqrt(3)) |dq| / T^2 reach a limit:
+    T = max_i max(1.875 |dq_i| / v_i, sqrt(10 / sqrt(3) |dq_i| / a_i)).
     """
-    line = JointLine(q0, q1)
+    line = JointLine(_vector("q0", q0), _vector("q1", q1))
     v = _limit_vector("velocity", velocity, "rad/s or m/s")
     a = _limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
     dq = np.abs(line.q1 - line.q0)
@@ -1317,7 +1326,7 @@ def quintic_min_duration(
 
 
 def line_optimal_duration(
-    q0: Sequence[float], q1: Sequence[float], velocity: Sequence[float], acceleration: Sequence[float]
+    q0: ArrayLike, q1: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> float:
     """T*: the shortest duration of the synchronised straight joint move under per-joint limits.
 
@@ -1329,10 +1338,10 @@ def line_optimal_duration(
 
 
 def trapezoidal(
-    q0: Sequence[float],
-    q1: Sequence[float],
-    velocity: Sequence[float],
-    acceleration: Sequence[float],
+    q0: ArrayLike,
+    q1: ArrayLike,
+    velocity: ArrayLike,
+    acceleration: ArrayLike,
     duration: float | None = None,
 ) -> Trajectory:
     """Synchronised point-to-point move: all joints start and stop together, trapezoidal velocity.
@@ -1342,8 +1351,10 @@ def trapezoidal(
     the same acceleration and a lower coast velocity.
 
     Args:
-        q0, q1: start and end [rad, m].
-        velocity, acceleration: per-joint limits (> 0).
+        q0: start [rad, m].
+        q1: end [rad, m].
+        velocity: per-joint velocity limits (> 0).
+        acceleration: per-joint acceleration limits (> 0).
         duration: [s], optional.
 
     Raises:

@@ -562,7 +562,7 @@ class _Checker:
                 self.add(Severity.WARNING, "length-implausible",
                          f"joint {j.name}'s origin xyz {' '.join(f'{v:g}' for v in j.xyz)} is more than "
                          f"{OFFSET_RANGE:g} m long: millimetres written as metres?", j.rpy_line, j.name)  # fmt: skip
-            for k, (axis_name, value) in enumerate(zip(("roll", "pitch", "yaw"), j.rpy)):
+            for _k, (axis_name, value) in enumerate(zip(("roll", "pitch", "yaw"), j.rpy)):
                 n = round(value / (math.pi / 2))
                 err = value - n * math.pi / 2
                 if n == 0 or not RPY_EXACT < abs(err) < RPY_NEAR:

@@ -72,6 +72,7 @@ from .errors import InvalidInputError, ParameterError
 from .ik import LIMIT_TOL, ScaraGeometry
 
 if TYPE_CHECKING:
+    from ._typing import ArrayLike
     from .model import Robot
 
 __all__ = [
@@ -414,7 +415,7 @@ class Workspace:
         return best
 
     # --------------------------------------------------------------------------------- rays
-    def ray(self, start: Sequence[float], direction: Sequence[float]) -> RayHit:
+    def ray(self, start: ArrayLike, direction: ArrayLike) -> RayHit:
         """The nearest edge along a ray (see the module docstring for starts on the edge).
 
         Args:
@@ -464,7 +465,7 @@ class Workspace:
             raise ParameterError("ray direction", D[i].tolist(), "must not be zero")
         D = D / norm[:, None]
         inside = self.contains(S[:, :2])
-        if not inside.all():
+        if not np.all(inside):
             i = int(np.argmin(inside))
             raise OutsideWorkspaceError(S[i], self._why_outside(S[i, :2]))
         n = len(S)
@@ -575,7 +576,8 @@ def workspace(
 
     Args:
         robot: a :class:`~scara_pin.model.Robot` or its :class:`~scara_pin.ik.ScaraGeometry`.
-        lower, upper: joint limits in q order replacing the model's (e.g. a software range) [rad, m].
+        lower: lower joint limits in q order replacing the model's (e.g. a software range) [rad, m].
+        upper: upper joint limits in q order replacing the model's [rad, m].
         yaw: a fixed tool yaw [rad]: the region is then the tool point's at that yaw (needs J4 to span at
             least 2 pi when the tool is offset from the wrist axis). None: the wrist axis point.
 
@@ -844,8 +846,8 @@ def plot_workspace(
         ax.add_patch(PathPatch(MPath(np.vstack(verts), codes), facecolor="lightsteelblue", alpha=0.5, lw=0))
     seen: set[Limit] = set()
     for a in ws.arcs:
-        pts = a.points(max(8, int(a.sweep * 90)))
-        ax.plot(pts[:, 0], pts[:, 1], color=colours[a.limit], lw=2.0,
+        xy = a.points(max(8, int(a.sweep * 90)))
+        ax.plot(xy[:, 0], xy[:, 1], color=colours[a.limit], lw=2.0,
                 label=a.description if a.limit not in seen else None)  # fmt: skip
         seen.add(a.limit)
     geo = ws.geometry

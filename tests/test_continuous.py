@@ -281,7 +281,7 @@ def test_batch_ik_agrees_with_the_single_target_solver(robot: Robot) -> None:
     targets = np.array([irb920_fk(q) for q in qs])
     for branch in ("right", "left"):
         batch = solve_batch(robot.kinematics, targets, branch=branch)
-        for k, q in enumerate(qs):
+        for k, _q in enumerate(qs):
             mine = [s.q for s in robot.ik(targets[k]).solutions if s.matches(branch)]
             if batch.status[k] != IKStatus.OK.value:
                 assert not mine, (k, batch.status[k])

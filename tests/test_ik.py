@@ -435,7 +435,7 @@ def test_tilted_axis_is_not_a_scara(joint: str) -> None:
     """A joint frame tilted by 1e-3 rad (roll): the first joint whose axis is off vertical is named, with its angle."""
     robot = Robot(yk400xe_y({joint: "0.001 0 0"}), origin="tilted")
     with pytest.raises(NotScaraError) as info:
-        robot.kinematics
+        _ = robot.kinematics
     msg = str(info.value)
     assert re.search(rf"\b{joint}\b", msg), msg
     assert not any(re.search(rf"\b{j}\b", msg) for j in ("j1", "j2", "j3", "j4") if j != joint), msg
@@ -503,7 +503,7 @@ def test_continuous_j4_is_accepted_and_matches_the_closed_form() -> None:
 def test_two_prismatic_joints_is_not_a_scara() -> None:
     robot = Robot(TWO_PRISMATIC, origin="two")
     with pytest.raises(NotScaraError) as info:
-        robot.kinematics
+        _ = robot.kinematics
     assert "j2" in str(info.value)
 
 

@@ -119,7 +119,7 @@ def test_ik_text_mode(capsys: pytest.CaptureFixture[str]) -> None:
     assert rc == 0 and err == ""
     rows = [line.split(None, 1) for line in out.splitlines() if line.startswith(("right", "left"))]
     assert len(rows) == 4
-    for label, values in rows:
+    for _label, values in rows:
         q = np.array([float(v) for v in values.strip("[] ").split(",")])
         assert pose_error(s4_pose(q), s4_pose(Q)) <= 1e-7  # text prints 9 significant digits
 

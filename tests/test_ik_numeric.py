@@ -100,7 +100,7 @@ def test_numeric_is_the_fallback_for_a_model_the_closed_form_refuses() -> None:
     assert 'rpy="0.001 0 0"' in urdf  # the fixture really is tilted
     robot = Robot(urdf, origin="tilted")
     with pytest.raises(NotScaraError):
-        robot.kinematics
+        _ = robot.kinematics
     lo, hi = limits(robot)
     for q in np.random.default_rng(107).uniform(lo, hi, size=(30, 4)):
         target = robot.tool_pose(q)

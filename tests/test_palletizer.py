@@ -375,11 +375,11 @@ def test_stretched_arm_is_one_singular_solution(robot: Robot) -> None:
 
 def test_geometry_needs_palletizer_parameters() -> None:
     with pytest.raises(NotPalletizerError, match="a scara robot"):
-        load_robot("default").palletizer
+        _ = load_robot("default").palletizer
     with pytest.raises(NotPalletizerError, match="a URDF file"):
-        load_urdf(GOLDEN).palletizer
+        _ = load_urdf(GOLDEN).palletizer
     with pytest.raises(NotScaraError, match="is a palletizer, not a SCARA"):
-        load_robot("palletizer").kinematics
+        _ = load_robot("palletizer").kinematics
 
 
 def test_geometric_ik_agrees_with_numeric_ik(robot: Robot) -> None:

@@ -61,7 +61,8 @@ def test_workspace_contains_agrees_with_ik(robot: sp.Robot, seed: int) -> None:
 def _peak_rss_of(argv: list[str]) -> int:
     """Peak resident memory [KiB] of a child Python process running the CLI."""
     code = ("import resource, sys; from scara_pin.cli import main; rc = main(sys.argv[1:]); "
-            "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss); sys.exit(0 if rc in (0, 3) else rc)")  # fmt: skip
+            "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss); "
+            "sys.exit(0 if rc in (0, 3) else rc)")  # fmt: skip
     out = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     return int(out.stdout.strip().splitlines()[-1])
