@@ -50,9 +50,9 @@ bench-ik: $(VENV)/.installed-test
 	$(RTB_VENV)/bin/python benchmarks/bench_ik.py
 
 lint: $(VENV)/.installed-test
-	$(BIN)/python -m pip install -q ruff mypy
+	$(BIN)/python -m pip install -q -e '.[test,lint]'
 	$(BIN)/ruff check scara_pin tests benchmarks
-	$(BIN)/mypy scara_pin
+	$(BIN)/mypy scara_pin --ignore-missing-imports
 
 clean:
 	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache

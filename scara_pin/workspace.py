@@ -841,7 +841,7 @@ def plot_workspace(
             pts.append(seg if a.region_inside else seg[::-1])
         v = np.vstack(pts)
         verts.append(v)
-        codes += [MPath.MOVETO] + [MPath.LINETO] * (len(v) - 2) + [MPath.CLOSEPOLY]
+        codes += [int(MPath.MOVETO)] + [int(MPath.LINETO)] * (len(v) - 2) + [int(MPath.CLOSEPOLY)]
     if verts:
         ax.add_patch(PathPatch(MPath(np.vstack(verts), codes), facecolor="lightsteelblue", alpha=0.5, lw=0))
     seen: set[Limit] = set()
