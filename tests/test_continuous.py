@@ -185,7 +185,7 @@ def test_task_jacobian_equals_finite_differences(robot: Robot) -> None:
 
 
 def test_trajectory_kinematics_convert_q(robot: Robot, twin: Robot) -> None:
-    from scara_pin.trajectory import _Kinematics
+    from scara_pin.paths import _Kinematics
 
     k, kt = _Kinematics(robot), _Kinematics(twin)
     rng = np.random.default_rng(4)

@@ -1,0 +1,66 @@
+"""Input checks shared by the path and trajectory modules (private)."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .description import JOINT_NAMES
+from .errors import ParameterError
+
+if TYPE_CHECKING:
+    from ._typing import ArrayLike
+
+
+def _vector(name: str, value: object, n: int = 4) -> np.ndarray:
+    """``value`` as ``n`` finite floats, or a :class:`ParameterError`."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, f"must be {n} numbers") from None
+    if arr.shape != (n,):
+        raise ParameterError(name, value, f"must be {n} numbers (got shape {arr.shape})")
+    if not np.isfinite(arr).all():
+        raise ParameterError(name, arr.tolist(), "must be finite")
+    return arr
+
+
+def _positive(name: str, value: object, unit: str = "") -> float:
+    """``value`` as a finite float > 0, or a :class:`ParameterError`."""
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, "must be a number") from None
+    if not (math.isfinite(v) and v > 0.0):
+        raise ParameterError(name, v, "must be finite and > 0", unit)
+    return v
+
+
+def _rows(name: str, value: object) -> np.ndarray:
+    """``value`` as an (m, 4) float array of finite numbers, m >= 2, or a :class:`ParameterError`."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, "must be rows of 4 numbers") from None
+    if arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 2:
+        raise ParameterError(name, f"array of shape {arr.shape}", "must have shape (m, 4) with m >= 2")
+    if not np.isfinite(arr).all():
+        raise ParameterError(name, arr.tolist(), "must be finite")
+    return arr
+
+
+def _limit_vector(name: str, values: ArrayLike, unit: str) -> np.ndarray:
+    """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0."""
+    arr = np.array(values, dtype=float)
+    if arr.shape != (4,):
+        raise ParameterError(name, values, "must hold 4 values")
+    for joint, v in zip(JOINT_NAMES, arr.tolist()):
+        if math.isnan(v):
+            raise ParameterError(f"{joint}_{name}", v, "must be given (a URDF file has no acceleration limits)")
+        if not (math.isfinite(v) and v > 0.0):
+            raise ParameterError(f"{joint}_{name}", v, "must be finite and > 0", unit)
+    return arr
+
+
