@@ -1,21 +1,12 @@
 """Joint and Cartesian paths, time laws, and the :class:`Trajectory` they make (sampling, export, setpoints).
 
-The paths are defined in :mod:`scara_pin.paths` and re-exported here, the public home of both.
-
 A motion is a geometric path followed by a time law. The path is ``q(s)`` for ``s`` in [0, 1]; the law
 is ``s(t)`` for ``t`` in [0, T]; the chain rule gives the joint trajectory
 
     q(t) = q(s(t)),    qd = q'(s) sd,    qdd = q'(s) sdd + q''(s) sd^2,
 
-with ``'`` a derivative in ``s`` and ``d`` one in ``t``. Paths (:class:`GeometricPath`):
-
-- :class:`JointLine`: ``q0 + s (q1 - q0)``, the synchronised straight line in joint space;
-- :class:`JointSpline`: a C2 cubic spline through joint waypoints (not-a-knot ends);
-- :class:`CartesianSegment`: the tool moves on a straight line, yaw linear, the joints given at EVERY
-  ``s`` by the closed-form IK (same elbow branch throughout, J4 continuous); :func:`cartesian_path`
-  builds one per pair of consecutive poses (via points) and refuses, with a :class:`PathError` giving
-  ``s`` and the pose, a line that leaves the workspace, reaches a joint limit or crosses the
-  stretched/folded-arm singularity.
+with ``'`` a derivative in ``s`` and ``d`` one in ``t``. The paths (:class:`JointLine`,
+:class:`JointSpline`, and the straight tool lines of :func:`cartesian_path`) are in :mod:`scara_pin.paths`.
 
 Time laws: :class:`QuinticLaw` (``jtraj``: zero velocity and acceleration at both ends),
 :class:`TrapezoidLaw` (bang-coast-bang, time-optimal on a straight joint line), :class:`ProfileLaw`
