@@ -67,7 +67,7 @@ class Units:
         self.length = 1000.0 if mm else 1.0
         self.angle_name = "deg" if deg else "rad"
         self.length_name = "mm" if mm else "m"
-        self.q: tuple[str, ...] = _Q_KINDS  # what each joint value measures; set per robot by _load
+        self.q: tuple[str, ...] = _Q_KINDS  # what each joint value measures; _load sets the robot's own
 
     def scale(self, kinds: Sequence[str]) -> list[float]:
         """Multipliers from SI for a sequence of quantity kinds ("angle" / "length")."""
@@ -102,8 +102,8 @@ def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
     from .model import load_robot
 
     robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf)
-    if units is not None and robot.kind == "palletizer":  # four angles (S2's q1, q2, theta3, q5)
-        units.q = ("angle",) * 4
+    if units is not None:  # what each joint value measures, read from the model (any joint order)
+        units.q = robot.joint_kinds
     return robot
 
 

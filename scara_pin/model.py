@@ -357,6 +357,16 @@ class Robot:
                     raise ParameterError(joint, value, f"must be within +/-{_Q_MAX:g} (rad or m)")
         return arr
 
+    @cached_property
+    def joint_kinds(self) -> tuple[str, ...]:
+        """What each value of q measures, in q order: ``"angle"`` (revolute) or ``"length"`` (prismatic).
+
+        Read from the model's actuated joints (mimic joints are not in q), so that human units (degrees,
+        millimetres) scale the right values whatever the joint order (a lift joint first, say).
+        """
+        actuated = [jm for jm in self.model.joints[1:] if jm.nv > 0]
+        return tuple("length" if jm.shortname().startswith("JointModelP") else "angle" for jm in actuated)
+
     def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:
         """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
         out = []

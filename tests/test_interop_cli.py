@@ -84,3 +84,27 @@ def test_check_reports_the_rpy_approximation_with_its_line(capsys: pytest.Captur
     assert lines, out
     number = int(lines[0].split(":")[1])
     assert "3.14" in path.read_text().splitlines()[number - 1]  # the line named holds the approximation
+
+
+def test_human_units_follow_the_joint_kinds_of_the_urdf(capsys: pytest.CaptureFixture[str]) -> None:
+    """A SCARA that lifts its whole arm has the prismatic joint FIRST: --deg/--mm must scale q1 as a length
+    and q4 as an angle (same pose as the SI call)."""
+    path = THIRD_PARTY / "irb920_like.urdf"
+    robot = sp.load_robot(urdf=path)
+    assert robot.joint_kinds == ("length", "angle", "angle", "angle")
+    q_si = [0.05, 0.3, 0.4, -0.5]
+    rc, out_si, err = run(capsys, ["fk", "--json", "--urdf", str(path), *map(str, q_si)])
+    assert rc == 0, err
+    q_human = [q_si[0] * 1000, *(math.degrees(v) for v in q_si[1:])]
+    rc, out_h, err = run(capsys, ["fk", "--json", "--deg", "--mm", "--urdf", str(path), *map(str, q_human)])
+    assert rc == 0, err
+    si, human = json.loads(out_si), json.loads(out_h)
+    assert np.allclose(np.array(human["position"]) / 1000, si["position"], atol=1e-12)
+    assert math.radians(human["yaw"]) == pytest.approx(si["yaw"], abs=1e-12)
+    assert human["q"] == pytest.approx(q_human, abs=1e-9)
+    # and IK answers in the same units: its first value is the lift in mm
+    target = [*(v * 1000 for v in si["position"]), human["yaw"]]
+    rc, out, err = run(capsys, ["ik", "--json", "--deg", "--mm", "--urdf", str(path), *map(str, target)])
+    assert rc == 0, err
+    qs = [s["q"] for s in json.loads(out)["solutions"]]
+    assert any(np.allclose(q, q_human, atol=1e-6) for q in qs), qs
