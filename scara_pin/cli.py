@@ -112,8 +112,13 @@ def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
 
     if len(args.q) != 4:
         raise ParameterError("q", " ".join(args.q), f"must be 4 joint values (got {len(args.q)})")
-    scale = units.scale(units.q)
-    return np.array([_number(n, t) / s for n, t, s in zip(_Q_NAMES, args.q, scale)])
+    return np.array(_q_values(args.q, units))
+
+
+def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]:
+    """Joint values as typed (units per --deg/--mm and the robot's joint kinds) in SI, each a finite number."""
+    prefix = f"{what} " if what else ""
+    return [_number(prefix + n, t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
 
 
 def _check_limits(robot: Robot, q: np.ndarray, strict: bool) -> None:
@@ -277,7 +282,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
     target = _read_pose(args.target, units)
     near = None
     if args.near:
-        near = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(units.q))])
+        near = robot.check_q(_q_values(args.near, units))
     numeric = args.numeric
     if robot.kind == "palletizer":
         if args.branch in ("left", "right"):
@@ -355,7 +360,7 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     branch = {"all": "nearest", "right": "right", "left": "left"}[args.branch]
     reference = None
     if args.near:
-        reference = [_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.near, units.scale(units.q))]
+        reference = _q_values(args.near, units)
     if robot.kind != "scara":
         raise InvalidInputError(f"ik --input (batch) is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     geo = robot.kinematics
@@ -434,7 +439,7 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
 
 
 def _joint_arg(robot: Robot, texts: Sequence[str], units: Units, what: str) -> np.ndarray:
-    q = robot.check_q([_number(f"{what} {n}", t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))])
+    q = robot.check_q(_q_values(texts, units, what))
     outside = robot.outside_limits(q, tol=1e-12)
     if outside:
         raise InfeasibleError(f"{what} is outside the joint limits: " + "; ".join(outside))
@@ -716,7 +721,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     robot = _load(args, units)
     q = None
     if args.q:
-        q = robot.check_q([_number(n, t) / sc for n, t, sc in zip(_Q_NAMES, args.q, units.scale(units.q))])
+        q = robot.check_q(_q_values(args.q, units))
         for item in robot.outside_limits(q):
             log.warning("%s (shown anyway)", item)
     times = qs = None

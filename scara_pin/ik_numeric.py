@@ -117,17 +117,6 @@ def _error(robot: Robot, q: np.ndarray, target: np.ndarray) -> np.ndarray:
     return e
 
 
-def _project(q: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: np.ndarray) -> np.ndarray:
-    """Into the limits: revolute joints by a 2 pi turn when that lands inside, then clipping."""
-    out = q.copy()
-    for i in np.flatnonzero(revolute):
-        if out[i] < lo[i] or out[i] > hi[i]:
-            k = math.ceil((lo[i] - out[i]) / _TWO_PI)
-            if out[i] + k * _TWO_PI <= hi[i]:
-                out[i] += k * _TWO_PI
-    return np.clip(out, lo, hi)
-
-
 def solve_numeric(
     robot: Robot,
     target: ArrayLike,
