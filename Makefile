@@ -12,11 +12,12 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 
-$(VENV)/.installed: pyproject.toml | $(BIN)/python
+# the C module is compiled by the install (hatch_build.py): a change to it re-installs
+$(VENV)/.installed: pyproject.toml hatch_build.py scara_pin/_speedups.c | $(BIN)/python
 	$(BIN)/python -m pip install -q -e .
 	touch $@
 
-$(VENV)/.installed-test: pyproject.toml | $(BIN)/python
+$(VENV)/.installed-test: pyproject.toml hatch_build.py scara_pin/_speedups.c | $(BIN)/python
 	$(BIN)/python -m pip install -q -e '.[test]'
 	touch $@ $(VENV)/.installed
 
@@ -51,8 +52,8 @@ bench-ik: $(VENV)/.installed-test
 
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[test,lint]'
-	$(BIN)/ruff check scara_pin tests benchmarks
+	$(BIN)/ruff check scara_pin tests benchmarks hatch_build.py
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
 clean:
-	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache scara_pin/_speedups*.so

@@ -17,6 +17,9 @@ Before timing anything it checks that the package computes the same numbers as r
 that it still rejects NaN and wrongly shaped q, and that the CLI prints the same pose, so that a
 fast-but-wrong change cannot look good: on any mismatch it says so and exits 1 without timing.
 The targets (package / raw <= 1.5x) are reported, not enforced: missing one does not change the exit code.
+The header says which route of the package ran: the compiled ``scara_pin._speedups`` or the pure-Python
+fallback (no C module built, or ``SCARA_PIN_NO_SPEEDUPS=1`` in the environment, which the cold-start
+commands inherit too).
 
 Options: ``--quick`` (fewer rounds and runs), ``--json`` (one JSON object on stdout instead of the table),
 ``--inherit-env`` (cold start in the environment as is).
@@ -41,6 +44,7 @@ import numpy as np
 import pinocchio as pin
 
 import scara_pin
+from scara_pin import _fast
 
 TARGET = 1.5  # package / reference, for every metric
 N_Q = 1000
@@ -323,6 +327,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "pinocchio": pin.__version__,
         "numpy": np.__version__,
         "scara_pin": scara_pin.__version__,
+        "route": "compiled" if _fast.speedups is not None else "pure Python fallback",
         "machine": platform.machine(),
         "n_q": N_Q,
         "seed": SEED,
@@ -342,6 +347,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"Python {env['python']} ({env['machine']}); {N_Q} random q (seed {SEED}), median of {rounds} "
         f"interleaved rounds; cold start: median of {runs} interleaved runs, bytecode {env['cold_bytecode']}"
     )
+    print(f"scara-pin route: {env['route']} (scara_pin._fast.speedups is "
+          f"{'not ' if _fast.speedups is not None else ''}None)")  # fmt: skip
     print(
         f"correctness: package == raw Pinocchio on all {N_Q} q (max |err| FK {errors['fk_max_abs_err']:.1e}, "
         f"Jacobian {errors['jacobian_max_abs_err']:.1e}, CLI {errors['cli_max_abs_err']:.1e}; tol {TOL:g}); "

@@ -13,6 +13,7 @@ __all__ = [
     "DescriptionError",
     "InfeasibleError",
     "InvalidInputError",
+    "NoSolutionError",
     "ParameterError",
     "ScaraError",
     "UnknownRobotError",
@@ -75,6 +76,20 @@ class InfeasibleError(ScaraError):
     """A valid request that the robot cannot carry out (exit code 3)."""
 
     exit_code: ClassVar[int] = 3
+
+
+class NoSolutionError(InfeasibleError):
+    """An IK target without a solution inside the joint limits (exit code 3).
+
+    Attributes:
+        status: the stable reason code (``IKStatus`` or ``PalletizerIKStatus``), e.g. ``OUT_OF_REACH``.
+        reason: the sentence with the numbers behind it.
+    """
+
+    def __init__(self, status: object, reason: str) -> None:
+        self.status = status
+        self.reason = reason
+        super().__init__(f"{getattr(status, 'name', status)}: {reason}")
 
 
 class DescriptionError(ScaraError):

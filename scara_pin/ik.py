@@ -31,12 +31,18 @@ Every 2 pi-equivalent of the revolute joints inside their limits is a separate s
 +/-400 deg gives several turns). Tolerances: targets within ``REACH_TOL`` (1e-10 m) outside the reach
 circles are solved on the circle; joint values within ``LIMIT_TOL`` (1e-10) outside a limit are clamped
 onto it.
+
+Three entry points: :func:`solve` (every solution of one target, as objects, with the reason when there
+is none), :func:`solve_nearest` (the one solution nearest to a reference configuration, as a controller
+needs it between consecutive points; its regular case runs in the compiled ``scara_pin._speedups``), and
+:func:`solve_batch` (N targets, vectorised with numpy).
 """
 
 from __future__ import annotations
 
 import enum
 import math
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, overload
@@ -44,7 +50,8 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import pinocchio as pin
 
-from .errors import InvalidInputError, ParameterError, UrdfError
+from . import _fast
+from .errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -64,6 +71,7 @@ __all__ = [
     "ScaraGeometry",
     "solve",
     "solve_batch",
+    "solve_nearest",
 ]
 
 REACH_TOL = 1e-10
@@ -75,6 +83,8 @@ SNAP_TOL = 8 * 2.0**-52
 taken as on it: the sampled q = 0 elbow then comes back exactly, not as two branches 3e-8 rad apart."""
 FREE_R = 1e-12
 """[m] a wrist this close to the shoulder axis (possible when l1 = l2) leaves the shoulder angle free."""
+SINGULAR_GAMMA = 1e-12
+"""[rad] an elbow angle this close to 0 or pi is stretched/folded: the two branches are one solution."""
 YAW_POSE_TOL = 1e-9
 """[rad] the largest tilt of a target rotation still taken as a pure yaw."""
 PARALLEL_TOL = 1e-6
@@ -221,6 +231,7 @@ class ScaraGeometry:
     beta2: float = field(init=False)
     _radius: tuple[float, float] | None = field(init=False, repr=False, compare=False)
     _fast: tuple[Any, ...] = field(init=False, repr=False, compare=False)
+    _cparams: bytes = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "l1", math.hypot(*self.u1))
@@ -256,6 +267,17 @@ class ScaraGeometry:
             wrist_any_turn, layout, one_a, one_b, inner_min, self.tool == (0.0, 0.0),
         )  # fmt: skip
         object.__setattr__(self, "_fast", fast)
+        # the same numbers for the compiled nearest() (scara_pin/_speedups.c, struct Geometry: this order)
+        cparams = (
+            ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip],
+            lo[ra], hi[ra], lo[rb], hi[rb], lo[rc], hi[rc], lo[ip], hi[ip],
+            lo[ra] - tol, hi[ra] + tol, lo[rb] - tol, hi[rb] + tol, lo[rc] - tol, hi[rc] + tol,
+            lo[ip] - tol, hi[ip] + tol,
+            self.z0, self.yaw0, self.a1[0], self.a1[1], self.tool[0], self.tool[1],
+            l1, l2, self.beta1, self.beta2, l1 + l2 + REACH_TOL, l1 + l2, abs(l1 - l2),
+            inner_min, float(self.tool == (0.0, 0.0)), SNAP_TOL, FREE_R, SINGULAR_GAMMA, _TWO_PI,
+        )  # fmt: skip
+        object.__setattr__(self, "_cparams", array("d", cparams).tobytes())
 
     # ---------------------------------------------------------------------------------------- reading
     @classmethod
@@ -487,7 +509,7 @@ def solve(
         inner = 0.0
     inner *= r + d12
     gamma = 2.0 * _atan2(_sqrt(outer), _sqrt(inner))
-    singular = gamma < 1e-12 or _PI - gamma < 1e-12
+    singular = gamma < SINGULAR_GAMMA or _PI - gamma < SINGULAR_GAMMA
     phi_ref = None
     if reference is not None:
         phi_ref = s_a * float(reference[ra])
@@ -582,6 +604,83 @@ def solve(
     order = (IKStatus.J2_LIMIT, IKStatus.J1_LIMIT, IKStatus.J4_LIMIT)  # the later the stage, the closer
     status = max((f[0] for f in failures), key=order.index)
     return _result(pose, (), status, "no solution inside the joint limits: " + "; ".join(f[1] for f in failures))
+
+
+_BRANCH_CODE = {"all": 0, "left": 1, "right": 2}
+_nearest_c = None if _fast.speedups is None else _fast.speedups.nearest
+
+
+def solve_nearest(
+    geo: ScaraGeometry,
+    target: ArrayLike | pin.SE3,
+    reference: ArrayLike,
+    *,
+    weights: ArrayLike | None = None,
+    branch: str = "all",
+) -> np.ndarray:
+    """The one solution nearest to ``reference``: what a controller needs between consecutive points.
+
+    The same answer as ``solve(geo, target, branch=branch, reference=reference).nearest(reference, weights,
+    branch).q``: among every solution inside the limits (both branches unless ``branch`` says otherwise,
+    every 2 pi turn), the one with the least sum_i w_i (q_i - reference_i)^2; on a tie the first in
+    :func:`solve`'s order. The regular case runs in the compiled ``scara_pin._speedups`` when it is built;
+    everything else (a free shoulder, SE3 targets, no solution) takes :func:`solve`.
+
+    Args:
+        geo: the robot's geometry (``robot.kinematics``).
+        target: (x, y, z, yaw) [m, rad], a pin.SE3 or a 4 x 4 pose, as for :func:`solve`.
+        reference: 4 joint values [rad, m] (the previous point, say).
+        weights: 4 non-negative weights of the joint-space distance (default: all 1).
+        branch: ``"all"``, ``"left"`` or ``"right"``.
+
+    Returns:
+        np.ndarray: the joint values (a new array).
+
+    Raises:
+        NoSolutionError: no solution inside the limits; ``status`` and ``reason`` say why (exit code 3).
+        InvalidInputError: a malformed target, reference, weights or branch.
+    """
+    if _nearest_c is not None:
+        q = _nearest_c(geo._cparams, target, reference, weights, _BRANCH_CODE.get(branch, -1))
+        if q is not None:
+            return q  # type: ignore[no-any-return]
+    return _nearest_py(geo, target, reference, weights, branch)
+
+
+def _nearest_py(
+    geo: ScaraGeometry, target: object, reference: object, weights: object, branch: str
+) -> np.ndarray:
+    """:func:`solve_nearest` through :func:`solve` (every case, with the reasons)."""
+    ref, w = _reference_weights(reference, weights)
+    return _pick_nearest(solve(geo, target, branch=branch, reference=ref), ref, w, branch)  # type: ignore[arg-type]
+
+
+def _reference_weights(reference: object, weights: object) -> tuple[np.ndarray, np.ndarray]:
+    """(reference, weights) as 4 finite floats each (weights >= 0, default 1), or a ParameterError."""
+    ref = _four("reference", reference)
+    w = np.ones(4) if weights is None else _four("weights", weights)
+    if (w < 0).any():
+        raise ParameterError("weights", w.tolist(), "must be >= 0")
+    return ref, w
+
+
+def _pick_nearest(result: IKResult, ref: np.ndarray, w: np.ndarray, branch: str) -> np.ndarray:
+    """The q of ``result``'s solution of ``branch`` nearest to ``ref``, or NoSolutionError with the reason."""
+    best = result.nearest(ref, w, branch) if result.success else None
+    if best is None:
+        raise NoSolutionError(result.status, result.message if not result.success else f"no {branch} solution")
+    return best.q.copy()
+
+
+def _four(name: str, value: object) -> np.ndarray:
+    """``value`` as 4 finite floats, or a ParameterError naming ``name``."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, "must be 4 numbers") from None
+    if arr.shape != (4,) or not np.isfinite(arr).all():
+        raise ParameterError(name, value, "must be 4 finite numbers")
+    return arr
 
 
 def _free_shoulder(geo: ScaraGeometry, alpha: float, phi2: float, phi_ref: float | None) -> float:

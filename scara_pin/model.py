@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from . import ik as _ik
+from ._fast import _Q_MAX, q_ok, task_rows
 from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
 
@@ -35,12 +37,6 @@ if TYPE_CHECKING:
     from .palletizer import PalletizerGeometry
 
 __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
-
-_Q_MAX = 1e6
-"""[rad or m] the largest joint value taken as a configuration (beyond it an angle has no precision)."""
-
-_F64 = np.dtype(np.float64)
-_FAST_Q2 = (0.5 * _Q_MAX) ** 2
 
 
 def _rerooted(model: pin.Model, baseMo: pin.SE3) -> pin.Model:
@@ -236,7 +232,6 @@ class Robot:
         # LOCAL_WORLD_ALIGNED Jacobians are in base axes, so the hot paths need no extra products.
         self._base_model = _rerooted(model, self.data.oMf[self.base_id].inverse())
         self._base_data = self._base_model.createData()
-        self._rows = np.array([0, 1, 2, 5])  # x, y, z, wz of a 6-row Jacobian
         self.continuous = continuous
         self.has_continuous = any(continuous)
         if self.has_continuous:
@@ -294,12 +289,10 @@ class Robot:
         Raises:
             NotScaraError: the model is not SCARA-like (the reason names the joint), or is a palletizer.
         """
-        from .ik import NotScaraError, ScaraGeometry
-
         if self.kind != "scara":
-            raise NotScaraError(f"robot {self.name!r} is a {self.kind}, not a SCARA: the SCARA closed form "
+            raise _ik.NotScaraError(f"robot {self.name!r} is a {self.kind}, not a SCARA: the SCARA closed form "
                                 "(and what is built on it) does not apply")  # fmt: skip
-        return ScaraGeometry.from_robot(self)
+        return _ik.ScaraGeometry.from_robot(self)
 
     @cached_property
     def palletizer(self) -> PalletizerGeometry:
@@ -322,9 +315,32 @@ class Robot:
             from . import palletizer
 
             return palletizer.solve(self.palletizer, target, branch=branch, reference=reference)
-        from .ik import solve
+        return _ik.solve(self.kinematics, target, branch=branch, reference=reference)
 
-        return solve(self.kinematics, target, branch=branch, reference=reference)
+    def ik_nearest(
+        self,
+        target: Any,
+        reference: ArrayLike,
+        *,
+        weights: ArrayLike | None = None,
+        branch: str = "all",
+    ) -> np.ndarray:
+        """The closed-form IK solution nearest to ``reference`` (weighted joint space), as a new array.
+
+        A SCARA: :func:`scara_pin.ik.solve_nearest`; a palletizer: the nearest of
+        :func:`scara_pin.palletizer.solve`'s solutions. Raises :class:`~scara_pin.NoSolutionError` with the
+        reason code when there is none.
+        """
+        if self.kind == "palletizer":
+            return self._nearest_of_all(target, reference, weights, branch)
+        if self.has_continuous:  # the duplicates at -pi/+pi are dropped by ik(); nearest is the same
+            return self._nearest_of_all(target, reference, weights, branch)
+        return _ik.solve_nearest(self.kinematics, target, reference, weights=weights, branch=branch)
+
+    def _nearest_of_all(self, target: Any, reference: ArrayLike, weights: ArrayLike | None, branch: str) -> np.ndarray:
+        """:meth:`ik_nearest` through :meth:`ik` (every solution, then the nearest)."""
+        ref, w = _ik._reference_weights(reference, weights)
+        return _ik._pick_nearest(self.ik(target, branch=branch, reference=ref), ref, w, branch)
 
     def branch_of(self, q: ArrayLike) -> str:
         """The IK branch of a configuration (SCARA: right/left; palletizer: up/down)."""
@@ -332,9 +348,7 @@ class Robot:
             from .palletizer import branch_of
 
             return branch_of(q)
-        from .ik import branch_of as scara_branch_of
-
-        return scara_branch_of(self.kinematics, q)
+        return _ik.branch_of(self.kinematics, q)
 
     # ----------------------------------------------------------------- input checks
     def check_q(self, q: object) -> np.ndarray:
@@ -382,15 +396,11 @@ class Robot:
     def _valid_q(self, q: Any) -> np.ndarray:
         """``q`` itself when it is obviously valid (4 moderate float64 values), else ``check_q(q)``.
 
-        The cheap test only ever sends inputs on to the full check; it never lets a bad one through.
+        The cheap test (:func:`scara_pin._fast.q_ok`) only ever sends inputs on to the full check; it never
+        lets a bad one through.
         """
-        try:
-            if q.dtype is _F64 and q.ndim == 1:
-                a, b, c, d = q.tolist()
-                if a * a + b * b + c * c + d * d <= _FAST_Q2:  # NaN and inf fail this comparison
-                    return q
-        except (AttributeError, TypeError, ValueError):
-            pass
+        if q_ok(q):
+            return q  # type: ignore[no-any-return]
         return self.check_q(q)
 
     _pin_q = _valid_q
@@ -447,7 +457,8 @@ class Robot:
 
         Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
         """
-        q = self._pin_q(q)
+        if not q_ok(q) or self.has_continuous:  # inline: the common case costs one C call (see _fast)
+            q = self._pin_q(q)
         model, data = self._base_model, self._base_data
         pin.forwardKinematics(model, data, q)
         return pin.updateFramePlacement(model, data, self.tool_id)
@@ -491,9 +502,11 @@ class Robot:
         Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
         base z axis, which equals d(yaw)/dt while the tool stays level).
         """
-        q = self._pin_q(q)
-        J = pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED)
-        return J.take(self._rows, 0)
+        if not q_ok(q) or self.has_continuous:
+            q = self._pin_q(q)
+        return task_rows(
+            pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED)
+        )
 
     def manipulability(self, q: np.ndarray) -> float:
         """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4)."""
