@@ -11,7 +11,7 @@
  *   nearest(params, target, reference, weights, branch)
  *                  the closed-form SCARA IK solution nearest to `reference`, for the regular case only:
  *                  the same expressions as scara_pin.ik.solve(), every 2 pi turn of the shoulder, elbow and
- *                  wrist inside the limits, both branches (branch 0 = all, 1 = left, 2 = right), and the
+ *                  wrist inside the limits, both branches (branch "all", "left" or "right"), and the
  *                  minimum of sum_i w_i (q_i - ref_i)^2 with the first one kept on a tie (solve()'s order:
  *                  right before left, then by shoulder, elbow and wrist turn). It returns None whenever it
  *                  has no solution to give (out of reach, limits, stroke, a free shoulder, inputs that are
@@ -23,6 +23,7 @@
 #define NPY_NO_DEPRECATED_API NPY_2_0_API_VERSION
 #include <numpy/arrayobject.h>
 
+static PyObject *str_all = NULL; /* interned "all" */
 static double q_max2 = -1.0; /* set by set_q_max2(); negative: q_ok() says False to everything */
 
 /* The geometry, as packed by scara_pin.ik.ScaraGeometry (_C_FIELDS there): doubles in this order. */
@@ -133,9 +134,13 @@ static PyObject *nearest(PyObject *self, PyObject *const *args, Py_ssize_t nargs
         for (int i = 0; i < 4; i++)
             if (!(w[i] >= 0.0)) Py_RETURN_NONE;
     }
-    long branch = PyLong_AsLong(args[4]);
-    if (branch == -1 && PyErr_Occurred()) return NULL;
-    if (branch < 0 || branch > 2) Py_RETURN_NONE;
+    int branch; /* 0 all, 1 left, 2 right */
+    if (args[4] == str_all) branch = 0; /* the default argument: the interned literal */
+    else if (!PyUnicode_Check(args[4])) Py_RETURN_NONE;
+    else if (PyUnicode_CompareWithASCIIString(args[4], "all") == 0) branch = 0;
+    else if (PyUnicode_CompareWithASCIIString(args[4], "left") == 0) branch = 1;
+    else if (PyUnicode_CompareWithASCIIString(args[4], "right") == 0) branch = 2;
+    else Py_RETURN_NONE;
 
     const double two_pi = g->two_pi, pi = 0.5 * g->two_pi;
     const double x = t[0], y = t[1], z = t[2], yaw = t[3];
@@ -246,5 +251,7 @@ static struct PyModuleDef module = {
 
 PyMODINIT_FUNC PyInit__speedups(void) {
     import_array();
+    str_all = PyUnicode_InternFromString("all");
+    if (str_all == NULL) return NULL;
     return PyModule_Create(&module);
 }

@@ -267,16 +267,9 @@ class ScaraGeometry:
             wrist_any_turn, layout, one_a, one_b, inner_min, self.tool == (0.0, 0.0),
         )  # fmt: skip
         object.__setattr__(self, "_fast", fast)
-        # the same numbers for the compiled nearest() (scara_pin/_speedups.c, struct Geometry: this order)
-        cparams = (
-            ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip],
-            lo[ra], hi[ra], lo[rb], hi[rb], lo[rc], hi[rc], lo[ip], hi[ip],
-            lo[ra] - tol, hi[ra] + tol, lo[rb] - tol, hi[rb] + tol, lo[rc] - tol, hi[rc] + tol,
-            lo[ip] - tol, hi[ip] + tol,
-            self.z0, self.yaw0, self.a1[0], self.a1[1], self.tool[0], self.tool[1],
-            l1, l2, self.beta1, self.beta2, l1 + l2 + REACH_TOL, l1 + l2, abs(l1 - l2),
-            inner_min, float(self.tool == (0.0, 0.0)), SNAP_TOL, FREE_R, SINGULAR_GAMMA, _TWO_PI,
-        )  # fmt: skip
+        # the same numbers for the compiled nearest() (scara_pin/_speedups.c, struct Geometry: this order):
+        # fast[:37] is everything from the joint indices to |l1 - l2|
+        cparams = (*fast[:37], inner_min, float(fast[-1]), SNAP_TOL, FREE_R, SINGULAR_GAMMA, _TWO_PI)
         object.__setattr__(self, "_cparams", array("d", cparams).tobytes())
 
     # ---------------------------------------------------------------------------------------- reading
@@ -606,7 +599,6 @@ def solve(
     return _result(pose, (), status, "no solution inside the joint limits: " + "; ".join(f[1] for f in failures))
 
 
-_BRANCH_CODE = {"all": 0, "left": 1, "right": 2}
 _nearest_c = None if _fast.speedups is None else _fast.speedups.nearest
 
 
@@ -641,7 +633,7 @@ def solve_nearest(
         InvalidInputError: a malformed target, reference, weights or branch.
     """
     if _nearest_c is not None:
-        q = _nearest_c(geo._cparams, target, reference, weights, _BRANCH_CODE.get(branch, -1))
+        q = _nearest_c(geo._cparams, target, reference, weights, branch)
         if q is not None:
             return q  # type: ignore[no-any-return]
     return _nearest_py(geo, target, reference, weights, branch)

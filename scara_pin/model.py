@@ -28,6 +28,7 @@ import pinocchio as pin
 
 from . import ik as _ik
 from ._fast import _Q_MAX, q_ok, task_rows
+from ._fast import speedups as _speedups
 from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
 
@@ -35,6 +36,8 @@ if TYPE_CHECKING:
     from ._typing import ArrayLike
     from .ik import IKResult, ScaraGeometry
     from .palletizer import PalletizerGeometry
+
+_nearest_c = None if _speedups is None else _speedups.nearest
 
 __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
 
@@ -331,11 +334,27 @@ class Robot:
         :func:`scara_pin.palletizer.solve`'s solutions. Raises :class:`~scara_pin.NoSolutionError` with the
         reason code when there is none.
         """
-        if self.kind == "palletizer":
-            return self._nearest_of_all(target, reference, weights, branch)
-        if self.has_continuous:  # the duplicates at -pi/+pi are dropped by ik(); nearest is the same
-            return self._nearest_of_all(target, reference, weights, branch)
-        return _ik.solve_nearest(self.kinematics, target, reference, weights=weights, branch=branch)
+        params = self._nearest_params
+        if params is not None:  # inline: the common case is one C call (solve_nearest's compiled route)
+            q = _nearest_c(params, target, reference, weights, branch)
+            if q is not None:
+                return q  # type: ignore[no-any-return]
+            return _ik._nearest_py(self.kinematics, target, reference, weights, branch)
+        return self._nearest_of_all(target, reference, weights, branch)
+
+    @cached_property
+    def _nearest_params(self) -> bytes | None:
+        """The packed geometry for the compiled nearest solution, or None where :meth:`ik` is the route.
+
+        None without the compiled module, for a palletizer, a robot with continuous joints (its -pi/+pi
+        twins are merged by :meth:`ik`; the nearest is the same) and a model the SCARA closed form refuses.
+        """
+        if _nearest_c is None or self.kind != "scara" or self.has_continuous:
+            return None
+        try:
+            return self.kinematics._cparams
+        except _ik.NotScaraError:
+            return None
 
     def _nearest_of_all(self, target: Any, reference: ArrayLike, weights: ArrayLike | None, branch: str) -> np.ndarray:
         """:meth:`ik_nearest` through :meth:`ik` (every solution, then the nearest)."""

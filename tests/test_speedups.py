@@ -87,20 +87,21 @@ BAD = {
 }
 
 
-def _q_oks() -> list[Any]:
-    out = [pytest.param(_fast.q_ok_py, id="python")]
+def routes(name: str) -> list[Any]:
+    """The Python function ``_fast.<name>_py`` and, when built, the compiled ``_speedups.<name>``."""
+    out = [pytest.param(getattr(_fast, name + "_py"), id="python")]
     if _fast.speedups is not None:
-        out.append(pytest.param(_fast.speedups.q_ok, id="compiled"))
+        out.append(pytest.param(getattr(_fast.speedups, name), id="compiled"))
     return out
 
 
-@pytest.mark.parametrize("q_ok", _q_oks())
+@pytest.mark.parametrize("q_ok", routes("q_ok"))
 @pytest.mark.parametrize("label", list(GOOD))
 def test_q_ok_accepts_plain_moderate_float64_quadruples(q_ok: Any, label: str) -> None:
     assert q_ok(GOOD[label]) is True
 
 
-@pytest.mark.parametrize("q_ok", _q_oks())
+@pytest.mark.parametrize("q_ok", routes("q_ok"))
 @pytest.mark.parametrize("label", list(BAD))
 def test_q_ok_sends_everything_else_to_the_full_check(q_ok: Any, label: str) -> None:
     assert q_ok(BAD[label]) is False
@@ -122,14 +123,7 @@ def test_other_valid_forms_give_the_float64_answer(default: Robot, label: str) -
 
 
 # ============================================================================== task_rows
-def _task_rows() -> list[Any]:
-    out = [pytest.param(_fast.task_rows_py, id="python")]
-    if _fast.speedups is not None:
-        out.append(pytest.param(_fast.speedups.task_rows, id="compiled"))
-    return out
-
-
-@pytest.mark.parametrize("task_rows", _task_rows())
+@pytest.mark.parametrize("task_rows", routes("task_rows"))
 @pytest.mark.parametrize("layout", ["C", "F", "strided"])
 def test_task_rows_are_rows_0_1_2_5(task_rows: Any, layout: str) -> None:
     J = np.random.default_rng(1).normal(size=(6, 9))
