@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import os
+from collections.abc import Callable
 from types import ModuleType
 from typing import Any
 
@@ -50,10 +51,15 @@ def task_rows_py(J: np.ndarray) -> np.ndarray:
     return J.take(_ROWS, 0)
 
 
+def nearest_none(*args: object) -> None:
+    """Stands for the compiled ``nearest`` without the module: "no answer here", i.e. the Python route."""
+    return None
+
+
+q_ok: Callable[[Any], bool] = q_ok_py
+task_rows: Callable[[np.ndarray], np.ndarray] = task_rows_py
+nearest: Callable[..., np.ndarray | None] = nearest_none
+"""``nearest(params, target, reference, weights, branch)``: see scara_pin/_speedups.c and ik.solve_nearest."""
 if speedups is not None:
     speedups.set_q_max2(Q_MAX2)
-    q_ok = speedups.q_ok
-    task_rows = speedups.task_rows
-else:
-    q_ok = q_ok_py
-    task_rows = task_rows_py
+    q_ok, task_rows, nearest = speedups.q_ok, speedups.task_rows, speedups.nearest

@@ -599,7 +599,7 @@ def solve(
     return _result(pose, (), status, "no solution inside the joint limits: " + "; ".join(f[1] for f in failures))
 
 
-_nearest_c = None if _fast.speedups is None else _fast.speedups.nearest
+_nearest_c = _fast.nearest
 
 
 def solve_nearest(
@@ -632,10 +632,9 @@ def solve_nearest(
         NoSolutionError: no solution inside the limits; ``status`` and ``reason`` say why (exit code 3).
         InvalidInputError: a malformed target, reference, weights or branch.
     """
-    if _nearest_c is not None:
-        q = _nearest_c(geo._cparams, target, reference, weights, branch)
-        if q is not None:
-            return q  # type: ignore[no-any-return]
+    q = _nearest_c(geo._cparams, target, reference, weights, branch)
+    if q is not None:
+        return q
     return _nearest_py(geo, target, reference, weights, branch)
 
 

@@ -28,6 +28,7 @@ import pinocchio as pin
 
 from . import ik as _ik
 from ._fast import _Q_MAX, q_ok, task_rows
+from ._fast import nearest as _nearest_c
 from ._fast import speedups as _speedups
 from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
@@ -36,8 +37,6 @@ if TYPE_CHECKING:
     from ._typing import ArrayLike
     from .ik import IKResult, ScaraGeometry
     from .palletizer import PalletizerGeometry
-
-_nearest_c = None if _speedups is None else _speedups.nearest
 
 __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
 
@@ -338,7 +337,7 @@ class Robot:
         if params is not None:  # inline: the common case is one C call (solve_nearest's compiled route)
             q = _nearest_c(params, target, reference, weights, branch)
             if q is not None:
-                return q  # type: ignore[no-any-return]
+                return q
             return _ik._nearest_py(self.kinematics, target, reference, weights, branch)
         return self._nearest_of_all(target, reference, weights, branch)
 
@@ -349,7 +348,7 @@ class Robot:
         None without the compiled module, for a palletizer, a robot with continuous joints (its -pi/+pi
         twins are merged by :meth:`ik`; the nearest is the same) and a model the SCARA closed form refuses.
         """
-        if _nearest_c is None or self.kind != "scara" or self.has_continuous:
+        if _speedups is None or self.kind != "scara" or self.has_continuous:
             return None
         try:
             return self.kinematics._cparams
