@@ -177,7 +177,8 @@ class IKResult:
             return None
         ref = np.asarray(reference, dtype=float)
         w = np.ones(4) if weights is None else np.asarray(weights, dtype=float)
-        return min(candidates, key=lambda s: float(w @ (s.q - ref) ** 2))
+        d = np.array([s.q for s in candidates]) - ref
+        return candidates[int(np.argmin((d * d) @ w))]  # argmin: the first on a tie, as min() would
 
 
 @dataclass(frozen=True)
