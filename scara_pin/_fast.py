@@ -37,7 +37,7 @@ def q_ok_py(q: Any) -> bool:
 
     False only means "run the full check" (``Robot.check_q``); it never lets a bad ``q`` through.
     """
-    if type(q) is np.ndarray and q.dtype is _F64 and q.ndim == 1:
+    if type(q) is np.ndarray and q.dtype is _F64 and q.ndim == 1:  # _F64: native byte order
         try:
             a, b, c, d = q.tolist()
         except ValueError:

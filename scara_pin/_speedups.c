@@ -4,7 +4,8 @@
  * Nothing here is needed for correctness: every function has a pure-Python equivalent that scara_pin uses
  * when this module is not built (see scara_pin/_fast.py), and the tests run both routes against each other.
  *
- *   q_ok(q)        True when q is obviously valid for the kinematics: a 1-D float64 ndarray of exactly 4
+ *   q_ok(q)        True when q is obviously valid for the kinematics: a 1-D float64 ndarray (native byte
+ *                  order, aligned) of exactly 4
  *                  values whose sum of squares is at most the bound given to set_q_max2() (NaN and inf fail
  *                  this comparison). False sends q to the full Python check; it never lets a bad q through.
  *   task_rows(J)   a new (4, n) float64 array: rows 0, 1, 2 and 5 (x, y, z, wz) of a (6, n) float64 Jacobian.
@@ -39,11 +40,16 @@ typedef struct {
     double snap_tol, free_r, singular_tol, two_pi;
 } Geometry;
 
+/* A float64 array in the machine's byte order, aligned: its doubles can be read in place. */
+static inline int native_f64(PyArrayObject *a) {
+    return PyArray_TYPE(a) == NPY_DOUBLE && PyArray_ISNOTSWAPPED(a) && PyArray_ISALIGNED(a);
+}
+
 /* 4 finite doubles from a 1-D float64 ndarray of 4 values, or a tuple/list of 4 Python floats. */
 static int read4(PyObject *obj, double out[4]) {
     if (PyArray_Check(obj)) {
         PyArrayObject *a = (PyArrayObject *)obj;
-        if (PyArray_TYPE(a) != NPY_DOUBLE || PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != 4) return 0;
+        if (!native_f64(a) || PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != 4) return 0;
         const char *p = PyArray_BYTES(a);
         npy_intp st = PyArray_STRIDE(a, 0);
         for (int i = 0; i < 4; i++) out[i] = *(const double *)(p + i * st);
@@ -72,7 +78,7 @@ static PyObject *set_q_max2(PyObject *self, PyObject *arg) {
 static PyObject *q_ok(PyObject *self, PyObject *q) {
     if (!PyArray_CheckExact(q)) Py_RETURN_FALSE;
     PyArrayObject *a = (PyArrayObject *)q;
-    if (PyArray_TYPE(a) != NPY_DOUBLE || PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != 4) Py_RETURN_FALSE;
+    if (!native_f64(a) || PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != 4) Py_RETURN_FALSE;
     const char *p = PyArray_BYTES(a);
     npy_intp st = PyArray_STRIDE(a, 0);
     double s = 0.0;
@@ -91,7 +97,7 @@ static PyObject *task_rows(PyObject *self, PyObject *obj) {
         return NULL;
     }
     PyArrayObject *J = (PyArrayObject *)obj;
-    if (PyArray_TYPE(J) != NPY_DOUBLE || PyArray_NDIM(J) != 2 || PyArray_DIM(J, 0) != 6) {
+    if (!native_f64(J) || PyArray_NDIM(J) != 2 || PyArray_DIM(J, 0) != 6) {
         PyErr_SetString(PyExc_TypeError, "task_rows: expected a (6, n) float64 array");
         return NULL;
     }

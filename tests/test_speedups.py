@@ -75,6 +75,8 @@ BAD = {
     "1x4": np.zeros((1, 4)),
     "0-d": np.array(1.0),
     "float32": np.zeros(4, dtype=np.float32),
+    "big-endian NaN": np.array([math.nan, 0.0, 0.0, 0.0], dtype=">f8" if sys.byteorder == "little" else "<f8"),
+    "byte-swapped": np.array([0.1, 0.2, 0.3, 0.4], dtype=">f8" if sys.byteorder == "little" else "<f8"),
     "int": np.zeros(4, dtype=int),
     "bool": np.zeros(4, dtype=bool),
     "complex": np.zeros(4, dtype=complex),
@@ -107,14 +109,18 @@ def test_q_ok_sends_everything_else_to_the_full_check(q_ok: Any, label: str) -> 
     assert q_ok(BAD[label]) is False
 
 
-@pytest.mark.parametrize("label", ["NaN", "inf", "huge", "3 values", "4x1", "complex", "string", "None"])
+@pytest.mark.parametrize(
+    "label", ["NaN", "big-endian NaN", "inf", "huge", "3 values", "4x1", "complex", "string", "None"]
+)
 @pytest.mark.parametrize("method", ["tool_placement", "task_jacobian", "tool_pose"])
 def test_bad_q_still_raises_the_typed_error(default: Robot, method: str, label: str) -> None:
     with pytest.raises(ParameterError):
         getattr(default, method)(BAD[label])
 
 
-@pytest.mark.parametrize("label", ["list", "tuple", "float32", "int", "strided view", "too large", "ndarray subclass"])
+@pytest.mark.parametrize(
+    "label", ["list", "tuple", "float32", "int", "strided view", "too large", "ndarray subclass", "byte-swapped"]
+)
 def test_other_valid_forms_give_the_float64_answer(default: Robot, label: str) -> None:
     q = BAD.get(label, GOOD.get(label))
     ref = np.asarray(q, dtype=float)
@@ -246,6 +252,7 @@ def test_nearest_bad_inputs_raise_typed_errors(default: Robot, kwargs: dict[str,
         (0.3, 0.1, -0.05, 0.2),  # a tuple
         np.array([0.3, 0.1, -0.05, 0.2], dtype=np.float32).astype(float),
         [0.3, 0.1, -0.05, 1],  # an int among floats: the Python route
+        np.array([0.3, 0.1, -0.05, 0.2], dtype=">f8" if sys.byteorder == "little" else "<f8"),  # swapped
     ],
 )
 def test_nearest_target_forms_agree(default: Robot, target: Any) -> None:
