@@ -71,6 +71,10 @@ def _compile(root: Path, *, inplace: bool, build_dir: Path) -> Path:
         extra_compile_args=["-O2", "-ffp-contract=off"] if os.name != "nt" else ["/O2", "/fp:precise"],
     )
     dist = Distribution({"name": "scara-pin", "ext_modules": [ext]})
+    if inplace:  # a module left by an earlier build must not survive a failed one (scara_pin._fast checks too)
+        for old in (root / "scara_pin").glob("_speedups.*"):
+            if old.suffix in (".so", ".pyd"):
+                old.unlink()
     cmd = build_ext(dist)
     cmd.inplace = inplace
     cmd.build_lib = str(build_dir / "lib")

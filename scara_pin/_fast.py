@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import warnings
 from collections.abc import Callable
 from types import ModuleType
 from typing import Any
@@ -23,13 +24,27 @@ Q_MAX2 = (0.5 * _Q_MAX) ** 2
 _F64 = np.dtype(np.float64)
 _ROWS = np.array([0, 1, 2, 5])  # x, y, z, wz of a 6-row Jacobian
 
+API_VERSION = 2
+"""The version of scara_pin/_speedups.c this Python code is written for (its API_VERSION)."""
+GEOMETRY_DOUBLES = 43
+"""The number of doubles in the packed SCARA geometry (ScaraGeometry._cparams, struct Geometry in C)."""
+
 speedups: ModuleType | None = None
-"""The compiled module, or None (not built, or SCARA_PIN_NO_SPEEDUPS=1)."""
+"""The compiled module, or None (not built, built from another version, or SCARA_PIN_NO_SPEEDUPS=1)."""
 if os.environ.get("SCARA_PIN_NO_SPEEDUPS") != "1":
     try:
         speedups = importlib.import_module("scara_pin._speedups")
     except ImportError:  # built without a C compiler (see hatch_build.py)
         pass
+    else:
+        if getattr(speedups, "API_VERSION", None) != API_VERSION or speedups.geometry_size() != GEOMETRY_DOUBLES:
+            warnings.warn(
+                f"scara_pin._speedups at {speedups.__file__} was built from another version of scara-pin; "
+                "ignoring it (the pure-Python route gives the same answers; reinstall to rebuild it)",
+                RuntimeWarning,
+                stacklevel=1,
+            )
+            speedups = None
 
 
 def q_ok_py(q: Any) -> bool:

@@ -24,6 +24,8 @@
 #define NPY_NO_DEPRECATED_API NPY_2_0_API_VERSION
 #include <numpy/arrayobject.h>
 
+#define API_VERSION 2 /* bump with any change of a function's arguments, results or the Geometry layout */
+
 static PyObject *str_all = NULL; /* interned "all" */
 static double q_max2 = -1.0; /* set by set_q_max2(); negative: q_ok() says False to everything */
 
@@ -133,6 +135,12 @@ static PyObject *nearest(PyObject *self, PyObject *const *args, Py_ssize_t nargs
         return NULL;
     }
     const Geometry *g = (const Geometry *)PyBytes_AS_STRING(args[0]);
+    const int ia = (int)g->ra, ib = (int)g->rb, ic = (int)g->rc, ip = (int)g->ip;
+    if (ia < 0 || ia > 3 || ib < 0 || ib > 3 || ic < 0 || ic > 3 || ip < 0 || ip > 3 || (ia + ib + ic + ip) != 6 ||
+        ia == ib || ia == ic || ia == ip || ib == ic || ib == ip || ic == ip) {
+        PyErr_SetString(PyExc_ValueError, "nearest: the packed joint indices are not a permutation of 0..3");
+        return NULL;
+    }
     double t[4], ref[4], w[4] = {1.0, 1.0, 1.0, 1.0};
     if (!read4(args[1], t) || !read4(args[2], ref)) Py_RETURN_NONE;
     if (args[3] != Py_None) {
@@ -165,7 +173,7 @@ static PyObject *nearest(PyObject *self, PyObject *const *args, Py_ssize_t nargs
         wx = x - (ca * g->tx - sa * g->ty) - g->a1x;
         wy = y - (sa * g->tx + ca * g->ty) - g->a1y;
     }
-    double r = hypot(wx, wy);
+    double r = sqrt(wx * wx + wy * wy); /* as solve(): both the C library's sqrt, bit for bit */
     if (r > g->reach || !(r >= g->inner_min) || !(r > g->free_r)) Py_RETURN_NONE;
     /* elbow angle gamma in [0, pi], by the half-angle form */
     const double l12 = g->l12, d12 = g->d12, snap = g->snap_tol * l12;
@@ -188,7 +196,6 @@ static PyObject *nearest(PyObject *self, PyObject *const *args, Py_ssize_t nargs
         eg[0] = gamma, et[0] = heading - lean, el[0] = 2;
         eg[1] = -gamma, et[1] = heading + lean, el[1] = 1, ne = 2;
     }
-    const int ia = (int)g->ra, ib = (int)g->rb, ic = (int)g->rc, ip = (int)g->ip;
     double best[4], best_cost = INFINITY;
     int found = 0;
     for (int e = 0; e < ne; e++) {
@@ -259,5 +266,12 @@ PyMODINIT_FUNC PyInit__speedups(void) {
     import_array();
     str_all = PyUnicode_InternFromString("all");
     if (str_all == NULL) return NULL;
-    return PyModule_Create(&module);
+    PyObject *m = PyModule_Create(&module);
+    if (m == NULL) return NULL;
+    /* scara_pin._fast uses the module only when this equals its own API_VERSION (a stale build is ignored) */
+    if (PyModule_AddIntConstant(m, "API_VERSION", API_VERSION) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
 }

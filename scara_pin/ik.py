@@ -94,7 +94,7 @@ _TWO_PI = 2.0 * math.pi
 _PI = math.pi
 _BRANCHES = ("all", "left", "right")
 # bound once for the per-target hot path of solve()
-_atan2, _sin, _cos, _sqrt, _hypot = math.atan2, math.sin, math.cos, math.sqrt, math.hypot
+_atan2, _sin, _cos, _sqrt = math.atan2, math.sin, math.cos, math.sqrt
 _ceil, _isfinite = math.ceil, math.isfinite
 _array = np.array
 _F64 = np.dtype(np.float64)
@@ -178,7 +178,10 @@ class IKResult:
         ref = np.asarray(reference, dtype=float)
         w = np.ones(4) if weights is None else np.asarray(weights, dtype=float)
         d = np.array([s.q for s in candidates]) - ref
-        return candidates[int(np.argmin((d * d) @ w))]  # argmin: the first on a tie, as min() would
+        t = d * d * w
+        # summed left to right, as scara_pin/_speedups.c does, so that both pick the same one on a tie;
+        # argmin: the first on a tie
+        return candidates[int(np.argmin(t[:, 0] + t[:, 1] + t[:, 2] + t[:, 3]))]
 
 
 @dataclass(frozen=True)
@@ -251,8 +254,6 @@ class ScaraGeometry:
         s, lo, hi = self.signs, self.lower, self.upper
         tol = LIMIT_TOL
         l1, l2 = self.l1, self.l2
-        # J4 always has a 2 pi-equivalent inside its limits when they span more than a turn (with margin)
-        wrist_any_turn = math.isfinite(lo[rc]) and math.isfinite(hi[rc]) and hi[rc] - lo[rc] >= _TWO_PI + 1e-9
         layout = 1 if (ra, rb, rc, ip) == (0, 1, 3, 2) else 0  # 1: q = (shoulder, elbow, prismatic, wrist)
         # at most one 2 pi-equivalent inside a range shorter than a turn (with margin): no list needed
         one_a = hi[ra] - lo[ra] + 2 * tol < _TWO_PI - 1e-9
@@ -265,12 +266,13 @@ class ScaraGeometry:
             lo[ip] - tol, hi[ip] + tol,
             self.z0, self.yaw0, self.a1[0], self.a1[1], self.tool[0], self.tool[1],
             l1, l2, self.beta1, self.beta2, l1 + l2 + REACH_TOL, l1 + l2, abs(l1 - l2),
-            wrist_any_turn, layout, one_a, one_b, inner_min, self.tool == (0.0, 0.0),
+            layout, one_a, one_b, inner_min, self.tool == (0.0, 0.0),
         )  # fmt: skip
         object.__setattr__(self, "_fast", fast)
         # the same numbers for the compiled nearest() (scara_pin/_speedups.c, struct Geometry: this order):
         # fast[:37] is everything from the joint indices to |l1 - l2|
         cparams = (*fast[:37], inner_min, float(fast[-1]), SNAP_TOL, FREE_R, SINGULAR_GAMMA, _TWO_PI)
+        assert len(cparams) == _fast.GEOMETRY_DOUBLES  # the layout of struct Geometry in _speedups.c
         object.__setattr__(self, "_cparams", array("d", cparams).tobytes())
 
     # ---------------------------------------------------------------------------------------- reading
@@ -404,17 +406,6 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % _TWO_PI - math.pi
 
 
-def _turns(value: float, lo: float, hi: float) -> list[float]:
-    """Every value + 2 pi k inside [lo, hi] (values within LIMIT_TOL outside are clamped)."""
-    k0 = math.ceil((lo - LIMIT_TOL - value) / _TWO_PI)
-    out = []
-    v = value + k0 * _TWO_PI
-    while v <= hi + LIMIT_TOL:
-        out.append(min(max(v, lo), hi))
-        v += _TWO_PI
-    return out
-
-
 def solve(
     geo: ScaraGeometry,
     target: ArrayLike | pin.SE3,
@@ -444,7 +435,7 @@ def solve(
      lt_a, ht_a, lt_b, ht_b, lt_c, ht_c, lt_p, ht_p,
      z0, yaw0, a1x, a1y, tx, ty,
      l1, l2, beta1, beta2, reach, l12, d12,
-     wrist_any_turn, layout, one_a, one_b, inner_min, tool_on_axis) = geo._fast  # fmt: skip
+     layout, one_a, one_b, inner_min, tool_on_axis) = geo._fast  # fmt: skip
     # a 4-vector of finite floats is read without numpy; anything else goes through _target
     plain = False
     kind = type(target)
@@ -481,7 +472,7 @@ def solve(
         ca, sa = _cos(alpha), _sin(alpha)
         wx = x - (ca * tx - sa * ty) - a1x
         wy = y - (sa * tx + ca * ty) - a1y
-    r = _hypot(wx, wy)
+    r = _sqrt(wx * wx + wy * wy)  # not math.hypot: the C library's sqrt, as scara_pin/_speedups.c and numpy do
     if r > reach:
         return _result(pose, (), IKStatus.OUT_OF_REACH,
                        f"the wrist axis would be {r:.9g} m from the shoulder axis, beyond the reach "
@@ -526,7 +517,7 @@ def solve(
             continue
         phi1 = theta1 - beta1
         phi2 = g + beta1 - beta2
-        # every 2 pi-equivalent inside the limits (as _turns), shoulder and elbow
+        # every 2 pi-equivalent inside the limits (values within LIMIT_TOL outside are clamped onto them)
         va = s_a * phi1
         v = va + _ceil((lt_a - va) / _TWO_PI) * _TWO_PI
         if one_a:
@@ -563,12 +554,7 @@ def solve(
             failures.append((IKStatus.J1_LIMIT, f"{label}: {geo.names[ra]} = {_wrap(va):.9g} rad (+2 pi k) "
                              f"outside [{lo_a:.9g}, {hi_a:.9g}]"))  # fmt: skip
             continue
-        if not wrist_any_turn:
-            phi4 = alpha - phi1 - phi2
-            if not _turns(s_c * phi4, lo_c, hi_c):
-                failures.append((IKStatus.J4_LIMIT, f"{label}: {geo.names[rc]} = {_wrap(s_c * phi4):.9g} rad "
-                                 f"(+2 pi k) outside [{lo_c:.9g}, {hi_c:.9g}]"))  # fmt: skip
-                continue
+        found = len(solutions)
         for qa in q_a:
             for qb in q_b:
                 # the wrist takes up whatever turns the shoulder and elbow add, to keep alpha
@@ -591,6 +577,10 @@ def solve(
                     d["branch"] = label
                     d["singular"] = singular
                     solutions.append(sol)
+        if len(solutions) == found:  # no wrist turn inside the limits (checked on the clamped q_a, q_b)
+            phi4 = s_c * (alpha - phi1 - phi2)
+            failures.append((IKStatus.J4_LIMIT, f"{label}: {geo.names[rc]} = {_wrap(phi4):.9g} rad "
+                             f"(+2 pi k) outside [{lo_c:.9g}, {hi_c:.9g}]"))  # fmt: skip
     if solutions:
         return _result(pose, tuple(solutions), _OK, f"{len(solutions)} solution(s)")
     if not failures:  # the requested branch was not tried: cannot happen for 'all'
@@ -824,7 +814,7 @@ class _BatchWork:
 
     - the reach: o = l12^2 - r^2 and i = r^2 - d12^2 (l12 = l1 + l2, d12 = |l1 - l2|) from r^2, without
       the square root, except on the rows near the stretched or folded arm (o or i below 1e-6 l1 l2,
-      gamma or pi - gamma below about 1e-3) where `solve`'s (l12 - r)(l12 + r) of r = hypot(wx, wy) is
+      gamma or pi - gamma below about 1e-3) where `solve`'s (l12 - r)(l12 + r) of r = sqrt(wx^2 + wy^2) is
       used, so that the ill-conditioned elbow angle there is computed from the same numbers;
     - the elbow: tan(gamma / 2) = sqrt(o / i), so tan gamma = 2 sqrt(o i) / (i - o), ONE atan2; and
       (l1 + l2 cos gamma, l2 sin gamma) is, up to the positive factor (i + o), (a, b) with
@@ -936,7 +926,8 @@ class _BatchWork:
         axis = None
         if near.any():
             rows = np.flatnonzero(near)
-            r = np.hypot(wx[rows], wy[rows])
+            wxr, wyr = wx[rows], wy[rows]
+            r = np.sqrt(wxr * wxr + wyr * wyr)
             l12, d12 = l1 + l2, abs(l1 - l2)
             snap = SNAP_TOL * l12
             o_lin, i_lin = l12 - r, r - d12

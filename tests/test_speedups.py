@@ -9,8 +9,9 @@ Independent routes for the expected values:
   on its own in test_ik.py), plus Pinocchio FK of the answer (pose within 1e-9) and the joint limits;
 - the command line gives the same answers with ``SCARA_PIN_NO_SPEEDUPS=1`` (the Python route).
 
-The compiled and the Python route of the nearest solution agree to 1e-9 in q (Q_TOL; they can differ in the
-last bits where the C library's hypot rounds differently from Python's, near the stretched arm).
+The compiled and the Python route of the nearest solution are the same operations on the same numbers:
+they must agree bit for bit, ties included (references exactly halfway between two solutions), and
+at the 1e-10 clamping edges of the limits.
 """
 
 from __future__ import annotations
@@ -176,7 +177,7 @@ def check_nearest(robot: Robot, target: np.ndarray, ref: np.ndarray, w: np.ndarr
     g = robot.kinematics.elbow_angle(float(got[geo.revolute[1]]))
     tol = Q_TOL if abs(math.sin(g)) >= 1e-6 else Q_TOL_SINGULAR
     assert np.abs(got - expected).max() <= tol, (got, expected)
-    assert np.abs(got - py).max() <= tol, (got, py)
+    assert np.array_equal(got, py), (got, py)
     assert pose_error(robot, got, target) <= POSE_TOL
     assert np.all(got >= lo) and np.all(got <= hi)
 
@@ -212,6 +213,56 @@ def test_nearest_of_the_sampled_q_is_that_q(robot_name: str) -> None:
             continue
         worst = max(worst, float(np.abs(robot.ik_nearest(robot.tool_pose(q), q) - q).max()))
     assert worst <= Q_TOL
+
+
+def test_ties_are_broken_alike_by_both_routes(default: Robot) -> None:
+    """A reference exactly halfway between two solutions: both routes return the same one (the first)."""
+    geo = default.kinematics
+    lo, hi = limits(default)
+    rng = np.random.default_rng(5)
+    checked = 0
+    for q in rng.uniform(lo, hi, size=(3000, 4)):
+        target = default.tool_pose(q)
+        sols = solve(geo, target).solutions
+        if len(sols) < 2:
+            continue
+        i, j = rng.choice(len(sols), 2, replace=False)
+        ref = 0.5 * (sols[i].q + sols[j].q)
+        got = solve_nearest(geo, target, ref)
+        assert np.array_equal(got, _nearest_py(geo, target, ref, None, "all")), (target, ref)
+        assert np.array_equal(got, brute_nearest(geo, target, ref, np.ones(4)))
+        checked += 1
+    assert checked > 2000
+
+
+@pytest.mark.parametrize("past", [0.0, 0.4e-10, 0.9e-10])
+@pytest.mark.parametrize("wrist_past", [0.0, 0.5e-10, 1.5e-10, 3e-10])
+def test_limit_edges_are_judged_alike(past: float, wrist_past: float) -> None:
+    """J1 up to LIMIT_TOL past its limit (clamped onto it) and J4 past its own: both routes, one answer.
+
+    The wrist is judged on the clamped shoulder value: 1.5e-10 past J4's limit before J1's clamp of 0.9e-10
+    is 0.6e-10 past after it, inside LIMIT_TOL: a solution; 3e-10 is outside either way: J4_LIMIT.
+    """
+    robot = load_robot("default", {"joint1_lower": math.radians(-130), "joint1_upper": math.radians(130),
+                                   "joint4_lower": math.radians(-170), "joint4_upper": math.radians(170)})  # fmt: skip
+    geo = robot.kinematics
+    q = np.array([geo.upper[0] + past, 1.0, 0.0, geo.lower[3] - wrist_past])
+    target = robot.tool_pose(q)
+    # J4's excess after J1's clamp, which moves it back by `past`; never within 1e-11 of LIMIT_TOL here
+    feasible = wrist_past - past <= 1e-10
+    res = solve(geo, target)
+    assert res.success is feasible, res.message
+    if not feasible:
+        assert res.status is IKStatus.J4_LIMIT and "joint4" in res.message
+        for route in (solve_nearest, _nearest_py):
+            with pytest.raises(NoSolutionError) as info:
+                route(geo, target, q, None, "all") if route is _nearest_py else route(geo, target, q)
+            assert info.value.status is IKStatus.J4_LIMIT
+        return
+    got = solve_nearest(geo, target, q)
+    assert np.array_equal(got, _nearest_py(geo, target, q, None, "all"))
+    assert pose_error(robot, got, target) <= POSE_TOL
+    assert got[0] == geo.upper[0] and geo.lower[3] <= got[3] <= geo.upper[3]
 
 
 def test_nearest_reasons_come_from_solve(default: Robot) -> None:
