@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from . import ik as _ik
+# scara_pin.ik is imported inside the methods that use it: `scara-pin fk` does not need it (start-up time)
 from ._fast import _Q_MAX, q_ok, task_rows
 from ._fast import nearest as _nearest_c
 from ._fast import speedups as _speedups
@@ -291,6 +291,8 @@ class Robot:
         Raises:
             NotScaraError: the model is not SCARA-like (the reason names the joint), or is a palletizer.
         """
+        from . import ik as _ik
+
         if self.kind != "scara":
             raise _ik.NotScaraError(f"robot {self.name!r} is a {self.kind}, not a SCARA: the SCARA closed form "
                                 "(and what is built on it) does not apply")  # fmt: skip
@@ -313,6 +315,8 @@ class Robot:
         A SCARA: :func:`scara_pin.ik.solve` (branches right/left); a palletizer:
         :func:`scara_pin.palletizer.solve` (branches up/down).
         """
+        from . import ik as _ik
+
         if self.kind == "palletizer":
             from . import palletizer
 
@@ -338,6 +342,8 @@ class Robot:
             q = _nearest_c(params, target, reference, weights, branch)
             if q is not None:
                 return q
+            from . import ik as _ik
+
             return _ik._nearest_py(self.kinematics, target, reference, weights, branch)
         return self._nearest_of_all(target, reference, weights, branch)
 
@@ -348,6 +354,8 @@ class Robot:
         None without the compiled module, for a palletizer, a robot with continuous joints (its -pi/+pi
         twins are merged by :meth:`ik`; the nearest is the same) and a model the SCARA closed form refuses.
         """
+        from . import ik as _ik
+
         if _speedups is None or self.kind != "scara" or self.has_continuous:
             return None
         try:
@@ -357,11 +365,15 @@ class Robot:
 
     def _nearest_of_all(self, target: Any, reference: ArrayLike, weights: ArrayLike | None, branch: str) -> np.ndarray:
         """:meth:`ik_nearest` through :meth:`ik` (every solution, then the nearest)."""
+        from . import ik as _ik
+
         ref, w = _ik._reference_weights(reference, weights)
         return _ik._pick_nearest(self.ik(target, branch=branch, reference=ref), ref, w, branch)
 
     def branch_of(self, q: ArrayLike) -> str:
         """The IK branch of a configuration (SCARA: right/left; palletizer: up/down)."""
+        from . import ik as _ik
+
         if self.kind == "palletizer":
             from .palletizer import branch_of
 
