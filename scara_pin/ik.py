@@ -51,6 +51,7 @@ import numpy as np
 import pinocchio as pin
 
 from . import _fast
+from ._checks import _vector
 from .errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
@@ -639,8 +640,8 @@ def _nearest_py(
 
 def _reference_weights(reference: object, weights: object) -> tuple[np.ndarray, np.ndarray]:
     """(reference, weights) as 4 finite floats each (weights >= 0, default 1), or a ParameterError."""
-    ref = _four("reference", reference)
-    w = np.ones(4) if weights is None else _four("weights", weights)
+    ref = _vector("reference", reference)
+    w = np.ones(4) if weights is None else _vector("weights", weights)
     if (w < 0).any():
         raise ParameterError("weights", w.tolist(), "must be >= 0")
     return ref, w
@@ -652,17 +653,6 @@ def _pick_nearest(result: IKResult, ref: np.ndarray, w: np.ndarray, branch: str)
     if best is None:
         raise NoSolutionError(result.status, result.message if not result.success else f"no {branch} solution")
     return best.q.copy()
-
-
-def _four(name: str, value: object) -> np.ndarray:
-    """``value`` as 4 finite floats, or a ParameterError naming ``name``."""
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(name, value, "must be 4 numbers") from None
-    if arr.shape != (4,) or not np.isfinite(arr).all():
-        raise ParameterError(name, value, "must be 4 finite numbers")
-    return arr
 
 
 def _free_shoulder(geo: ScaraGeometry, alpha: float, phi2: float, phi_ref: float | None) -> float:

@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
+from ._checks import _vector
 from .errors import InvalidInputError, ParameterError, UrdfError
 from .ik import LIMIT_TOL, REACH_TOL, YAW_POSE_TOL, IKResult, IKSolution
 
@@ -161,32 +162,25 @@ class PalletizerGeometry:
 # ------------------------------------------------------------------------------------ conventions
 def from_s2(q_s2: Sequence[float]) -> np.ndarray:
     """S2's ``(q1, q2, q3, q5)`` (q3 relative to the big arm) -> ``q = (q1, q2, theta3 = q2 + q3, q5)``."""
-    a = _four("q_s2", q_s2)
+    a = _vector("q_s2", q_s2)
     return np.array([a[0], a[1], a[1] + a[2], a[3]])
 
 
 def to_s2(q: Sequence[float]) -> np.ndarray:
     """``q = (q1, q2, theta3, q4)`` -> S2's ``(q1, q2, q3 = theta3 - q2, q5 = q4)``."""
-    a = _four("q", q)
+    a = _vector("q", q)
     return np.array([a[0], a[1], a[2] - a[1], a[3]])
 
 
 def wrist_pitch(q: Sequence[float]) -> float:
     """S2's passive wrist pitch ``q4 = -(q2 + q3) = -theta3`` [rad] at ``q`` (the ``wrist_pitch`` joint)."""
-    return -float(_four("q", q)[2])
-
-
-def _four(name: str, values: ArrayLike) -> np.ndarray:
-    a = np.asarray(values, dtype=float)
-    if a.shape != (4,) or not np.isfinite(a).all():
-        raise ParameterError(name, np.asarray(values).tolist(), "must be 4 finite numbers")
-    return a
+    return -float(_vector("q", q)[2])
 
 
 # ------------------------------------------------------------------------------------ kinematics
 def forward(geo: PalletizerGeometry, q: Sequence[float]) -> np.ndarray:
     """S2's closed-form FK: (x, y, z, yaw) of tool0 in ``base`` at ``q`` (motor side) [m, rad]."""
-    q1, q2, t3, q4 = _four("q", q)
+    q1, q2, t3, q4 = _vector("q", q)
     r = geo.a1 + geo.a2 * math.sin(q2) + geo.a3 * math.sin(t3) + geo.a4
     z = geo.d1 + geo.d2 + geo.a2 * math.cos(q2) + geo.a3 * math.cos(t3) + geo.d5
     return np.array([r * math.cos(q1), r * math.sin(q1), z, q1 + q4 + geo.tool_yaw])
@@ -194,7 +188,7 @@ def forward(geo: PalletizerGeometry, q: Sequence[float]) -> np.ndarray:
 
 def branch_of(q: ArrayLike) -> str:
     """``"up"`` when sin(q3) >= 0 (q3 = theta3 - q2, S2's small-arm angle), else ``"down"``."""
-    a = _four("q", q)
+    a = _vector("q", q)
     return "up" if math.sin(a[2] - a[1]) >= 0.0 else "down"
 
 
