@@ -256,9 +256,6 @@ class ScaraGeometry:
         tol = LIMIT_TOL
         l1, l2 = self.l1, self.l2
         layout = 1 if (ra, rb, rc, ip) == (0, 1, 3, 2) else 0  # 1: q = (shoulder, elbow, prismatic, wrist)
-        # at most one 2 pi-equivalent inside a range shorter than a turn (with margin): no list needed
-        one_a = hi[ra] - lo[ra] + 2 * tol < _TWO_PI - 1e-9
-        one_b = hi[rb] - lo[rb] + 2 * tol < _TWO_PI - 1e-9
         inner_min = math.nan if radius is None else radius[0] - REACH_TOL
         fast = (
             ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip],
@@ -267,7 +264,7 @@ class ScaraGeometry:
             lo[ip] - tol, hi[ip] + tol,
             self.z0, self.yaw0, self.a1[0], self.a1[1], self.tool[0], self.tool[1],
             l1, l2, self.beta1, self.beta2, l1 + l2 + REACH_TOL, l1 + l2, abs(l1 - l2),
-            layout, one_a, one_b, inner_min, self.tool == (0.0, 0.0),
+            layout, inner_min, self.tool == (0.0, 0.0),
         )  # fmt: skip
         object.__setattr__(self, "_fast", fast)
         # the same numbers for the compiled nearest() (scara_pin/_speedups.c, struct Geometry: this order):
@@ -407,6 +404,18 @@ def _wrap(a: float) -> float:
     return (a + math.pi) % _TWO_PI - math.pi
 
 
+def _turns(value: float, lo: float, hi: float) -> list[float]:
+    """Every value + 2 pi k inside [lo, hi] (values within LIMIT_TOL outside are clamped onto it)."""
+    lt, ht = lo - LIMIT_TOL, hi + LIMIT_TOL  # the same numbers as struct Geometry's lt_*, ht_* in _speedups.c
+    v = value + _ceil((lt - value) / _TWO_PI) * _TWO_PI
+    out = []
+    while v <= ht:
+        m = lo if lo > v else v
+        out.append(hi if hi < m else m)
+        v += _TWO_PI
+    return out
+
+
 def solve(
     geo: ScaraGeometry,
     target: ArrayLike | pin.SE3,
@@ -436,7 +445,7 @@ def solve(
      lt_a, ht_a, lt_b, ht_b, lt_c, ht_c, lt_p, ht_p,
      z0, yaw0, a1x, a1y, tx, ty,
      l1, l2, beta1, beta2, reach, l12, d12,
-     layout, one_a, one_b, inner_min, tool_on_axis) = geo._fast  # fmt: skip
+     layout, inner_min, tool_on_axis) = geo._fast  # fmt: skip
     # a 4-vector of finite floats is read without numpy; anything else goes through _target
     plain = False
     kind = type(target)
@@ -518,35 +527,11 @@ def solve(
             continue
         phi1 = theta1 - beta1
         phi2 = g + beta1 - beta2
-        # every 2 pi-equivalent inside the limits (values within LIMIT_TOL outside are clamped onto them)
+        # every 2 pi-equivalent inside the limits, shoulder and elbow
         va = s_a * phi1
-        v = va + _ceil((lt_a - va) / _TWO_PI) * _TWO_PI
-        if one_a:
-            if v <= ht_a:
-                m = lo_a if lo_a > v else v
-                q_a: Sequence[float] = (hi_a if hi_a < m else m,)
-            else:
-                q_a = ()
-        else:
-            q_a = []
-            while v <= ht_a:
-                m = lo_a if lo_a > v else v
-                q_a.append(hi_a if hi_a < m else m)
-                v += _TWO_PI
+        q_a = _turns(va, lo_a, hi_a)
         vb = s_b * phi2
-        v = vb + _ceil((lt_b - vb) / _TWO_PI) * _TWO_PI
-        if one_b:
-            if v <= ht_b:
-                m = lo_b if lo_b > v else v
-                q_b: Sequence[float] = (hi_b if hi_b < m else m,)
-            else:
-                q_b = ()
-        else:
-            q_b = []
-            while v <= ht_b:
-                m = lo_b if lo_b > v else v
-                q_b.append(hi_b if hi_b < m else m)
-                v += _TWO_PI
+        q_b = _turns(vb, lo_b, hi_b)
         if not q_b:
             failures.append((IKStatus.J2_LIMIT, f"{label}: {geo.names[rb]} = {_wrap(vb):.9g} rad (+2 pi k) "
                              f"outside [{lo_b:.9g}, {hi_b:.9g}]"))  # fmt: skip
@@ -559,12 +544,7 @@ def solve(
         for qa in q_a:
             for qb in q_b:
                 # the wrist takes up whatever turns the shoulder and elbow add, to keep alpha
-                vc = s_c * (alpha - s_a * qa - s_b * qb)
-                v = vc + _ceil((lt_c - vc) / _TWO_PI) * _TWO_PI
-                while v <= ht_c:
-                    m = lo_c if lo_c > v else v
-                    qc = hi_c if hi_c < m else m
-                    v += _TWO_PI
+                for qc in _turns(s_c * (alpha - s_a * qa - s_b * qb), lo_c, hi_c):
                     if layout:
                         q = _array((qa, qb, qp, qc))
                     else:

@@ -46,7 +46,7 @@ import pinocchio as pin
 
 from ._checks import _vector
 from .errors import InvalidInputError, ParameterError, UrdfError
-from .ik import LIMIT_TOL, REACH_TOL, YAW_POSE_TOL, IKResult, IKSolution
+from .ik import REACH_TOL, YAW_POSE_TOL, IKResult, IKSolution, _turns
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -190,17 +190,6 @@ def branch_of(q: ArrayLike) -> str:
     """``"up"`` when sin(q3) >= 0 (q3 = theta3 - q2, S2's small-arm angle), else ``"down"``."""
     a = _vector("q", q)
     return "up" if math.sin(a[2] - a[1]) >= 0.0 else "down"
-
-
-def _turns(value: float, lo: float, hi: float) -> list[float]:
-    """Every value + 2 pi k inside [lo, hi] (values within LIMIT_TOL outside are clamped)."""
-    k0 = math.ceil((lo - LIMIT_TOL - value) / _TWO_PI)
-    out = []
-    v = value + k0 * _TWO_PI
-    while v <= hi + LIMIT_TOL:
-        out.append(min(max(v, lo), hi))
-        v += _TWO_PI
-    return out
 
 
 def _target(geo: PalletizerGeometry, target: object) -> tuple[np.ndarray, float]:
