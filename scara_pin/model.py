@@ -237,15 +237,9 @@ class Robot:
         self.continuous = continuous
         self.has_continuous = any(continuous)
         if self.has_continuous:
-            # (index in q, index in Pinocchio's q, continuous?) per joint; the hot paths convert q on the way
-            # in. Robots without continuous joints keep Robot._pin_q (= _valid_q): no extra cost, not even an
-            # instance attribute that would slow the method lookups of every Robot in the process.
+            # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
             iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
             self._q_map = tuple(zip(range(len(JOINT_NAMES)), iq, continuous))
-            if type(self) is Robot:
-                self.__class__ = _ContinuousRobot
-            else:  # a user's subclass: keep it, convert through an instance attribute
-                self._pin_q = self._valid_pin_q  # type: ignore[method-assign]
 
     # ----------------------------------------------------------------- construction helpers
     @classmethod
@@ -321,7 +315,34 @@ class Robot:
             from . import palletizer
 
             return palletizer.solve(self.palletizer, target, branch=branch, reference=reference)
-        return _ik.solve(self.kinematics, target, branch=branch, reference=reference)
+        result = _ik.solve(self.kinematics, target, branch=branch, reference=reference)
+        if self.has_continuous and len(result.solutions) > 1:
+            return self._without_turn_twins(result, reference)
+        return result
+
+    def _without_turn_twins(self, result: IKResult, reference: ArrayLike | None) -> IKResult:
+        """``result`` with each solution listed once.
+
+        A continuous joint's range [-pi, pi] has the same joint position at both ends, so a solution found
+        at -pi and at +pi is kept once (the first found, or the one nearer to ``reference`` when given).
+        """
+        import dataclasses
+
+        ref = None if reference is None else np.asarray(reference, dtype=float)
+        cont = self.continuous
+        keep: list[Any] = []
+        for s in result.solutions:
+            for k, t in enumerate(keep):
+                if all(abs(math.remainder(a - b, 2 * math.pi) if c else a - b) <= 1e-9
+                       for a, b, c in zip(s.q.tolist(), t.q.tolist(), cont)):  # fmt: skip
+                    if ref is not None and float(np.sum((s.q - ref) ** 2)) < float(np.sum((t.q - ref) ** 2)):
+                        keep[k] = s
+                    break
+            else:
+                keep.append(s)
+        if len(keep) == len(result.solutions):
+            return result
+        return dataclasses.replace(result, solutions=tuple(keep))
 
     def ik_nearest(
         self,
@@ -433,10 +454,9 @@ class Robot:
             return q  # type: ignore[no-any-return]
         return self.check_q(q)
 
-    _pin_q = _valid_q
-    """``q`` as Pinocchio takes it, checked (the fast path first). A robot with continuous joints is given the
-    class :class:`_ContinuousRobot`, whose ``_pin_q`` is :meth:`_valid_pin_q`: robots without continuous
-    joints pay nothing for the conversion."""
+    def _pin_q(self, q: object) -> np.ndarray:
+        """``q`` as Pinocchio takes it, checked: with continuous joints, converted (:meth:`_valid_pin_q`)."""
+        return self._valid_pin_q(q) if self.has_continuous else self._valid_q(q)
 
     def _valid_pin_q(self, q: object) -> np.ndarray:
         """:meth:`_valid_q` then the conversion to Pinocchio's q (continuous joints as cos, sin)."""
@@ -547,42 +567,6 @@ class Robot:
             names = ", ".join(f.name for f in self.model.frames)
             raise InvalidInputError(f"no frame named {frame!r}; frames: {names}")
         return int(self.model.getFrameId(frame))
-
-
-class _ContinuousRobot(Robot):
-    """A :class:`Robot` with continuous joints (``Robot(...)`` gives such an instance this class).
-
-    Its hot paths (``tool_placement``, ``task_jacobian``) convert q to Pinocchio's (cos, sin) on the way in.
-    """
-
-    _pin_q = Robot._valid_pin_q
-
-    def ik(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None) -> IKResult:
-        """:meth:`Robot.ik`, each solution listed once.
-
-        A continuous joint's range [-pi, pi] has the same joint position at both ends, so a solution found
-        at -pi and at +pi is kept once (the first found, or the one nearer to ``reference`` when given).
-        """
-        import dataclasses
-
-        result = super().ik(target, branch=branch, reference=reference)
-        if len(result.solutions) < 2:
-            return result
-        ref = None if reference is None else np.asarray(reference, dtype=float)
-        cont = self.continuous
-        keep: list[Any] = []
-        for s in result.solutions:
-            for k, t in enumerate(keep):
-                if all(abs(math.remainder(a - b, 2 * math.pi) if c else a - b) <= 1e-9
-                       for a, b, c in zip(s.q.tolist(), t.q.tolist(), cont)):  # fmt: skip
-                    if ref is not None and float(np.sum((s.q - ref) ** 2)) < float(np.sum((t.q - ref) ** 2)):
-                        keep[k] = s
-                    break
-            else:
-                keep.append(s)
-        if len(keep) == len(result.solutions):
-            return result
-        return dataclasses.replace(result, solutions=tuple(keep))
 
 
 def load_robot(
