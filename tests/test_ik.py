@@ -779,21 +779,6 @@ def test_stretched_targets_from_fk_have_one_solution_per_turn(default: Robot) ->
         assert closest([s.q for s in res.solutions], q) <= Q_TOL
 
 
-def test_stretched_targets_from_fk_reach_the_target(default: Robot) -> None:
-    """What holds today for FK(q2 = 0) targets: FK(IK) = target at 1e-9 and q within the ill-conditioned bound."""
-    geo = default.kinematics
-    lo, hi = limits(default)
-    rng = np.random.default_rng(1)
-    for _ in range(200):
-        q = np.array([rng.uniform(lo[0], hi[0]), 0.0, rng.uniform(lo[2], hi[2]), rng.uniform(lo[3], hi[3])])
-        target = default.tool_pose(q)
-        res = solve(geo, target)
-        assert res.status is IKStatus.OK
-        for s in res.solutions:
-            assert pose_error(default, s.q, target) <= POSE_TOL
-        assert closest([s.q for s in res.solutions], q) <= Q_TOL_SINGULAR
-
-
 def test_folded_with_j2_beyond_pi_from_fk() -> None:
     l1, l2 = 0.25, 0.125
     robot = load_robot("default", {"l1": l1, "l2": l2, "joint2_lower": D(-200), "joint2_upper": D(200)})
