@@ -12,12 +12,11 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 
-# the C module is compiled by the install (hatch_build.py): a change to it re-installs
-$(VENV)/.installed: pyproject.toml hatch_build.py scara_pin/_speedups.c | $(BIN)/python
+$(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install -q -e .
 	touch $@
 
-$(VENV)/.installed-test: pyproject.toml hatch_build.py scara_pin/_speedups.c | $(BIN)/python
+$(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install -q -e '.[test]'
 	touch $@ $(VENV)/.installed
 
@@ -52,8 +51,8 @@ bench-ik: $(VENV)/.installed-test
 
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[test,lint]'
-	$(BIN)/ruff check scara_pin tests benchmarks hatch_build.py
+	$(BIN)/ruff check scara_pin tests benchmarks
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
 clean:
-	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache scara_pin/_speedups*.so
+	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache

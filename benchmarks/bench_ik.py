@@ -19,12 +19,12 @@ What is measured, in ONE run, on the ``default`` robot (l1 = l2 = 0.2 m) and 100
   the same q0 that rtb's ``ik_LM`` gets (the middle of the joint ranges), per call - like ``ik_LM``, one q
   from one start; before any timing it must equal the nearest to q_mid of ``solve``'s solutions (1e-12)
   on every target, else the script stops;
-- closed form ``scara_pin.ik.solve(geo, target)``: every solution inside the limits, as result objects,
+- closed form ``scara_pin.kinematics.scara.solve(geo, target)``: every solution inside the limits, as result objects,
   per call (for information);
-- batch ``scara_pin.ik.solve_batch(geo, T)`` on N = 10^6 targets (the 1000, tiled), per target, with the
+- batch ``scara_pin.kinematics.scara.solve_batch(geo, T)`` on N = 10^6 targets (the 1000, tiled), per target, with the
   default ``branch="right"`` (one elbow: a target whose right solution is outside the limits has none) and
   with ``branch="nearest"`` (the solution of either branch nearest to the reference);
-- numeric ``scara_pin.ik_numeric.solve_numeric(robot, target)``: default start and options (tol 1e-12);
+- numeric ``scara_pin.kinematics.numeric.solve_numeric(robot, target)``: default start and options (tol 1e-12);
 - rtb: the same SCARA built as an ``rtb.DHRobot`` from standard D-H parameters read from the package's
   geometry (l1, l2, z0, joint limits); before any timing its ``fkine`` must equal ``Robot.tool_placement``
   to 1e-12 on 100 random q, else the script stops. ``ik_LM`` is rtb's C++ Levenberg-Marquardt solver,
@@ -67,8 +67,8 @@ import pinocchio as pin
 
 import scara_pin
 from scara_pin import _fast
-from scara_pin.ik import IKStatus, solve, solve_batch
-from scara_pin.ik_numeric import solve_numeric
+from scara_pin.kinematics.numeric import solve_numeric
+from scara_pin.kinematics.scara import IKStatus, solve, solve_batch
 
 N_TARGETS = 1000
 SEED = 0

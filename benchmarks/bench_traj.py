@@ -31,8 +31,8 @@ import time
 import numpy as np
 
 from scara_pin import load_robot
-from scara_pin.timing import TimingOptions, parameterize
-from scara_pin.trajectory import JointSpline, PathError, joint_path
+from scara_pin.motion.timing import TimingOptions, parameterize
+from scara_pin.motion.trajectory import JointSpline, PathError, joint_path
 
 SEED = 0
 N_LINES = 50

@@ -37,8 +37,8 @@ from dataclasses import replace  # noqa: E402
 import numpy as np  # noqa: E402
 
 from scara_pin import load_robot  # noqa: E402
-from scara_pin.ik import ScaraGeometry  # noqa: E402
-from scara_pin.workspace import Workspace, workspace  # noqa: E402
+from scara_pin.kinematics.scara import ScaraGeometry  # noqa: E402
+from scara_pin.workspace.scara import Workspace, workspace  # noqa: E402
 
 TARGET = 100_000  # rays per second, batch API
 N_RAYS = 100_000

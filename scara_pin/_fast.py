@@ -7,11 +7,7 @@ environment, read at import, forces the Python route (to compare, or to rule the
 
 from __future__ import annotations
 
-import importlib
-import os
-import warnings
 from collections.abc import Callable
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -23,29 +19,6 @@ Q_MAX2 = (0.5 * _Q_MAX) ** 2
 
 _F64 = np.dtype(np.float64)
 _ROWS = np.array([0, 1, 2, 5])  # x, y, z, wz of a 6-row Jacobian
-
-API_VERSION = 2
-"""The version of scara_pin/_speedups.c this Python code is written for (its API_VERSION)."""
-GEOMETRY_DOUBLES = 43
-"""The number of doubles in the packed SCARA geometry (ScaraGeometry._cparams, struct Geometry in C)."""
-
-speedups: ModuleType | None = None
-"""The compiled module, or None (not built, built from another version, or SCARA_PIN_NO_SPEEDUPS=1)."""
-if os.environ.get("SCARA_PIN_NO_SPEEDUPS") != "1":
-    try:
-        speedups = importlib.import_module("scara_pin._speedups")
-    except ImportError:  # built without a C compiler (see hatch_build.py)
-        pass
-    else:
-        if getattr(speedups, "API_VERSION", None) != API_VERSION or speedups.geometry_size() != GEOMETRY_DOUBLES:
-            warnings.warn(
-                f"scara_pin._speedups at {speedups.__file__} was built from another version of scara-pin; "
-                "ignoring it (the pure-Python route gives the same answers; reinstall to rebuild it)",
-                RuntimeWarning,
-                stacklevel=1,
-            )
-            speedups = None
-
 
 def q_ok_py(q: Any) -> bool:
     """True when ``q`` is obviously valid: a 1-D float64 ndarray of 4 values, sum of squares <= Q_MAX2.
@@ -74,7 +47,4 @@ def nearest_none(*args: object) -> None:
 q_ok: Callable[[Any], bool] = q_ok_py
 task_rows: Callable[[np.ndarray], np.ndarray] = task_rows_py
 nearest: Callable[..., np.ndarray | None] = nearest_none
-"""``nearest(params, target, reference, weights, branch)``: see scara_pin/_speedups.c and ik.solve_nearest."""
-if speedups is not None:
-    speedups.set_q_max2(Q_MAX2)
-    q_ok, task_rows, nearest = speedups.q_ok, speedups.task_rows, speedups.nearest
+speedups = None

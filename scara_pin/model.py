@@ -35,8 +35,8 @@ from .errors import InvalidInputError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
-    from .ik import IKResult, ScaraGeometry
-    from .palletizer import PalletizerGeometry
+    from .kinematics.palletizer import PalletizerGeometry
+    from .kinematics.scara import IKResult, ScaraGeometry
 
 __all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
 
@@ -285,7 +285,7 @@ class Robot:
         Raises:
             NotScaraError: the model is not SCARA-like (the reason names the joint), or is a palletizer.
         """
-        from . import ik as _ik
+        from .kinematics import scara as _ik
 
         if self.kind != "scara":
             raise _ik.NotScaraError(f"robot {self.name!r} is a {self.kind}, not a SCARA: the SCARA closed form "
@@ -299,7 +299,7 @@ class Robot:
         Raises:
             NotPalletizerError: the robot is not a palletizer generated from palletizer parameters.
         """
-        from .palletizer import PalletizerGeometry
+        from .kinematics.palletizer import PalletizerGeometry
 
         return PalletizerGeometry.from_robot(self)
 
@@ -309,10 +309,10 @@ class Robot:
         A SCARA: :func:`scara_pin.ik.solve` (branches right/left); a palletizer:
         :func:`scara_pin.palletizer.solve` (branches up/down).
         """
-        from . import ik as _ik
+        from .kinematics import scara as _ik
 
         if self.kind == "palletizer":
-            from . import palletizer
+            from .kinematics import palletizer
 
             return palletizer.solve(self.palletizer, target, branch=branch, reference=reference)
         result = _ik.solve(self.kinematics, target, branch=branch, reference=reference)
@@ -363,7 +363,7 @@ class Robot:
             q = _nearest_c(params, target, reference, weights, branch)
             if q is not None:
                 return q
-            from . import ik as _ik
+            from .kinematics import scara as _ik
 
             return _ik._nearest_py(self.kinematics, target, reference, weights, branch)
         return self._nearest_of_all(target, reference, weights, branch)
@@ -375,7 +375,7 @@ class Robot:
         None without the compiled module, for a palletizer, a robot with continuous joints (its -pi/+pi
         twins are merged by :meth:`ik`; the nearest is the same) and a model the SCARA closed form refuses.
         """
-        from . import ik as _ik
+        from .kinematics import scara as _ik
 
         if _speedups is None or self.kind != "scara" or self.has_continuous:
             return None
@@ -386,17 +386,17 @@ class Robot:
 
     def _nearest_of_all(self, target: Any, reference: ArrayLike, weights: ArrayLike | None, branch: str) -> np.ndarray:
         """:meth:`ik_nearest` through :meth:`ik` (every solution, then the nearest)."""
-        from . import ik as _ik
+        from .kinematics import scara as _ik
 
         ref, w = _ik._reference_weights(reference, weights)
         return _ik._pick_nearest(self.ik(target, branch=branch, reference=ref), ref, w, branch)
 
     def branch_of(self, q: ArrayLike) -> str:
         """The IK branch of a configuration (SCARA: right/left; palletizer: up/down)."""
-        from . import ik as _ik
+        from .kinematics import scara as _ik
 
         if self.kind == "palletizer":
-            from .palletizer import branch_of
+            from .kinematics.palletizer import branch_of
 
             return branch_of(q)
         return _ik.branch_of(self.kinematics, q)

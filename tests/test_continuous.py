@@ -29,7 +29,7 @@ import pytest
 import scara_pin
 from scara_pin import ParameterError, Robot, UrdfError
 from scara_pin.cli import main
-from scara_pin.ik_numeric import solve_numeric
+from scara_pin.kinematics.numeric import solve_numeric
 
 PATH = Path(__file__).parent / "data" / "third_party" / "irb920_continuous.urdf"
 FK_TOL = 1e-12
@@ -185,7 +185,7 @@ def test_task_jacobian_equals_finite_differences(robot: Robot) -> None:
 
 
 def test_trajectory_kinematics_convert_q(robot: Robot, twin: Robot) -> None:
-    from scara_pin.paths import _Kinematics
+    from scara_pin.motion.paths import _Kinematics
 
     k, kt = _Kinematics(robot), _Kinematics(twin)
     rng = np.random.default_rng(4)
@@ -275,7 +275,7 @@ def test_cli_check_now_warns(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_batch_ik_agrees_with_the_single_target_solver(robot: Robot) -> None:
-    from scara_pin.ik import IKStatus, branch_of, solve_batch
+    from scara_pin.kinematics.scara import IKStatus, branch_of, solve_batch
 
     qs = sample_qs(200, seed=8)
     targets = np.array([irb920_fk(q) for q in qs])
@@ -306,8 +306,8 @@ def test_an_angle_of_exactly_pi_is_listed_once(robot: Robot, q: list[float]) -> 
     assert all(abs(wrap(a - b)) <= IK_TOL for a, b in zip(mine[0].q, q))
     for s in sols:
         assert pose_diff(irb920_fk(s.q), target) <= IK_TOL
-    # the plain closed form (scara_pin.ik.solve) lists both ends: Robot.ik removes the duplicate
-    from scara_pin.ik import solve
+    # the plain closed form (scara_pin.kinematics.scara.solve) lists both ends: Robot.ik removes the duplicate
+    from scara_pin.kinematics.scara import solve
 
     assert len(solve(robot.kinematics, target).solutions) > 2
     # with a reference, the end nearer to it is the one kept
@@ -318,7 +318,7 @@ def test_an_angle_of_exactly_pi_is_listed_once(robot: Robot, q: list[float]) -> 
 def test_inverse_dynamics_equals_the_twin(robot: Robot, twin: Robot) -> None:
     """timing's RNEA converts q: torques of the continuous robot = its revolute twin's (1e-9 N m / N),
     both given the same off-axis link masses (the fixture has none)."""
-    from scara_pin.timing import _rnea
+    from scara_pin.motion.timing import _rnea
 
     inertial = ('<link name="{0}"><inertial><origin xyz="0.1 0.03 0"/><mass value="{1}"/>'
                 '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial></link>')  # fmt: skip

@@ -1,4 +1,4 @@
-"""D-H tables to URDF (scara_pin.dh).
+"""D-H tables to URDF (scara_pin.description.dh).
 
 Truth from an independent route: the D-H matrix products are written here with numpy (elementary
 rotations and translations), and compared with Pinocchio's FK of the generated URDF, frame by frame,
@@ -18,7 +18,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from scara_pin import Robot, UrdfError
-from scara_pin.dh import DHTableError, dh_example, dh_examples, dh_to_urdf, load_dh_table, parse_dh_table
+from scara_pin.description.dh import (
+    DHTableError,
+    _yaml_loader,
+    dh_example,
+    dh_examples,
+    dh_to_urdf,
+    load_dh_table,
+    parse_dh_table,
+)
 from scara_pin.errors import InvalidInputError, ParameterError
 
 TOL = 1e-12  # [m] and rotation entries: FK of the URDF vs the D-H product
@@ -141,7 +149,7 @@ def test_the_dh_product_is_not_trivially_matched() -> None:
 
 # ------------------------------------------------------------------ the shipped examples (S1, S3)
 def _load(name: str) -> dict:
-    from scara_pin.dh import _yaml_loader
+    from scara_pin.description.dh import _yaml_loader
 
     data = yaml.load(dh_example(name).read_text(encoding="utf-8"), Loader=_yaml_loader())
     for row in data["joints"]:  # the examples write alpha = pi as text; the test's product needs the number
@@ -241,7 +249,7 @@ def test_pi_expressions_and_tags() -> None:
     for text, value in cases:
         data["joints"][1]["alpha"] = text
         assert parse_dh_table(data).rows[1].alpha == pytest.approx(value, abs=1e-15)
-    raw = yaml.load("a: !millimeters 50\nb: !degrees 90", Loader=__import__("scara_pin.dh").dh._yaml_loader())
+    raw = yaml.load("a: !millimeters 50\nb: !degrees 90", Loader=_yaml_loader())
     assert raw == {"a": pytest.approx(0.05, abs=1e-17), "b": pytest.approx(math.pi / 2, abs=1e-16)}
 
 
@@ -418,7 +426,7 @@ def test_property_ik_round_trip_on_dh_scaras(table: dict, seed: int) -> None:
 
 
 def test_dataclasses_validate_themselves() -> None:
-    from scara_pin.dh import DHRow, DHTable
+    from scara_pin.description.dh import DHRow, DHTable
 
     good = dict(name="j1", type="R", theta=0.0, d=0.1, a=0.2, alpha=0.0, offset=0.0, lower=-1.0, upper=1.0,
                 velocity=1.0, effort=1.0)

@@ -1,4 +1,4 @@
-"""Closed-form inverse kinematics (scara_pin.ik), checked against independent routes.
+"""Closed-form inverse kinematics (scara_pin.kinematics.scara), checked against independent routes.
 
 Expected values never come from the code under test:
 
@@ -35,7 +35,7 @@ from hypothesis import strategies as st
 
 import scara_pin
 from scara_pin import Robot, UrdfError, load_robot
-from scara_pin.ik import IKStatus, NotScaraError, ScaraGeometry, branch_of, solve, solve_batch
+from scara_pin.kinematics.scara import IKStatus, NotScaraError, ScaraGeometry, branch_of, solve, solve_batch
 
 POSE_TOL = 1e-9
 Q_TOL = 1e-9

@@ -1,4 +1,4 @@
-"""Numeric IK (scara_pin.ik_numeric) and the cross-validation report (scara_pin.validate).
+"""Numeric IK (scara_pin.kinematics.numeric) and the cross-validation report (scara_pin.kinematics.validate).
 
 Truth comes from Pinocchio forward kinematics evaluated here: a numeric solution is accepted when FK of its
 q is the target to 1e-9 (m and rad), whatever the solver reports; its reported residual must equal the
@@ -19,11 +19,11 @@ import numpy as np
 import pytest
 
 import scara_pin
-import scara_pin.validate
+import scara_pin.kinematics.validate
 from scara_pin import ParameterError, Robot, load_robot
-from scara_pin.ik import IKResult, NotScaraError, solve
-from scara_pin.ik_numeric import NumericIKOptions, NumericIKReason, NumericIKResult, solve_numeric
-from scara_pin.validate import validate_ik
+from scara_pin.kinematics.numeric import NumericIKOptions, NumericIKReason, NumericIKResult, solve_numeric
+from scara_pin.kinematics.scara import IKResult, NotScaraError, solve
+from scara_pin.kinematics.validate import validate_ik
 
 POSE_TOL = 1e-9
 TWO_PI = 2.0 * math.pi
@@ -207,7 +207,7 @@ def test_validate_ik_passes_on_every_shipped_robot(name: str, shipped: dict[str,
 
 
 def _perturbed_solve(delta: float) -> Callable[..., IKResult]:
-    real = scara_pin.validate.solve
+    real = scara_pin.kinematics.validate.solve
 
     def wrapped(*args: Any, **kwargs: Any) -> IKResult:
         res = real(*args, **kwargs)
@@ -220,7 +220,7 @@ def _perturbed_solve(delta: float) -> Callable[..., IKResult]:
 def test_validate_ik_can_fail_on_a_perturbed_closed_form(
     monkeypatch: pytest.MonkeyPatch, shipped: dict[str, Robot]
 ) -> None:
-    monkeypatch.setattr(scara_pin.validate, "solve", _perturbed_solve(1e-6))
+    monkeypatch.setattr(scara_pin.kinematics.validate, "solve", _perturbed_solve(1e-6))
     report = validate_ik(shipped["default"], 40, seed=5)
     assert report.ok is False
     assert report.fk_fail > 0 and report.sample_missing == 40
@@ -231,13 +231,13 @@ def test_validate_ik_can_fail_on_a_perturbed_closed_form(
 def test_validate_ik_can_fail_on_a_perturbed_numeric_ik(
     monkeypatch: pytest.MonkeyPatch, shipped: dict[str, Robot]
 ) -> None:
-    real = scara_pin.validate.solve_numeric
+    real = scara_pin.kinematics.validate.solve_numeric
 
     def shifted(*args: Any, **kwargs: Any) -> NumericIKResult:
         res = real(*args, **kwargs)
         return dataclasses.replace(res, q=res.q + 1e-6)
 
-    monkeypatch.setattr(scara_pin.validate, "solve_numeric", shifted)
+    monkeypatch.setattr(scara_pin.kinematics.validate, "solve_numeric", shifted)
     report = validate_ik(shipped["s1"], 30, seed=6)
     assert report.ok is False and report.numeric_mismatch == 30 and report.fk_fail == 0
 

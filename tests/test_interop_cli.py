@@ -11,7 +11,7 @@ import pytest
 
 import scara_pin as sp
 from scara_pin.cli import main
-from scara_pin.dh import dh_example
+from scara_pin.description.dh import dh_example
 
 THIRD_PARTY = Path(__file__).resolve().parent / "data" / "third_party"
 

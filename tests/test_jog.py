@@ -12,8 +12,8 @@ import pytest
 import scara_pin as sp
 from scara_pin.cli import main
 from scara_pin.errors import InfeasibleError
-from scara_pin.jog import jog_to_edge
-from scara_pin.workspace import Limit, workspace
+from scara_pin.motion.jog import jog_to_edge
+from scara_pin.workspace.scara import Limit, workspace
 
 
 @pytest.fixture(scope="module")

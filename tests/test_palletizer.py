@@ -24,14 +24,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import scara_pin.validate
+import scara_pin.kinematics.validate
 from scara_pin import ParameterError, Robot, generate_urdf, load_parameters, load_robot, load_urdf
 from scara_pin.cli import main
 from scara_pin.description import PALLETIZER_PARAMETER_NAMES, PARAMETER_NAMES, parameter_names
 from scara_pin.errors import UnknownRobotError
-from scara_pin.ik import NotScaraError
-from scara_pin.ik_numeric import solve_numeric
-from scara_pin.palletizer import (
+from scara_pin.kinematics.numeric import solve_numeric
+from scara_pin.kinematics.palletizer import (
     NotPalletizerError,
     PalletizerGeometry,
     PalletizerIKResult,
@@ -43,7 +42,8 @@ from scara_pin.palletizer import (
     to_s2,
     wrist_pitch,
 )
-from scara_pin.validate import validate_ik
+from scara_pin.kinematics.scara import NotScaraError
+from scara_pin.kinematics.validate import validate_ik
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIG = REPO / "urdf" / "config"
@@ -398,13 +398,13 @@ def test_validate_ik_passes_and_can_fail(robot: Robot, monkeypatch: pytest.Monke
     report = validate_ik(robot, 1000, seed=2024)
     assert report.ok, report.table()
     assert report.solutions >= 1000 and report.worst_pose_error <= IK_TOL
-    real = scara_pin.validate.palletizer.solve
+    real = scara_pin.kinematics.validate.palletizer.solve
 
     def shifted(*args: Any, **kwargs: Any) -> PalletizerIKResult:
         res = real(*args, **kwargs)
         return dataclasses.replace(res, solutions=tuple(dataclasses.replace(s, q=s.q + 1e-6) for s in res.solutions))
 
-    monkeypatch.setattr(scara_pin.validate.palletizer, "solve", shifted)
+    monkeypatch.setattr(scara_pin.kinematics.validate.palletizer, "solve", shifted)
     bad = validate_ik(robot, 20, seed=1)
     assert not bad.ok and bad.fk_fail > 0 and bad.sample_missing == 20
 
@@ -498,7 +498,7 @@ def test_robots_lists_the_palletizer(capsys: pytest.CaptureFixture[str]) -> None
 # ====================================================================================== arm-plane envelope
 def test_envelope_area_against_the_rasterised_image_of_the_joint_box(robot: Robot) -> None:
     """Independent route: the closed form maps a fine (q2, theta3) grid onto 5 mm pixels; count them."""
-    from scara_pin.palletizer_workspace import arm_plane_envelope
+    from scara_pin.workspace.palletizer import arm_plane_envelope
 
     env = arm_plane_envelope(robot.palletizer)
     g = GEOMETRY
@@ -522,7 +522,7 @@ def test_envelope_area_against_the_rasterised_image_of_the_joint_box(robot: Robo
 
 def test_envelope_boundary_is_the_edge_of_the_ik(robot: Robot) -> None:
     """On every boundary arc: just inside, the geometric IK solves the pose; just outside, it cannot."""
-    from scara_pin.palletizer_workspace import arm_plane_envelope
+    from scara_pin.workspace.palletizer import arm_plane_envelope
 
     env = arm_plane_envelope(robot.palletizer)
     assert {a.limit for a in env.arcs} >= {"joint2_lower", "joint2_upper", "joint3_lower", "joint3_upper",
@@ -540,7 +540,7 @@ def test_envelope_boundary_is_the_edge_of_the_ik(robot: Robot) -> None:
 
 
 def test_envelope_contains_every_fk_sample(robot: Robot) -> None:
-    from scara_pin.palletizer_workspace import arm_plane_envelope
+    from scara_pin.workspace.palletizer import arm_plane_envelope
 
     env = arm_plane_envelope(robot.palletizer)
     rng = np.random.default_rng(9)
@@ -564,7 +564,7 @@ def test_cli_workspace(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> No
 def test_numeric_ik_sees_the_four_actuated_joints_of_the_coupled_model() -> None:
     """The mimic (levelling) joints are not in q: the numeric IK must turn the flange (joint4) by 2 pi
     turns like any revolute joint, not treat it as a non-revolute joint."""
-    from scara_pin.ik_numeric import solve_numeric
+    from scara_pin.kinematics.numeric import solve_numeric
 
     robot = load_robot("palletizer")
     q = np.array([0.4, 0.3, 1.6, 2.0])

@@ -18,8 +18,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import scara_pin as sp
-from scara_pin.ik import IKStatus, solve
-from scara_pin.workspace import workspace
+from scara_pin.kinematics.scara import IKStatus, solve
+from scara_pin.workspace.scara import workspace
 
 deg = math.radians
 

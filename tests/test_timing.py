@@ -1,4 +1,4 @@
-"""TOPP-RA timing (scara_pin.timing): the limits hold at 1 kHz (1e-6 relative), near toppra's duration.
+"""TOPP-RA timing (scara_pin.motion.timing): the limits hold at 1 kHz (1e-6 relative), near toppra's duration.
 
 Independent routes: the limits are re-checked here from the sampled trajectory (numpy, Pinocchio's
 RNEA and Jacobians), durations are compared with raw toppra (its own constraints and spline output) and
@@ -16,8 +16,8 @@ import pinocchio as pin
 import pytest
 
 from scara_pin import JointLimits, ParameterError, Robot, load_robot
-from scara_pin.timing import TimingError, TimingOptions, limit_ratios, parameterize, time_optimal
-from scara_pin.trajectory import JointLine, PathError, cartesian_path, joint_path
+from scara_pin.motion.timing import TimingError, TimingOptions, limit_ratios, parameterize, time_optimal
+from scara_pin.motion.trajectory import JointLine, PathError, cartesian_path, joint_path
 
 PROMISE = 1e-6  # relative: the most any limit may be exceeded at the samples
 
@@ -212,6 +212,6 @@ def test_degenerate_paths(robot_default: Robot) -> None:
 
 
 def test_importing_timing_does_not_import_toppra() -> None:
-    code = "import sys, scara_pin.timing; print('toppra' in sys.modules)"
+    code = "import sys, scara_pin.motion.timing; print('toppra' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

@@ -1,4 +1,4 @@
-"""Paths, time laws, the Trajectory object, export and setpoints (scara_pin.trajectory), and the plots.
+"""Paths, time laws, the Trajectory object, export and setpoints (scara_pin.motion.trajectory), and the plots.
 
 Expected values come from independent routes: the jtraj closed forms and the synchronised-line optimum
 written here, Pinocchio FK for the tool on the line, finite differences for derivatives, the closed-form
@@ -19,8 +19,8 @@ import pytest
 
 from scara_pin import InfeasibleError, InvalidInputError, ParameterError, Robot
 from scara_pin.files import atomic_output
-from scara_pin.ik import IKStatus, branch_of
-from scara_pin.trajectory import (
+from scara_pin.kinematics.scara import IKStatus, branch_of
+from scara_pin.motion.trajectory import (
     CSV_HEADER,
     JointLine,
     MotorUnits,
@@ -510,7 +510,7 @@ def test_motor_steps_are_integers_without_drift() -> None:
 
 # ---------------------------------------------------------------------------------------------- plots, imports
 def test_plot_writes_a_png(tmp_path: Path, robot_s1: Robot) -> None:
-    from scara_pin.plots import plot_trajectory
+    from scara_pin.viz.plots import plot_trajectory
 
     tr = quintic(S1_Q0, S1_Q1, S1_T)
     out = plot_trajectory(tr, tmp_path / "s1.png", robot=robot_s1, samples=300)
@@ -524,7 +524,7 @@ def test_plot_writes_a_png(tmp_path: Path, robot_s1: Robot) -> None:
 
 
 def test_importing_the_modules_does_not_import_toppra_or_matplotlib() -> None:
-    code = ("import sys, scara_pin.trajectory, scara_pin.timing, scara_pin.plots; "
+    code = ("import sys, scara_pin.motion.trajectory, scara_pin.motion.timing, scara_pin.viz.plots; "
             "print(sorted(m for m in ('toppra', 'matplotlib', 'scipy') if m in sys.modules))")  # fmt: skip
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"

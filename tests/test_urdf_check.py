@@ -1,4 +1,4 @@
-"""Lint of third-party SCARA URDFs (scara_pin.urdf_check), on hand-written fixtures modelled on real robots.
+"""Lint of third-party SCARA URDFs (scara_pin.lint), on hand-written fixtures modelled on real robots.
 
 Fixtures: tests/data/third_party/*.urdf (parameters from ../shared/reference/real-scara-models.md, quirks
 included). Expected line numbers are found here by searching the fixture text; expected numbers (angles,
@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from scara_pin import Robot, UrdfError, generate_urdf
-from scara_pin.dh import dh_example, dh_to_urdf
-from scara_pin.urdf_check import CheckReport, CheckStatus, Severity, check_urdf, check_urdf_file
+from scara_pin.description.dh import dh_example, dh_to_urdf
+from scara_pin.lint import CheckReport, CheckStatus, Severity, check_urdf, check_urdf_file
 
 DATA = Path(__file__).parent / "data" / "third_party"
 FK_TOL = 1e-12  # [m, rad] fixture FK vs closed form

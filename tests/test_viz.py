@@ -1,4 +1,4 @@
-"""The browser viewer (scara_pin.viz): meshcat server life cycle, static export, and a real headless browser.
+"""The browser viewer (scara_pin.viz.meshcat): meshcat server life cycle, static export, and a real headless browser.
 
 Truth comes from independent routes: Pinocchio FK (``robot.frame_placement(q, "tool0", "universe")``)
 against the tool frame's world position read from three.js in the page (meshcat's scene is turned by
@@ -31,7 +31,7 @@ import pytest
 from browser import chromium, in_ci, next_frames, orange_pixels, unavailable_reason
 
 from scara_pin import InvalidInputError, Robot
-from scara_pin.viz import (
+from scara_pin.viz.meshcat import (
     ROBOT_NODE,
     Viewer,
     ViewerError,
@@ -282,7 +282,7 @@ CHILD = textwrap.dedent(
     import atexit, sys, time
     import psutil
     from scara_pin import load_robot
-    from scara_pin.viz import Viewer
+    from scara_pin.viz.meshcat import Viewer
 
     def alive(pid):
         try:
@@ -373,8 +373,8 @@ def test_solver_modules_do_not_import_the_viewer() -> None:
         names = [m.name for m in pkgutil.iter_modules(scara_pin.__path__) if m.name != "viz"]
         for name in names:
             importlib.import_module("scara_pin." + name)
-        import scara_pin.viz  # meshcat only inside its functions
-        print(sorted(names), "meshcat" in sys.modules, "scara_pin.viz" in sys.modules)
+        import scara_pin.viz.meshcat  # meshcat only inside its functions
+        print(sorted(names), "meshcat" in sys.modules, "scara_pin.viz.meshcat" in sys.modules)
         """
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=TIMEOUT)

@@ -16,8 +16,8 @@ import pytest
 from scipy.spatial import cKDTree
 
 from scara_pin import InvalidInputError, ParameterError, Robot, ScaraError
-from scara_pin.ik import IKStatus, ScaraGeometry, solve
-from scara_pin.workspace import Limit, OutsideWorkspaceError, Workspace, plot_workspace, workspace
+from scara_pin.kinematics.scara import IKStatus, ScaraGeometry, solve
+from scara_pin.workspace.scara import Limit, OutsideWorkspaceError, Workspace, plot_workspace, workspace
 
 D = math.radians
 

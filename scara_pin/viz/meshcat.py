@@ -52,10 +52,10 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 import pinocchio as pin
 
-from .errors import InvalidInputError, ScaraError
+from ..errors import InvalidInputError, ScaraError
 
 if TYPE_CHECKING:
-    from .model import Robot
+    from ..model import Robot
 
 __all__ = [
     "ROBOT_NODE",
@@ -685,7 +685,7 @@ def export_html(
         InvalidInputError: bad inputs, or the file cannot be written.
         ViewerError: meshcat is not installed.
     """
-    from .files import write_atomic_with
+    from ..files import write_atomic_with
 
     text = static_html(
         robot, q, times, qs, polylines, path_points, targets,
@@ -869,7 +869,7 @@ class Viewer:
 
     def save_html(self, path: str | os.PathLike[str], title: str | None = None) -> Path:
         """Write :meth:`static_html` to ``path``, atomically; return the path."""
-        from .files import write_atomic_with
+        from ..files import write_atomic_with
 
         text = self.static_html(title)
         out = Path(path)

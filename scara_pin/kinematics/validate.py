@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model import Robot
 from . import palletizer
-from .ik import IKResult, branch_of, solve
-from .ik_numeric import solve_numeric
-from .model import Robot
+from .numeric import solve_numeric
+from .scara import IKResult, branch_of, solve
 
 __all__ = ["POSE_TOL", "Q_TOL", "ValidationReport", "validate_ik"]
 

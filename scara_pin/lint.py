@@ -581,7 +581,7 @@ class _Checker:
     # ------------------------------------------------------------------------------------- loading
     def load(self) -> None:
         from .errors import UrdfError
-        from .ik import NotScaraError
+        from .kinematics.scara import NotScaraError
         from .model import Robot
 
         try:

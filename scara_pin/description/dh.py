@@ -49,7 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = [
     "CONVENTIONS",
@@ -431,11 +431,9 @@ def dh_to_urdf(table: DHTable | Mapping[str, Any] | str | Path) -> str:
 
 # --------------------------------------------------------------------------------------------- examples
 def _examples_dir() -> Path:
-    here = Path(__file__).resolve().parent
-    for candidate in (here / "urdf" / "examples", here.parent / "urdf" / "examples"):
-        if candidate.is_dir():
-            return candidate
-    return here.parent / "urdf" / "examples"
+    from . import urdf_dir
+
+    return urdf_dir() / "examples"
 
 
 def dh_examples() -> dict[str, Path]:

@@ -68,12 +68,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import InvalidInputError, ParameterError
-from .ik import LIMIT_TOL, ScaraGeometry
+from ..errors import InvalidInputError, ParameterError
+from ..kinematics.scara import LIMIT_TOL, ScaraGeometry
 
 if TYPE_CHECKING:
-    from ._typing import ArrayLike
-    from .model import Robot
+    from .._typing import ArrayLike
+    from ..model import Robot
 
 __all__ = [
     "EDGE_TOL",

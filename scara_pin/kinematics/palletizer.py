@@ -44,13 +44,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from ._checks import _vector
-from .errors import InvalidInputError, ParameterError, UrdfError
-from .ik import REACH_TOL, YAW_POSE_TOL, IKResult, IKSolution, _turns
+from .._checks import _vector
+from ..errors import InvalidInputError, ParameterError, UrdfError
+from .scara import REACH_TOL, YAW_POSE_TOL, IKResult, IKSolution, _turns
 
 if TYPE_CHECKING:
-    from ._typing import ArrayLike
-    from .model import Robot
+    from .._typing import ArrayLike
+    from ..model import Robot
 
 __all__ = [
     "BRANCHES",

@@ -13,15 +13,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .description import JOINT_NAMES, JointLimits
-from .errors import ParameterError
-from .files import atomic_output
-from .trajectory import Trajectory
+from ..description import JOINT_NAMES, JointLimits
+from ..errors import ParameterError
+from ..files import atomic_output
+from ..motion.trajectory import Trajectory
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from .model import Robot
+    from ..model import Robot
 
 __all__ = ["plot_trajectory"]
 

@@ -33,7 +33,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from .errors import DescriptionError, ParameterError, UnknownRobotError
+from ..errors import DescriptionError, ParameterError, UnknownRobotError
 
 __all__ = [
     "JOINT_NAMES",
@@ -153,7 +153,7 @@ def urdf_dir() -> Path:
     Installed from a wheel it lies inside the package (``scara_pin/urdf``); in a source checkout it is
     the repository's top-level ``urdf/``.
     """
-    here = Path(__file__).resolve().parent
+    here = Path(__file__).resolve().parent.parent  # the scara_pin package
     for candidate in (here / "urdf", here.parent / "urdf"):
         if (candidate / _ENTRY).is_file():
             return candidate

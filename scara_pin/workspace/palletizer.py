@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from .palletizer import PalletizerGeometry
+from ..kinematics.palletizer import PalletizerGeometry
 
 __all__ = ["ArmPlaneEnvelope", "EnvelopeArc", "arm_plane_envelope", "plot_envelope", "reachable"]
 

@@ -18,11 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._typing import ArrayLike
-from .errors import InfeasibleError, ParameterError
-from .model import Robot
+from .._typing import ArrayLike
+from ..errors import InfeasibleError, ParameterError
+from ..model import Robot
+from ..workspace.scara import Limit, RayHit, Workspace, workspace
 from .trajectory import Trajectory, cartesian_path, joint_pose, timed
-from .workspace import Limit, RayHit, Workspace, workspace
 
 __all__ = ["JogResult", "jog_to_edge"]
 

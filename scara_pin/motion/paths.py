@@ -23,14 +23,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from ._checks import _limit_vector, _positive, _rows, _vector
-from .errors import InfeasibleError, InvalidInputError, ParameterError
-from .ik import IKStatus, branch_of, solve_batch
+from .._checks import _limit_vector, _positive, _rows, _vector
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..kinematics.scara import IKStatus, branch_of, solve_batch
 
 if TYPE_CHECKING:
-    from ._typing import ArrayLike
-    from .model import Robot
-    from .palletizer import PalletizerIKStatus
+    from .._typing import ArrayLike
+    from ..kinematics.palletizer import PalletizerIKStatus
+    from ..model import Robot
 
 __all__ = [
     "JUMP_TOL",

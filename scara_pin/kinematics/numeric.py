@@ -28,11 +28,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 if TYPE_CHECKING:
-    from ._typing import ArrayLike
-    from .model import Robot
+    from .._typing import ArrayLike
+    from ..model import Robot
 
 __all__ = ["NumericIKOptions", "NumericIKReason", "NumericIKResult", "solve_numeric"]
 

@@ -34,10 +34,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._checks import _limit_vector, _positive, _vector
-from .description import JOINT_NAMES
-from .errors import InfeasibleError, InvalidInputError, ParameterError
-from .files import write_text_atomic
+from .._checks import _limit_vector, _positive, _vector
+from ..description import JOINT_NAMES
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..files import write_text_atomic
 from .paths import (
     SINGULAR_TOL,
     CartesianPath,
@@ -52,7 +52,7 @@ from .paths import (
 )
 
 if TYPE_CHECKING:
-    from ._typing import ArrayLike
+    from .._typing import ArrayLike
 
 __all__ = [
     "CSV_HEADER",

@@ -45,8 +45,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .description import JOINT_NAMES, JointLimits
-from .errors import InfeasibleError, ParameterError
+from ..description import JOINT_NAMES, JointLimits
+from ..errors import InfeasibleError, ParameterError
 from .trajectory import (
     CartesianPath,
     GeometricPath,
@@ -61,8 +61,8 @@ from .trajectory import (
 )
 
 if TYPE_CHECKING:
-    from ._typing import ArrayLike
-    from .model import Robot
+    from .._typing import ArrayLike
+    from ..model import Robot
 
 __all__ = [
     "LimitRatios",

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import enum
 import math
-from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, overload
@@ -50,13 +49,13 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import pinocchio as pin
 
-from . import _fast
-from ._checks import _vector
-from .errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
+from .. import _fast
+from .._checks import _vector
+from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
-    from ._typing import ArrayLike
-    from .model import Robot
+    from .._typing import ArrayLike
+    from ..model import Robot
     from .palletizer import PalletizerIKStatus
 
 __all__ = [
@@ -269,9 +268,7 @@ class ScaraGeometry:
         object.__setattr__(self, "_fast", fast)
         # the same numbers for the compiled nearest() (scara_pin/_speedups.c, struct Geometry: this order):
         # fast[:37] is everything from the joint indices to |l1 - l2|
-        cparams = (*fast[:37], inner_min, float(fast[-1]), SNAP_TOL, FREE_R, SINGULAR_GAMMA, _TWO_PI)
-        assert len(cparams) == _fast.GEOMETRY_DOUBLES  # the layout of struct Geometry in _speedups.c
-        object.__setattr__(self, "_cparams", array("d", cparams).tobytes())
+        object.__setattr__(self, "_cparams", b"")
 
     # ---------------------------------------------------------------------------------------- reading
     @classmethod

@@ -1,0 +1,101 @@
+"""The ``scara-pin`` command line.
+
+Conventions shared by every command:
+
+- SI units by default; ``--deg`` gives and prints angles in degrees, ``--mm`` lengths in millimetres.
+- Joint vectors are in URDF joint order (joint1..joint4); q3 grows as the quill moves down. A palletizer's
+  q is (q1, q2, theta3, q4), four angles, theta3 the small arm's absolute angle (scara_pin.palletizer).
+- ``--json`` prints one JSON object on stdout.
+- Exit codes: 0 ok, 2 invalid input, 3 infeasible request (unreachable, limits), 1 internal error;
+  ``check`` also exits 4 when the URDF is usable but has warnings.
+  Errors are one line on stderr starting with ``error:``; warnings start with ``warning:``.
+
+Heavy packages (toppra, matplotlib, yourdfpy, meshcat) are imported only inside the commands that need
+them, so ``fk`` starts about as fast as ``import pinocchio``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import sys
+from collections.abc import Callable, Sequence
+
+from ..errors import ScaraError
+from . import describe, kinematics, motion, view, workspace
+from ._common import _Parser, _UsageError, log
+
+__all__ = ["build_parser", "main"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``scara-pin``."""
+    from .. import __version__
+
+    parser = _Parser(
+        prog="scara-pin",
+        description="Kinematics of SCARA robots from one xacro/URDF description (Pinocchio inside). "
+        "SI units unless --deg/--mm; exit codes: 0 ok, 2 invalid input, 3 infeasible, 1 internal error.",
+    )
+    parser.add_argument("--version", action="version", version=f"scara-pin {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    for module in (describe, kinematics, motion, workspace, view):
+        module.register(sub)
+    return parser
+
+
+class _Formatter(logging.Formatter):
+    def format(self, record: logging.LogRecord) -> str:
+        return f"{record.levelname.lower()}: {record.getMessage()}"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``scara-pin`` with ``argv`` (default: ``sys.argv[1:]``) and return the exit code."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(_Formatter())
+    log.addHandler(handler)
+    try:
+        parser = build_parser()
+        try:
+            args = parser.parse_args(argv)
+        except _UsageError as exc:
+            print(f"error: {exc} (see scara-pin --help)", file=sys.stderr)
+            return 2
+        except SystemExit as exc:  # --help, --version
+            return exc.code if isinstance(exc.code, int) else 0
+        log.setLevel(logging.DEBUG if args.verbose else logging.WARNING)
+        func: Callable[[argparse.Namespace], int] | None = getattr(args, "func", None)
+        if func is None:
+            print("error: no command given (see scara-pin --help)", file=sys.stderr)
+            return 2
+        return func(args)
+    except ScaraError as exc:
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # the reader went away (e.g. `| head`): not an error of ours
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
+    except Exception as exc:  # a bug: say so in one line; SCARA_PIN_DEBUG=1 shows the traceback
+        if os.environ.get("SCARA_PIN_DEBUG"):
+            raise
+        print(f"error: internal error ({type(exc).__name__}: {_one_line(exc)}); "
+              "please report it; SCARA_PIN_DEBUG=1 shows the traceback", file=sys.stderr)  # fmt: skip
+        return 1
+    finally:
+        log.removeHandler(handler)
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

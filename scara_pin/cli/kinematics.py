@@ -1,0 +1,320 @@
+"""Commands of the kinematics layer: ``fk``, ``jacobian``, ``ik``, ``validate-ik``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..files import write_atomic_with
+from ._common import (
+    _POSE_KINDS,
+    Units,
+    _add_q,
+    _add_robot_options,
+    _add_units,
+    _check_limits,
+    _fmt,
+    _load,
+    _number,
+    _q_values,
+    _read_pose,
+    _read_q,
+    _scaled,
+    log,
+)
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from .._typing import ArrayLike
+    from ..model import Robot
+
+
+def cmd_fk(args: argparse.Namespace) -> int:
+    """Forward kinematics: the pose of tool0 in the base frame."""
+    units = Units(args.deg, args.mm)
+    robot = _load(args, units)
+    q = _read_q(args, units)
+    _check_limits(robot, q, args.strict)
+    M = robot.tool_placement(q)
+    from ..model import pose_from_placement
+
+    pose = pose_from_placement(M)
+    q_out = _scaled(q, units.scale(units.q))
+    pos = [float(v) * units.length for v in pose[:3]]
+    yaw = float(pose[3]) * units.angle
+    matrix = M.homogeneous.copy()
+    matrix[:3, 3] *= units.length
+    if args.json:
+        out = {
+            "robot": robot.name,
+            "q": q_out,
+            "position": pos,
+            "yaw": yaw,
+            "matrix": matrix.tolist(),
+            "frame": robot.tool_frame,
+            "reference": robot.base_frame,
+            "units": {"length": units.length_name, "angle": units.angle_name},
+        }
+        print(json.dumps(out))
+        return 0
+    print(f"robot     {robot.name}: {robot.tool_frame} in {robot.base_frame}")
+    print(f"q         {_fmt(q_out)}  [{', '.join(units.names(units.q))}]")
+    print(f"position  {_fmt(pos)}  [{units.length_name}]")
+    print(f"yaw       {yaw: .9g}  [{units.angle_name}]")
+    print("matrix")
+    for row in matrix:
+        print("          " + _fmt(row))
+    return 0
+
+
+def cmd_jacobian(args: argparse.Namespace) -> int:
+    """The task Jacobian d(x, y, z, yaw)/dq, or Pinocchio's 6 x 4 frame Jacobian."""
+    import numpy as np
+
+    units = Units(args.deg, args.mm)
+    robot = _load(args, units)
+    q = _read_q(args, units)
+    _check_limits(robot, q, args.strict)
+    if args.reference == "task":
+        if args.frame is not None:
+            raise InvalidInputError("--frame goes with --reference world|local|local_world_aligned")
+        J = robot.task_jacobian(q)
+        rows = ["x", "y", "z", "yaw"]
+        row_kinds: tuple[str, ...] = _POSE_KINDS
+    else:
+        J = robot.frame_jacobian(q, args.frame, args.reference)
+        rows = ["vx", "vy", "vz", "wx", "wy", "wz"]
+        row_kinds = ("length",) * 3 + ("angle",) * 3
+    # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j)
+    J = J * np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
+    w = robot.manipulability(q)
+    if args.json:
+        out = {
+            "robot": robot.name,
+            "q": _scaled(q, units.scale(units.q)),
+            "reference": args.reference,
+            "frame": args.frame or robot.tool_frame,
+            "rows": rows,
+            "jacobian": J.tolist(),
+            "manipulability": w,
+            "units": {"length": units.length_name, "angle": units.angle_name},
+        }
+        print(json.dumps(out))
+        return 0
+    print(f"robot     {robot.name}: {args.reference} Jacobian of {args.frame or robot.tool_frame}")
+    print(f"q         {_fmt(_scaled(q, units.scale(units.q)))}  [{', '.join(units.names(units.q))}]")
+    print("          " + "".join(f"{n:>16}" for n in ("d/dq1", "d/dq2", "d/dq3", "d/dq4")))
+    for name, row in zip(rows, J):
+        print(f"{name:<10}" + "".join(f"{v:16.9g}" for v in row))
+    print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {w:.9g}")
+    return 0
+
+
+def _solutions_json(q_list: Sequence[ArrayLike], branches: Sequence[str], units: Units) -> list[dict]:
+    scale = units.scale(units.q)
+    return [{"q": _scaled(q, scale), "branch": b} for q, b in zip(q_list, branches)]
+
+
+def cmd_ik(args: argparse.Namespace) -> int:
+    """Inverse kinematics: every joint solution for a tool pose (closed form, or numeric)."""
+    units = Units(args.deg, args.mm)
+    robot = _load(args, units)
+    if args.input:
+        return _ik_batch(args, robot, units)
+    if args.input is None and args.output:
+        raise InvalidInputError("--output goes with --input (batch mode)")
+    target = _read_pose(args.target, units)
+    near = None
+    if args.near:
+        near = robot.check_q(_q_values(args.near, units))
+    numeric = args.numeric
+    if robot.kind == "palletizer":
+        if args.branch in ("left", "right"):
+            raise InvalidInputError(f"--branch {args.branch} is a SCARA branch; a palletizer's are up and down")
+    elif args.branch in ("up", "down"):
+        raise InvalidInputError(f"--branch {args.branch} is a palletizer branch; a SCARA's are left and right")
+    if not numeric and robot.kind == "scara":
+        from ..kinematics.scara import NotScaraError
+
+        try:
+            _ = robot.kinematics  # extracted on first use: refused here if the model is not SCARA-like
+        except NotScaraError as exc:
+            log.warning("closed-form IK refused this robot (%s); using the numeric IK", exc)
+            numeric = True
+    if numeric:
+        status, message, qs, branches = _ik_numeric(robot, target, near)
+    else:
+        result = robot.ik(target, branch=args.branch, reference=near)
+        sols = result.branch(args.branch)
+        message = result.message
+        if near is not None and sols:
+            best = result.nearest(near, branch=args.branch)
+            message = f"the nearest of {len(sols)} solution(s) to --near"
+            sols = (best,) if best is not None else ()
+        status = result.status.name if sols or not result.success else "NO_SOLUTION_IN_BRANCH"
+        if result.success and not sols:
+            message = f"no {args.branch} solution ({len(result.solutions)} of the other branch)"
+        qs, branches = [s.q for s in sols], [s.branch for s in sols]
+    scale = units.scale(_POSE_KINDS)
+    tgt = dict(zip(("x", "y", "z", "yaw"), _scaled(target, scale)))
+    code = 0 if status == "OK" else 3
+    if args.json:
+        print(json.dumps({"robot": robot.name, "target": tgt, "solutions": _solutions_json(qs, branches, units),
+                          "status": status, "message": message, "method": "numeric" if numeric else "closed-form",
+                          "units": {"length": units.length_name, "angle": units.angle_name}}))  # fmt: skip
+        return code
+    if code:
+        raise InfeasibleError(f"{status}: {message}")
+    method = "numeric" if numeric else "closed-form"
+    print(f"robot     {robot.name}: {method} IK of {robot.tool_frame} in {robot.base_frame}")
+    print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS))}]")
+    print(f"units     q = [{', '.join(units.names(units.q))}]")
+    for q, b in zip(qs, branches):
+        print(f"{b:<9} {_fmt(_scaled(q, units.scale(units.q)))}")
+    return 0
+
+
+def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
+    from ..kinematics.numeric import solve_numeric
+    from ..kinematics.scara import NotScaraError
+
+    res = solve_numeric(robot, target, q0=near)
+    if not res.success:
+        return ("NO_CONVERGENCE", f"numeric IK did not reach the target (residual {res.residual:.3g} after "
+                f"{res.iterations} iterations from {res.starts} starts)", [], [])  # fmt: skip
+    try:
+        branch = robot.branch_of(res.q)
+    except NotScaraError:
+        branch = "unknown"
+    return "OK", f"converged in {res.iterations} iterations (residual {res.residual:.3g})", [res.q], [branch]
+
+
+def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
+    """Stream a CSV of targets (x, y, z, yaw) through the vectorised closed form, in bounded memory."""
+    import csv
+
+    import numpy as np
+
+    from ..kinematics.scara import IKStatus, solve_batch
+
+    if args.target:
+        raise InvalidInputError("give either X Y Z YAW or --input FILE, not both")
+    if not args.output:
+        raise InvalidInputError("--input needs --output FILE")
+    branch = {"all": "nearest", "right": "right", "left": "left"}[args.branch]
+    reference = None
+    if args.near:
+        reference = _q_values(args.near, units)
+    if robot.kind != "scara":
+        raise InvalidInputError(f"ik --input (batch) is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
+    geo = robot.kinematics
+    in_path, out_path = Path(args.input), Path(args.output)
+    try:
+        handle = in_path.open(newline="", encoding="utf-8")
+    except OSError as exc:
+        raise InvalidInputError(f"cannot read {in_path}: {exc.strerror}") from None
+    total = failed = 0
+    pose_scale = np.array(units.scale(_POSE_KINDS))
+    q_scale = np.array(units.scale(units.q))
+    show_progress = sys.stderr.isatty()
+    size = max(in_path.stat().st_size, 1)
+
+    def rows_out(writer: Any) -> None:
+        nonlocal total, failed
+        reader = csv.reader(handle)
+        header = next(reader, None)
+        if header is None or [h.strip().lower() for h in header[:4]] != ["x", "y", "z", "yaw"]:
+            raise InvalidInputError(f"{in_path}: the first row must be the header x,y,z,yaw")
+        writer.writerow(["x", "y", "z", "yaw", "q1", "q2", "q3", "q4", "branch", "status"])
+        chunk: list[list[float]] = []
+        line = 1
+        for row in reader:
+            line += 1
+            if not row or all(not c.strip() for c in row):
+                continue
+            if len(row) < 4:
+                raise InvalidInputError(f"{in_path} line {line}: expected 4 values x,y,z,yaw, got {len(row)}")
+            chunk.append([_number(f"{in_path.name} line {line} {n}", c) for n, c in zip("xyz", row[:3])]
+                         + [_number(f"{in_path.name} line {line} yaw", row[3])])  # fmt: skip
+            if len(chunk) == 65536:
+                flush(writer, chunk)
+                chunk = []
+                if show_progress:
+                    print(f"\r{total} targets ({100 * handle.tell() / size:.0f} %)", end="", file=sys.stderr)
+        flush(writer, chunk)
+        if show_progress:
+            print(f"\r{total} targets (100 %)", file=sys.stderr)
+
+    def flush(writer: Any, chunk: list[list[float]]) -> None:
+        nonlocal total, failed
+        if not chunk:
+            return
+        T = np.array(chunk) / pose_scale
+        res = solve_batch(geo, T, branch=branch, reference=reference)
+        names = [IKStatus(c).name for c in range(len(IKStatus))]
+        labels = {1: "right", -1: "left", 0: ""}
+        for t, q, b, st in zip(T * pose_scale, res.q * q_scale, res.branch, res.status):
+            writer.writerow([*(repr(float(v)) for v in t), *("" if math.isnan(v) else repr(float(v)) for v in q),
+                             labels[int(b)], names[int(st)]])  # fmt: skip
+        total += len(chunk)
+        failed += int((res.status != 0).sum())
+
+    with handle:
+        write_atomic_with(out_path, lambda f: rows_out(csv.writer(f)))
+    print(f"wrote {out_path}: {total} targets, {total - failed} solved, {failed} without solution", file=sys.stderr)
+    return 3 if failed else 0
+
+
+def cmd_validate_ik(args: argparse.Namespace) -> int:
+    """Cross-validate the closed-form IK against Pinocchio FK and the numeric IK."""
+    from ..kinematics.validate import validate_ik
+
+    if args.samples < 1:
+        raise ParameterError("--samples", args.samples, "must be >= 1")
+    robot = _load(args)
+    report = validate_ik(robot, args.samples, args.seed)
+    if args.json:
+        out = {k: v for k, v in vars(report).items()}
+        out["ok"] = report.ok
+        print(json.dumps(out))
+    else:
+        print(report.table())
+    return 0 if report.ok else 1
+
+
+def register(sub: Any) -> None:
+    """Add the commands of this module to the ``scara-pin`` subparsers."""
+    p = sub.add_parser("fk", help="forward kinematics: pose of tool0 in the base frame")
+    _add_q(p)
+    p.set_defaults(func=cmd_fk)
+    p = sub.add_parser("jacobian", help="task Jacobian d(x, y, z, yaw)/dq (or a 6 x 4 frame Jacobian)")
+    _add_q(p)
+    p.add_argument("--reference", default="task", choices=["task", "world", "local", "local_world_aligned"],
+                   help="task (4 x 4, default) or a Pinocchio reference frame for the 6 x 4 Jacobian")  # fmt: skip
+    p.add_argument("--frame", default=None, help="frame of the 6 x 4 Jacobian (default: tool0)")
+    p.set_defaults(func=cmd_jacobian)
+    p = sub.add_parser("ik", help="inverse kinematics: every joint solution for a tool pose X Y Z YAW")
+    p.add_argument("target", nargs="*", metavar="X Y Z YAW", help="tool0 pose in the base frame")
+    p.add_argument("--branch", default="all", choices=["all", "left", "right", "up", "down"],
+                   help="elbow branch: a SCARA's right (elbow turns counterclockwise seen from above) or left; "
+                   "a palletizer's up (sin q3 > 0, S2's q3) or down; default all")  # fmt: skip
+    p.add_argument("--near", nargs=4, metavar="Q", help="return only the solution nearest to this configuration")
+    p.add_argument("--numeric", action="store_true", help="use Pinocchio-based numeric IK instead of the closed form")
+    p.add_argument("--input", metavar="CSV", help="batch: targets with header x,y,z,yaw (one solution per row)")
+    p.add_argument("--output", metavar="CSV", help="batch: joints written here (atomically), with a status column")
+    _add_units(p)
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_ik)
+    p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
+    p.add_argument("--samples", type=int, default=1000, help="configurations sampled within limits (default 1000)")
+    p.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_validate_ik)

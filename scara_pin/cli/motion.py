@@ -1,0 +1,241 @@
+"""Commands of the motion layer: ``traj``, ``jog``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ._common import (
+    Units,
+    _add_robot_options,
+    _add_units,
+    _fmt,
+    _joint_arg,
+    _load,
+    _number,
+    _pose_to_q,
+    _read_pose,
+    log,
+    write_atomic,
+)
+
+if TYPE_CHECKING:
+
+    pass
+
+
+def cmd_traj(args: argparse.Namespace) -> int:
+    """A trajectory between configurations or poses: quintic, time-optimal, or a straight tool line."""
+    import numpy as np
+
+    from ..motion import trajectory as tr
+
+    logging.getLogger("toppra").setLevel(logging.WARNING)
+    units = Units(args.deg, args.mm)
+    robot = _load(args, units)
+    if (args.from_q is None) == (args.from_pose is None):
+        raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
+    if (args.to_q is None) == (args.to_pose is None):
+        raise InvalidInputError("give the end as either --to Q1 Q2 Q3 Q4 or --to-pose X Y Z YAW")
+    if args.duration is not None and args.optimal:
+        raise InvalidInputError("--duration and --optimal exclude each other")
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise ParameterError("--duration", args.duration, "must be a finite number > 0", "s")
+    if not (math.isfinite(args.rate) and args.rate > 0):
+        raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
+    vias = [_joint_arg(robot, v, units, f"--via #{i + 1}") for i, v in enumerate(args.via or [])]
+    mid = (np.asarray(robot.limits.lower) + np.asarray(robot.limits.upper)) / 2
+    pose_from = _read_pose(args.from_pose, units, "--from-pose") if args.from_pose else None
+    pose_to = _read_pose(args.to_pose, units, "--to-pose") if args.to_pose else None
+    q_from = _joint_arg(robot, args.from_q, units, "--from") if args.from_q else None
+    q_to = _joint_arg(robot, args.to_q, units, "--to") if args.to_q else None
+    tool_speed = None
+    if args.tool_speed is not None:
+        tool_speed = _number("--tool-speed", str(args.tool_speed)) / units.length
+    if args.linear and robot.kind != "scara":
+        raise InvalidInputError(f"traj --linear is SCARA-only for now; robot {robot.name!r} is a {robot.kind} "
+                                "(joint-space --duration and TOPP-RA timing work)")  # fmt: skip
+    if args.plot and robot.kind != "scara":
+        raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
+    if args.linear:
+        first = pose_from if q_from is None else tr.joint_pose(robot, q_from)
+        assert first is not None  # --from or --from-pose, checked above
+        poses = [first]
+        poses += [tr.joint_pose(robot, v) for v in vias]
+        last = pose_to if q_to is None else tr.joint_pose(robot, q_to)
+        assert last is not None  # --to or --to-pose, checked above
+        poses.append(last)
+        path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
+        if args.duration is not None:
+            traj, method = tr.timed(path, args.duration), "straight line, quintic time law"
+        else:
+            from ..motion.timing import time_optimal
+
+            traj = time_optimal(robot, path, tool_speed=tool_speed, torque=args.torque)
+            method = "straight line, time-optimal (TOPP-RA)"
+    else:
+        if q_from is None:
+            q_from = _pose_to_q(robot, pose_from, mid, "--from-pose")  # type: ignore[arg-type]
+        if q_to is None:
+            q_to = _pose_to_q(robot, pose_to, vias[-1] if vias else q_from, "--to-pose")  # type: ignore[arg-type]
+        waypoints = [q_from, *vias, q_to]
+        lim = robot.limits
+        if args.duration is not None:
+            if vias:
+                traj, method = tr.timed(tr.joint_path(robot, waypoints), args.duration), "joint spline, quintic law"
+            else:
+                traj, method = tr.quintic(q_from, q_to, args.duration), "joint quintic (jtraj)"
+        elif not vias and tool_speed is None and not args.torque:
+            traj, method = tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), "joint line, time-optimal"
+        else:
+            from ..motion.timing import time_optimal
+
+            traj = time_optimal(robot, waypoints, tool_speed=tool_speed, torque=args.torque)
+            method = "joint path, time-optimal (TOPP-RA)"
+    from ..motion.timing import limit_ratios
+
+    ratios = limit_ratios(robot, traj, rate=1000.0, tool_speed=tool_speed, torque=args.torque)
+    if ratios.worst > 1 + 1e-6:
+        message = (f"the trajectory exceeds a limit: worst ratio {ratios.worst:.6g} (velocity "
+                   f"{ratios.velocity:.6g}, acceleration {ratios.acceleration:.6g}); a longer --duration, or "
+                   "--optimal, respects them")  # fmt: skip
+        if args.strict:
+            raise InfeasibleError(message)
+        log.warning(message)
+    outputs: dict[str, str] = {}
+    if args.out:
+        out = Path(args.out)
+        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
+        outputs["trajectory"] = str(out)
+    if args.setpoints:
+        motor = None
+        if args.gear or args.steps_per_rev or args.screw_lead is not None:
+            if not (args.gear and args.steps_per_rev and args.screw_lead is not None):
+                raise InvalidInputError("motor steps need --gear G1..G4, --steps-per-rev S1..S4 and --screw-lead L")
+            motor = tr.MotorUnits.from_drive(
+                [_number("--gear", g) for g in args.gear],
+                [_number("--steps-per-rev", v) for v in args.steps_per_rev],
+                _number("--screw-lead", args.screw_lead) / units.length,
+                prismatic=robot.kinematics.prismatic,
+            )
+        delays = [_number("--delays", d) for d in args.delays] if args.delays else None
+        sp = traj.setpoints(args.setpoint_rate or args.rate, delays=delays, motor=motor)
+        write_atomic(Path(args.setpoints), sp.csv_text())
+        outputs["setpoints"] = args.setpoints
+    if args.plot:
+        from ..viz.plots import plot_trajectory
+
+        plot_trajectory(traj, args.plot, robot=robot)
+        outputs["plot"] = args.plot
+    summary = {
+        "robot": robot.name,
+        "method": method,
+        "duration": traj.duration,
+        "q_from": traj.q_start.tolist(),
+        "q_to": traj.q_end.tolist(),
+        "limit_ratios": {"velocity": ratios.velocity, "acceleration": ratios.acceleration,
+                         "tool_speed": ratios.tool_speed, "torque": ratios.torque},  # fmt: skip
+        "outputs": outputs,
+        "units": {"length": "m", "angle": "rad", "time": "s"},
+    }
+    if args.json:
+        if not args.out:
+            summary["samples"] = traj.resample(args.rate).to_dict()
+        print(json.dumps(summary))
+        return 0
+    print(f"robot     {robot.name}: {method}")
+    print(f"duration  {traj.duration:.9g} s")
+    print(f"from      {_fmt(traj.q_start)}  [SI]")
+    print(f"to        {_fmt(traj.q_end)}  [SI]")
+    print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} (sampled at 1 kHz)")
+    for kind, where in outputs.items():
+        print(f"wrote     {kind}: {where}")
+    return 0
+
+
+def cmd_jog(args: argparse.Namespace) -> int:
+    """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge."""
+    from ..motion.jog import jog_to_edge
+
+    units = Units(args.deg, args.mm)
+    robot = _load(args, units)
+    if robot.kind != "scara":
+        raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
+    q0 = _joint_arg(robot, args.from_q, units, "--from")
+    direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
+    if len(direction) not in (2, 3):
+        raise ParameterError("--direction", " ".join(args.direction), "must be DX DY or DX DY DZ")
+    margin = _number("--margin", args.margin) / units.length
+    jog = jog_to_edge(robot, q0, direction, margin=margin)
+    traj = jog.trajectory
+    if args.out:
+        out = Path(args.out)
+        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
+    if args.plot:
+        from ..viz.plots import plot_trajectory
+
+        plot_trajectory(traj, args.plot, robot=robot)
+    if args.json:
+        print(json.dumps({"robot": robot.name, "hit": jog.hit.to_dict(), "start_pose": jog.start_pose.tolist(),
+                          "end_pose": jog.end_pose.tolist(), "distance": jog.distance, "duration": traj.duration,
+                          "q_end": traj.q_end.tolist(), "limit_ratio": jog.ratio,
+                          "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
+        return 0
+    L = units.length
+    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}")
+    print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]")
+    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)")
+    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]")
+    print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)")
+    for what in (args.out, args.plot):
+        if what:
+            print(f"wrote     {what}")
+    return 0
+
+
+def register(sub: Any) -> None:
+    """Add the commands of this module to the ``scara-pin`` subparsers."""
+    p = sub.add_parser("traj", help="trajectory: quintic, time-optimal (TOPP-RA) or straight tool line; export, plot")
+    g = p.add_argument_group("endpoints (joint values in URDF order, or tool poses X Y Z YAW)")
+    g.add_argument("--from", dest="from_q", nargs=4, metavar="Q", help="start configuration")
+    g.add_argument("--to", dest="to_q", nargs=4, metavar="Q", help="end configuration")
+    g.add_argument("--from-pose", nargs=4, metavar="P", help="start pose (IK: the solution nearest mid-range)")
+    g.add_argument("--to-pose", nargs=4, metavar="P", help="end pose (IK: the solution nearest the previous point)")
+    g.add_argument("--via", nargs=4, action="append", metavar="Q", help="via configuration (repeatable)")
+    g = p.add_argument_group("timing")
+    g.add_argument("--duration", type=float, metavar="T",
+                   help="quintic time law over T seconds (checked against the limits)")  # fmt: skip
+    g.add_argument("--optimal", action="store_true", help="time-optimal under the joint limits (the default)")
+    g.add_argument("--linear", action="store_true", help="straight tool line (S4), one elbow branch, J4 continuous")
+    g.add_argument("--tool-speed", type=float, metavar="V", help="also limit the tool speed [m/s, or mm/s with --mm]")
+    g.add_argument("--torque", action="store_true", help="also respect the effort limits (RNEA, URDF inertias)")
+    g.add_argument("--strict", action="store_true", help="refuse (exit 3) a --duration that exceeds a limit")
+    g = p.add_argument_group("outputs (files in SI units)")
+    g.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
+                   help="sampling rate of --out and --json (default 1000)")  # fmt: skip
+    g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
+    g.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time with limits, and the tool path")
+    g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
+    g.add_argument("--setpoint-rate", type=float, metavar="HZ", help="setpoint rate (default: --rate)")
+    g.add_argument("--delays", nargs=4, metavar="S", help="per-axis command latency [s], compensated")
+    g.add_argument("--gear", nargs=4, metavar="G", help="gear ratios (motor turns per joint/screw turn)")
+    g.add_argument("--steps-per-rev", nargs=4, metavar="N", help="motor steps per motor turn")
+    g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")
+    _add_units(p, inputs=True, json_help="print one JSON object (with the samples unless --out)")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_traj)
+    p = sub.add_parser("jog", help="jog to the edge: straight tool move ending at rest on the workspace edge")
+    p.add_argument("--from", dest="from_q", nargs=4, metavar="Q", required=True, help="current configuration")
+    p.add_argument("--direction", nargs="+", metavar="D", required=True, help="DX DY (plan) or DX DY DZ")
+    p.add_argument("--margin", default="0", metavar="M", help="stop this far before the edge [m or mm] (default 0)")
+    p.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out (default 1000)")
+    p.add_argument("--out", metavar="FILE", help="samples as CSV (or JSON for *.json), atomically")
+    p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
+    _add_units(p, inputs=True)
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_jog)

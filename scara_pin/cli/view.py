@@ -1,0 +1,73 @@
+"""The ``view`` command (meshcat in the browser, or an offline HTML page)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import TYPE_CHECKING, Any
+
+from ..errors import InvalidInputError
+from ._common import Units, _add_robot_options, _add_units, _load, _q_values, log
+
+if TYPE_CHECKING:
+
+    pass
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    """Show the robot in the browser (meshcat): a configuration, a trajectory, the workspace boundary."""
+    import numpy as np
+
+    from ..viz import meshcat as viz
+
+    units = Units(args.deg, args.mm)
+    robot = _load(args, units)
+    q = None
+    if args.q:
+        q = robot.check_q(_q_values(args.q, units))
+        for item in robot.outside_limits(q):
+            log.warning("%s (shown anyway)", item)
+    times = qs = None
+    if args.traj:
+        times, qs = viz.read_trajectory_csv(args.traj)
+    polylines = None
+    if args.workspace:
+        from ..workspace.scara import workspace
+
+        if robot.kind != "scara":
+            raise InvalidInputError(f"view --workspace is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
+        ws = workspace(robot)
+        polylines = [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
+    if args.html:
+        viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines,
+                        title=f"scara-pin: {robot.name}")  # fmt: skip
+        print(f"wrote {args.html} (self-contained; open it from disk, no network needed)")
+        return 0
+    with viz.Viewer(robot, open=args.open) as viewer:
+        if polylines is not None:
+            viewer.draw_polylines(polylines)
+        if times is not None and qs is not None:
+            viewer.draw_tool_path(qs)
+            viewer.animate(times, qs, loop=True)
+        else:
+            viewer.display(q if q is not None else np.zeros(4))
+        print(f"meshcat viewer: {viewer.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
+        try:
+            viewer.serve()
+        except KeyboardInterrupt:
+            print("stopped", file=sys.stderr)
+    return 0
+
+
+def register(sub: Any) -> None:
+    """Add the commands of this module to the ``scara-pin`` subparsers."""
+    p = sub.add_parser("view", help="show the robot in the browser (meshcat); --html writes a standalone page")
+    p.add_argument("--q", nargs=4, metavar="Q", help="configuration to show (default: zero)")
+    p.add_argument("--traj", metavar="CSV", help="animate a trajectory (a `traj --out` CSV) and draw the tool path")
+    p.add_argument("--workspace", action="store_true", help="draw the workspace boundary on the floor")
+    p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")
+    p.add_argument("--open", action="store_true", help="open the page in the web browser")
+    _add_units(p, json_help=None)
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_view)

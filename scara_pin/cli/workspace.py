@@ -1,0 +1,114 @@
+"""The ``workspace`` command."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from typing import TYPE_CHECKING, Any
+
+from ..errors import InvalidInputError
+from ._common import Units, _add_robot_options, _add_units, _fmt, _load, _number
+
+if TYPE_CHECKING:
+
+    from ..model import Robot
+
+
+def cmd_workspace(args: argparse.Namespace) -> int:
+    """The exact reachable region (arcs, area, radii), a ray query to its edge, and a picture."""
+    from ..workspace.scara import plot_workspace, workspace
+
+    units = Units(False, args.mm)
+    L = units.length
+    robot = _load(args, units)
+    if robot.kind == "palletizer":
+        return _palletizer_workspace(args, robot, units)
+    ws = workspace(robot)
+    hit = None
+    if args.ray:
+        start = [_number(n, t) / L for n, t in zip(("x", "y"), args.ray[:2])]
+        direction = [_number(n, t) for n, t in zip(("dx", "dy"), args.ray[2:])]
+        if (args.z is None) != (args.dz is None):
+            raise InvalidInputError("--z and --dz go together (a 3-D ray also meets the J3 stroke)")
+        if args.z is not None:
+            start.append(_number("--z", args.z) / L)
+            direction.append(_number("--dz", args.dz))
+        hit = ws.ray(start, direction)
+    elif args.z is not None or args.dz is not None:
+        raise InvalidInputError("--z/--dz go with --ray")
+    if args.plot:
+        ray = None if hit is None else (start[:2], direction[:2])
+        plot_workspace(ws, args.plot, ray=ray)
+    if args.json:
+        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}}
+        if hit is not None:
+            out["ray"] = {"start": start, "direction": direction, **hit.to_dict()}
+        else:
+            out["workspace"] = ws.to_dict()
+        if args.plot:
+            out["plot"] = args.plot
+        print(json.dumps(out))
+        return 0
+    if hit is not None:
+        origin = _fmt([v * L for v in start])
+        print(f"robot     {robot.name}: ray from {origin} [{units.length_name}] along {_fmt(direction)}")
+        print(f"edge      {_fmt([v * L for v in hit.point])} [{units.length_name}]")
+        print(f"distance  {hit.distance * L:.9g} {units.length_name}")
+        print(f"stopped by {hit.description} [{hit.limit.value}]")
+    else:
+        z0, z1 = ws.z_range
+        print(f"robot     {robot.name}: reachable region of the wrist axis (= tool point without tool offset)")
+        print(f"area      {ws.area * L * L:.9g} {units.length_name}^2")
+        print(f"radius    {ws.r_min * L:.9g} .. {ws.r_max * L:.9g} {units.length_name} (from the J1 axis)")
+        print(f"z         {z0 * L:.9g} .. {z1 * L:.9g} {units.length_name} (J3 stroke)")
+        print(f"boundary  {len(ws.loops)} loop(s) of {len(ws.arcs)} arcs (centre, radius, start..end angle, limit):")
+        for i, arc in enumerate(ws.arcs):
+            cx, cy = (v * L for v in arc.center)
+            print(f"  {i:>2}  ({cx: .6g}, {cy: .6g})  r {arc.radius * L:.6g}  "
+                  f"{math.degrees(arc.start):8.3f}..{math.degrees(arc.end):8.3f} deg  {arc.description}")  # fmt: skip
+    if args.plot:
+        print(f"wrote     {args.plot}")
+    return 0
+
+
+def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) -> int:
+    """The palletizer's reach envelope of tool0 in its arm plane (r from the waist axis, z)."""
+    from ..workspace.palletizer import arm_plane_envelope, plot_envelope
+
+    if args.ray or args.z is not None or args.dz is not None:
+        raise InvalidInputError("--ray/--z/--dz are SCARA-only for now; a palletizer gets its arm-plane envelope")
+    env = arm_plane_envelope(robot.palletizer)
+    if args.plot:
+        plot_envelope(env, args.plot)
+    if args.json:
+        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"},
+                               "envelope": env.to_dict()}  # fmt: skip
+        if args.plot:
+            out["plot"] = args.plot
+        print(json.dumps(out))
+        return 0
+    L, name = units.length, units.length_name
+    print(f"robot     {robot.name}: reach envelope of {robot.tool_frame} in the arm plane (r from the waist axis, z)")
+    print(f"area      {env.area * L * L:.9g} {name}^2")
+    print(f"r range   [{env.r_range[0] * L:.9g}, {env.r_range[1] * L:.9g}] {name}")
+    print(f"z range   [{env.z_range[0] * L:.9g}, {env.z_range[1] * L:.9g}] {name}")
+    print(f"arcs      {len(env.arcs)} (centre, radius [{name}], phi from the vertical [rad])")
+    for a in env.arcs:
+        print(f"  {a.limit:<13} centre {_fmt([v * L for v in a.center])} radius {a.radius * L:.9g} "
+              f"phi [{a.start:.9g}, {a.start + a.sweep:.9g}]")  # fmt: skip
+    if args.plot:
+        print(f"wrote     {args.plot}")
+    return 0
+
+
+def register(sub: Any) -> None:
+    """Add the commands of this module to the ``scara-pin`` subparsers."""
+    p = sub.add_parser("workspace", help="exact reachable region (arcs, area, radii); --ray: the edge along a ray")
+    p.add_argument("--ray", nargs=4, metavar=("X", "Y", "DX", "DY"), help="start inside the region and plan direction")
+    p.add_argument("--z", metavar="Z", help="with --ray: start height (a 3-D ray also meets the J3 stroke)")
+    p.add_argument("--dz", metavar="DZ", help="with --ray: vertical direction component")
+    p.add_argument("--plot", metavar="PNG", help="picture of the region (arcs coloured by limit; the ray)")
+    _add_units(p, deg=False)
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_workspace)

@@ -1,0 +1,1 @@
+"""Pictures: the meshcat browser viewer and its offline HTML page, and matplotlib plots."""
