@@ -27,7 +27,8 @@ from .errors import (
     UnknownRobotError,
     UrdfError,
 )
-from .model import Robot, load_robot, load_urdf, pose_from_placement
+from .model import Kinematics, Robot, pose_from_placement
+from .robots import kinematics_for, load_robot, load_urdf, robot_from_urdf
 
 __version__ = "0.1.0"
 
@@ -38,6 +39,7 @@ __all__ = [
     "InfeasibleError",
     "InvalidInputError",
     "JointLimits",
+    "Kinematics",
     "NoSolutionError",
     "ParameterError",
     "Robot",
@@ -48,10 +50,12 @@ __all__ = [
     "__version__",
     "available_robots",
     "generate_urdf",
+    "kinematics_for",
     "load_parameters",
     "load_robot",
     "load_urdf",
     "pose_from_placement",
+    "robot_from_urdf",
     "urdf_dir",
 ]
 

@@ -13,6 +13,10 @@ from .errors import ParameterError
 if TYPE_CHECKING:
     from ._typing import ArrayLike
 
+MAGNITUDE_MAX = 1e6
+"""[m or rad] the largest joint value or target coordinate taken as such: beyond it an angle has no
+precision left (its ulp exceeds 1e-10 rad) and no SCARA is that large."""
+
 
 def _vector(name: str, value: object, n: int = 4) -> np.ndarray:
     """``value`` as ``n`` finite floats, or a :class:`ParameterError`."""

@@ -583,9 +583,10 @@ class _Checker:
         from .errors import UrdfError
         from .kinematics.scara import NotScaraError
         from .model import Robot
+        from .robots import kinematics_for
 
         try:
-            robot = Robot(self.text, origin=self.source, tool_frame=self.tool or "tool0")
+            robot = Robot(self.text, origin=self.source, tool_frame=self.tool or "tool0", kinematics=kinematics_for)
         except UrdfError as exc:
             self.error("not-loadable", f"the toolkit cannot load it: {exc}")
             return

@@ -15,30 +15,70 @@ Conventions (used by every command of the package):
 
 from __future__ import annotations
 
+import enum
 import math
 import os
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 import pinocchio as pin
 
-# scara_pin.ik is imported inside the methods that use it: `scara-pin fk` does not need it (start-up time)
-from ._fast import _Q_MAX, q_ok, task_rows
-from ._fast import nearest as _nearest_c
-from ._fast import speedups as _speedups
+from ._checks import MAGNITUDE_MAX
 from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
-    from .kinematics.palletizer import PalletizerGeometry
-    from .kinematics.scara import IKResult, ScaraGeometry
+    from .kinematics.results import BatchIKResult, IKResult
 
-__all__ = ["Robot", "load_robot", "load_urdf", "pose_from_placement"]
+__all__ = ["Kinematics", "Robot", "pose_from_placement"]
+
+_Q_MAX2 = (0.5 * MAGNITUDE_MAX) ** 2
+"""The largest sum of squares of q that the cheap input test waves through (NaN and inf never pass)."""
+_F64 = np.dtype(np.float64)
+_TASK_ROWS = np.array([0, 1, 2, 5])  # x, y, z, wz of a 6-row Jacobian
+
+
+class Kinematics(Protocol):
+    """What each robot kind provides, read from the loaded model (see :mod:`scara_pin.robots`).
+
+    The robot holds one (``Robot.kinematics``) and knows nothing else of inverse kinematics.
+    """
+
+    kind: str
+    branches: tuple[str, ...]
+    status: type[enum.IntEnum]
+    geometry: Any
+
+    def solve(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None,
+              all_turns: bool = False) -> IKResult:  # fmt: skip
+        """Every branch's solution (its turns nearest ``reference``), or the reason there is none."""
+        ...
+
+    def nearest(self, target: Any, reference: ArrayLike | None = None, *, weights: ArrayLike | None = None,
+                branch: str = "all") -> np.ndarray:  # fmt: skip
+        """The one solution nearest ``reference``; NoSolutionError when there is none."""
+        ...
+
+    def batch(self, targets: ArrayLike, reference: ArrayLike | None = None, *,
+              branch: str = "nearest") -> BatchIKResult:  # fmt: skip
+        """One solution per row of an (N, 4) array of targets, with status codes."""
+        ...
+
+    def branch_of(self, q: ArrayLike) -> str:
+        """The branch of a configuration."""
+        ...
+
+    def workspace(self) -> Any:
+        """The reachable region (the kind's own description of it)."""
+        ...
+
+
+KinematicsFactory = Callable[["Robot"], Kinematics]
 
 
 def _rerooted(model: pin.Model, baseMo: pin.SE3) -> pin.Model:
@@ -182,6 +222,7 @@ class Robot:
         base_frame: str = "base",
         tool_frame: str = "tool0",
         origin: str = "URDF",
+        kinematics: KinematicsFactory | None = None,
     ) -> None:
         """Load URDF text.
 
@@ -193,6 +234,8 @@ class Robot:
             base_frame: the frame poses are expressed in; falls back to the root link if absent.
             tool_frame: the tool frame (``tool0``).
             origin: how to name the source in error messages (a file name).
+            kinematics: builds the robot's kinematics object from the loaded robot (its kind's; see
+                :func:`scara_pin.robots.kinematics_for`, which :func:`scara_pin.load_robot` passes).
 
         Raises:
             UrdfError: unreadable, invalid or disconnected URDF, or not a 4-joint robot.
@@ -236,6 +279,7 @@ class Robot:
         self._base_data = self._base_model.createData()
         self.continuous = continuous
         self.has_continuous = any(continuous)
+        self._kinematics_factory = kinematics
         if self.has_continuous:
             # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
             iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
@@ -247,14 +291,11 @@ class Robot:
         cls,
         robot: str | Path | RobotParameters = "default",
         overrides: Mapping[str, object] | None = None,
+        **kwargs: Any,
     ) -> Robot:
         """Generate the URDF of a configured robot (see :mod:`scara_pin.description`) and load it."""
         params = load_parameters(robot, overrides)
-        return cls(
-            generate_urdf(params),
-            parameters=params,
-            origin=f"robot {params.name!r}",
-        )
+        return cls(generate_urdf(params), parameters=params, origin=f"robot {params.name!r}", **kwargs)
 
     @classmethod
     def from_file(cls, path: str | Path, **kwargs: Any) -> Robot:
@@ -277,129 +318,44 @@ class Robot:
         """Collision geometry of the URDF, built on first use."""
         return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.COLLISION)
 
-    # ----------------------------------------------------------------- inverse kinematics
+    # ----------------------------------------------------------------- inverse kinematics (delegated)
     @cached_property
-    def kinematics(self) -> ScaraGeometry:
-        """The SCARA geometry read from the model for the closed-form IK (extracted once, on first use).
+    def kinematics(self) -> Kinematics:
+        """The kinematics object of the robot's kind (built on first use by the factory given at load).
 
         Raises:
-            NotScaraError: the model is not SCARA-like (the reason names the joint), or is a palletizer.
+            UrdfError: no kinematics factory was given, or the kind's closed form refuses the model (e.g.
+                ``NotScaraError``, naming the joint).
         """
-        from .kinematics import scara as _ik
+        if self._kinematics_factory is None:
+            raise UrdfError(
+                f"robot {self.name!r} was loaded without its kinematics: load it with scara_pin.load_robot(...) "
+                "(or pass kinematics=scara_pin.robots.kinematics_for)"
+            )
+        return self._kinematics_factory(self)
 
-        if self.kind != "scara":
-            raise _ik.NotScaraError(f"robot {self.name!r} is a {self.kind}, not a SCARA: the SCARA closed form "
-                                "(and what is built on it) does not apply")  # fmt: skip
-        return _ik.ScaraGeometry.from_robot(self)
+    def ik(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None,
+           all_turns: bool = False) -> IKResult:  # fmt: skip
+        """Closed-form IK of the robot's kind: each branch's solution, turns nearest ``reference`` (default 0)."""
+        return self.kinematics.solve(target, branch=branch, reference=reference, all_turns=all_turns)
 
-    @cached_property
-    def palletizer(self) -> PalletizerGeometry:
-        """The palletizer geometry for the geometric IK (see :mod:`scara_pin.palletizer`).
+    def ik_nearest(self, target: Any, reference: ArrayLike | None = None, *, weights: ArrayLike | None = None,
+                   branch: str = "all") -> np.ndarray:  # fmt: skip
+        """The closed-form solution nearest ``reference`` (weighted joint space), as a new array.
 
         Raises:
-            NotPalletizerError: the robot is not a palletizer generated from palletizer parameters.
+            NoSolutionError: no solution inside the limits (``status``, ``reason``; exit code 3).
         """
-        from .kinematics.palletizer import PalletizerGeometry
+        return self.kinematics.nearest(target, reference, weights=weights, branch=branch)
 
-        return PalletizerGeometry.from_robot(self)
-
-    def ik(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None) -> IKResult:
-        """Closed-form IK of the robot's kind: every solution inside the limits.
-
-        A SCARA: :func:`scara_pin.ik.solve` (branches right/left); a palletizer:
-        :func:`scara_pin.palletizer.solve` (branches up/down).
-        """
-        from .kinematics import scara as _ik
-
-        if self.kind == "palletizer":
-            from .kinematics import palletizer
-
-            return palletizer.solve(self.palletizer, target, branch=branch, reference=reference)
-        result = _ik.solve(self.kinematics, target, branch=branch, reference=reference)
-        if self.has_continuous and len(result.solutions) > 1:
-            return self._without_turn_twins(result, reference)
-        return result
-
-    def _without_turn_twins(self, result: IKResult, reference: ArrayLike | None) -> IKResult:
-        """``result`` with each solution listed once.
-
-        A continuous joint's range [-pi, pi] has the same joint position at both ends, so a solution found
-        at -pi and at +pi is kept once (the first found, or the one nearer to ``reference`` when given).
-        """
-        import dataclasses
-
-        ref = None if reference is None else np.asarray(reference, dtype=float)
-        cont = self.continuous
-        keep: list[Any] = []
-        for s in result.solutions:
-            for k, t in enumerate(keep):
-                if all(abs(math.remainder(a - b, 2 * math.pi) if c else a - b) <= 1e-9
-                       for a, b, c in zip(s.q.tolist(), t.q.tolist(), cont)):  # fmt: skip
-                    if ref is not None and float(np.sum((s.q - ref) ** 2)) < float(np.sum((t.q - ref) ** 2)):
-                        keep[k] = s
-                    break
-            else:
-                keep.append(s)
-        if len(keep) == len(result.solutions):
-            return result
-        return dataclasses.replace(result, solutions=tuple(keep))
-
-    def ik_nearest(
-        self,
-        target: Any,
-        reference: ArrayLike,
-        *,
-        weights: ArrayLike | None = None,
-        branch: str = "all",
-    ) -> np.ndarray:
-        """The closed-form IK solution nearest to ``reference`` (weighted joint space), as a new array.
-
-        A SCARA: :func:`scara_pin.ik.solve_nearest`; a palletizer: the nearest of
-        :func:`scara_pin.palletizer.solve`'s solutions. Raises :class:`~scara_pin.NoSolutionError` with the
-        reason code when there is none.
-        """
-        params = self._nearest_params
-        if params is not None:  # inline: the common case is one C call (solve_nearest's compiled route)
-            q = _nearest_c(params, target, reference, weights, branch)
-            if q is not None:
-                return q
-            from .kinematics import scara as _ik
-
-            return _ik._nearest_py(self.kinematics, target, reference, weights, branch)
-        return self._nearest_of_all(target, reference, weights, branch)
-
-    @cached_property
-    def _nearest_params(self) -> bytes | None:
-        """The packed geometry for the compiled nearest solution, or None where :meth:`ik` is the route.
-
-        None without the compiled module, for a palletizer, a robot with continuous joints (its -pi/+pi
-        twins are merged by :meth:`ik`; the nearest is the same) and a model the SCARA closed form refuses.
-        """
-        from .kinematics import scara as _ik
-
-        if _speedups is None or self.kind != "scara" or self.has_continuous:
-            return None
-        try:
-            return self.kinematics._cparams
-        except _ik.NotScaraError:
-            return None
-
-    def _nearest_of_all(self, target: Any, reference: ArrayLike, weights: ArrayLike | None, branch: str) -> np.ndarray:
-        """:meth:`ik_nearest` through :meth:`ik` (every solution, then the nearest)."""
-        from .kinematics import scara as _ik
-
-        ref, w = _ik._reference_weights(reference, weights)
-        return _ik._pick_nearest(self.ik(target, branch=branch, reference=ref), ref, w, branch)
+    def ik_batch(self, targets: ArrayLike, reference: ArrayLike | None = None, *, branch: str = "nearest"
+                 ) -> BatchIKResult:  # fmt: skip
+        """One closed-form solution per row of (N, 4) targets: ``.q`` (N, 4), ``.status`` (N,), ``.branch``."""
+        return self.kinematics.batch(targets, reference, branch=branch)
 
     def branch_of(self, q: ArrayLike) -> str:
         """The IK branch of a configuration (SCARA: right/left; palletizer: up/down)."""
-        from .kinematics import scara as _ik
-
-        if self.kind == "palletizer":
-            from .kinematics.palletizer import branch_of
-
-            return branch_of(q)
-        return _ik.branch_of(self.kinematics, q)
+        return self.kinematics.branch_of(q)
 
     # ----------------------------------------------------------------- input checks
     def check_q(self, q: object) -> np.ndarray:
@@ -414,12 +370,12 @@ class Robot:
             arr = arr.astype(np.float64)
         if arr.shape != (4,):
             raise ParameterError("q", q, f"must be 4 numbers (got shape {arr.shape})")
-        if not all(-_Q_MAX <= v <= _Q_MAX for v in arr.tolist()):  # NaN fails every comparison
+        if not all(-MAGNITUDE_MAX <= v <= MAGNITUDE_MAX for v in arr.tolist()):  # NaN fails every comparison
             for joint, value in zip(JOINT_NAMES, arr.tolist()):
                 if not math.isfinite(value):
                     raise ParameterError(joint, value, "must be finite")
-                if abs(value) > _Q_MAX:
-                    raise ParameterError(joint, value, f"must be within +/-{_Q_MAX:g} (rad or m)")
+                if abs(value) > MAGNITUDE_MAX:
+                    raise ParameterError(joint, value, f"must be within +/-{MAGNITUDE_MAX:g} (rad or m)")
         return arr
 
     @cached_property
@@ -431,6 +387,11 @@ class Robot:
         """
         actuated = [jm for jm in self.model.joints[1:] if jm.nv > 0]
         return tuple("length" if jm.shortname().startswith("JointModelP") else "angle" for jm in actuated)
+
+    @cached_property
+    def joint_names(self) -> tuple[str, ...]:
+        """The URDF names of the joints of q, in q order (mimic joints are not in q)."""
+        return tuple(self.model.names[j] for j in range(1, self.model.njoints) if self.model.joints[j].nv > 0)
 
     def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:
         """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
@@ -445,12 +406,8 @@ class Robot:
 
     # ----------------------------------------------------------------- kinematics
     def _valid_q(self, q: Any) -> np.ndarray:
-        """``q`` itself when it is obviously valid (4 moderate float64 values), else ``check_q(q)``.
-
-        The cheap test (:func:`scara_pin._fast.q_ok`) only ever sends inputs on to the full check; it never
-        lets a bad one through.
-        """
-        if q_ok(q):
+        """``q`` itself when it is obviously valid (4 moderate float64 values), else ``check_q(q)``."""
+        if _q_ok(q):
             return q  # type: ignore[no-any-return]
         return self.check_q(q)
 
@@ -507,7 +464,7 @@ class Robot:
 
         Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
         """
-        if not q_ok(q) or self.has_continuous:  # inline: the common case costs one C call (see _fast)
+        if self.has_continuous or not _q_ok(q):
             q = self._pin_q(q)
         model, data = self._base_model, self._base_data
         pin.forwardKinematics(model, data, q)
@@ -552,11 +509,10 @@ class Robot:
         Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
         base z axis, which equals d(yaw)/dt while the tool stays level).
         """
-        if not q_ok(q) or self.has_continuous:
+        if self.has_continuous or not _q_ok(q):
             q = self._pin_q(q)
-        return task_rows(
-            pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id, pin.LOCAL_WORLD_ALIGNED)
-        )
+        return pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id,
+                                        pin.LOCAL_WORLD_ALIGNED).take(_TASK_ROWS, 0)  # fmt: skip
 
     def manipulability(self, q: np.ndarray) -> float:
         """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4)."""
@@ -569,26 +525,17 @@ class Robot:
         return int(self.model.getFrameId(frame))
 
 
-def load_robot(
-    robot: str | Path | RobotParameters = "default",
-    overrides: Mapping[str, object] | None = None,
-    *,
-    urdf: str | Path | None = None,
-) -> Robot:
-    """Load a robot: a configured one (name or config folder, with overrides) or a URDF file.
 
-    Args:
-        robot: shipped robot name, config folder, or parameters (ignored when ``urdf`` is given).
-        overrides: parameter overrides (flat names), for configured robots only.
-        urdf: path of a URDF file to load instead.
+def _q_ok(q: Any) -> bool:
+    """True when ``q`` is obviously valid: a 1-D float64 ndarray of 4 values, sum of squares <= _Q_MAX2.
+
+    False only means "run the full check" (``Robot.check_q``); it never lets a bad ``q`` through (NaN and
+    inf fail the comparison; a wrong length fails the unpacking).
     """
-    if urdf is not None:
-        if overrides:
-            raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file")
-        return Robot.from_file(urdf)
-    return Robot.from_config(robot, overrides)
-
-
-def load_urdf(path: str | Path) -> Robot:
-    """Load a 4-joint URDF file (a SCARA, or with ``<mimic>`` passive joints) into Pinocchio."""
-    return Robot.from_file(path)
+    if type(q) is np.ndarray and q.dtype is _F64:  # _F64: native byte order
+        try:
+            a, b, c, d = q.tolist()
+        except (ValueError, TypeError):
+            return False
+        return a * a + b * b + c * c + d * d <= _Q_MAX2
+    return False

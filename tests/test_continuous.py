@@ -27,7 +27,7 @@ import pinocchio as pin
 import pytest
 
 import scara_pin
-from scara_pin import ParameterError, Robot, UrdfError
+from scara_pin import ParameterError, Robot, UrdfError, robot_from_urdf
 from scara_pin.cli import main
 from scara_pin.kinematics.numeric import solve_numeric
 
@@ -76,7 +76,7 @@ def twin() -> Robot:
     text = re.sub(r'lower="-?[0-9.]+" upper="[0-9.]+" velocity="0" effort="(50|5)"',
                   r'lower="-100" upper="100" velocity="0" effort="\1"', text)  # fmt: skip
     assert text.count('lower="-100"') == 2 and 'type="continuous"' not in text
-    out = Robot(text, origin="twin")
+    out = robot_from_urdf(text, origin="twin")
     assert out.model.nq == 4 and not out.has_continuous
     return out
 
@@ -139,7 +139,7 @@ def test_other_joint_kinds_are_still_refused() -> None:
     # a planar joint (nq = 4, nv = 3) is not a single-DOF joint
     text = PATH.read_text(encoding="utf-8").replace('name="elbow" type="revolute"', 'name="elbow" type="planar"')
     with pytest.raises(UrdfError, match="4 single-DOF joints"):
-        Robot(text, origin="planar.urdf")
+        robot_from_urdf(text, origin="planar.urdf")
 
 
 # ============================================================================== forward kinematics
@@ -197,10 +197,12 @@ def test_trajectory_kinematics_convert_q(robot: Robot, twin: Robot) -> None:
 
 # ============================================================================== inverse kinematics
 def test_geometry_uses_the_one_turn_range(robot: Robot) -> None:
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     assert geo.revolute == (1, 2, 3) and geo.prismatic == 0
-    assert geo.lower == (0.0, -math.pi, -2.530727415391778, -math.pi)
-    assert geo.upper == (0.145, math.pi, 2.530727415391778, math.pi)
+    # continuous joints have no limits: every turn is theirs (the nearest to the reference is chosen)
+    assert geo.lower == (0.0, -math.inf, -2.530727415391778, -math.inf)
+    assert geo.upper == (0.145, math.inf, 2.530727415391778, math.inf)
+    assert geo.continuous == (False, True, False, True)
     assert geo.l1 == pytest.approx(0.3917, abs=1e-15) and geo.l2 == pytest.approx(0.2585, abs=1e-15)
     r_min, r_max = geo.radius_range()
     gamma = 2.530727415391778  # the elbow's limit: the most folded arm
@@ -280,7 +282,7 @@ def test_batch_ik_agrees_with_the_single_target_solver(robot: Robot) -> None:
     qs = sample_qs(200, seed=8)
     targets = np.array([irb920_fk(q) for q in qs])
     for branch in ("right", "left"):
-        batch = solve_batch(robot.kinematics, targets, branch=branch)
+        batch = solve_batch(robot.kinematics.geometry, targets, branch=branch)
         for k, _q in enumerate(qs):
             mine = [s.q for s in robot.ik(targets[k]).solutions if s.matches(branch)]
             if batch.status[k] != IKStatus.OK.value:
@@ -290,7 +292,7 @@ def test_batch_ik_agrees_with_the_single_target_solver(robot: Robot) -> None:
             assert pose_diff(irb920_fk(qb), targets[k]) <= IK_TOL
             assert -math.pi <= qb[1] <= math.pi and -math.pi <= qb[3] <= math.pi
             assert any(np.abs(qb - m).max() <= 1e-7 for m in mine), (qb, mine)
-            assert branch_of(robot.kinematics, qb) == branch or abs(math.sin(qb[2])) < 1e-6
+            assert branch_of(robot.kinematics.geometry, qb) == branch or abs(math.sin(qb[2])) < 1e-6
 
 
 @pytest.mark.parametrize("q", [[0.05, 0.4, 1.1, math.pi], [0.05, -math.pi, -0.7, 0.3], [0.0, math.pi, 0.5, -math.pi]])
@@ -306,13 +308,12 @@ def test_an_angle_of_exactly_pi_is_listed_once(robot: Robot, q: list[float]) -> 
     assert all(abs(wrap(a - b)) <= IK_TOL for a, b in zip(mine[0].q, q))
     for s in sols:
         assert pose_diff(irb920_fk(s.q), target) <= IK_TOL
-    # the plain closed form (scara_pin.kinematics.scara.solve) lists both ends: Robot.ik removes the duplicate
-    from scara_pin.kinematics.scara import solve
-
-    assert len(solve(robot.kinematics, target).solutions) > 2
-    # with a reference, the end nearer to it is the one kept
-    (near,) = [s for s in robot.ik(target, reference=[0.0, 3.0, q[2], 3.0]).solutions if abs(s.q[2] - q[2]) <= IK_TOL]
-    assert all(v > 0 for v in near.q[[1, 3]] if abs(abs(v) - math.pi) <= IK_TOL)
+    # with a reference, each continuous joint takes its turn nearest to it (a few turns away included)
+    for ref in ([0.0, 3.0, q[2], 3.0], [0.0, 3.0 + 4 * math.pi, q[2], -3.0 - 6 * math.pi]):
+        (near,) = [s for s in robot.ik(target, reference=ref).solutions if abs(s.q[2] - q[2]) <= IK_TOL]
+        for j in (1, 3):
+            assert abs(near.q[j] - ref[j]) <= math.pi + 1e-12  # the nearest turn: within half a turn
+            assert abs(wrap(near.q[j] - q[j])) <= IK_TOL  # the same joint position as the sample
 
 
 def test_inverse_dynamics_equals_the_twin(robot: Robot, twin: Robot) -> None:
@@ -327,7 +328,7 @@ def test_inverse_dynamics_equals_the_twin(robot: Robot, twin: Robot) -> None:
         text = r.urdf
         for name, mass in (("arm1", 4.0), ("arm2", 2.0), ("flange", 0.5)):
             text = text.replace(f'<link name="{name}"/>', inertial.format(name, mass))
-        return Robot(text, origin="massive")
+        return robot_from_urdf(text, origin="massive")
 
     m, mt = massive(robot), massive(twin)
     assert m.has_continuous and not mt.has_continuous

@@ -19,12 +19,12 @@ import xacro
 from scara_pin import (
     InvalidInputError,
     ParameterError,
-    Robot,
     UnknownRobotError,
     available_robots,
     generate_urdf,
     load_parameters,
     load_robot,
+    robot_from_urdf,
 )
 
 REPO = Path(__file__).resolve().parents[1]
@@ -407,7 +407,7 @@ def test_prefix_prefixes_every_link_and_joint(default_urdf: str) -> None:
 
 def test_prefixed_urdf_has_the_same_kinematics() -> None:
     plain = load_robot("default")
-    left = Robot(generate_urdf("default", prefix="left_"), base_frame="left_base", tool_frame="left_tool0")
+    left = robot_from_urdf(generate_urdf("default", prefix="left_"), base_frame="left_base", tool_frame="left_tool0")
     assert [left.model.names[i] for i in range(1, 5)] == [f"left_{j}" for j in JOINTS]
     q = np.array([0.3, -0.7, 0.04, 1.1])
     assert left.tool_pose(q) == pytest.approx(plain.tool_pose(q), abs=1e-12)

@@ -17,7 +17,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from scara_pin import Robot, UrdfError
+from scara_pin import UrdfError, load_urdf, robot_from_urdf
 from scara_pin.description.dh import (
     DHTableError,
     _yaml_loader,
@@ -166,7 +166,7 @@ def test_examples_are_shipped() -> None:
 @pytest.mark.parametrize("name", ["s1_dh", "s3_dh"])
 def test_example_fk_equals_its_dh_product(name: str) -> None:
     data = _load(name)
-    robot = Robot(dh_to_urdf(dh_example(name)), origin=name)
+    robot = robot_from_urdf(dh_to_urdf(dh_example(name)), origin=name)
     lo, hi = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
     for q in np.random.default_rng(21).uniform(lo, hi, size=(100, 4)):
         want = dh_frames(data, q)[-1]
@@ -176,7 +176,7 @@ def test_example_fk_equals_its_dh_product(name: str) -> None:
 
 def test_s1_example_matches_the_digest_formulas() -> None:
     """S1 (corrected, digest): x = l1 c1 + l2 c12, y = l1 s1 + l2 s12, z = d1 - q3, yaw = q1 + q2 - q4."""
-    robot = Robot(dh_to_urdf(dh_example("s1_dh")))
+    robot = robot_from_urdf(dh_to_urdf(dh_example("s1_dh")))
     for q in np.random.default_rng(2).uniform(robot.model.lowerPositionLimit, robot.model.upperPositionLimit,
                                               size=(100, 4)):  # fmt: skip
         q1, q2, q3, q4 = q
@@ -190,8 +190,8 @@ def test_s1_example_matches_the_digest_formulas() -> None:
 
 def test_s1_and_s3_are_the_same_robot() -> None:
     """S3's q = (q1, q2, d1 - q3, -q4) of S1 gives the same tool position and yaw; tool z differs (down/up)."""
-    s1 = Robot(dh_to_urdf(dh_example("s1_dh")), origin="s1")
-    s3 = Robot(dh_to_urdf(dh_example("s3_dh")), origin="s3")
+    s1 = robot_from_urdf(dh_to_urdf(dh_example("s1_dh")), origin="s1")
+    s3 = robot_from_urdf(dh_to_urdf(dh_example("s3_dh")), origin="s3")
     d1 = 0.100
     lo, hi = s1.model.lowerPositionLimit, s1.model.upperPositionLimit
     for q in np.random.default_rng(4).uniform(lo, hi, size=(200, 4)):
@@ -211,7 +211,7 @@ def test_s1_and_s3_are_the_same_robot() -> None:
 
 @pytest.mark.parametrize("name", ["s1_dh", "s3_dh"])
 def test_example_ik_round_trip(name: str) -> None:
-    robot = Robot(dh_to_urdf(dh_example(name)), origin=name)
+    robot = robot_from_urdf(dh_to_urdf(dh_example(name)), origin=name)
     lo, hi = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
     for q in np.random.default_rng(8).uniform(lo, hi, size=(200, 4)):
         p = robot.tool_pose(q)
@@ -396,9 +396,9 @@ def test_property_urdf_agrees_with_dh_product(table: dict, seed: int) -> None:
 
 def _arm_lengths_ok(table: dict) -> bool:
     """The closed form needs arms of length: the plan-view distance between consecutive revolute axes."""
-    robot = Robot(dh_to_urdf(table))
+    robot = robot_from_urdf(dh_to_urdf(table))
     try:
-        geo = robot.kinematics
+        geo = robot.kinematics.geometry
     except UrdfError:  # NotScaraError: an arm of zero length (two revolute axes on one line)
         return False
     return min(geo.l1, geo.l2) > 0.02
@@ -410,7 +410,7 @@ def test_property_ik_round_trip_on_dh_scaras(table: dict, seed: int) -> None:
     from hypothesis import assume
 
     assume(_arm_lengths_ok(table))
-    robot = Robot(dh_to_urdf(table))
+    robot = robot_from_urdf(dh_to_urdf(table))
     lo, hi = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
     for q in np.random.default_rng(seed).uniform(lo, hi, size=(20, 4)):
         want = dh_frames(table, q)[-1]
@@ -461,8 +461,8 @@ def test_kr5_table_equals_the_hand_written_kr5_urdf() -> None:
              "upper": d(358), "velocity": d(2400), "effort": 20},
         ],
     }  # fmt: skip
-    generated = Robot(dh_to_urdf(table), origin="kr5 table")
-    hand = Robot.from_file(Path(__file__).parent / "data" / "third_party" / "kr5_scara_dh.urdf")
+    generated = robot_from_urdf(dh_to_urdf(table), origin="kr5 table")
+    hand = load_urdf(Path(__file__).parent / "data" / "third_party" / "kr5_scara_dh.urdf")
     assert np.allclose(generated.model.lowerPositionLimit, hand.model.lowerPositionLimit, rtol=0, atol=1e-14)
     for q in np.random.default_rng(31).uniform(hand.model.lowerPositionLimit, hand.model.upperPositionLimit,
                                                size=(100, 4)):  # fmt: skip

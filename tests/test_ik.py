@@ -34,7 +34,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import scara_pin
-from scara_pin import Robot, UrdfError, load_robot
+from scara_pin import Robot, UrdfError, load_robot, robot_from_urdf
 from scara_pin.kinematics.scara import IKStatus, NotScaraError, ScaraGeometry, branch_of, solve, solve_batch
 
 POSE_TOL = 1e-9
@@ -47,6 +47,15 @@ D = math.radians
 
 
 # ============================================================================== independent helpers
+def solve_all(geo: ScaraGeometry, target: Any, **kwargs: Any) -> Any:
+    """Every solution, each turn of each joint inside the limits listed on its own (``all_turns=True``).
+
+    The tests below compare the whole solution set with an enumeration written here; the one-solution-per-
+    branch answer (turns nearest a reference, with turn ranges) is tested in tests/test_turns.py.
+    """
+    return solve(geo, target, all_turns=True, **kwargs)
+
+
 def wrap(a: float) -> float:
     return (a + math.pi) % TWO_PI - math.pi
 
@@ -207,7 +216,7 @@ def robot_overrides(draw: st.DrawFn) -> dict[str, float]:
 @given(overrides=robot_overrides(), seed=st.integers(0, 2**32 - 1))
 def test_fk_of_ik_on_random_robots(overrides: dict[str, float], seed: int) -> None:
     robot = load_robot("default", overrides)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     p = dict(robot.parameters.values)
     lo, hi = limits(robot)
     rng = np.random.default_rng(seed)
@@ -217,7 +226,7 @@ def test_fk_of_ik_on_random_robots(overrides: dict[str, float], seed: int) -> No
         e = xacro_fk(p, q) - target
         e[3] = wrap(e[3])
         assert np.abs(e).max() <= TOL_FK
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         assert res.status is IKStatus.OK, (q, res.message)
         sols = [s.q for s in res.solutions]
         for s in res.solutions:
@@ -380,7 +389,7 @@ HAND: dict[str, tuple[Callable[[], str], Callable[[np.ndarray], np.ndarray], tup
 
 @pytest.fixture(scope="module")
 def hand_robots() -> dict[str, Robot]:
-    return {name: Robot(spec[0](), origin=name) for name, spec in HAND.items()}
+    return {name: robot_from_urdf(spec[0](), origin=name) for name, spec in HAND.items()}
 
 
 @pytest.mark.parametrize("name", list(HAND))
@@ -400,7 +409,7 @@ def test_hand_urdf_fk_is_the_closed_form(name: str, hand_robots: dict[str, Robot
      ("kr5_dh_flip", 0.125, 0.225), ("irb920_lift", 0.3917, 0.2585)],
 )  # fmt: skip
 def test_hand_urdf_geometry_arm_lengths(name: str, l1: float, l2: float, hand_robots: dict[str, Robot]) -> None:
-    geo = hand_robots[name].kinematics
+    geo = hand_robots[name].kinematics.geometry
     assert (geo.l1, geo.l2) == pytest.approx((l1, l2), abs=1e-12)
 
 
@@ -409,13 +418,13 @@ def test_hand_urdf_ik_round_trip(name: str, hand_robots: dict[str, Robot]) -> No
     """250 seeded q per robot: FK(IK) = target at 1e-9, q among the solutions, labels from the geometry."""
     robot = hand_robots[name]
     _, fk, frames, elbow, sign = HAND[name]
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     lo, hi = limits(robot)
     rng = np.random.default_rng(1234)
     seen = set()
     for q in rng.uniform(lo, hi, size=(250, 4)):
         target = fk(q)  # the target from the closed form, not from the code under test
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         assert res.status is IKStatus.OK, (q, res.message)
         for s in res.solutions:
             assert pose_error(robot, s.q, target) <= POSE_TOL, (q, s.q)
@@ -433,9 +442,9 @@ def test_hand_urdf_ik_round_trip(name: str, hand_robots: dict[str, Robot]) -> No
 @pytest.mark.parametrize("joint", ["j1", "j2", "j3", "j4"])
 def test_tilted_axis_is_not_a_scara(joint: str) -> None:
     """A joint frame tilted by 1e-3 rad (roll): the first joint whose axis is off vertical is named, with its angle."""
-    robot = Robot(yk400xe_y({joint: "0.001 0 0"}), origin="tilted")
+    robot = robot_from_urdf(yk400xe_y({joint: "0.001 0 0"}), origin="tilted")
     with pytest.raises(NotScaraError) as info:
-        _ = robot.kinematics
+        _ = robot.kinematics.geometry
     msg = str(info.value)
     assert re.search(rf"\b{joint}\b", msg), msg
     assert not any(re.search(rf"\b{j}\b", msg) for j in ("j1", "j2", "j3", "j4") if j != joint), msg
@@ -444,8 +453,8 @@ def test_tilted_axis_is_not_a_scara(joint: str) -> None:
 
 
 def test_tilt_below_one_microradian_is_accepted() -> None:
-    robot = Robot(yk400xe_y({"j2": "1e-9 0 0"}), origin="almost")
-    assert robot.kinematics.l1 == pytest.approx(0.225, abs=1e-12)
+    robot = robot_from_urdf(yk400xe_y({"j2": "1e-9 0 0"}), origin="almost")
+    assert robot.kinematics.geometry.l1 == pytest.approx(0.225, abs=1e-12)
 
 
 RRP_ROS_TUTORIAL = _robot("rrp", [_link(n) for n in ("base_link", "arm1", "arm2", "tool0")] + [
@@ -476,7 +485,7 @@ TWO_PRISMATIC = _robot("two_prismatic", [_link(n) for n in ("base_link", "a", "b
 )  # fmt: skip
 def test_not_four_single_dof_joints_is_refused(urdf: str, needles: list[str]) -> None:
     with pytest.raises(UrdfError) as info:
-        Robot(urdf, origin="fixture.urdf")
+        robot_from_urdf(urdf, origin="fixture.urdf")
     msg = str(info.value)
     assert "fixture.urdf" in msg
     for needle in needles:
@@ -486,7 +495,7 @@ def test_not_four_single_dof_joints_is_refused(urdf: str, needles: list[str]) ->
 def test_continuous_j4_is_accepted_and_matches_the_closed_form() -> None:
     """A continuous J4 (Pinocchio: nq = 2, cos/sin) loads with a 4-value q; FK is the fixture's closed form
     (1e-12) at any angle, and the closed-form IK presents J4 in [-pi, pi] (more in tests/test_continuous.py)."""
-    robot = Robot(CONTINUOUS_J4, origin="fixture.urdf")
+    robot = robot_from_urdf(CONTINUOUS_J4, origin="fixture.urdf")
     assert robot.model.nq == 5 and robot.continuous == (False, False, False, True)
     rng = np.random.default_rng(7)
     for _ in range(50):
@@ -501,15 +510,15 @@ def test_continuous_j4_is_accepted_and_matches_the_closed_form() -> None:
 
 
 def test_two_prismatic_joints_is_not_a_scara() -> None:
-    robot = Robot(TWO_PRISMATIC, origin="two")
+    robot = robot_from_urdf(TWO_PRISMATIC, origin="two")
     with pytest.raises(NotScaraError) as info:
-        _ = robot.kinematics
+        _ = robot.kinematics.geometry
     assert "j2" in str(info.value)
 
 
 # ============================================================================== branches
 def test_generic_target_has_both_branches_labelled_by_the_geometry(default: Robot) -> None:
-    geo = default.kinematics
+    geo = default.kinematics.geometry
     lo, hi = limits(default)
     rng = np.random.default_rng(7)
     n_checked = 0
@@ -518,7 +527,7 @@ def test_generic_target_has_both_branches_labelled_by_the_geometry(default: Robo
         if abs(math.sin(q[1])) < 0.2:
             continue
         target = default.tool_pose(q)
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         # generic: r well inside the annulus, both elbows inside the symmetric J2 range, J1 has room
         w = math.hypot(*target[:2])
         if not 0.15 < w < 0.38:
@@ -539,7 +548,7 @@ def test_generic_target_has_both_branches_labelled_by_the_geometry(default: Robo
             assert (s.branch == "right") == (elbow_sin(default, s.q, "link1", "link2", "quill") > 0)
         assert all(s.branch == "right" for s in right) and all(s.branch == "left" for s in left)
         for branch, subset in (("right", right), ("left", left)):
-            alone = solve(geo, target, branch=branch)
+            alone = solve_all(geo, target, branch=branch)
             assert match_count([s.q for s in alone.solutions], [s.q for s in subset], 0.0)
             assert {s.branch for s in alone.solutions} == {branch}
     assert n_checked >= 50
@@ -548,7 +557,7 @@ def test_generic_target_has_both_branches_labelled_by_the_geometry(default: Robo
 def test_branch_of_for_elbow_beyond_pi() -> None:
     """q2 = 200 deg is gamma = -160 deg: the elbow turns clockwise: left (sin < 0), whatever q2's sign."""
     robot = load_robot("default", {"joint2_lower": D(-250), "joint2_upper": D(250)})
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     for q2, expected in [(D(200), "left"), (D(-200), "right"), (D(100), "right"), (D(-100), "left")]:
         q = np.array([0.3, q2, 0.0, 0.1])
         c = cross_label(robot, q, "link1", "link2", "quill")
@@ -568,7 +577,7 @@ def test_branch_of_for_elbow_beyond_pi() -> None:
 )  # fmt: skip
 def test_every_2pi_equivalent_inside_the_limits_is_a_solution(overrides: dict[str, float]) -> None:
     robot = load_robot("default", overrides)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     p = dict(robot.parameters.values)
     lo, hi = limits(robot)
     rng = np.random.default_rng(11)
@@ -577,7 +586,7 @@ def test_every_2pi_equivalent_inside_the_limits_is_a_solution(overrides: dict[st
         if abs(math.sin(q[1])) < 1e-3:
             continue
         target = robot.tool_pose(q)
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         sols = [s.q for s in res.solutions]
         expected = xacro_ik(p, lo, hi, target)
         # the count from the limits alone: per elbow, (#q1 turns) x (#q2 turns) x (#q4 turns)
@@ -599,7 +608,7 @@ def test_every_2pi_equivalent_inside_the_limits_is_a_solution(overrides: dict[st
 # ============================================================================== reason codes
 def test_out_of_reach_gives_r_and_the_reach(default: Robot) -> None:
     target = [0.45 * math.cos(0.3), 0.45 * math.sin(0.3), -0.05, 0.0]
-    res = solve(default.kinematics, target)
+    res = solve_all(default.kinematics.geometry, target)
     assert res.status is IKStatus.OUT_OF_REACH and not res.success and res.solutions == ()
     assert mentions(res.message, 0.45, 1e-9) and mentions(res.message, 0.4, 1e-9), res.message
 
@@ -608,26 +617,26 @@ def test_inside_inner_limit_s5_example() -> None:
     """l1 = 0.325, l2 = 0.275, J2 +/-88 deg: r_min = sqrt(l1^2 + l2^2 + 2 l1 l2 cos 88deg) = 0.433 m."""
     l1, l2, q2max = 0.325, 0.275, D(88)
     robot = load_robot("default", {"l1": l1, "l2": l2, "joint2_lower": -q2max, "joint2_upper": q2max})
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     r_min = math.sqrt(l1**2 + l2**2 + 2 * l1 * l2 * math.cos(q2max))
     assert r_min == pytest.approx(0.433, abs=5e-4)
     assert geo.radius_range() == pytest.approx((r_min, l1 + l2), abs=1e-12)
-    res = solve(geo, [0.2, 0.0, -0.05, 0.0])
+    res = solve_all(geo, [0.2, 0.0, -0.05, 0.0])
     assert 0.2 > abs(l1 - l2)
     assert res.status is IKStatus.INSIDE_INNER_LIMIT
     assert mentions(res.message, 0.2, 1e-9) and mentions(res.message, r_min, 1e-8), res.message
     assert "joint2" in res.message
     # the boundary itself: 1e-7 m outside r_min solves (q2 near +/-88 deg), 1e-7 m inside does not
     for a in (0.0, 1.1, -2.0):
-        ok = solve(geo, [(r_min + 1e-7) * math.cos(a), (r_min + 1e-7) * math.sin(a), -0.05, 0.4])
+        ok = solve_all(geo, [(r_min + 1e-7) * math.cos(a), (r_min + 1e-7) * math.sin(a), -0.05, 0.4])
         assert ok.status is IKStatus.OK
         assert all(abs(abs(s.q[1]) - q2max) < 1e-5 for s in ok.solutions)
-        bad = solve(geo, [(r_min - 1e-7) * math.cos(a), (r_min - 1e-7) * math.sin(a), -0.05, 0.4])
+        bad = solve_all(geo, [(r_min - 1e-7) * math.cos(a), (r_min - 1e-7) * math.sin(a), -0.05, 0.4])
         assert bad.status is IKStatus.INSIDE_INNER_LIMIT
 
 
 def test_j1_limit_behind_the_robot(default: Robot) -> None:
-    res = solve(default.kinematics, [-0.3, 0.0, -0.05, 0.0])
+    res = solve_all(default.kinematics.geometry, [-0.3, 0.0, -0.05, 0.0])
     assert res.status is IKStatus.J1_LIMIT
     # right: q1 = pi - acos(0.125)/2 ... both |q1| = pi - q2/2 with cos q2 = (0.09 - 0.08) / 0.08
     q1 = math.pi - math.acos(0.125) / 2
@@ -639,16 +648,16 @@ def test_j1_limit_behind_the_robot(default: Robot) -> None:
 
 def test_j2_limit_range_without_zero_near_full_stretch() -> None:
     robot = load_robot("default", {"joint2_lower": D(20), "joint2_upper": D(150)})
-    res = solve(robot.kinematics, [0.399, 0.0, -0.05, 0.0])
+    res = solve_all(robot.kinematics.geometry, [0.399, 0.0, -0.05, 0.0])
     assert res.status is IKStatus.J2_LIMIT
     q2 = math.acos((0.399**2 - 0.08) / 0.08)
     assert "joint2" in res.message and mentions(res.message, q2, 1e-7), res.message
     # the same target with J2 +/-150 deg solves
-    assert solve(load_robot("default").kinematics, [0.399, 0.0, -0.05, 0.0]).status is IKStatus.OK
+    assert solve_all(load_robot("default").kinematics.geometry, [0.399, 0.0, -0.05, 0.0]).status is IKStatus.OK
 
 
 def test_j3_stroke(default: Robot) -> None:
-    res = solve(default.kinematics, [0.3, 0.0, 0.01, 0.0])
+    res = solve_all(default.kinematics.geometry, [0.3, 0.0, 0.01, 0.0])
     assert res.status is IKStatus.J3_STROKE
     assert "joint3" in res.message
     for v in (0.01, -0.06, -0.05, 0.1):
@@ -657,13 +666,13 @@ def test_j3_stroke(default: Robot) -> None:
 
 def test_j4_limit_narrow_range() -> None:
     robot = load_robot("default", {"joint4_lower": D(-10), "joint4_upper": D(10)})
-    res = solve(robot.kinematics, [0.3, 0.0, -0.05, math.pi])
+    res = solve_all(robot.kinematics.geometry, [0.3, 0.0, -0.05, math.pi])
     assert res.status is IKStatus.J4_LIMIT
     assert "joint4" in res.message
     q4 = math.pi - math.acos(0.125) / 2  # right: q1 + q2 = +41.4 deg, q4 = 180 - 41.4 deg
     assert mentions(res.message, q4, 1e-7) and mentions(res.message, -q4, 1e-7), res.message
     # a yaw the narrow J4 allows
-    ok = solve(robot.kinematics, [0.3, 0.0, -0.05, math.acos(0.125) / 2])
+    ok = solve_all(robot.kinematics.geometry, [0.3, 0.0, -0.05, math.acos(0.125) / 2])
     assert ok.status is IKStatus.OK and all(abs(s.q[3]) <= D(10) for s in ok.solutions)
 
 
@@ -676,20 +685,20 @@ def _tilted(M: pin.SE3, angle: float, axis: np.ndarray) -> np.ndarray:
 
 @pytest.mark.parametrize("axis", [np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([1.0, -2.0, 0])])
 def test_not_a_yaw_pose(default: Robot, axis: np.ndarray) -> None:
-    geo = default.kinematics
+    geo = default.kinematics.geometry
     q = np.array([0.4, 1.1, 0.03, -0.7])
     M = default.tool_placement(q)
-    res = solve(geo, _tilted(M, 1e-6, axis))
+    res = solve_all(geo, _tilted(M, 1e-6, axis))
     assert res.status is IKStatus.NOT_A_YAW_POSE and res.solutions == ()
     assert mentions(res.message, math.degrees(1e-6), 1e-9) or mentions(res.message, 1e-6, 1e-12), res.message
     # 1e-11 rad of tilt is rounding: accepted, the same solutions as the 4-vector
-    near = solve(geo, _tilted(M, 1e-11, axis))
-    plain = solve(geo, default.tool_pose(q))
+    near = solve_all(geo, _tilted(M, 1e-11, axis))
+    plain = solve_all(geo, default.tool_pose(q))
     assert near.status is IKStatus.OK
     assert match_count([s.q for s in near.solutions], [s.q for s in plain.solutions], Q_TOL)
     # the pin.SE3 itself and its 4 x 4 matrix
     for target in (M, M.homogeneous):
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         assert res.status is IKStatus.OK
         assert closest([s.q for s in res.solutions], q) <= Q_TOL
         for s in res.solutions:
@@ -702,7 +711,8 @@ def test_se3_target_on_a_robot_with_tool_yaw_and_negative_axes(hand_robots: dict
     M = robot.tool_placement(q)
     res = robot.ik(M)
     assert res.status is IKStatus.OK and closest([s.q for s in res.solutions], q) <= Q_TOL
-    assert solve(robot.kinematics, _tilted(M, 1e-6, np.array([0, 1.0, 0]))).status is IKStatus.NOT_A_YAW_POSE
+    tilted = _tilted(M, 1e-6, np.array([0, 1.0, 0]))
+    assert solve_all(robot.kinematics.geometry, tilted).status is IKStatus.NOT_A_YAW_POSE
 
 
 # ============================================================================== the named hard cases (yaml)
@@ -721,7 +731,7 @@ def _overrides(raw: dict[str, float] | None) -> dict[str, float]:
 def test_hard_case(case: dict[str, Any]) -> None:
     robot = load_robot(case["robot"], _overrides(case.get("overrides")))
     target = np.array(case["target"], dtype=float)
-    res = solve(robot.kinematics, target)
+    res = solve_all(robot.kinematics.geometry, target)
     assert res.status.name == case["status"], res.message
     lo, hi = limits(robot)
     if case["status"] != "OK":
@@ -744,13 +754,13 @@ def test_hard_case(case: dict[str, Any]) -> None:
 # ============================================================================== degenerate cases
 def test_stretched_targets_on_and_just_outside_the_circle(default: Robot) -> None:
     """Targets exactly at r = l1 + l2 (and 1e-13 beyond): one solution per J4 turn, singular, both filters."""
-    geo = default.kinematics
+    geo = default.kinematics.geometry
     lo, hi = limits(default)
     rng = np.random.default_rng(3)
     for a, yaw in rng.uniform([-D(130), -math.pi], [D(130), math.pi], size=(50, 2)):
         for r in (0.4 + 1e-13, 0.4 + 5e-11):
             target = np.array([r * math.cos(a), r * math.sin(a), -0.07, yaw])
-            res = solve(geo, target)
+            res = solve_all(geo, target)
             assert res.status is IKStatus.OK, res.message
             # q1 = a, q2 = 0, q4 = yaw - a + 2 pi k: one per J4 turn
             assert len(res.solutions) == n_turns(yaw - a, lo[3], hi[3])
@@ -759,18 +769,18 @@ def test_stretched_targets_on_and_just_outside_the_circle(default: Robot) -> Non
                 assert abs(wrap(s.q[0] - a)) <= Q_TOL
                 assert pose_error(default, s.q, target) <= POSE_TOL
             assert res.branch("left") == res.branch("right") == res.solutions
-        far = solve(geo, [(0.4 + 1e-6) * math.cos(a), (0.4 + 1e-6) * math.sin(a), -0.07, yaw])
+        far = solve_all(geo, [(0.4 + 1e-6) * math.cos(a), (0.4 + 1e-6) * math.sin(a), -0.07, yaw])
         assert far.status is IKStatus.OUT_OF_REACH
 
 
 def test_stretched_targets_from_fk_have_one_solution_per_turn(default: Robot) -> None:
-    geo = default.kinematics
+    geo = default.kinematics.geometry
     lo, hi = limits(default)
     rng = np.random.default_rng(1)
     for _ in range(200):
         q = np.array([rng.uniform(lo[0], hi[0]), 0.0, rng.uniform(lo[2], hi[2]), rng.uniform(lo[3], hi[3])])
         target = default.tool_pose(q)
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         assert res.status is IKStatus.OK
         for s in res.solutions:
             assert pose_error(default, s.q, target) <= POSE_TOL
@@ -782,13 +792,13 @@ def test_stretched_targets_from_fk_have_one_solution_per_turn(default: Robot) ->
 def test_folded_with_j2_beyond_pi_from_fk() -> None:
     l1, l2 = 0.25, 0.125
     robot = load_robot("default", {"l1": l1, "l2": l2, "joint2_lower": D(-200), "joint2_upper": D(200)})
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     lo, hi = limits(robot)
     rng = np.random.default_rng(8)
     for _ in range(100):
         q = np.array([rng.uniform(lo[0], hi[0]), math.pi * rng.choice([-1, 1]), 0.02, rng.uniform(-3, 3)])
         target = robot.tool_pose(q)
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         assert res.status is IKStatus.OK
         assert math.hypot(*target[:2]) == pytest.approx(l1 - l2, abs=1e-15)
         for s in res.solutions:
@@ -802,11 +812,11 @@ def test_folded_with_j2_beyond_pi_from_fk() -> None:
 def test_wrist_on_the_shoulder_axis_uses_the_reference() -> None:
     """l1 = l2, r = 0: J1 is free; the reference's q1 (or 0 without one), every solution reaches the target."""
     robot = load_robot("default", {"joint2_lower": D(-190), "joint2_upper": D(190), "tool_yaw": 0.2})
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     target = np.array([0.0, 0.0, -0.08, 0.9])  # the tool (on the J4 axis) exactly on the J1 axis
     for ref_q1 in (None, 0.7, -1.9):
         ref = None if ref_q1 is None else [ref_q1, 0.5, 0.0, 0.0]
-        res = solve(geo, target, reference=ref)
+        res = solve_all(geo, target, reference=ref)
         assert res.status is IKStatus.OK, res.message
         for s in res.solutions:
             assert s.q[0] == pytest.approx(0.0 if ref_q1 is None else ref_q1, abs=1e-12)
@@ -823,7 +833,7 @@ def test_wrist_on_the_shoulder_axis_with_j1_limits(overrides: dict[str, float], 
     robot = load_robot("default", {"joint2_lower": D(-190), "joint2_upper": D(190), **overrides})
     lo, hi = limits(robot)
     target = np.array([0.0, 0.0, -0.05, 0.3])
-    res = solve(robot.kinematics, target, reference=reference)
+    res = solve_all(robot.kinematics.geometry, target, reference=reference)
     assert res.status is IKStatus.OK, res.message
     for s in res.solutions:
         assert lo[0] <= s.q[0] <= hi[0]
@@ -832,11 +842,11 @@ def test_wrist_on_the_shoulder_axis_with_j1_limits(overrides: dict[str, float], 
 
 def test_wrist_on_the_shoulder_axis_up_to_rounding_uses_the_reference() -> None:
     robot = load_robot("default", {"joint2_lower": D(-190), "joint2_upper": D(190), "tool_x": 0.02, "tool_yaw": 0.2})
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     for yaw in np.linspace(-3, 3, 61):
         psi = yaw - 0.2
         target = np.array([0.02 * math.cos(psi), 0.02 * math.sin(psi), -0.08, yaw])  # wrist on the J1 axis
-        res = solve(geo, target, reference=[0.7, 0.5, 0.0, 0.0])
+        res = solve_all(geo, target, reference=[0.7, 0.5, 0.0, 0.0])
         assert res.status is IKStatus.OK, (target.tolist(), res.message)
         for s in res.solutions:
             assert pose_error(robot, s.q, target) <= POSE_TOL
@@ -856,7 +866,7 @@ def test_sampled_q_exactly_on_a_joint_limit_is_found_and_clamped(
         robot = load_robot("default", {"joint2_lower": D(-100), "joint2_upper": D(200), "tool_x": 0.04})
     else:
         robot = load_robot(robot_name)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     lo, hi = limits(robot)
     rng = np.random.default_rng(13)
     for _ in range(60):
@@ -865,7 +875,7 @@ def test_sampled_q_exactly_on_a_joint_limit_is_found_and_clamped(
         on[rng.integers(4)] = True  # at least one joint on a limit
         q = np.where(on, np.where(rng.random(4) < 0.5, lo, hi), q)
         target = robot.tool_pose(q)
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         assert res.status is IKStatus.OK, (q.tolist(), res.message)
         for s in res.solutions:
             assert np.all(s.q >= lo) and np.all(s.q <= hi), s.q.tolist()  # clamped: exactly inside
@@ -881,7 +891,7 @@ def test_nearest_is_the_weighted_minimum() -> None:
     robot = load_robot("default", {"joint1_lower": D(-350), "joint1_upper": D(350), "joint2_lower": D(-200),
                                    "joint2_upper": D(200), "joint4_lower": D(-400),
                                    "joint4_upper": D(400)})  # fmt: skip
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     p = dict(robot.parameters.values)
     lo, hi = limits(robot)
     rng = np.random.default_rng(17)
@@ -890,7 +900,7 @@ def test_nearest_is_the_weighted_minimum() -> None:
         if abs(math.sin(q[1])) < 1e-3:
             continue
         target = robot.tool_pose(q)
-        res = solve(geo, target)
+        res = solve_all(geo, target)
         expected = xacro_ik(p, lo, hi, target)
         assert match_count([s.q for s in res.solutions], [e for e, _ in expected], Q_TOL)
         ref = rng.uniform(lo, hi)
@@ -906,10 +916,10 @@ def test_nearest_is_the_weighted_minimum() -> None:
 
 
 def test_nearest_is_none_only_without_a_solution(default: Robot) -> None:
-    res = solve(default.kinematics, [1.0, 0.0, -0.05, 0.0])
+    res = solve_all(default.kinematics.geometry, [1.0, 0.0, -0.05, 0.0])
     assert res.nearest([0, 0, 0, 0]) is None
     one_branch = load_robot("default", {"joint2_lower": D(10), "joint2_upper": D(150)})
-    res = solve(one_branch.kinematics, [0.3, 0.1, -0.05, 0.0])
+    res = solve_all(one_branch.kinematics.geometry, [0.3, 0.1, -0.05, 0.0])
     assert res.status is IKStatus.OK
     assert res.nearest([0, 0, 0, 0], branch="left") is None
     assert res.nearest([0, 0, 0, 0], branch="right") is not None
@@ -921,7 +931,7 @@ def _batch_targets(robot: Robot, n: int, seed: int) -> np.ndarray:
     rng = np.random.default_rng(seed)
     lo, hi = limits(robot)
     mid, half = (lo + hi) / 2, (hi - lo) / 2
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     reach = geo.l1 + geo.l2 + math.hypot(*geo.tool)
     k = n // 4
     q = rng.uniform(mid - 1.3 * half, mid + 1.3 * half, size=(2 * k, 4))
@@ -946,7 +956,7 @@ def _batch_robot(name: str, hand_robots: dict[str, Robot]) -> Robot:
 @pytest.mark.parametrize(("name", "n"), [("limited", 10_000), ("kr5_negz", 10_000), ("wide", 3_000)])
 def test_batch_agrees_with_scalar(name: str, n: int, hand_robots: dict[str, Robot]) -> None:
     robot = _batch_robot(name, hand_robots)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     T = _batch_targets(robot, n, seed=23)
     lo, hi = limits(robot)
     mid = (lo + hi) / 2
@@ -960,7 +970,7 @@ def test_batch_agrees_with_scalar(name: str, n: int, hand_robots: dict[str, Robo
     for label, (batch, ref, scalar_branch) in runs.items():
         assert batch.q.shape == (n, 4) and batch.status.shape == (n,) and batch.branch.shape == (n,)
         for i in range(n):
-            res = solve(geo, T[i], branch=scalar_branch)
+            res = solve_all(geo, T[i], branch=scalar_branch)
             st_b = int(batch.status[i])
             statuses.add(st_b)
             assert st_b == int(res.status), (label, i, T[i].tolist(), IKStatus(st_b).name, res.status.name, res.message)
@@ -1000,11 +1010,11 @@ def _hard_case_params() -> list[Any]:
 @pytest.mark.parametrize("case", _hard_case_params())
 def test_batch_agrees_with_scalar_on_the_hard_cases(case: dict[str, Any]) -> None:
     robot = load_robot(case["robot"], _overrides(case.get("overrides")))
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     T = np.array([case["target"]], dtype=float)
     for batch_branch, scalar_branch in (("right", "right"), ("left", "left"), ("nearest", "all")):
         batch = solve_batch(geo, T, branch=batch_branch)
-        res = solve(geo, T[0], branch=scalar_branch)
+        res = solve_all(geo, T[0], branch=scalar_branch)
         assert int(batch.status[0]) == int(res.status), (batch_branch, res.message)
         if res.success:
             assert pose_error(robot, batch.q[0], T[0]) <= POSE_TOL
@@ -1015,22 +1025,22 @@ def test_batch_free_j1_status_agrees_with_scalar() -> None:
     robot = load_robot("default", {"joint2_lower": D(-190), "joint2_upper": D(190), "joint1_lower": -0.5,
                                    "joint1_upper": 0.5})  # fmt: skip
     T = np.array([[0.0, 0.0, -0.05, 0.3]])
-    res = solve(robot.kinematics, T[0], reference=[0.2, 0.0, 0.0, 0.0])
+    res = solve_all(robot.kinematics.geometry, T[0], reference=[0.2, 0.0, 0.0, 0.0])
     assert res.status is IKStatus.OK  # q1 = 0.2: J1 is free
-    batch = solve_batch(robot.kinematics, T, branch="nearest", reference=[0.2, 0.0, 0.0, 0.0])
+    batch = solve_batch(robot.kinematics.geometry, T, branch="nearest", reference=[0.2, 0.0, 0.0, 0.0])
     assert int(batch.status[0]) == int(res.status)
 
 
 def test_batch_validates_its_input(default: Robot) -> None:
-    geo = default.kinematics
+    geo = default.kinematics.geometry
     with pytest.raises(scara_pin.ParameterError):
         solve_batch(geo, np.zeros((3, 3)))
     with pytest.raises(scara_pin.InvalidInputError):
         solve_batch(geo, np.zeros((3, 4)), branch="all")
     with pytest.raises(scara_pin.InvalidInputError):
-        solve(geo, [0.3, 0, -0.05, 0], branch="up")
+        solve_all(geo, [0.3, 0, -0.05, 0], branch="up")
     with pytest.raises(scara_pin.ParameterError):
-        solve(geo, [0.3, 0, math.nan, 0])
+        solve_all(geo, [0.3, 0, math.nan, 0])
 
 
 def test_geometry_is_read_from_the_model(default: Robot) -> None:

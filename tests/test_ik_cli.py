@@ -92,7 +92,7 @@ def argv_pose(pose: np.ndarray) -> list[str]:
 # ============================================================================== one target
 def test_ik_json_lists_every_solution(default: Robot, capsys: pytest.CaptureFixture[str]) -> None:
     target = s4_pose(Q)
-    rc, out, err = run(capsys, ["ik", *argv_pose(target), "--json"])
+    rc, out, err = run(capsys, ["ik", *argv_pose(target), "--json", "--all-turns"])
     assert rc == 0 and err == ""
     data = json.loads(out)
     assert {"target", "solutions", "status", "message"} <= set(data)
@@ -105,7 +105,7 @@ def test_ik_json_lists_every_solution(default: Robot, capsys: pytest.CaptureFixt
     for e in expected:
         assert min(np.abs(np.array(s["q"]) - e).max() for s in data["solutions"]) <= 1e-9
     for sol in data["solutions"]:
-        assert set(sol) == {"q", "branch"}
+        assert set(sol) == {"q", "branch", "turns"}
         q = np.array(sol["q"])
         assert pose_error(s4_pose(q), target) <= POSE_TOL
         assert pose_error(default.tool_pose(q), target) <= POSE_TOL
@@ -115,7 +115,7 @@ def test_ik_json_lists_every_solution(default: Robot, capsys: pytest.CaptureFixt
 
 
 def test_ik_text_mode(capsys: pytest.CaptureFixture[str]) -> None:
-    rc, out, err = run(capsys, ["ik", *argv_pose(s4_pose(Q))])
+    rc, out, err = run(capsys, ["ik", *argv_pose(s4_pose(Q)), "--all-turns"])
     assert rc == 0 and err == ""
     rows = [line.split(None, 1) for line in out.splitlines() if line.startswith(("right", "left"))]
     assert len(rows) == 4
@@ -127,7 +127,7 @@ def test_ik_text_mode(capsys: pytest.CaptureFixture[str]) -> None:
 @pytest.mark.parametrize("branch", ["left", "right"])
 def test_ik_branch_filter(branch: str, capsys: pytest.CaptureFixture[str]) -> None:
     target = s4_pose(Q)
-    rc, out, _ = run(capsys, ["ik", *argv_pose(target), "--json", "--branch", branch])
+    rc, out, _ = run(capsys, ["ik", *argv_pose(target), "--json", "--branch", branch, "--all-turns"])
     assert rc == 0
     sols = json.loads(out)["solutions"]
     assert len(sols) == 2
@@ -156,7 +156,7 @@ def test_ik_near_returns_only_the_nearest(capsys: pytest.CaptureFixture[str]) ->
 def test_ik_degrees_and_millimetres(capsys: pytest.CaptureFixture[str]) -> None:
     target = s4_pose(Q)
     args = [repr(float(target[i] * 1000)) for i in range(3)] + [repr(math.degrees(target[3]))]
-    rc, out, _ = run(capsys, ["ik", *args, "--deg", "--mm", "--json"])
+    rc, out, _ = run(capsys, ["ik", *args, "--deg", "--mm", "--json", "--all-turns"])
     assert rc == 0
     data = json.loads(out)
     assert data["target"]["x"] == pytest.approx(target[0] * 1000, abs=1e-9)

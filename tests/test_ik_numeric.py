@@ -20,7 +20,7 @@ import pytest
 
 import scara_pin
 import scara_pin.kinematics.validate
-from scara_pin import ParameterError, Robot, load_robot
+from scara_pin import ParameterError, Robot, load_robot, robot_from_urdf
 from scara_pin.kinematics.numeric import NumericIKOptions, NumericIKReason, NumericIKResult, solve_numeric
 from scara_pin.kinematics.scara import IKResult, NotScaraError, solve
 from scara_pin.kinematics.validate import validate_ik
@@ -98,9 +98,9 @@ def _tilted_urdf() -> str:
 def test_numeric_is_the_fallback_for_a_model_the_closed_form_refuses() -> None:
     urdf = _tilted_urdf()
     assert 'rpy="0.001 0 0"' in urdf  # the fixture really is tilted
-    robot = Robot(urdf, origin="tilted")
+    robot = robot_from_urdf(urdf, origin="tilted")
     with pytest.raises(NotScaraError):
-        _ = robot.kinematics
+        _ = robot.kinematics.geometry
     lo, hi = limits(robot)
     for q in np.random.default_rng(107).uniform(lo, hi, size=(30, 4)):
         target = robot.tool_pose(q)
@@ -153,7 +153,7 @@ def test_unreachable_target_returns_failure_with_the_residual(
 def test_target_outside_the_joint_limits_fails(shipped: dict[str, Robot]) -> None:
     """Behind the shoulder (J1 +/-132 deg): geometrically at reach, outside the limits."""
     robot = shipped["default"]
-    assert solve(robot.kinematics, [-0.3, 0.0, -0.05, 0.0]).status.name == "J1_LIMIT"
+    assert solve(robot.kinematics.geometry, [-0.3, 0.0, -0.05, 0.0]).status.name == "J1_LIMIT"
     res = solve_numeric(robot, [-0.3, 0.0, -0.05, 0.0], options=NumericIKOptions(restarts=3))
     assert not res.success and res.residual > 1e-3
     assert res.residual == pytest.approx(float(np.linalg.norm(task_error(robot, res.q, np.array([-0.3, 0, -0.05, 0])))),
@@ -206,8 +206,7 @@ def test_validate_ik_passes_on_every_shipped_robot(name: str, shipped: dict[str,
     assert "PASS" in report.table() and "FAIL" not in report.table()
 
 
-def _perturbed_solve(delta: float) -> Callable[..., IKResult]:
-    real = scara_pin.kinematics.validate.solve
+def _perturbed_solve(real: Callable[..., IKResult], delta: float) -> Callable[..., IKResult]:
 
     def wrapped(*args: Any, **kwargs: Any) -> IKResult:
         res = real(*args, **kwargs)
@@ -220,7 +219,8 @@ def _perturbed_solve(delta: float) -> Callable[..., IKResult]:
 def test_validate_ik_can_fail_on_a_perturbed_closed_form(
     monkeypatch: pytest.MonkeyPatch, shipped: dict[str, Robot]
 ) -> None:
-    monkeypatch.setattr(scara_pin.kinematics.validate, "solve", _perturbed_solve(1e-6))
+    kin = shipped["default"].kinematics
+    monkeypatch.setattr(kin, "solve", _perturbed_solve(kin.solve, 1e-6))
     report = validate_ik(shipped["default"], 40, seed=5)
     assert report.ok is False
     assert report.fk_fail > 0 and report.sample_missing == 40
@@ -269,7 +269,7 @@ def test_validate_ik_on_hand_written_urdfs(which: str) -> None:
         assert urdf.count('<axis xyz="0 0 -1"/>') == 4
     else:
         urdf = LIFT_FIRST
-    robot = Robot(urdf, origin=which)
+    robot = robot_from_urdf(urdf, origin=which)
     report = validate_ik(robot, 200, seed=9)
     assert report.ok, report.table()
     assert report.solutions >= 200

@@ -21,6 +21,7 @@ from scara_pin import (
     generate_urdf,
     load_robot,
     load_urdf,
+    robot_from_urdf,
 )
 
 JOINTS = ("joint1", "joint2", "joint3", "joint4")
@@ -138,7 +139,7 @@ BAD_URDFS = {
 def test_bad_urdf_text(case: str, capfd: pytest.CaptureFixture[str]) -> None:
     text, needles = BAD_URDFS[case]
     with pytest.raises(UrdfError) as info:
-        Robot(text)
+        robot_from_urdf(text)
     message = str(info.value)
     for needle in needles:
         assert needle in message, (needle, message)
@@ -167,7 +168,7 @@ def test_bad_urdf_file(case: str, tmp_path: Path, capfd: pytest.CaptureFixture[s
 def test_malformed_xml_names_line_and_column() -> None:
     text = '<robot name="r">\n  <link name="a"/>\n  <link name="b" <oops/>\n</robot>'
     with pytest.raises(UrdfError, match=r"line 3, column \d+"):
-        Robot(text)
+        robot_from_urdf(text)
 
 
 @pytest.mark.parametrize("name", ["missing.urdf", "no/such/dir/x.urdf"])

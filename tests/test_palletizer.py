@@ -33,7 +33,6 @@ from scara_pin.kinematics.numeric import solve_numeric
 from scara_pin.kinematics.palletizer import (
     NotPalletizerError,
     PalletizerGeometry,
-    PalletizerIKResult,
     PalletizerIKStatus,
     branch_of,
     forward,
@@ -42,7 +41,7 @@ from scara_pin.kinematics.palletizer import (
     to_s2,
     wrist_pitch,
 )
-from scara_pin.kinematics.scara import NotScaraError
+from scara_pin.kinematics.results import IKResult
 from scara_pin.kinematics.validate import validate_ik
 
 REPO = Path(__file__).resolve().parents[1]
@@ -226,7 +225,7 @@ def test_fk_equals_s2_closed_form_and_flange_stays_level(robot: Robot) -> None:
 
 
 def test_palletizer_forward_equals_pinocchio(robot: Robot, rng: np.random.Generator) -> None:
-    geo = robot.palletizer
+    geo = robot.kinematics.geometry
     for q in rng.uniform(-math.pi, math.pi, size=(500, 4)):
         p, e = robot.tool_pose(q), forward(geo, q)
         assert np.abs(p[:3] - e[:3]).max() <= FK_TOL and abs(wrap(p[3] - e[3])) <= FK_TOL
@@ -260,8 +259,8 @@ def test_ik_finds_every_sample_both_branches(robot: Robot) -> None:
     for q in rng.uniform(lo, hi, size=(1000, 4)):
         target = robot.tool_pose(q)
         res = robot.ik(target)
-        assert isinstance(res, PalletizerIKResult) and res.success, (q.tolist(), res.message)
-        assert min(np.abs(s.q - q).max() for s in res.solutions) <= IK_TOL
+        assert isinstance(res, IKResult) and res.success, (q.tolist(), res.message)
+        assert min(s.distance(q) for s in res.solutions) <= IK_TOL
         for s in res.solutions:
             p = robot.tool_pose(s.q)
             assert np.abs(p[:3] - target[:3]).max() <= IK_TOL and abs(wrap(p[3] - target[3])) <= IK_TOL
@@ -290,12 +289,12 @@ def test_branch_filter(robot: Robot) -> None:
 def test_ik_reaches_backwards_over_the_waist(wide: Robot) -> None:
     """With wide limits the arm reaches behind the waist axis (r < 0): q1 = atan2(y, x) + pi."""
     q = np.array([0.3, -1.2, -1.4, 0.0])
-    geo = wide.palletizer
-    r = geo.a1 + geo.a2 * math.sin(q[1]) + geo.a3 * math.sin(q[2]) + geo.a4
+    geo = wide.kinematics.geometry
+    r = geo.r0 + geo.a2 * math.sin(q[1]) + geo.a3 * math.sin(q[2])
     assert r < 0  # the flange is behind the waist axis
     target = wide.tool_pose(q)
     res = wide.ik(target)
-    assert res.success and min(np.abs(s.q - q).max() for s in res.solutions) <= IK_TOL
+    assert res.success and min(s.distance(q) for s in res.solutions) <= IK_TOL
     assert abs(wrap(math.atan2(target[1], target[0]) - q[0] - math.pi)) <= 1e-12  # the target is behind
 
 
@@ -306,7 +305,7 @@ def test_validate_on_wide_limits_finds_every_solution(wide: Robot) -> None:
 
 
 def _geo(robot: Robot, **limits: tuple[float, float]) -> PalletizerGeometry:
-    geo = robot.palletizer
+    geo = robot.kinematics.geometry
     lo, hi = list(geo.lower), list(geo.upper)
     for j, (a, b) in limits.items():
         i = int(j[1]) - 1
@@ -333,14 +332,14 @@ def test_reason_codes(robot: Robot, target: Any, limits: dict, branch: str, stat
     assert res.status is status and words in res.message, res.message
     # the same target without the narrowed limits is solved (the failure is the limit's)
     if isinstance(target, str):
-        assert solve(robot.palletizer, tgt, branch=branch).success
+        assert solve(robot.kinematics.geometry, tgt, branch=branch).success
 
 
 def test_inside_inner_limit(robot: Robot) -> None:
     # no shoulder offsets and a short small arm: both the forward and the backward candidate put the
     # wrist 0.1 m from the shoulder, inside |a2 - a3| = 0.45 m
-    geo = dataclasses.replace(robot.palletizer, a1=0.0, a4=0.0, a3=0.5)
-    res = solve(geo, [0.1, 0.0, geo.d1 + geo.d2 + geo.d5, 0.0])
+    geo = dataclasses.replace(robot.kinematics.geometry, r0=0.0, a3=0.5)
+    res = solve(geo, [0.1, 0.0, geo.h0, 0.0])
     assert res.status is PalletizerIKStatus.INSIDE_INNER_LIMIT and "inside |a2 - a3| = 0.45 m" in res.message
     # the default robot: the wrist on the shoulder axis forwards, but the backward reach gets further
     res = robot.ik([0.46, 0.0, 0.55, 0.0])
@@ -358,7 +357,7 @@ def test_pose_targets_and_tilt(robot: Robot) -> None:
     M = robot.tool_placement(q)
     for target in (M, M.homogeneous):
         res = robot.ik(target)
-        assert res.success and min(np.abs(s.q - q).max() for s in res.solutions) <= IK_TOL
+        assert res.success and min(s.distance(q) for s in res.solutions) <= IK_TOL
     tilted = M * pin.SE3(pin.utils.rotate("x", 1e-6), np.zeros(3))
     res = robot.ik(tilted)
     assert res.status is PalletizerIKStatus.NOT_A_YAW_POSE and "tilted by 1e-06 rad" in res.message
@@ -373,13 +372,17 @@ def test_stretched_arm_is_one_singular_solution(robot: Robot) -> None:
     assert np.abs(robot.tool_pose(s.q) - robot.tool_pose(q)).max() <= IK_TOL
 
 
-def test_geometry_needs_palletizer_parameters() -> None:
-    with pytest.raises(NotPalletizerError, match="a scara robot"):
-        _ = load_robot("default").palletizer
-    with pytest.raises(NotPalletizerError, match="a URDF file"):
-        _ = load_urdf(GOLDEN).palletizer
-    with pytest.raises(NotScaraError, match="is a palletizer, not a SCARA"):
-        _ = load_robot("palletizer").kinematics
+def test_geometry_is_read_from_the_model() -> None:
+    """The palletizer's geometry comes from its URDF (FK probes), as the SCARA's: the yaml values come back."""
+    v = load_robot("palletizer").parameters.values  # the independent route: the yaml the URDF was made from
+    for robot in (load_robot("palletizer"), load_urdf(GOLDEN)):  # a URDF file as well: no yaml needed
+        geo = PalletizerGeometry.from_robot(robot)
+        assert geo.a2 == pytest.approx(v["a2"], abs=1e-12) and geo.a3 == pytest.approx(v["a3"], abs=1e-12)
+        assert geo.r0 == pytest.approx(v["a1"] + v["a4"], abs=1e-12)
+        assert geo.h0 == pytest.approx(v["d1"] + v["d2"] + v["d5"], abs=1e-12)
+        assert geo.shoulder == pytest.approx((v["a1"], v["d1"] + v["d2"]), abs=1e-12)
+    with pytest.raises(NotPalletizerError, match="not a palletizer"):
+        PalletizerGeometry.from_robot(load_robot("default"))  # a SCARA's joint 2 turns about z
 
 
 def test_geometric_ik_agrees_with_numeric_ik(robot: Robot) -> None:
@@ -391,20 +394,20 @@ def test_geometric_ik_agrees_with_numeric_ik(robot: Robot) -> None:
         num = solve_numeric(robot, target)
         assert num.success, q.tolist()
         twins = robot.ik(target, branch=branch_of(num.q)).solutions
-        assert min(np.abs(s.q - num.q).max() for s in twins) <= IK_TOL
+        assert min(s.distance(num.q) for s in twins) <= IK_TOL
 
 
 def test_validate_ik_passes_and_can_fail(robot: Robot, monkeypatch: pytest.MonkeyPatch) -> None:
     report = validate_ik(robot, 1000, seed=2024)
     assert report.ok, report.table()
     assert report.solutions >= 1000 and report.worst_pose_error <= IK_TOL
-    real = scara_pin.kinematics.validate.palletizer.solve
+    real = robot.kinematics.solve
 
-    def shifted(*args: Any, **kwargs: Any) -> PalletizerIKResult:
+    def shifted(*args: Any, **kwargs: Any) -> IKResult:
         res = real(*args, **kwargs)
         return dataclasses.replace(res, solutions=tuple(dataclasses.replace(s, q=s.q + 1e-6) for s in res.solutions))
 
-    monkeypatch.setattr(scara_pin.kinematics.validate.palletizer, "solve", shifted)
+    monkeypatch.setattr(robot.kinematics, "solve", shifted)
     bad = validate_ik(robot, 20, seed=1)
     assert not bad.ok and bad.fk_fail > 0 and bad.sample_missing == 20
 
@@ -500,7 +503,7 @@ def test_envelope_area_against_the_rasterised_image_of_the_joint_box(robot: Robo
     """Independent route: the closed form maps a fine (q2, theta3) grid onto 5 mm pixels; count them."""
     from scara_pin.workspace.palletizer import arm_plane_envelope
 
-    env = arm_plane_envelope(robot.palletizer)
+    env = arm_plane_envelope(robot.kinematics.geometry)
     g = GEOMETRY
     lo, hi = limits(robot)
     q2, t3 = np.meshgrid(np.linspace(lo[1], hi[1], 1200), np.linspace(lo[2], hi[2], 1200))
@@ -524,7 +527,7 @@ def test_envelope_boundary_is_the_edge_of_the_ik(robot: Robot) -> None:
     """On every boundary arc: just inside, the geometric IK solves the pose; just outside, it cannot."""
     from scara_pin.workspace.palletizer import arm_plane_envelope
 
-    env = arm_plane_envelope(robot.palletizer)
+    env = arm_plane_envelope(robot.kinematics.geometry)
     assert {a.limit for a in env.arcs} >= {"joint2_lower", "joint2_upper", "joint3_lower", "joint3_upper",
                                            "stretched"}  # fmt: skip
     q1 = 0.7
@@ -542,7 +545,7 @@ def test_envelope_boundary_is_the_edge_of_the_ik(robot: Robot) -> None:
 def test_envelope_contains_every_fk_sample(robot: Robot) -> None:
     from scara_pin.workspace.palletizer import arm_plane_envelope
 
-    env = arm_plane_envelope(robot.palletizer)
+    env = arm_plane_envelope(robot.kinematics.geometry)
     rng = np.random.default_rng(9)
     lo, hi = limits(robot)
     for q in rng.uniform(lo, hi, size=(300, 4)):

@@ -42,7 +42,7 @@ def robots(draw: st.DrawFn) -> sp.Robot:
 @given(robot=robots(), seed=st.integers(0, 2**32 - 1))
 def test_workspace_contains_agrees_with_ik(robot: sp.Robot, seed: int) -> None:
     ws = workspace(robot)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     reach = geo.l1 + geo.l2
     rng = np.random.default_rng(seed)
     pts = rng.uniform(-1.1 * reach, 1.1 * reach, (400, 2))

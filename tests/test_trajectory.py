@@ -191,7 +191,7 @@ def _line_errors(robot: Robot, q: np.ndarray, p0: np.ndarray, p1: np.ndarray) ->
 
 def test_cartesian_line_stays_on_the_line_on_one_branch(robot_default: Robot) -> None:
     robot = robot_default
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     rng = np.random.default_rng(11)
     for _ in range(8):
         q0, p0, p1 = _random_line(robot, rng)
@@ -264,7 +264,7 @@ def test_cartesian_via_points(robot_default: Robot) -> None:
     np.testing.assert_allclose(robot.tool_pose(q_via)[:3], poses[1][:3], atol=1e-9)
     np.testing.assert_allclose(qd_via, 0.0, atol=1e-12)  # the tool stops where the line turns
     q = tr.sample(tr.times(1000.0))[0]
-    assert {branch_of(robot.kinematics, x) for x in q} == {path.branch}
+    assert {branch_of(robot.kinematics.geometry, x) for x in q} == {path.branch}
 
 
 def test_line_leaving_the_workspace_fails_where_the_arm_stretches(robot_default: Robot) -> None:

@@ -245,7 +245,7 @@ def test_contains_agrees_with_ik(name: str, spaces: dict[str, Workspace]) -> Non
 def test_shipped_robots(robot_name: str, robots: dict[str, Robot]) -> None:
     robot = robots[robot_name]
     ws = workspace(robot)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     rng = np.random.default_rng(6)
     P = joint_samples(geo, 50_000, rng, edges=1_000)
     assert (ws.contains_by_arcs(P) | (ws.distance_to_boundary(P) <= 1e-9)).all()

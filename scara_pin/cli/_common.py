@@ -80,7 +80,7 @@ def _parse_sets(items: Sequence[str] | None) -> dict[str, str]:
 
 
 def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
-    from ..model import load_robot
+    from ..robots import load_robot
 
     robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf)
     if units is not None:  # what each joint value measures, read from the model (any joint order)

@@ -14,6 +14,7 @@ from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_atomic_with
 from ._common import (
     _POSE_KINDS,
+    _Q_NAMES,
     Units,
     _add_q,
     _add_robot_options,
@@ -140,6 +141,8 @@ def cmd_ik(args: argparse.Namespace) -> int:
             raise InvalidInputError(f"--branch {args.branch} is a SCARA branch; a palletizer's are up and down")
     elif args.branch in ("up", "down"):
         raise InvalidInputError(f"--branch {args.branch} is a palletizer branch; a SCARA's are left and right")
+    if args.all_turns and (numeric or near is not None):
+        raise InvalidInputError("--all-turns lists every closed-form solution: not with --numeric or --near")
     if not numeric and robot.kind == "scara":
         from ..kinematics.scara import NotScaraError
 
@@ -148,10 +151,12 @@ def cmd_ik(args: argparse.Namespace) -> int:
         except NotScaraError as exc:
             log.warning("closed-form IK refused this robot (%s); using the numeric IK", exc)
             numeric = True
+    turns: list[Any] = []
     if numeric:
         status, message, qs, branches = _ik_numeric(robot, target, near)
     else:
-        result = robot.ik(target, branch=args.branch, reference=near)
+        # --all-turns: InvalidInputError (exit 2) above MAX_SOLUTIONS, counted before any is built
+        result = robot.ik(target, branch=args.branch, reference=near, all_turns=args.all_turns)
         sols = result.branch(args.branch)
         message = result.message
         if near is not None and sols:
@@ -162,11 +167,15 @@ def cmd_ik(args: argparse.Namespace) -> int:
         if result.success and not sols:
             message = f"no {args.branch} solution ({len(result.solutions)} of the other branch)"
         qs, branches = [s.q for s in sols], [s.branch for s in sols]
+        turns = [[list(t) if t is not None else None for t in s.turns] for s in sols]
     scale = units.scale(_POSE_KINDS)
     tgt = dict(zip(("x", "y", "z", "yaw"), _scaled(target, scale)))
     code = 0 if status == "OK" else 3
     if args.json:
-        print(json.dumps({"robot": robot.name, "target": tgt, "solutions": _solutions_json(qs, branches, units),
+        solutions = _solutions_json(qs, branches, units)
+        for sol, t in zip(solutions, turns):
+            sol["turns"] = t
+        print(json.dumps({"robot": robot.name, "target": tgt, "solutions": solutions,
                           "status": status, "message": message, "method": "numeric" if numeric else "closed-form",
                           "units": {"length": units.length_name, "angle": units.angle_name}}))  # fmt: skip
         return code
@@ -176,8 +185,12 @@ def cmd_ik(args: argparse.Namespace) -> int:
     print(f"robot     {robot.name}: {method} IK of {robot.tool_frame} in {robot.base_frame}")
     print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS))}]")
     print(f"units     q = [{', '.join(units.names(units.q))}]")
-    for q, b in zip(qs, branches):
-        print(f"{b:<9} {_fmt(_scaled(q, units.scale(units.q)))}")
+    for i, (q, b) in enumerate(zip(qs, branches)):
+        extra = ""
+        if turns and not args.all_turns and any(t is None or t != [0, 0] for t in turns[i]):
+            extra = "  turns " + " ".join(f"{n}:{'any' if t is None else t}" for n, t in zip(_Q_NAMES, turns[i])
+                                          if t != [0, 0])  # fmt: skip
+        print(f"{b:<9} {_fmt(_scaled(q, units.scale(units.q)))}{extra}")
     return 0
 
 
@@ -202,19 +215,17 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
 
     import numpy as np
 
-    from ..kinematics.scara import IKStatus, solve_batch
-
     if args.target:
         raise InvalidInputError("give either X Y Z YAW or --input FILE, not both")
     if not args.output:
         raise InvalidInputError("--input needs --output FILE")
-    branch = {"all": "nearest", "right": "right", "left": "left"}[args.branch]
+    kin = robot.kinematics
+    if args.branch != "all" and args.branch not in kin.branches:
+        raise InvalidInputError(f"--branch {args.branch} is not a branch of a {robot.kind} ({', '.join(kin.branches)})")
+    branch = "nearest" if args.branch == "all" else args.branch
     reference = None
     if args.near:
         reference = _q_values(args.near, units)
-    if robot.kind != "scara":
-        raise InvalidInputError(f"ik --input (batch) is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
-    geo = robot.kinematics
     in_path, out_path = Path(args.input), Path(args.output)
     try:
         handle = in_path.open(newline="", encoding="utf-8")
@@ -257,9 +268,9 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
         if not chunk:
             return
         T = np.array(chunk) / pose_scale
-        res = solve_batch(geo, T, branch=branch, reference=reference)
-        names = [IKStatus(c).name for c in range(len(IKStatus))]
-        labels = {1: "right", -1: "left", 0: ""}
+        res = robot.ik_batch(T, reference, branch=branch)
+        names = {int(c): c.name for c in kin.status}
+        labels = {1: kin.branches[0], -1: kin.branches[1], 0: ""}
         for t, q, b, st in zip(T * pose_scale, res.q * q_scale, res.branch, res.status):
             writer.writerow([*(repr(float(v)) for v in t), *("" if math.isnan(v) else repr(float(v)) for v in q),
                              labels[int(b)], names[int(st)]])  # fmt: skip
@@ -307,6 +318,10 @@ def register(sub: Any) -> None:
                    "a palletizer's up (sin q3 > 0, S2's q3) or down; default all")  # fmt: skip
     p.add_argument("--near", nargs=4, metavar="Q", help="return only the solution nearest to this configuration")
     p.add_argument("--numeric", action="store_true", help="use Pinocchio-based numeric IK instead of the closed form")
+    p.add_argument("--all-turns", action="store_true",
+                   help="list every 2 pi turn of every joint inside the limits as its own solution (at most "
+                   "100000; by default one solution per branch, each joint at its turn nearest --near or 0, "
+                   "with the range of turns that fit)")  # fmt: skip
     p.add_argument("--input", metavar="CSV", help="batch: targets with header x,y,z,yaw (one solution per row)")
     p.add_argument("--output", metavar="CSV", help="batch: joints written here (atomically), with a status column")
     _add_units(p)

@@ -121,7 +121,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
                 [_number("--gear", g) for g in args.gear],
                 [_number("--steps-per-rev", v) for v in args.steps_per_rev],
                 _number("--screw-lead", args.screw_lead) / units.length,
-                prismatic=robot.kinematics.prismatic,
+                prismatic=robot.joint_kinds.index("length"),
             )
         delays = [_number("--delays", d) for d in args.delays] if args.delays else None
         sp = traj.setpoints(args.setpoint_rate or args.rate, delays=delays, motor=motor)

@@ -17,20 +17,20 @@ Forward kinematics (S2, in ``q``; tool0 on the flange axis, its yaw turned by ``
     r = a1 + a2 sin q2 + a3 sin theta3 + a4,   x = r cos q1,   y = r sin q1,
     z = d1 + d2 + a2 cos q2 + a3 cos theta3 + d5,   yaw = q1 + q4 + tool_yaw.
 
+The geometry is read from the loaded Pinocchio model (:meth:`PalletizerGeometry.from_robot`), as the
+SCARA's is: its forward kinematics at three configurations gives r0 = a1 + a4, h0 = d1 + d2 + d5, a2, a3
+and the tool's yaw, and the closed form above is then checked against the model at random configurations.
+
 Inverse (S2): ``q1 = atan2(y, x)`` (and ``q1 + pi`` with the arm reaching backwards, ``r < 0``);
-the shoulder-to-wrist vector in the arm plane ``(h, v) = (r - a1 - a4, z - d1 - d2 - d5)``, of length
-``D``; the law of cosines on the (a2, a3, D) triangle, in its half-angle form (accurate at the
-stretched and folded boundaries),
-
-    tan(|q3| / 2) = sqrt((a2 + a3 - D)(a2 + a3 + D)) / sqrt((D - a2 + a3)(D + a2 - a3)),
-
-gives the two elbow branches: ``up`` with ``sin q3 > 0`` (the elbow above the shoulder-wrist line when
-the wrist is in front of the shoulder) and ``down`` with ``sin q3 < 0``; then
+the shoulder-to-wrist vector in the arm plane ``(h, v) = (r - r0, z - h0)`` is a planar two-link arm
+(a2, a3) with angles measured from the vertical (:mod:`scara_pin.kinematics.planar2r`, with
+(x, y) = (v, h)), whose law of cosines gives the two elbow branches: ``up`` with ``sin q3 > 0`` (the
+elbow above the shoulder-wrist line when the wrist is in front of the shoulder) and ``down`` with ``sin q3 < 0``; then
 ``q2 = atan2(h, v) - atan2(a3 sin q3, a2 + a3 cos q3)``, ``theta3 = q2 + q3``, ``q4 = yaw - tool_yaw - q1``.
 On the stretched (q3 = 0) or folded (q3 = pi) boundary the branches coincide: one solution, flagged
 ``singular``, labelled ``up`` (q3 = 0) or ``down`` (q3 = pi). Every 2 pi-equivalent of a joint inside
-its limits is a separate solution. Tolerances as the SCARA's (:data:`scara_pin.ik.REACH_TOL`,
-:data:`scara_pin.ik.LIMIT_TOL`).
+its limits is the same solution: each joint takes its turn nearest the reference, with the range of
+turns that fit (as the SCARA's).
 """
 
 from __future__ import annotations
@@ -38,15 +38,17 @@ from __future__ import annotations
 import enum
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
 from .._checks import _vector
-from ..errors import InvalidInputError, ParameterError, UrdfError
-from .scara import REACH_TOL, YAW_POSE_TOL, IKResult, IKSolution, _turns
+from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
+from .planar2r import FREE_R, REACH_TOL, Planar2R, Reach, nearest_turn, turn_edge, wrap
+from .results import BatchIKResult, IKResult, IKSolution
+from .targets import parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -56,25 +58,27 @@ __all__ = [
     "BRANCHES",
     "NotPalletizerError",
     "PalletizerGeometry",
-    "PalletizerIKResult",
     "PalletizerIKStatus",
     "branch_of",
     "forward",
     "from_s2",
     "solve",
+    "solve_batch",
+    "solve_nearest",
     "to_s2",
     "wrist_pitch",
 ]
 
-BRANCHES = ("all", "up", "down")
-"""Branch filters of :func:`solve`."""
-FREE_R = 1e-12
-"""[m] a target this close to the waist axis leaves q1 free (the reference's q1, else mid-range)."""
-_TWO_PI = 2.0 * math.pi
+BRANCHES = ("up", "down")
+"""The palletizer's elbow branches, in the order solutions are listed."""
+YAW_POSE_TOL = 1e-9
+"""[rad] the largest tilt of a target rotation still taken as a pure yaw (the flange stays level)."""
+FK_TOL = 1e-9
+"""[m, rad] the largest difference between the closed-form FK and the model for it to be a palletizer."""
 
 
 class NotPalletizerError(UrdfError):
-    """The robot is not a palletizer described by palletizer parameters (the reason says why)."""
+    """The model does not follow the palletizer's kinematics (the reason says where it departs)."""
 
 
 class PalletizerIKStatus(enum.IntEnum):
@@ -102,61 +106,83 @@ _STAGE = {
 
 
 @dataclass(frozen=True)
-class PalletizerIKResult(IKResult):
-    """As :class:`scara_pin.ik.IKResult`, with :class:`PalletizerIKStatus` codes and branches up/down."""
-
-    @property
-    def success(self) -> bool:
-        """True when at least one solution exists."""
-        return self.status is PalletizerIKStatus.OK
-
-
-@dataclass(frozen=True)
 class PalletizerGeometry:
-    """The palletizer's parameters (see ``urdf/config/palletizer/kinematics.yaml``) and joint limits.
+    """The palletizer's geometry, read from its model, and its joint limits.
 
     Attributes:
-        d1, d2, a1, a2, a3, a4, d5: S2's lengths [m]. tool_yaw: tool0's turn about the flange axis [rad].
-        lower, upper: position limits of ``q`` (motor side: q1, q2, theta3, q4) [rad].
+        r0: a1 + a4, the tool's distance from the waist axis with both arms vertical [m].
+        h0: d1 + d2 + d5, the tool's height with both arms of zero length [m].
+        a2, a3: big and small arm [m] (> 0).
+        tool_yaw: tool0's turn about the flange axis [rad].
+        shoulder: (r, z) of the big arm's axis in the arm plane [m] (for pictures).
+        lower, upper: position limits of ``q`` (q1, q2, theta3, q4) [rad]; -inf/inf for a continuous joint.
+        continuous: per joint, whether it is continuous.
+        R0: tool0's rotation in the base frame at q = 0.
+        arm: the planar two-link arm (a2, a3).
     """
 
-    d1: float
-    d2: float
-    a1: float
+    r0: float
+    h0: float
     a2: float
     a3: float
-    a4: float
-    d5: float
     tool_yaw: float
     lower: tuple[float, float, float, float]
     upper: tuple[float, float, float, float]
+    shoulder: tuple[float, float] = (0.0, 0.0)
+    continuous: tuple[bool, ...] = (False, False, False, False)
+    R0: np.ndarray = field(default_factory=lambda: np.diag([1.0, -1.0, -1.0]))
+    arm: Planar2R = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("d1", "d2", "a1", "a2", "a3", "a4", "d5", "tool_yaw"):
+        for name in ("r0", "h0", "a2", "a3", "tool_yaw"):
             value = getattr(self, name)
             if not math.isfinite(value):
                 raise ParameterError(name, value, "must be finite")
         for name in ("a2", "a3"):
             if getattr(self, name) <= 0:
                 raise ParameterError(name, getattr(self, name), "must be > 0")
+        object.__setattr__(self, "arm", Planar2R(self.a2, self.a3))
 
     @classmethod
     def from_robot(cls, robot: Robot) -> PalletizerGeometry:
-        """The geometry of a robot generated from palletizer parameters (the same yaml as its URDF).
+        """Read the geometry from the robot's Pinocchio model (forward kinematics at three configurations).
 
         Raises:
-            NotPalletizerError: the robot was not generated from palletizer parameters (a SCARA, or a
-                URDF file: this solver reads the yaml, not the model).
+            NotPalletizerError: the model does not follow the closed form (checked at 8 seeded random
+                configurations to FK_TOL), or its arms have no length.
         """
-        params = robot.parameters
-        if params is None or params.kind != "palletizer":
-            what = "a URDF file" if params is None else f"a {params.kind} robot"
-            raise NotPalletizerError(f"robot {robot.name!r} is {what}: the palletizer IK needs palletizer "
-                                     "parameters (kind: palletizer in kinematics.yaml)")  # fmt: skip
-        v = params.values
-        lim = robot.limits
-        return cls(v["d1"], v["d2"], v["a1"], v["a2"], v["a3"], v["a4"], v["d5"], v["tool_yaw"],
-                   tuple(lim.lower), tuple(lim.upper))  # type: ignore[arg-type]  # fmt: skip
+        fk = robot.tool_pose
+        x0, y0, z0, yaw0 = fk(np.zeros(4)).tolist()
+        x2, _, z2, _ = fk(np.array([0.0, 0.5 * math.pi, 0.0, 0.0])).tolist()
+        x3, _, _, _ = fk(np.array([0.0, 0.0, 0.5 * math.pi, 0.0])).tolist()
+        a2, a3 = x2 - x0, x3 - x0
+        if not (a2 > 1e-9 and a3 > 1e-9 and abs(y0) < FK_TOL):
+            raise NotPalletizerError(f"robot {robot.name!r}: turning joint2 or joint3 by 90 deg does not move the "
+                                     "tool forwards: not a palletizer's arm (q = q1, q2, theta3, q4)")  # fmt: skip
+        model = robot.model
+        data = model.createData()
+        pin.framesForwardKinematics(model, data, pin.neutral(model))
+        bMs = data.oMf[robot.base_id].actInv(data.oMi[model.getJointId(robot.joint_names[1])])
+        limits = robot.limits
+        cont = tuple(robot.continuous)
+        geo = cls(
+            r0=x0, h0=z0 - a2 - a3, a2=a2, a3=a3, tool_yaw=yaw0,
+            lower=tuple(-math.inf if c else v for c, v in zip(cont, limits.lower)),  # type: ignore[arg-type]
+            upper=tuple(math.inf if c else v for c, v in zip(cont, limits.upper)),  # type: ignore[arg-type]
+            shoulder=(float(bMs.translation[0]), float(bMs.translation[2])),
+            continuous=cont,
+            R0=robot.tool_placement(np.zeros(4)).rotation.copy(),
+        )  # fmt: skip
+        rng = np.random.default_rng(0)
+        for q in rng.uniform(-math.pi, math.pi, (8, 4)):
+            err = np.abs(forward(geo, q) - fk(q))
+            err[3] = abs(wrap(float(err[3])))
+            if err.max() > FK_TOL:
+                raise NotPalletizerError(
+                    f"robot {robot.name!r}: the palletizer's closed form departs from the model by {err.max():.3g} "
+                    f"at q = {np.round(q, 6).tolist()} (a2 = {a2:.9g}, a3 = {a3:.9g} m read from the model)"
+                )
+        return geo
 
 
 # ------------------------------------------------------------------------------------ conventions
@@ -178,11 +204,11 @@ def wrist_pitch(q: Sequence[float]) -> float:
 
 
 # ------------------------------------------------------------------------------------ kinematics
-def forward(geo: PalletizerGeometry, q: Sequence[float]) -> np.ndarray:
+def forward(geo: PalletizerGeometry, q: ArrayLike) -> np.ndarray:
     """S2's closed-form FK: (x, y, z, yaw) of tool0 in ``base`` at ``q`` (motor side) [m, rad]."""
     q1, q2, t3, q4 = _vector("q", q)
-    r = geo.a1 + geo.a2 * math.sin(q2) + geo.a3 * math.sin(t3) + geo.a4
-    z = geo.d1 + geo.d2 + geo.a2 * math.cos(q2) + geo.a3 * math.cos(t3) + geo.d5
+    r = geo.r0 + geo.a2 * math.sin(q2) + geo.a3 * math.sin(t3)
+    z = geo.h0 + geo.a2 * math.cos(q2) + geo.a3 * math.cos(t3)
     return np.array([r * math.cos(q1), r * math.sin(q1), z, q1 + q4 + geo.tool_yaw])
 
 
@@ -192,21 +218,98 @@ def branch_of(q: ArrayLike) -> str:
     return "up" if math.sin(a[2] - a[1]) >= 0.0 else "down"
 
 
-def _target(geo: PalletizerGeometry, target: object) -> tuple[np.ndarray, float]:
-    """The (x, y, z, yaw) of a target and the tilt of its rotation from a pure yaw [rad]."""
-    M = target.homogeneous if isinstance(target, pin.SE3) else np.asarray(target, dtype=float)
-    if M.shape == (4,):
-        if not np.isfinite(M).all():
-            raise ParameterError("target", M.tolist(), "must be 4 finite numbers (x, y, z, yaw)")
-        return M.astype(float), 0.0
-    if M.shape != (4, 4) or not np.isfinite(M).all():
-        raise ParameterError("target", "array of shape " + str(M.shape), "must be (x, y, z, yaw) or a 4 x 4 pose")
-    R = M[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
-        raise ParameterError("target rotation", R.round(12).tolist(), "must be a rotation matrix")
-    # tool0's z axis points down: a pure yaw pose has R[:, 2] = (0, 0, -1)
-    tilt = math.atan2(math.hypot(R[0, 2], R[1, 2]), -R[2, 2])
-    return np.array([M[0, 3], M[1, 3], M[2, 3], math.atan2(R[1, 0], R[0, 0])]), tilt
+_Branch = tuple[str, bool, list[float], list[tuple[int, int] | None]]
+
+
+def _branches(
+    geo: PalletizerGeometry, x: float, y: float, z: float, yaw: float, ref: list[float], branch: str
+) -> tuple[list[_Branch], tuple[PalletizerIKStatus, str] | None]:
+    """The solutions of the requested branches (reaching forwards, then backwards), or the most telling failure."""
+    lo, hi, cont = geo.lower, geo.upper, geo.continuous
+    arm = geo.arm
+    rho = math.hypot(x, y)
+    if rho <= FREE_R:  # on the waist axis: q1 is free; the reference's, inside the limits
+        q1 = ref[0] if cont[0] else min(max(ref[0], lo[0]), hi[0])
+        candidates = [(q1, 0.0)]
+    else:
+        phi = math.atan2(y, x)
+        candidates = [(phi, rho), (phi + math.pi, -rho)]  # reaching forwards, and backwards over the waist
+    found: list[_Branch] = []
+    worst: tuple[int, PalletizerIKStatus, str] = (-1, PalletizerIKStatus.OUT_OF_REACH, "")
+    v = z - geo.h0
+
+    def failed(status: PalletizerIKStatus, message: str) -> None:
+        nonlocal worst
+        if _STAGE[status] > worst[0]:
+            worst = (_STAGE[status], status, message)
+
+    for phi, r in candidates:
+        code, D, g, heading = arm.solve(v, r - geo.r0)  # the arm plane as (x, y) = (v, h)
+        if code == Reach.OUT:
+            failed(PalletizerIKStatus.OUT_OF_REACH,
+                   f"the wrist would be {D:.9g} m from the shoulder axis, beyond a2 + a3 = {arm.l12:.9g} m")
+            continue
+        if code == Reach.IN:
+            failed(PalletizerIKStatus.INSIDE_INNER_LIMIT,
+                   f"the wrist would be {D:.9g} m from the shoulder axis, inside |a2 - a3| = {arm.d12:.9g} m")
+            continue
+        singular = arm.singular(g)
+        lean = arm.lean(g)
+        wob = arm.wobble(g)
+        if singular:
+            elbows: list[tuple[float, float, str]] = [(g, heading - lean, "up" if g < 1.0 else "down")]
+        else:
+            elbows = [(g, heading - lean, "up"), (-g, heading + lean, "down")]
+        for q3, q2, label in elbows:
+            if not (branch == "all" or label == branch or singular):
+                continue
+            t2 = nearest_turn(q2, lo[1], hi[1], ref[1], cont[1])
+            if t2 is None:  # rounding alone may put it outside: on the limit, the small arm re-solved
+                edge = turn_edge(q2, lo[1], hi[1], wob)
+                if edge is not None:
+                    g2, miss = arm.with_link1(v, r - geo.r0, edge)
+                    if miss <= REACH_TOL:
+                        q2, q3, t2 = edge, g2, nearest_turn(edge, lo[1], hi[1], ref[1])
+            if t2 is None:
+                failed(PalletizerIKStatus.J2_LIMIT, f"q2 = {wrap(q2):.9g} rad ({label}) (+2 pi k) is outside "
+                       f"[{lo[1]:.9g}, {hi[1]:.9g}]")  # fmt: skip
+                continue
+            t3 = q2 + q3
+            tt3 = nearest_turn(t3, lo[2], hi[2], ref[2], cont[2])
+            if tt3 is None:
+                edge = turn_edge(t3, lo[2], hi[2], wob)
+                if edge is not None:
+                    q2b, miss = arm.with_link2(v, r - geo.r0, edge)
+                    t2b = nearest_turn(q2b, lo[1], hi[1], ref[1], cont[1])
+                    if miss <= REACH_TOL and t2b is not None:
+                        t2, tt3 = t2b, nearest_turn(edge, lo[2], hi[2], ref[2])
+            if tt3 is None:
+                failed(PalletizerIKStatus.J3_LIMIT, f"theta3 = {wrap(t3):.9g} rad ({label}) (+2 pi k) is outside "
+                       f"[{lo[2]:.9g}, {hi[2]:.9g}]")  # fmt: skip
+                continue
+            t1 = nearest_turn(phi, lo[0], hi[0], ref[0], cont[0])
+            if t1 is None:
+                failed(PalletizerIKStatus.J1_LIMIT, f"q1 = {wrap(phi):.9g} rad (+2 pi k) is outside "
+                       f"[{lo[0]:.9g}, {hi[0]:.9g}]")  # fmt: skip
+                continue
+            q4 = yaw - geo.tool_yaw - t1[0]
+            t4 = nearest_turn(q4, lo[3], hi[3], ref[3], cont[3])
+            if t4 is None:
+                failed(PalletizerIKStatus.J4_LIMIT, f"q4 = {wrap(q4):.9g} rad (+2 pi k) is outside "
+                       f"[{lo[3]:.9g}, {hi[3]:.9g}]")  # fmt: skip
+                continue
+            ts = (t1, t2, tt3, t4)
+            found.append((label, singular, [t[0] for t in ts],
+                          [None if c else (t[1], t[2]) for c, t in zip(cont, ts)]))  # fmt: skip
+    if found:
+        found.sort(key=lambda b: b[0] != "up")  # up before down (stable: forwards before backwards)
+        return found, None
+    return [], (worst[1], worst[2])
+
+
+def _pose(geo: PalletizerGeometry, target: object) -> tuple[float, float, float, float, float]:
+    x, y, z, alpha, tilt = parse_target(target, geo.tool_yaw, geo.R0)
+    return x, y, z, alpha + geo.tool_yaw, tilt
 
 
 def solve(
@@ -215,104 +318,90 @@ def solve(
     *,
     branch: str = "all",
     reference: ArrayLike | None = None,
-) -> PalletizerIKResult:
-    """Every configuration ``q`` (motor side) inside the limits that puts tool0 at ``target``.
+    all_turns: bool = False,
+) -> IKResult:
+    """The configurations ``q`` (motor side) that put tool0 at ``target``, each joint at its turn nearest ``reference``.
 
     Args:
         geo: the palletizer's geometry.
         target: (x, y, z, yaw) of tool0 in ``base`` [m, rad], or its 4 x 4 pose / pin.SE3 (a pure yaw).
         branch: ``"all"``, ``"up"`` or ``"down"``.
-        reference: a configuration; only used to fix q1 when the target lies on the waist axis.
+        reference: the configuration whose nearest turns are chosen (default q = 0); also fixes q1 when
+            the target lies on the waist axis.
+        all_turns: list every turn of every joint inside the limits (at most ``MAX_SOLUTIONS``).
 
     Returns:
-        PalletizerIKResult: the solutions of ``branch`` (up before down, then by q), or the status of
-        the most advanced failure of that branch (reach, then J2, J3, J1, J4 limits) with its numbers.
+        IKResult: the solutions of ``branch`` (up before down; reaching forwards before backwards), or the
+        status of the most advanced failure (reach, then J2, J3, J1, J4 limits) with its numbers.
     """
-    if branch not in BRANCHES:
-        raise InvalidInputError(f"branch {branch!r} must be one of {', '.join(BRANCHES)}")
-    pose, tilt = _target(geo, target)
+    if branch != "all" and branch not in BRANCHES:
+        raise InvalidInputError(f"branch {branch!r} must be one of all, {', '.join(BRANCHES)}")
+    x, y, z, yaw, tilt = _pose(geo, target)
+    pose = np.array([x, y, z, wrap(yaw)])
     if tilt > YAW_POSE_TOL:
-        return PalletizerIKResult(pose, (), PalletizerIKStatus.NOT_A_YAW_POSE,
-                                  f"the target's z axis is tilted by {tilt:.3g} rad from the vertical; "
-                                  "the palletizer's flange stays level")  # fmt: skip
-    x, y, z, yaw = (float(v) for v in pose)
-    lo, hi = geo.lower, geo.upper
-    rho = math.hypot(x, y)
-    if rho <= FREE_R:
-        phi = float(reference[0]) if reference is not None else 0.5 * (lo[0] + hi[0])
-        candidates = [(phi, 0.0)]
-    else:
-        phi = math.atan2(y, x)
-        candidates = [(phi, rho), (phi + math.pi, -rho)]  # reaching forwards, and backwards over the waist
-    solutions: list[IKSolution] = []
-    worst = (-1, PalletizerIKStatus.OUT_OF_REACH, "")
-    v = z - geo.d1 - geo.d2 - geo.d5
-    a2, a3 = geo.a2, geo.a3
-    reach, inner = a2 + a3, abs(a2 - a3)
-
-    def failed(status: PalletizerIKStatus, message: str) -> None:
-        nonlocal worst
-        if _STAGE[status] > worst[0]:
-            worst = (_STAGE[status], status, message)
-
-    for phi, r in candidates:
-        h = r - geo.a1 - geo.a4
-        D = math.hypot(h, v)
-        if D > reach:
-            if D > reach + REACH_TOL:
-                failed(PalletizerIKStatus.OUT_OF_REACH,
-                       f"the wrist would be {D:.9g} m from the shoulder axis, beyond a2 + a3 = {reach:.9g} m")
-                continue
-            D = reach
-        if D < inner:
-            if D < inner - REACH_TOL:
-                failed(PalletizerIKStatus.INSIDE_INNER_LIMIT,
-                       f"the wrist would be {D:.9g} m from the shoulder axis, inside |a2 - a3| = {inner:.9g} m")
-                continue
-            D = inner
-        g = 2.0 * math.atan2(math.sqrt(max((reach - D) * (reach + D), 0.0)),
-                             math.sqrt(max((D - a2 + a3) * (D + a2 - a3), 0.0)))  # fmt: skip
-        psi = math.atan2(h, v)
-        if g == 0.0 or g == math.pi:
-            elbows = [(g, "up" if g == 0.0 else "down", True)]
-        else:
-            elbows = [(g, "up", False), (-g, "down", False)]
-        for q3, label, singular in elbows:
-            if not (branch == "all" or label == branch or singular):
-                continue
-            q2 = psi - math.atan2(a3 * math.sin(q3), a2 + a3 * math.cos(q3))
-            q2 = (q2 + math.pi) % _TWO_PI - math.pi
-            t3 = (q2 + q3 + math.pi) % _TWO_PI - math.pi
-            q2s = _turns(q2, lo[1], hi[1])
-            if not q2s:
-                failed(PalletizerIKStatus.J2_LIMIT,
-                       f"q2 = {q2:.9g} rad ({label}) is outside [{lo[1]:.9g}, {hi[1]:.9g}]")
-                continue
-            t3s = _turns(t3, lo[2], hi[2])
-            if not t3s:
-                failed(PalletizerIKStatus.J3_LIMIT,
-                       f"theta3 = {t3:.9g} rad ({label}) is outside [{lo[2]:.9g}, {hi[2]:.9g}]")
-                continue
-            q1s = _turns(phi, lo[0], hi[0])
-            if not q1s:
-                failed(PalletizerIKStatus.J1_LIMIT, f"q1 = {_wrap(phi):.9g} rad (+ 2 pi k) is outside "
-                       f"[{lo[0]:.9g}, {hi[0]:.9g}]")  # fmt: skip
-                continue
-            for q1 in q1s:
-                q4s = _turns(yaw - geo.tool_yaw - q1, lo[3], hi[3])
-                if not q4s:
-                    failed(PalletizerIKStatus.J4_LIMIT, f"q4 = {_wrap(yaw - geo.tool_yaw - q1):.9g} rad (+ 2 pi k) "
-                           f"is outside [{lo[3]:.9g}, {hi[3]:.9g}]")  # fmt: skip
-                    continue
-                for q2v in q2s:
-                    for t3v in t3s:
-                        for q4 in q4s:
-                            solutions.append(IKSolution(np.array([q1, q2v, t3v, q4]), label, singular))
-    if solutions:
-        solutions.sort(key=lambda s: (s.branch != "up", s.q.tolist()))
-        return PalletizerIKResult(pose, tuple(solutions), PalletizerIKStatus.OK, f"{len(solutions)} solution(s)")
-    return PalletizerIKResult(pose, (), worst[1], worst[2])
+        return IKResult(pose, (), PalletizerIKStatus.NOT_A_YAW_POSE,
+                        f"the target's z axis is tilted by {tilt:.3g} rad from the vertical; the palletizer's "
+                        "flange stays level", geo.continuous)  # fmt: skip
+    found, failure = _branches(geo, x, y, z, yaw, reference_floats(reference), branch)
+    if failure is not None:
+        return IKResult(pose, (), failure[0], failure[1], geo.continuous)
+    sols = tuple(IKSolution(np.array(q), label, singular, tuple(turns)) for label, singular, q, turns in found)
+    result = IKResult(pose, sols, PalletizerIKStatus.OK, f"{len(sols)} solution(s)", geo.continuous)
+    return result.expand(geo.lower, geo.upper) if all_turns else result
 
 
-def _wrap(a: float) -> float:
-    return (a + math.pi) % _TWO_PI - math.pi
+def solve_nearest(
+    geo: PalletizerGeometry,
+    target: ArrayLike | pin.SE3,
+    reference: ArrayLike | None = None,
+    *,
+    weights: ArrayLike | None = None,
+    branch: str = "all",
+) -> np.ndarray:
+    """The solution nearest to ``reference`` (weighted joint space), as a new array (see the SCARA's).
+
+    Raises:
+        NoSolutionError: no solution inside the limits (``status``, ``reason``).
+    """
+    if branch != "all" and branch not in BRANCHES:
+        raise InvalidInputError(f"branch {branch!r} must be one of all, {', '.join(BRANCHES)}")
+    x, y, z, yaw, tilt = _pose(geo, target)
+    if tilt > YAW_POSE_TOL:
+        raise NoSolutionError(PalletizerIKStatus.NOT_A_YAW_POSE, f"the target's z axis is tilted by {tilt:.3g} rad")
+    ref = reference_floats(reference)
+    found, failure = _branches(geo, x, y, z, yaw, ref, branch)
+    if failure is not None:
+        raise NoSolutionError(*failure)
+    w = [1.0] * 4 if weights is None else weight_floats(weights)
+    best = min(found, key=lambda b: sum(wi * (qi - ri) ** 2 for wi, qi, ri in zip(w, b[2], ref)))
+    return np.array(best[2])
+
+
+def solve_batch(
+    geo: PalletizerGeometry, targets: ArrayLike, *, branch: str = "nearest", reference: ArrayLike | None = None
+) -> BatchIKResult:
+    """One solution per target (as the SCARA's :func:`~scara_pin.kinematics.scara.solve_batch`), row by row.
+
+    Returns:
+        BatchIKResult: q (NaN rows without a solution), PalletizerIKStatus codes, branch +1 up / -1 down.
+    """
+    T = np.asarray(targets, dtype=float)
+    if T.ndim != 2 or T.shape[1] != 4:
+        raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
+    if branch not in ("nearest", *BRANCHES):
+        raise InvalidInputError(f"branch {branch!r} must be 'nearest', 'up' or 'down'")
+    ref = np.zeros(4) if reference is None else np.asarray(reference, dtype=float)
+    n = len(T)
+    q = np.full((n, 4), np.nan)
+    status = np.zeros(n, dtype=np.int64)
+    sign = np.zeros(n, dtype=np.int64)
+    for i in range(n):
+        row_ref = ref if ref.ndim == 1 else ref[i]
+        res = solve(geo, T[i], branch="all" if branch == "nearest" else branch, reference=row_ref)
+        best = res.nearest(row_ref) if res.success else None
+        status[i] = int(res.status)
+        if best is not None:
+            q[i] = best.q
+            sign[i] = 1 if best.branch == "up" else -1
+    return BatchIKResult(q, status, sign)
+

@@ -6,7 +6,7 @@ geometric IK (:func:`scara_pin.palletizer.solve`, on the coupled model with its 
 For N configurations sampled inside the joint limits (seeded), with target = FK(q) from Pinocchio:
 
 1. every closed-form solution reproduces the target under Pinocchio FK to ``POSE_TOL`` (1e-9 m / rad);
-2. the sampled q is among the closed-form solutions (to ``Q_TOL``, 1e-9);
+2. the sampled q is among the closed-form solutions (to ``Q_TOL``, 1e-9; at any of a solution's turns);
 3. the numeric IK (:mod:`scara_pin.ik_numeric`) from the default start (middle of the joint ranges)
    converges to the target and coincides (to ``Q_TOL``) with a closed-form solution of the same branch.
 """
@@ -20,9 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import Robot
-from . import palletizer
 from .numeric import solve_numeric
-from .scara import IKResult, branch_of, solve
 
 __all__ = ["POSE_TOL", "Q_TOL", "ValidationReport", "validate_ik"]
 
@@ -95,24 +93,7 @@ def _pose_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
 
 def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: int = 10) -> ValidationReport:
     """Run the three checks on ``samples`` seeded configurations (see the module docstring)."""
-    if robot.kind == "palletizer":
-        pgeo = robot.palletizer
-
-        def closed(target: np.ndarray) -> IKResult:
-            return palletizer.solve(pgeo, target)
-
-        def branch_at(q: np.ndarray) -> str:
-            return palletizer.branch_of(q)
-    else:
-        geo = robot.kinematics
-        scara_solve = solve  # looked up at call time: tests may replace it
-
-        def closed(target: np.ndarray) -> IKResult:
-            return scara_solve(geo, target)
-
-        def branch_at(q: np.ndarray) -> str:
-            return branch_of(geo, q)
-
+    kin = robot.kinematics
     rng = np.random.default_rng(seed)
     lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
     report = ValidationReport(robot.name, samples, seed)
@@ -126,7 +107,7 @@ def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: 
         q = rng.uniform(lo, hi)
         target = robot.tool_pose(q)
         t0 = time.perf_counter()
-        result = closed(target)
+        result = kin.solve(target)
         t_closed += time.perf_counter() - t0
         report.solutions += len(result.solutions)
         for sol in result.solutions:
@@ -135,7 +116,7 @@ def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: 
             if err > POSE_TOL:
                 report.fk_fail += 1
                 fail(f"q = {q.tolist()}: solution {sol.q.tolist()} ({sol.branch}) is {err:.3g} off target")
-        dist = min((float(np.abs(s.q - q).max()) for s in result.solutions), default=math.inf)
+        dist = min((s.distance(q) for s in result.solutions), default=math.inf)
         report.worst_sample_distance = max(report.worst_sample_distance, dist)
         if dist > Q_TOL:
             report.sample_missing += 1
@@ -147,9 +128,9 @@ def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: 
             report.numeric_fail += 1
             fail(f"q = {q.tolist()}: numeric IK did not converge (residual {num.residual:.3g})")
             continue
-        branch = branch_at(num.q)
+        branch = kin.branch_of(num.q)
         twins = [s for s in result.solutions if s.matches(branch)]
-        dist = min((float(np.abs(s.q - num.q).max()) for s in twins), default=math.inf)
+        dist = min((s.distance(num.q) for s in twins), default=math.inf)
         report.worst_numeric_distance = max(report.worst_numeric_distance, dist)
         if dist > Q_TOL:
             report.numeric_mismatch += 1

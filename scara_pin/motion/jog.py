@@ -85,7 +85,7 @@ def jog_to_edge(
         raise ParameterError("direction", d.tolist(), "must be 2 or 3 finite numbers, not all zero")
     u = d / np.linalg.norm(d)
     pose0 = joint_pose(robot, q0)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     if ws is None:
         offset = math.hypot(*geo.tool) > 0
         ws = workspace(robot, yaw=float(pose0[3])) if offset else workspace(robot)

@@ -15,6 +15,7 @@ which also re-exports these names (the public home of paths and trajectories).
 from __future__ import annotations
 
 import abc
+import enum
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -29,7 +30,6 @@ from ..kinematics.scara import IKStatus, branch_of, solve_batch
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..kinematics.palletizer import PalletizerIKStatus
     from ..model import Robot
 
 __all__ = [
@@ -76,7 +76,7 @@ class PathError(InfeasibleError):
         segment: int = 0,
         pose: np.ndarray | None = None,
         q: np.ndarray | None = None,
-        status: IKStatus | PalletizerIKStatus | None = None,
+        status: enum.IntEnum | None = None,
     ) -> None:
         self.s = float(s)
         self.segment = segment
@@ -325,7 +325,7 @@ class CartesianSegment(GeometricPath):
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
         idx = np.clip(np.searchsorted(self.s_ref, s, side="right") - 1, 0, len(self.s_ref) - 1)
-        res = solve_batch(self.robot.kinematics, self.poses(s), branch=self.branch, reference=self.q_ref[idx])
+        res = solve_batch(self.robot.kinematics.geometry, self.poses(s), branch=self.branch, reference=self.q_ref[idx])
         if (res.status != 0).any():  # cannot happen on a checked segment
             k = int(np.argmax(res.status != 0))
             raise PathError(f"no IK solution ({IKStatus(int(res.status[k])).name})", s=s[k], pose=self.poses(s[k])[0],
@@ -387,7 +387,7 @@ def joint_pose(robot: Robot, q: ArrayLike) -> np.ndarray:
     whenever the line stays feasible.
     """
     q = robot.check_q(q)
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     pose = robot.tool_pose(q)
     turned = geo.yaw0 + sum(geo.signs[i] * float(q[i]) for i in geo.revolute)
     pose[3] += 2.0 * math.pi * round((turned - pose[3]) / (2.0 * math.pi))
@@ -396,7 +396,7 @@ def joint_pose(robot: Robot, q: ArrayLike) -> np.ndarray:
 
 def _elbow_sin(robot: Robot, q: np.ndarray) -> np.ndarray:
     """sin(gamma) of configurations (n, 4): > 0 on the right branch, < 0 on the left, 0 when singular."""
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     return np.sin(geo.elbow_angle(q[..., geo.revolute[1]]))
 
 
@@ -445,7 +445,7 @@ def cartesian_path(
         raise ParameterError("n", n, "must be an integer >= 2 (points per segment, ends included)")
     step = _positive("max_step", _DEFAULT_STEP if max_step is None else max_step, "m")
     yaw_step = _positive("max_yaw_step", _DEFAULT_YAW_STEP if max_yaw_step is None else max_yaw_step, "rad")
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     if start is not None:
         q0 = robot.check_q(start).astype(float)
         fk = robot.tool_pose(q0)
@@ -459,8 +459,8 @@ def cartesian_path(
         branch = branch or start_branch
     else:
         branch = branch or "right"
-        res = robot.ik(P[0], branch=branch)
-        mid = (np.array(geo.lower) + np.array(geo.upper)) / 2
+        mid = np.array([0.5 * (lo + hi) if math.isfinite(lo + hi) else 0.0 for lo, hi in zip(geo.lower, geo.upper)])
+        res = robot.ik(P[0], branch=branch, reference=mid)
         sol = res.nearest(mid, branch=branch)
         if sol is None:
             raise PathError(f"no {branch} IK solution at the start: {res.message}", s=0.0, pose=P[0], status=res.status)
@@ -497,9 +497,9 @@ def cartesian_path(
 
 def _ik_step(
     robot: Robot, branch: str, pose: np.ndarray, q_prev: np.ndarray
-) -> tuple[np.ndarray | None, str, IKStatus | PalletizerIKStatus | None]:
+) -> tuple[np.ndarray | None, str, enum.IntEnum | None]:
     """The branch solution at ``pose`` nearest ``q_prev``, or None with the reason and the IK status."""
-    res = robot.ik(pose, branch=branch)
+    res = robot.ik(pose, branch=branch, reference=q_prev)
     sol = res.nearest(q_prev, branch=branch) if res.success else None
     if sol is None:
         if res.success:
@@ -519,9 +519,9 @@ def _jump(robot: Robot, q: np.ndarray, q_prev: np.ndarray) -> str:
     j = int(np.argmax(dq))
     if dq[j] <= JUMP_TOL:
         return ""
-    name = robot.kinematics.names[j]
+    name = robot.joint_names[j]
     turns = dq[j] / (2 * math.pi)
-    if j in robot.kinematics.revolute and abs(turns - round(turns)) < 0.05:
+    if robot.joint_kinds[j] == "angle" and abs(turns - round(turns)) < 0.05:
         return (f"{name} would jump by {round(turns)} turn(s), from {q_prev[j]:.9g} to {q[j]:.9g} rad: it reaches "
                 "its limit and the line cannot continue on this turn")  # fmt: skip
     return f"{name} would jump from {q_prev[j]:.9g} to {q[j]:.9g}: the arm passes through the singularity"
@@ -578,7 +578,7 @@ def _dense_check(
     m = len(s_pts) - 1
     ds = 1.0 / m
     sub = max(4, math.ceil(np.linalg.norm(d[:3]) * ds / _DENSE_STEP), math.ceil(abs(d[3]) * ds / _DENSE_YAW_STEP))
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     sign = 1.0 if branch == "right" else -1.0
     q_prev = q_pts[:-1]
     rows = [q_pts[:-1]]

@@ -68,7 +68,7 @@ def plot_trajectory(
         raise ParameterError("samples", samples, "must be an integer >= 2")
     if limits is None and robot is not None:
         limits = robot.limits
-    prismatic = robot.kinematics.prismatic if robot is not None else 2
+    prismatic = robot.joint_kinds.index("length") if robot is not None else 2
     units = ["m" if i == prismatic else "rad" for i in range(4)]
     t = np.linspace(0.0, trajectory.duration, samples)
     q, qd, qdd = trajectory.sample(t)
@@ -119,7 +119,7 @@ def plot_trajectory(
 def _tool_panel(ax: Axes, robot: Robot, q: np.ndarray) -> None:
     """The tool path in the base x-y plane, the start and end, and the reach circles."""
     P = np.array([robot.tool_pose(x) for x in q])
-    geo = robot.kinematics
+    geo = robot.kinematics.geometry
     ring = np.linspace(0.0, 2.0 * math.pi, 361)
     r_min, r_max = geo.radius_range()
     cx, cy = geo.a1

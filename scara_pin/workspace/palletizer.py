@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..kinematics.palletizer import PalletizerGeometry
+from ..kinematics.planar2r import Reach, nearest_turn
 
 __all__ = ["ArmPlaneEnvelope", "EnvelopeArc", "arm_plane_envelope", "plot_envelope", "reachable"]
 
@@ -117,28 +118,27 @@ class ArmPlaneEnvelope:
 
 
 def _origin(geo: PalletizerGeometry) -> tuple[float, float]:
-    return geo.a1 + geo.a4, geo.d1 + geo.d2 + geo.d5
+    return geo.r0, geo.h0
 
 
-def _in_range(value: float, lo: float, hi: float, tol: float = 0.0) -> bool:
-    k = math.ceil((lo - tol - value) / _TWO_PI)
-    return value + k * _TWO_PI <= hi + tol
+def _fits(value: float, lo: float, hi: float, continuous: bool) -> bool:
+    return continuous or nearest_turn(value, lo, hi, value) is not None
 
 
 def reachable(geo: PalletizerGeometry, r: float, z: float) -> bool:
-    """Whether some (q2, theta3) inside the limits puts the tool point at (r, z) of the arm plane."""
-    r0, z0 = _origin(geo)
-    h, v = r - r0, z - z0
-    a2, a3 = geo.a2, geo.a3
-    D = math.hypot(h, v)
-    if D > a2 + a3 or D < abs(a2 - a3):
+    """Whether some (q2, theta3) inside the limits puts the tool point at (r, z) of the arm plane.
+
+    The planar two-link solution (:mod:`scara_pin.kinematics.planar2r`) of the arm plane, both elbows,
+    with the IK's tolerances.
+    """
+    arm = geo.arm
+    code, _, g, heading = arm.solve(z - geo.h0, r - geo.r0)  # the arm plane as (x, y) = (v, h)
+    if code != Reach.OK:
         return False
-    g = 2.0 * math.atan2(math.sqrt(max((a2 + a3 - D) * (a2 + a3 + D), 0.0)),
-                         math.sqrt(max((D - a2 + a3) * (D + a2 - a3), 0.0)))  # fmt: skip
-    psi = math.atan2(h, v)
-    for q3 in (g, -g):
-        q2 = psi - math.atan2(a3 * math.sin(q3), a2 + a3 * math.cos(q3))
-        if _in_range(q2, geo.lower[1], geo.upper[1]) and _in_range(q2 + q3, geo.lower[2], geo.upper[2]):
+    lean = arm.lean(g)
+    lo, hi, cont = geo.lower, geo.upper, geo.continuous
+    for q3, q2 in ((g, heading - lean), (-g, heading + lean)):
+        if _fits(q2, lo[1], hi[1], cont[1]) and _fits(q2 + q3, lo[2], hi[2], cont[2]):
             return True
     return False
 
@@ -147,7 +147,8 @@ def _candidates(geo: PalletizerGeometry) -> list[tuple[tuple[float, float], floa
     """(center, radius, phi0, phi1, limit) of every candidate arc."""
     r0, z0 = _origin(geo)
     a2, a3 = geo.a2, geo.a3
-    lo2, hi2, lo3, hi3 = geo.lower[1], geo.upper[1], geo.lower[2], geo.upper[2]
+    (lo2, hi2), (lo3, hi3) = ((-math.pi, math.pi) if geo.continuous[j] else (geo.lower[j], geo.upper[j])
+                              for j in (1, 2))  # fmt: skip
     hi2, hi3 = min(hi2, lo2 + _TWO_PI), min(hi3, lo3 + _TWO_PI)
     out = []
     for q2, name in ((lo2, "joint2_lower"), (hi2, "joint2_upper")):
@@ -249,11 +250,11 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str, q: np.ndarray | None = None)
                 label=None if a.limit in seen else a.limit)  # fmt: skip
         seen.add(a.limit)
     q = (np.asarray(geo.lower) + np.asarray(geo.upper)) / 2 if q is None else np.asarray(q, dtype=float)
-    sh = (geo.a1, geo.d1 + geo.d2)
+    sh = geo.shoulder
     el = (sh[0] + geo.a2 * math.sin(q[1]), sh[1] + geo.a2 * math.cos(q[1]))
     wr = (el[0] + geo.a3 * math.sin(q[2]), el[1] + geo.a3 * math.cos(q[2]))
-    tool = (wr[0] + geo.a4, wr[1] + geo.d5)
-    chain = np.array([(0.0, 0.0), (0.0, geo.d1 + geo.d2), sh, el, wr, (tool[0], wr[1]), tool])
+    tool = (wr[0] + geo.r0 - sh[0], wr[1] + geo.h0 - sh[1])
+    chain = np.array([(0.0, 0.0), (0.0, sh[1]), sh, el, wr, (tool[0], wr[1]), tool])
     ax.plot(chain[:, 0], chain[:, 1], "k-o", ms=3, lw=1.5, label="arm (mid-range)")
     ax.axhline(0.0, color="grey", lw=0.8)
     ax.set_aspect("equal")

@@ -69,7 +69,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidInputError, ParameterError
-from ..kinematics.scara import LIMIT_TOL, ScaraGeometry
+from ..kinematics.planar2r import LIMIT_TOL, Planar2R, fits_array
+from ..kinematics.scara import ScaraGeometry
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -245,34 +246,32 @@ class _Params:
     g_lo: float
     g_hi: float
     g_full: bool
+    arm: Planar2R
 
 
 def _turn_ok(v: np.ndarray, lo: float, hi: float, full: bool, tol: float) -> np.ndarray:
     """Whether v + 2 pi k lies in [lo - tol, hi + tol] for some integer k (elementwise)."""
-    if full:
-        return np.ones(np.shape(v), dtype=bool)
-    return v + np.ceil((lo - tol - v) / _TWO_PI) * _TWO_PI <= hi + tol
+    return np.ones(np.shape(v), dtype=bool) if full else fits_array(v, lo, hi, tol)
 
 
 def _contains_xy(p: _Params, x: np.ndarray, y: np.ndarray, tol: float = LIMIT_TOL) -> np.ndarray:
-    """The closed-form IK's reachability test of wrist points (module docstring); tol [rad] and [m]."""
-    l1, l2 = p.l1, p.l2
-    l12, d12 = l1 + l2, abs(l1 - l2)
-    dx, dy = x - p.a1[0], y - p.a1[1]
-    r = np.hypot(dx, dy)
-    outer = np.maximum(l12 - r, 0.0) * (l12 + r)
-    inner = np.maximum(r - d12, 0.0) * (r + d12)
-    g0 = 2.0 * np.arctan2(np.sqrt(outer), np.sqrt(inner))
+    """The closed-form IK's reachability test of wrist points (the planar arm's, module docstring).
+
+    tol [rad] and [m]: how far outside a joint limit or a reach circle still counts as inside.
+    """
+    arm = p.arm
+    dx, dy = np.asarray(x, dtype=float) - p.a1[0], np.asarray(y, dtype=float) - p.a1[1]
+    r = np.sqrt(dx * dx + dy * dy)
+    g0 = arm.elbow_array(r)
     heading = np.arctan2(dy, dx)
+    lean = arm.lean_array(g0)
     free = r < 1e-15  # l1 = l2 and the wrist on the shoulder axis: the shoulder angle is free
     inside = np.zeros(np.shape(r), dtype=bool)
     for sign in (1.0, -1.0):
-        g = sign * g0
-        ok_g = _turn_ok(g, p.g_lo, p.g_hi, p.g_full, tol)
-        theta = heading - np.arctan2(l2 * np.sin(g), l1 + l2 * np.cos(g))
-        ok_t = _turn_ok(theta, p.t_lo, p.t_hi, p.t_full, tol) | free
+        ok_g = _turn_ok(sign * g0, p.g_lo, p.g_hi, p.g_full, tol)
+        ok_t = _turn_ok(heading - sign * lean, p.t_lo, p.t_hi, p.t_full, tol) | free
         inside |= ok_g & ok_t
-    return inside & (r <= l12 + tol) & (r >= d12 - tol)
+    return inside & (r <= arm.l12 + tol) & (r >= arm.d12 - tol)
 
 
 def _circle_intersections(c1: tuple[float, float], r1: float, c2: tuple[float, float], r2: float) -> list[float]:
@@ -588,13 +587,17 @@ def workspace(
         ParameterError: limits that are not ordered or not numbers, J1 or J2 limits that leave no range,
             or a yaw with J4 limited to less than a turn and a tool offset.
     """
-    geo = robot if isinstance(robot, ScaraGeometry) else robot.kinematics
+    geo = robot if isinstance(robot, ScaraGeometry) else robot.kinematics.geometry
     if lower is not None or upper is not None:
         lo = tuple(float(v) for v in (geo.lower if lower is None else lower))
         hi = tuple(float(v) for v in (geo.upper if upper is None else upper))
         if len(lo) != len(geo.lower) or len(hi) != len(geo.upper):
             raise ParameterError("joint limits", f"{len(lo)} and {len(hi)} values", f"must have {len(geo.lower)}")
-        geo = replace(geo, lower=lo, upper=hi)
+        # an infinite limit is a joint that turns without end: continuous
+        cont = tuple(c or not (math.isfinite(a) and math.isfinite(b)) for c, a, b in zip(geo.continuous, lo, hi))
+        if any(math.isnan(v) for v in lo + hi):
+            raise ParameterError("joint limits", (lo, hi), "must be numbers")
+        geo = replace(geo, lower=lo, upper=hi, continuous=cont)
     for i, name in enumerate(geo.names):
         if math.isnan(geo.lower[i]) or math.isnan(geo.upper[i]) or geo.lower[i] > geo.upper[i]:
             limits = (geo.lower[i], geo.upper[i])
@@ -641,7 +644,7 @@ def _params(geo: ScaraGeometry) -> _Params:
     g = sorted((geo.elbow_angle(geo.lower[rb]), geo.elbow_angle(geo.upper[rb])))
     t_full = not (math.isfinite(t[0]) and math.isfinite(t[1]) and t[1] - t[0] < _TWO_PI)
     g_full = not (math.isfinite(g[0]) and math.isfinite(g[1]) and g[1] - g[0] < _TWO_PI)
-    return _Params(geo.a1, geo.l1, geo.l2, t[0], t[1], t_full, g[0], g[1], g_full)
+    return _Params(geo.a1, geo.l1, geo.l2, t[0], t[1], t_full, g[0], g[1], g_full, geo.arm)
 
 
 def _deg(v: float) -> str:
@@ -660,9 +663,6 @@ def _candidates(geo: ScaraGeometry, p: _Params) -> list[_Candidate]:
     def reaches(angle: float) -> bool:
         return p.g_full or angle + math.ceil((p.g_lo - angle) / _TWO_PI) * _TWO_PI <= p.g_hi
 
-    def radius(g: float) -> float:
-        return math.sqrt(max(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * math.cos(g), 0.0))
-
     # J1 edges: J1 at a limit, J2 sweeping: radius l2 about the elbow
     if not p.t_full:
         for t, lower_q in ((p.t_lo, geo.signs[ra] > 0), (p.t_hi, geo.signs[ra] < 0)):
@@ -677,7 +677,7 @@ def _candidates(geo: ScaraGeometry, p: _Params) -> list[_Candidate]:
     # J2 edges: J2 at a limit, J1 sweeping: radius r(g) about the shoulder
     if not p.g_full:
         for g, lower_q in ((p.g_lo, geo.signs[rb] > 0), (p.g_hi, geo.signs[rb] < 0)):
-            R = radius(g)
+            R = p.arm.radius(g)
             if R <= 1e-12 * (l1 + l2):
                 continue
             q = geo.lower[rb] if lower_q else geo.upper[rb]

@@ -1,0 +1,95 @@
+"""Targets, references and weights as the closed forms take them: checked once, at the edge (private)."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pinocchio as pin
+
+from .._checks import MAGNITUDE_MAX, _vector
+from ..errors import ParameterError
+
+if TYPE_CHECKING:
+    from .._typing import ArrayLike
+
+__all__ = ["check_magnitude", "parse_target", "reference_floats", "weight_floats"]
+
+_F64 = np.dtype(np.float64)
+_isfinite = math.isfinite
+
+
+def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, float, float, float, float]:
+    """(x, y, z, alpha, tilt) of a target: alpha = yaw - yaw0, tilt the angle of its rotation from a pure yaw.
+
+    Args:
+        target: (x, y, z, yaw) [m, rad], a 4 x 4 pose or a pin.SE3, of the tool frame in the base frame.
+        yaw0: the tool's yaw at q = 0 [rad].
+        R0: the tool's rotation at q = 0 (a pure-yaw target is Rz(alpha) R0).
+
+    Raises:
+        ParameterError: not (x, y, z, yaw) or a 4 x 4 pose, a value not finite or beyond +/-MAGNITUDE_MAX.
+    """
+    kind = type(target)
+    if kind is tuple or kind is list or (kind is np.ndarray and target.dtype is _F64 and target.shape == (4,)):  # type: ignore[attr-defined]
+        try:
+            a: Any
+            b: Any
+            c: Any
+            d: Any
+            a, b, c, d = target  # type: ignore[misc]
+            if type(a) is float and type(b) is float and type(c) is float and type(d) is float:
+                x, y, z, yaw = a, b, c, d
+            else:
+                x, y, z, yaw = float(a), float(b), float(c), float(d)
+        except (TypeError, ValueError):
+            raise ParameterError("target", target, "must be 4 numbers (x, y, z, yaw)") from None
+        m = MAGNITUDE_MAX
+        if -m <= x <= m and -m <= y <= m and -m <= z <= m and -m <= yaw <= m:  # NaN fails every comparison
+            return x, y, z, yaw - yaw0, 0.0
+    M = target.homogeneous if isinstance(target, pin.SE3) else np.asarray(target, dtype=float)  # type: ignore[arg-type]
+    if M.shape == (4,):
+        x, y, z, yaw = (float(v) for v in _vector("target", M))
+        check_magnitude((x, y, z, yaw))
+        return x, y, z, yaw - yaw0, 0.0
+    if M.shape != (4, 4) or not np.isfinite(M).all():
+        raise ParameterError("target", "array of shape " + str(M.shape), "must be (x, y, z, yaw) or a 4 x 4 pose")
+    check_magnitude(M[:3, 3].tolist())
+    R = M[:3, :3]
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
+        raise ParameterError("target rotation", R.round(12).tolist(), "must be a rotation matrix")
+    E = R @ R0.T  # a pure yaw of the tool's zero-pose rotation: E = Rz(alpha)
+    tilt = math.atan2(math.hypot(E[0, 2], E[1, 2]), E[2, 2])
+    return float(M[0, 3]), float(M[1, 3]), float(M[2, 3]), math.atan2(E[1, 0], E[0, 0]), tilt
+
+
+def check_magnitude(values: ArrayLike) -> None:
+    """Raise a ParameterError naming the first of (x, y, z, yaw) that is not finite or beyond +/-MAGNITUDE_MAX."""
+    for name, v in zip(("x", "y", "z", "yaw"), values):
+        if not _isfinite(v):
+            raise ParameterError(f"target {name}", v, "must be finite")
+        if abs(v) > MAGNITUDE_MAX:
+            raise ParameterError(f"target {name}", v, f"must be within +/-{MAGNITUDE_MAX:g} (m or rad)")
+
+
+def reference_floats(reference: object, n: int = 4) -> list[float]:
+    """A reference configuration as n finite floats within +/-MAGNITUDE_MAX (default: zeros)."""
+    if reference is None:
+        return [0.0] * n
+    if type(reference) is np.ndarray and reference.dtype is _F64 and reference.shape == (n,):  # type: ignore[attr-defined]
+        out = reference.tolist()  # type: ignore[attr-defined]
+        if abs(sum(out)) <= MAGNITUDE_MAX and all(-MAGNITUDE_MAX <= v <= MAGNITUDE_MAX for v in out):
+            return out  # type: ignore[no-any-return]
+    arr = _vector("reference", reference, n)
+    if (np.abs(arr) > MAGNITUDE_MAX).any():
+        raise ParameterError("reference", arr.tolist(), f"must be within +/-{MAGNITUDE_MAX:g} (rad or m)")
+    return arr.tolist()  # type: ignore[no-any-return]
+
+
+def weight_floats(weights: object, n: int = 4) -> list[float]:
+    """Weights of a joint-space distance as n finite floats >= 0."""
+    w = _vector("weights", weights, n)
+    if (w < 0).any():
+        raise ParameterError("weights", w.tolist(), "must be >= 0")
+    return w.tolist()  # type: ignore[no-any-return]
