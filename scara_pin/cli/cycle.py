@@ -23,7 +23,7 @@ def _payload(args: argparse.Namespace, units: Units) -> Any:
     mass = 0.0 if args.payload is None else _number("--payload", args.payload)
     if mass < 0.0:
         raise ParameterError("--payload", mass, "must be >= 0", "kg")
-    com = (0.0, 0.0, 0.0)
+    com: tuple[float, ...] = (0.0, 0.0, 0.0)
     if args.payload_com is not None:
         com = tuple(_number(f"--payload-com {n}", v) / units.length for n, v in zip("XYZ", args.payload_com))
     return Payload(mass, com)  # type: ignore[arg-type]
