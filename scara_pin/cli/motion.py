@@ -23,6 +23,7 @@ from ._common import (
     log,
     write_atomic,
 )
+from .cycle import _payload
 
 if TYPE_CHECKING:
 
@@ -60,6 +61,18 @@ def cmd_traj(args: argparse.Namespace) -> int:
     if args.linear and robot.kind != "scara":
         raise InvalidInputError(f"traj --linear is SCARA-only for now; robot {robot.name!r} is a {robot.kind} "
                                 "(joint-space --duration and TOPP-RA timing work)")  # fmt: skip
+    if args.arch and not args.linear and robot.kind == "scara":
+        return _traj_arch(args, robot, units, pose_from, pose_to, q_from)
+    if args.arch:
+        raise InvalidInputError("--arch is a SCARA move on its own (not with --linear)" if args.linear
+                                else f"traj --arch is SCARA-only; robot {robot.name!r} is a {robot.kind}")
+    payload = _payload(args, units)
+    if payload.mass and not args.torque:
+        raise InvalidInputError("--payload changes only the torques: give --torque too")
+    if payload.mass:
+        from ..motion.payload import with_payload
+
+        robot = with_payload(robot, payload)
     if args.plot and robot.kind != "scara":
         raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     if args.linear:
@@ -158,6 +171,53 @@ def cmd_traj(args: argparse.Namespace) -> int:
     return 0
 
 
+def _traj_arch(args: argparse.Namespace, robot: Any, units: Units, pose_from: Any, pose_to: Any, q_from: Any) -> int:
+    """``traj --arch``: the arch (jump) move between two poses (lift, traverse, descend, blended corners)."""
+    import numpy as np
+
+    from ..motion import trajectory as tr
+    from ..motion.cycle import arch_move
+
+    if args.via:
+        raise InvalidInputError("--arch takes no --via (one arch between two poses)")
+    if args.duration is not None:
+        raise InvalidInputError("--arch is time-optimal: --duration does not apply")
+    first = pose_from if q_from is None else tr.joint_pose(robot, q_from)
+    last = pose_to if args.to_q is None else tr.joint_pose(robot, _joint_arg(robot, args.to_q, units, "--to"))
+    rise = _number("--rise", args.rise) / units.length
+    blend = None if args.blend is None else _number("--blend", args.blend) / units.length
+    move = arch_move(robot, np.array([first, last], dtype=float), rise=rise, blend=blend, payload=_payload(args, units),
+                     torque=args.torque, start=q_from)  # fmt: skip
+    traj = move.trajectory
+    outputs: dict[str, str] = {}
+    if args.out:
+        out = Path(args.out)
+        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
+        outputs["trajectory"] = str(out)
+    if args.plot:
+        from ..viz.cycle import plot_cycle
+
+        plot_cycle(robot, move, args.plot, title=f"{robot.name}: arch move {traj.duration:.4g} s")
+        outputs["plot"] = args.plot
+    if args.json:
+        summary = {"robot": robot.name, "method": "arch (jump) move, time-optimal (TOPP-RA)",
+                   "duration": traj.duration, "q_from": traj.q_start.tolist(), "q_to": traj.q_end.tolist(),
+                   "legs": [leg.to_dict() for leg in move.legs], "limit_ratios": move.ratios,
+                   "payload": move.payload.to_dict(), "outputs": outputs,
+                   "units": {"length": "m", "angle": "rad", "time": "s"}}  # fmt: skip
+        if not args.out:
+            summary["samples"] = traj.resample(args.rate).to_dict()
+        print(json.dumps(summary))
+        return 0
+    print(f"robot     {robot.name}: arch (jump) move, time-optimal (TOPP-RA)")
+    print(f"duration  {traj.duration:.9g} s")
+    for leg in move.legs:
+        print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit")
+    for kind, where in outputs.items():
+        print(f"wrote     {kind}: {where}")
+    return 0
+
+
 def cmd_jog(args: argparse.Namespace) -> int:
     """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge."""
     from ..motion.jog import jog_to_edge
@@ -215,6 +275,12 @@ def register(sub: Any) -> None:
     g.add_argument("--tool-speed", type=float, metavar="V", help="also limit the tool speed [m/s, or mm/s with --mm]")
     g.add_argument("--torque", action="store_true", help="also respect the effort limits (RNEA, URDF inertias)")
     g.add_argument("--strict", action="store_true", help="refuse (exit 3) a --duration that exceeds a limit")
+    g.add_argument("--payload", metavar="KG", help="payload at the tool, for --torque (and --arch) [kg]")
+    g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")
+    g = p.add_argument_group("arch (jump) move between --from-pose and --to-pose")
+    g.add_argument("--arch", action="store_true", help="lift, traverse, descend, corners blended (time-optimal)")
+    g.add_argument("--rise", default="0.025", metavar="H", help="traverse height above the higher pose (0.025 m)")
+    g.add_argument("--blend", metavar="B", help="blend distance at each corner (default: as large as allowed)")
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
                    help="sampling rate of --out and --json (default 1000)")  # fmt: skip

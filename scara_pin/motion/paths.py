@@ -17,7 +17,7 @@ from __future__ import annotations
 import abc
 import enum
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -322,7 +322,13 @@ class CartesianSegment(GeometricPath):
         """(n, 4) tool poses at s."""
         return self.pose0 + np.asarray(s, dtype=float).reshape(-1, 1) * self.delta
 
-    def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
+    def pose_derivatives(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(pose', pose'') at s, each (n, 4): the constant ``delta`` and zero on a line."""
+        n = np.asarray(s).size
+        return np.broadcast_to(self.delta, (n, 4)), np.zeros((n, 4))
+
+    def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
+        """(q, q', q'') at s: ``q' = J^-1 pose'``, ``q'' = J^-1 (pose'' - (dJ/ds) q')`` (J the task Jacobian)."""
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
         idx = np.clip(np.searchsorted(self.s_ref, s, side="right") - 1, 0, len(self.s_ref) - 1)
         res = solve_batch(self.robot.kinematics.geometry, self.poses(s), branch=self.branch, reference=self.q_ref[idx])
@@ -336,13 +342,13 @@ class CartesianSegment(GeometricPath):
         n = len(s)
         dq = np.empty((n, 4))
         ddq = np.empty((n, 4))
-        d = self.delta
+        d1, d2 = self.pose_derivatives(s)
         for k in range(n):
             J = self._kin.jacobian(q[k])
             try:
-                dq[k] = np.linalg.solve(J, d)
+                dq[k] = np.linalg.solve(J, d1[k])
                 if order >= 2:
-                    ddq[k] = -np.linalg.solve(J, self._kin.jacobian_rate(q[k], dq[k]) @ dq[k])
+                    ddq[k] = np.linalg.solve(J, d2[k] - self._kin.jacobian_rate(q[k], dq[k]) @ dq[k])
             except np.linalg.LinAlgError:
                 raise PathError("the task Jacobian is singular (stretched or folded arm)", s=s[k],
                                 pose=self.poses(s[k])[0], q=q[k]) from None  # fmt: skip
@@ -476,13 +482,8 @@ def cartesian_path(
             raise ParameterError(f"pose {k + 1}", b.tolist(), "must differ from the one before it")
         m = n - 1 if n is not None else max(1, math.ceil(np.linalg.norm(d[:3]) / step - 1e-9),
                                             math.ceil(abs(d[3]) / yaw_step - 1e-9))  # fmt: skip
-        s_pts = np.linspace(0.0, 1.0, m + 1)
-        q_pts = np.empty((m + 1, 4))
-        _check_start(robot, a, seg_start, k)
-        q_pts[0] = seg_start
-        for j in range(1, m + 1):
-            q_pts[j] = _checkpoint(robot, branch, a, d, k, s_pts[j - 1], s_pts[j], q_pts[j - 1])
-        s_ref, q_ref = _dense_check(robot, branch, a, d, k, s_pts, q_pts)
+        line = _Line(a, d)
+        s_pts, q_pts, s_ref, q_ref = follow_curve(robot, branch, line, seg_start, m, k)
         segments.append(CartesianSegment(robot, branch, a.copy(), b.copy(), s_ref, q_ref))
         checkpoints.append((s_pts, q_pts))
         q_prev = q_pts[-1]
@@ -493,6 +494,67 @@ def cartesian_path(
                             f"requested end q = {np.round(q_end, 9).tolist()} (another elbow branch or J4 turn)",
                             s=1.0, segment=P.shape[0] - 2, pose=P[-1], q=q_prev)  # fmt: skip
     return CartesianPath(robot, P, branch, tuple(segments), tuple(checkpoints))
+
+
+PoseCurve = Callable[[np.ndarray], np.ndarray]
+"""A tool-pose curve: (n, 4) poses (x, y, z, yaw) at n parameters s in [0, 1]."""
+
+
+@dataclass(frozen=True)
+class _Line:
+    """The pose curve ``a + s d`` (a straight tool line, yaw linear)."""
+
+    a: np.ndarray
+    d: np.ndarray
+
+    def __call__(self, s: np.ndarray) -> np.ndarray:
+        return self.a + np.asarray(s, dtype=float).reshape(-1, 1) * self.d
+
+    @property
+    def extent(self) -> tuple[float, float]:
+        """(position length [m], |yaw change| [rad])."""
+        return float(np.linalg.norm(self.d[:3])), abs(float(self.d[3]))
+
+
+def follow_curve(
+    robot: Robot, branch: str, curve: PoseCurve, q_start: np.ndarray, m: int, segment: int = 0,
+    extent: tuple[float, float] | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Follow a tool-pose curve with the closed-form IK on one branch, continuously; checked densely.
+
+    The curve is solved at ``m + 1`` equally spaced checkpoints (each the branch solution nearest the
+    previous one), then between them on the fine grid of :func:`cartesian_path` (0.5 mm, 0.01 rad).
+
+    Args:
+        robot: the robot.
+        branch: ``"right"`` or ``"left"``.
+        curve: the poses at parameters in [0, 1] (``curve.extent``, or ``extent``, gives its position
+            length [m] and yaw change [rad], for the fine grid; a bound is enough).
+        q_start: the configuration at ``curve(0)``.
+        m: checkpoint intervals (>= 1).
+        segment: index of the segment (error messages).
+        extent: (length [m], yaw change [rad]) when ``curve`` has no ``extent``.
+
+    Returns:
+        (s_pts, q_pts) the checkpoints and (s_ref, q_ref) the dense checked solutions.
+
+    Raises:
+        PathError: the curve leaves the workspace or the joint limits, reaches the singularity, or makes a
+            joint jump; with ``s`` and the pose.
+    """
+    ext = extent if extent is not None else curve.extent  # type: ignore[attr-defined]
+    s_pts = np.linspace(0.0, 1.0, m + 1)
+    q_pts = np.empty((m + 1, 4))
+    _check_start(robot, curve(np.zeros(1))[0], q_start, segment)
+    q_pts[0] = q_start
+    for j in range(1, m + 1):
+        q_pts[j] = _checkpoint(robot, branch, curve, segment, s_pts[j - 1], s_pts[j], q_pts[j - 1])
+    s_ref, q_ref = _dense_check(robot, branch, curve, ext, segment, s_pts, q_pts)
+    return s_pts, q_pts, s_ref, q_ref
+
+
+def _at(curve: PoseCurve, s: float) -> np.ndarray:
+    return curve(np.array([s]))[0]
 
 
 def _ik_step(
@@ -535,21 +597,20 @@ def _check_start(robot: Robot, pose: np.ndarray, q: np.ndarray, segment: int) ->
 
 
 def _checkpoint(
-    robot: Robot, branch: str, a: np.ndarray, d: np.ndarray, segment: int, s0: float, s1: float, q0: np.ndarray
+    robot: Robot, branch: str, curve: PoseCurve, segment: int, s0: float, s1: float, q0: np.ndarray
 ) -> np.ndarray:
     """IK at s1 continuing q0 (at s0); on failure, locate it by bisection and raise :class:`PathError`."""
-    q, _, _ = _ik_step(robot, branch, a + s1 * d, q0)
+    q, _, _ = _ik_step(robot, branch, _at(curve, s1), q0)
     if q is not None and not _jump(robot, q, q0):
         return q
-    _fail(robot, branch, a, d, segment, s0, s1, q0)
+    _fail(robot, branch, curve, segment, s0, s1, q0)
     raise AssertionError("unreachable")  # pragma: no cover
 
 
 def _fail(
     robot: Robot,
     branch: str,
-    a: np.ndarray,
-    d: np.ndarray,
+    curve: PoseCurve,
     segment: int,
     s_good: float,
     s_bad: float,
@@ -560,31 +621,37 @@ def _fail(
         if s_bad - s_good <= 1e-13:
             break
         mid = 0.5 * (s_good + s_bad)
-        q, _, _ = _ik_step(robot, branch, a + mid * d, q_good)
+        q, _, _ = _ik_step(robot, branch, _at(curve, mid), q_good)
         if q is not None and not _jump(robot, q, q_good):
             s_good, q_good = mid, q
         else:
             s_bad = mid
-    q, reason, status = _ik_step(robot, branch, a + s_bad * d, q_good)
+    q, reason, status = _ik_step(robot, branch, _at(curve, s_bad), q_good)
     if q is not None:
         reason = _jump(robot, q, q_good) or "the solution changes discontinuously"
-    raise PathError(reason, s=s_bad, segment=segment, pose=a + s_bad * d, q=q_good, status=status)
+    raise PathError(reason, s=s_bad, segment=segment, pose=_at(curve, s_bad), q=q_good, status=status)
 
 
 def _dense_check(
-    robot: Robot, branch: str, a: np.ndarray, d: np.ndarray, segment: int, s_pts: np.ndarray, q_pts: np.ndarray
+    robot: Robot,
+    branch: str,
+    curve: PoseCurve,
+    extent: tuple[float, float],
+    segment: int,
+    s_pts: np.ndarray,
+    q_pts: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Solve the line on a fine grid between checkpoints (vectorised); return it as the IK reference."""
+    """Solve the curve on a fine grid between checkpoints (vectorised); return it as the IK reference."""
     m = len(s_pts) - 1
     ds = 1.0 / m
-    sub = max(4, math.ceil(np.linalg.norm(d[:3]) * ds / _DENSE_STEP), math.ceil(abs(d[3]) * ds / _DENSE_YAW_STEP))
+    sub = max(4, math.ceil(extent[0] * ds / _DENSE_STEP), math.ceil(extent[1] * ds / _DENSE_YAW_STEP))
     geo = robot.kinematics.geometry
     sign = 1.0 if branch == "right" else -1.0
     q_prev = q_pts[:-1]
     rows = [q_pts[:-1]]
     for k in range(1, sub + 1):
         s = s_pts[:-1] + (s_pts[1:] - s_pts[:-1]) * (k / sub)
-        res = solve_batch(geo, a + s[:, None] * d, branch=branch, reference=q_prev)
+        res = solve_batch(geo, curve(s), branch=branch, reference=q_prev)
         q = np.where((res.status != 0)[:, None], np.nan, res.q)
         if k == sub:
             q = np.where(np.isnan(q), np.nan, q_pts[1:])  # the checkpoints themselves (same solutions)
@@ -593,7 +660,7 @@ def _dense_check(
         if not ok.all():
             j = int(np.argmax(~ok))
             s_lo = s_pts[j] + (s_pts[j + 1] - s_pts[j]) * ((k - 1) / sub)
-            _fail(robot, branch, a, d, segment, float(s_lo), float(s[j]), q_prev[j])
+            _fail(robot, branch, curve, segment, float(s_lo), float(s[j]), q_prev[j])
         rows.append(q)
         q_prev = q
     # interleave: interval j contributes its sub-points in order

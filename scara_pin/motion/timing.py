@@ -78,6 +78,8 @@ logger = logging.getLogger(__name__)
 
 _ACCEPT = 1.0 + 1e-10
 """The verification accepts a worst limit ratio up to this: far inside the 1e-6 promise."""
+_END = 1.0 - 1e-9
+"""Fraction of a grid segment where its end value (the left limit at the next grid point) is checked."""
 _X_CAP = 1e8
 """Cap of the path-velocity-squared bound where q' = 0 (the acceleration limit then decides)."""
 
@@ -467,7 +469,9 @@ def _check_times(law: ProfileLaw, opts: TimingOptions, sub: bool, t_start: float
     start in the whole trajectory), the trajectory's check_rate grid k / rate (the promise) that falls in
     this segment.
     """
-    parts = [law.t]
+    # the grid points give each segment's value at its start; the path acceleration jumps there, so the
+    # value at each segment's END (its left limit at the next grid point) is checked as well
+    parts = [law.t, law.t[:-1] + np.diff(law.t) * _END]
     if sub:
         M = opts.check_subdivisions
         parts.append((law.t[:-1, None] + np.diff(law.t)[:, None] * (np.arange(1, M) / M)[None, :]).ravel())
@@ -525,7 +529,7 @@ def _check(
 
 
 def _polynomial_extremes(path: GeometricPath, law: ProfileLaw) -> tuple[np.ndarray, np.ndarray]:
-    """Qd and qdd at every interior extremum of qd or qdd, per joint, for a path cubic between grid points.
+    """Qd and qdd at every interior extremum of qd or qdd and at each segment end, for a path cubic between knots.
 
     On grid segment i (inside one cubic piece, the knots being grid points) ``x = sd^2`` is linear in s
     and ``qdd_j(s) = q'_j(s) u_i + q''_j(s) x(s)`` is a quadratic in s: its extremum is at its vertex,
@@ -549,8 +553,9 @@ def _polynomial_extremes(path: GeometricPath, law: ProfileLaw) -> tuple[np.ndarr
         disc = np.sqrt(np.where(quad, b * b - 4.0 * c * f0, np.nan))
         r1 = np.where(quad, (-b - disc) / (2.0 * c), np.where(np.abs(b) > 1e-12 * scale, -f0 / b, np.nan))
         r2 = np.where(quad, (-b + disc) / (2.0 * c), np.nan)
-    sig = np.concatenate([vertex, r1, r2]).ravel()  # (3 n 4,), segment index = (row // 4) % n
-    seg = np.tile(np.repeat(np.arange(n), 4), 3)
+    ends = np.full_like(vertex, _END)  # each segment's end: the left limit of qdd at the next grid point
+    sig = np.concatenate([vertex, r1, r2, ends]).ravel()  # (4 n 4,), segment index = (row // 4) % n
+    seg = np.tile(np.repeat(np.arange(n), 4), 4)
     keep = np.isfinite(sig) & (sig > 0.0) & (sig < 1.0)
     sig, seg = sig[keep], seg[keep]
     if not len(sig):

@@ -1,0 +1,679 @@
+"""Arch (jump) moves and the standard SCARA cycle, timed under velocity, acceleration, torque and jerk limits.
+
+**Arch move** (Epson's JUMP, others' gate or arch motion) from pose A to pose B: lift vertically to the
+traverse height ``z_top = max(z_A, z_B) + rise``, move horizontally, descend to B. It is ONE path of
+straight tool lines (:class:`~scara_pin.motion.paths.CartesianSegment`, same elbow branch, J4 continuous)
+whose two corners are replaced by blends. A blend at a corner C between the incoming unit direction e1
+and the outgoing e2 starts ``b`` before C and ends ``b`` after it, ``b = min(blend, lift, D / 2)`` (D the
+horizontal distance); it is the quintic Hermite curve
+
+    p(tau) = P0 + H5(tau) (P1 - P0) + 2 b (H1(tau) e1 + H4(tau) e2),    tau in [0, 1],
+    P0 = C - b e1, P1 = C + b e2,
+
+with H1, H4, H5 the quintic Hermite basis functions (end velocities 2 b e1 and 2 b e2, end accelerations
+zero). Written in the path's arc-length-like parameter (each line its length, each blend 2 b) the tool
+path is C2: tangent and curvature are continuous, so the joint accelerations are continuous along the
+path and a jerk limit can be met without stopping. The blend stays in the corner's triangle: it never
+rises above the traverse height nor passes the lift line (the z and horizontal coordinates are
+monotonic on it). The yaw moves in proportion to the horizontal progress (constant while lifting and
+descending straight). ``blend = 0`` (``--no-blend``) keeps the corners: three lines, stopping at each.
+
+Timing: :func:`~scara_pin.motion.timing.parameterize` (TOPP-RA, limits verified between grid points, at
+1 kHz), torques from Pinocchio's RNEA with the payload added to the tool body of a COPY of the model
+(:mod:`~scara_pin.motion.payload`); optionally a joint jerk limit (:mod:`~scara_pin.motion.jerk`).
+
+**Standard cycle** (the figure SCARA datasheets quote, ISO 9283-like conditions): up ``rise`` (25 mm),
+across ``span`` (305 mm), down, and back the same way, rest at both ends. Default placement
+(:func:`cycle_placement`): the traverse is the chord perpendicular to the arm's direction at the middle of
+J1's range, centred on it, at mid-stroke height (the stroke from ``z - rise/2`` to ``z + rise/2`` centred),
+at the distance from the J1 axis that MAXIMISES THE SMALLEST MANIPULABILITY |det J| along the chord
+(for a SCARA l1 l2 |sin q2|: the elbow stays as far from stretched and folded as the chord allows).
+Why: the cycle time depends on the joint speeds the tool speed needs, which blow up near the singular
+arm; this is the place the robot reaches best, with symmetric joint motion about J1's middle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .._checks import _vector
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from .jerk import jerk_limited, joint_jerk
+from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
+from .payload import Payload, with_payload
+from .timing import TimingOptions, _limits, _rnea, parameterize
+from .trajectory import Motion, Trajectory
+
+if TYPE_CHECKING:
+    from .._typing import ArrayLike
+    from ..description import JointLimits
+    from ..model import Robot
+
+__all__ = [
+    "STANDARD_RISE",
+    "STANDARD_SPAN",
+    "ArchMove",
+    "ArchPath",
+    "BlendSegment",
+    "CycleResult",
+    "Leg",
+    "arch_move",
+    "arch_path",
+    "cycle_placement",
+    "limits_dict",
+    "standard_cycle",
+    "trajectory_jerk",
+]
+
+STANDARD_SPAN = 0.305
+"""[m] the horizontal stroke of the standard cycle."""
+STANDARD_RISE = 0.025
+"""[m] the vertical stroke of the standard cycle."""
+_STEP = 2e-3  # [m] checkpoint spacing along a blend (as cartesian_path's default)
+_QUANTITIES = ("velocity", "acceleration", "torque", "jerk")
+
+# quintic Hermite basis (coefficients of tau^0..tau^5): H1 (start velocity), H4 (end velocity), H5 (end point)
+_H1 = np.array([0.0, 1.0, 0.0, -6.0, 8.0, -3.0])
+_H4 = np.array([0.0, 0.0, 0.0, -4.0, 7.0, -3.0])
+_H5 = np.array([0.0, 0.0, 0.0, 10.0, -15.0, 6.0])
+
+
+def _poly(c: np.ndarray, t: np.ndarray, order: int) -> np.ndarray:
+    from numpy.polynomial import polynomial as P
+
+    return P.polyval(t, P.polyder(c, order) if order else c)
+
+
+@dataclass(frozen=True, eq=False)
+class BlendSegment(CartesianSegment):
+    """A corner blend (module docstring): the quintic from ``corner - b e_in`` to ``corner + b e_out``.
+
+    The yaw is ``pose0[3] + yaw_rate * (p - p0) . horizontal``. ``pose0``/``pose1`` are its end poses.
+
+    Attributes:
+        corner: the corner point (x, y, z) [m].
+        e_in, e_out: unit directions of the incoming and outgoing lines.
+        b: the blend distance along each line [m].
+        horizontal: unit horizontal direction of the traverse.
+        yaw_rate: [rad/m] yaw per metre of horizontal progress.
+    """
+
+    corner: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    e_in: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    e_out: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    b: float = 0.0
+    horizontal: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    yaw_rate: float = 0.0
+
+    @staticmethod
+    def curve(
+        corner: np.ndarray, e_in: np.ndarray, e_out: np.ndarray, b: float, horizontal: np.ndarray, yaw0: float,
+        yaw_rate: float, s: np.ndarray, order: int = 0,
+    ) -> np.ndarray:
+        """The blend's pose (order 0) or its order-th derivative in tau, (n, 4)."""
+        t = np.asarray(s, dtype=float).ravel()
+        p0, p1 = corner - b * e_in, corner + b * e_out
+        p = (_poly(_H5, t, order)[:, None] * (p1 - p0) + 2.0 * b * (_poly(_H1, t, order)[:, None] * e_in
+             + _poly(_H4, t, order)[:, None] * e_out))  # fmt: skip
+        if order == 0:
+            p = p + p0
+        yaw = yaw_rate * ((p - (p0 if order == 0 else 0.0)) @ horizontal) + (yaw0 if order == 0 else 0.0)
+        return np.column_stack([p, yaw])
+
+    def _at(self, s: np.ndarray, order: int) -> np.ndarray:
+        return self.curve(self.corner, self.e_in, self.e_out, self.b, self.horizontal, float(self.pose0[3]),
+                          self.yaw_rate, s, order)  # fmt: skip
+
+    def poses(self, s: np.ndarray) -> np.ndarray:  # noqa: D102
+        return self._at(np.clip(np.asarray(s, dtype=float), 0.0, 1.0), 0)
+
+    def pose_derivatives(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # noqa: D102
+        return self._at(s, 1), self._at(s, 2)
+
+
+@dataclass(frozen=True, eq=False)
+class ArchPath(GeometricPath):
+    """Tool segments (lines and blends) joined into one path q(s), s in [0, 1]; C2 in s across knots.
+
+    Segment k covers ``[bounds[k], bounds[k + 1]]`` with ``bounds`` proportional to the segments' lengths
+    (a line its length, a blend 2 b), so d(pose)/ds is continuous at the knots.
+
+    Attributes:
+        segments: the segments in order.
+        bounds: (len(segments) + 1,) increasing from 0 to 1.
+        names: the leg name of each segment ("lift", "blend up", "traverse", "blend down", "descend").
+    """
+
+    segments: tuple[CartesianSegment, ...]
+    bounds: np.ndarray
+    names: tuple[str, ...]
+
+    def knots(self) -> np.ndarray:  # noqa: D102
+        return self.bounds.copy()
+
+    @property
+    def branch(self) -> str:
+        """The elbow branch of every configuration on the path."""
+        return self.segments[0].branch
+
+    @property
+    def q_start(self) -> np.ndarray:
+        """The configuration at the start."""
+        return self.segments[0].q_ref[0].copy()
+
+    @property
+    def q_end(self) -> np.ndarray:
+        """The configuration at the end."""
+        return self.segments[-1].q_ref[-1].copy()
+
+    def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
+        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
+        idx = np.clip(np.searchsorted(self.bounds, s, side="right") - 1, 0, len(self.segments) - 1)
+        out = [np.empty((len(s), 4)) for _ in range(order + 1)]
+        for k, seg in enumerate(self.segments):
+            sel = idx == k
+            if not sel.any():
+                continue
+            width = self.bounds[k + 1] - self.bounds[k]
+            res = seg.evaluate((s[sel] - self.bounds[k]) / width, order)
+            for o in range(order + 1):
+                out[o][sel] = res[o] / width**o
+        return tuple(out)
+
+    def tool_poses(self, s: np.ndarray) -> np.ndarray:
+        """(n, 4) tool poses on the path at s (from the segments' curves, not FK)."""
+        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
+        idx = np.clip(np.searchsorted(self.bounds, s, side="right") - 1, 0, len(self.segments) - 1)
+        out = np.empty((len(s), 4))
+        for k, seg in enumerate(self.segments):
+            sel = idx == k
+            if sel.any():
+                out[sel] = seg.poses((s[sel] - self.bounds[k]) / (self.bounds[k + 1] - self.bounds[k]))
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class _Arch:
+    """The geometry of an arch: corner points, blend sizes, yaw rate."""
+
+    a: np.ndarray
+    b: np.ndarray
+    top: float
+    u: np.ndarray
+    D: float
+    b1: float
+    b2: float
+    yaw_rate: float
+
+
+def _arch_geometry(pose_from: np.ndarray, pose_to: np.ndarray, rise: float, blend: float) -> _Arch:
+    d = pose_to[:2] - pose_from[:2]
+    D = float(np.hypot(*d))
+    if D < 1e-6:
+        raise InvalidInputError(f"the two poses are {D:.3g} m apart horizontally: an arch needs a horizontal move "
+                                "(use a straight line, traj --linear, for a vertical one)")  # fmt: skip
+    top = max(float(pose_from[2]), float(pose_to[2])) + rise
+    u = np.array([d[0] / D, d[1] / D, 0.0])
+    b1 = min(blend, top - float(pose_from[2]), D / 2.0)
+    b2 = min(blend, top - float(pose_to[2]), D / 2.0)
+    return _Arch(pose_from, pose_to, top, u, D, b1, b2, float(pose_to[3] - pose_from[3]) / D)
+
+
+def arch_path(
+    robot: Robot,
+    pose_from: ArrayLike,
+    pose_to: ArrayLike,
+    *,
+    rise: float = STANDARD_RISE,
+    blend: float | None = None,
+    start: ArrayLike | None = None,
+    end: ArrayLike | None = None,
+    branch: str | None = None,
+) -> ArchPath | Any:
+    """The arch path from ``pose_from`` to ``pose_to`` (module docstring); checked like a straight line.
+
+    Args:
+        robot: a SCARA.
+        pose_from: (x, y, z, yaw) at the start [m, rad].
+        pose_to: (x, y, z, yaw) at the end [m, rad]; the yaw is interpolated as written (no wrap).
+        rise: [m] > 0, the traverse height above the higher of the two poses.
+        blend: [m] >= 0, the largest blend distance along each line (it is also limited by the lift and
+            half the horizontal distance); None: as large as allowed; 0: no blend (stop at the corners).
+        start: the configuration at ``pose_from`` (fixes the branch and the J4 turn).
+        end: the configuration the path must end at, if given.
+        branch: ``"right"`` or ``"left"`` (default: the start's, or ``"right"``).
+
+    Returns:
+        An :class:`ArchPath`, or with ``blend = 0`` the :class:`~scara_pin.motion.paths.CartesianPath`
+        of the three lines.
+
+    Raises:
+        ParameterError: a pose or number is malformed (NaN, infinite, negative).
+        InvalidInputError: no horizontal move.
+        PathError: the path leaves the workspace or the joint limits, or reaches the singularity.
+    """
+    A, B = _vector("pose_from", pose_from), _vector("pose_to", pose_to)
+    rise = _nonneg("rise", rise, strict=True)
+    blend = math.inf if blend is None else _nonneg("blend", blend)
+    g = _arch_geometry(A, B, rise, blend)
+    corners = [A, np.array([*A[:2], g.top, A[3]]), np.array([*B[:2], g.top, B[3]]), B]
+    lines = cartesian_path(robot, corners, start=start, end=end, branch=branch)
+    if blend == 0.0:
+        return lines
+    z = np.array([0.0, 0.0, 1.0])
+    c1, c2 = np.array([*A[:2], g.top]), np.array([*B[:2], g.top])
+    y1, y2 = float(A[3]) + g.yaw_rate * g.b1, float(B[3]) - g.yaw_rate * g.b2
+    pieces: list[tuple[str, Any]] = []
+    if g.top - A[2] - g.b1 > 1e-12:
+        pieces.append(("lift", (A, np.array([*A[:2], g.top - g.b1, A[3]]))))
+    pieces.append(("blend up", (c1, z, g.u, g.b1, float(A[3]))))
+    if g.D - g.b1 - g.b2 > 1e-12:
+        pieces.append(("traverse", (np.array([*(c1 + g.b1 * g.u), y1]), np.array([*(c2 - g.b2 * g.u), y2]))))
+    pieces.append(("blend down", (c2, g.u, -z, g.b2, y2)))
+    if g.top - B[2] - g.b2 > 1e-12:
+        pieces.append(("descend", (np.array([*B[:2], g.top - g.b2, B[3]]), B)))
+    segments: list[CartesianSegment] = []
+    lengths: list[float] = []
+    q = lines.q_start
+    for k, (name, data) in enumerate(pieces):
+        if name.startswith("blend"):
+            corner, e_in, e_out, b, yaw0 = data
+
+            def curve(s: np.ndarray, c: Any = data) -> np.ndarray:
+                return BlendSegment.curve(c[0], c[1], c[2], c[3], g.u, c[4], g.yaw_rate, s)
+
+            m = max(1, math.ceil(2.0 * b / _STEP))
+            _, q_pts, s_ref, q_ref = follow_curve(robot, lines.branch, curve, q, m, k,
+                                                  extent=(2.0 * b, abs(g.yaw_rate) * b))  # fmt: skip
+            p0, p1 = curve(np.array([0.0, 1.0]))
+            seg: CartesianSegment = BlendSegment(robot, lines.branch, p0, p1, s_ref, q_ref, corner=corner,
+                                                 e_in=e_in, e_out=e_out, b=b, horizontal=g.u,
+                                                 yaw_rate=g.yaw_rate)  # fmt: skip
+            lengths.append(2.0 * b)
+        else:
+            a, bb = data
+            sub = cartesian_path(robot, [a, bb], start=q, branch=lines.branch)
+            seg = sub.segments[0]
+            q_pts = sub.checkpoints[0][1]
+            lengths.append(float(np.linalg.norm(bb[:3] - a[:3])))
+        segments.append(seg)
+        q = q_pts[-1]
+    if np.abs(q - lines.q_end).max() > 1e-9:
+        raise PathError(f"the blended arch ends at q = {np.round(q, 9).tolist()}, the corner path at "
+                        f"{np.round(lines.q_end, 9).tolist()} (another J4 turn)", s=1.0, pose=B, q=q)  # fmt: skip
+    bounds = np.concatenate([[0.0], np.cumsum(lengths)])
+    bounds /= bounds[-1]
+    bounds[-1] = 1.0
+    return ArchPath(tuple(segments), bounds, tuple(name for name, _ in pieces))
+
+
+def _nonneg(name: str, value: object, strict: bool = False) -> float:
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, "must be a number", "m") from None
+    if not math.isfinite(v) or v < 0.0 or (strict and v == 0.0):
+        raise ParameterError(name, v, "must be finite and " + ("> 0" if strict else ">= 0"), "m")
+    return v
+
+
+# ---------------------------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class Leg:
+    """One leg of a move: its time span and the limit that is active (closest to 1) on it.
+
+    Attributes:
+        name: "lift", "blend up", "traverse", "blend down" or "descend".
+        move: index of the move in the cycle (0 out, 1 back).
+        t_start, t_end: [s] in the whole trajectory.
+        active: the quantity ("velocity", "acceleration", "torque", "jerk") with the largest ratio on it.
+        joint: the joint where that ratio is reached.
+        ratio: |value| / limit there (1.0: on the limit).
+    """
+
+    name: str
+    move: int
+    t_start: float
+    t_end: float
+    active: str
+    joint: str
+    ratio: float
+
+    @property
+    def duration(self) -> float:
+        """[s]."""
+        return self.t_end - self.t_start
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
+                "duration": self.duration, "active_limit": self.active, "joint": self.joint, "ratio": self.ratio}
+
+
+@dataclass(frozen=True, eq=False)
+class ArchMove:
+    """A timed arch move (or several, joined rest to rest) and how its limits are used.
+
+    Attributes:
+        trajectory: the trajectory (one motion per arch, or per line without blends).
+        paths: the geometric paths (ArchPath or the corner lines) in order.
+        legs: the legs with their times and active limits.
+        ratios: worst ratio per quantity ("velocity", "acceleration", "torque", "jerk"; None if not limited).
+        payload: the payload carried.
+        jerk: the jerk limits per joint, or None.
+    """
+
+    trajectory: Trajectory
+    paths: tuple[Any, ...]
+    legs: tuple[Leg, ...]
+    ratios: dict[str, float | None]
+    payload: Payload
+    jerk: tuple[float, ...] | None
+
+    @property
+    def duration(self) -> float:
+        """[s]."""
+        return self.trajectory.duration
+
+
+@dataclass(frozen=True, eq=False)
+class CycleResult:
+    """The standard cycle: out and back, with its placement.
+
+    Attributes:
+        move: the timed cycle (two moves).
+        start, end: the poses at the ends of the traverse (x, y, z, yaw) [m, rad].
+        span, rise, blend: the strokes and the blend distance used [m] (blend 0: none).
+        placement: how the placement was chosen (a sentence), and its smallest manipulability.
+        min_manipulability: the smallest |det J| along the traverse at the start height.
+    """
+
+    move: ArchMove
+    start: np.ndarray
+    end: np.ndarray
+    span: float
+    rise: float
+    blend: float
+    placement: str
+    min_manipulability: float
+
+    @property
+    def cycle_time(self) -> float:
+        """[s] out and back."""
+        return self.move.duration
+
+
+# ---------------------------------------------------------------------------------------------- timing
+def arch_move(
+    robot: Robot,
+    poses: ArrayLike,
+    *,
+    rise: float = STANDARD_RISE,
+    blend: float | None = None,
+    payload: Payload | None = None,
+    jerk: float | ArrayLike | None = None,
+    torque: bool = True,
+    limits: JointLimits | None = None,
+    start: ArrayLike | None = None,
+    branch: str | None = None,
+    options: TimingOptions | None = None,
+) -> ArchMove:
+    """Time-optimal arch moves through ``poses`` (rest at each), under the robot's limits.
+
+    Args:
+        robot: a SCARA.
+        poses: (m, 4) poses, m >= 2: an arch from each to the next, the robot at rest at each.
+        rise: [m] the traverse height above the higher pose (:func:`arch_path`).
+        blend: [m] the largest blend distance (:func:`arch_path`; 0: stop at the corners).
+        payload: carried by the tool (torques); default none.
+        jerk: joint jerk limit [rad/s^3, m/s^3], one or four numbers; None: not limited.
+        torque: respect the effort limits (RNEA with the payload).
+        limits: limits instead of ``robot.limits`` (a URDF file has no accelerations: give them here).
+        start: the configuration at ``poses[0]`` (fixes branch and J4 turn).
+        branch: ``"right"`` or ``"left"``.
+        options: TOPP-RA grid and verification options.
+
+    Raises:
+        ParameterError, InvalidInputError: bad input (exit 2); PathError, TimingError: infeasible (exit 3).
+    """
+    payload = Payload() if payload is None else payload
+    P = np.asarray(poses, dtype=float)
+    if P.ndim != 2 or P.shape[1] != 4 or P.shape[0] < 2:
+        raise ParameterError("poses", f"shape {P.shape}", "must be (m, 4) with m >= 2")
+    lim = _limits(robot, limits, None, torque)  # refuses NaN (a URDF's missing accelerations) up front
+    loaded = with_payload(robot, payload)
+    paths: list[Any] = []
+    q = None if start is None else np.asarray(start, dtype=float)
+    for k in range(P.shape[0] - 1):
+        path = arch_path(robot, P[k], P[k + 1], rise=rise, blend=blend, start=q, branch=branch)
+        paths.append(path)
+        q, branch = path.q_end, path.branch
+    pieces: list[Motion] = []
+    for path in paths:
+        res = parameterize(loaded, path, torque=torque, limits=limits, options=options)
+        pieces.extend(p for p in res.trajectory.pieces if isinstance(p, Motion))
+    traj = Trajectory(tuple(pieces))
+    jv = None
+    if jerk is not None:
+        traj, _ = jerk_limited(loaded, traj, jerk, torque=torque, limits=limits, options=options)
+        jv = tuple(float(v) for v in np.broadcast_to(np.asarray(jerk, dtype=float), (4,)))
+    legs, ratios = _legs(loaded, traj, paths, lim, None if jv is None else np.array(jv))
+    return ArchMove(traj, tuple(paths), legs, ratios, payload, jv)
+
+
+def _leg_names(path: Any) -> tuple[tuple[str, ...], np.ndarray]:
+    if isinstance(path, ArchPath):
+        return path.names, path.bounds
+    return ("lift", "traverse", "descend"), np.array([0.0, 1.0])
+
+
+def _law_time(law: Any, s_target: float) -> float:
+    """The time at which a monotonic law reaches s (bisection)."""
+    lo, hi = 0.0, float(law.duration)
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        if float(law.evaluate(np.array([mid]))[0][0]) < s_target:
+            lo = mid
+        else:
+            hi = mid
+    return hi
+
+
+def _legs(
+    robot: Robot, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
+) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
+    """Legs (time spans) and, per leg, the most used limit, from a dense sampling (rate and 8 per 1/rate)."""
+    from ..description import JOINT_NAMES
+
+    spans: list[tuple[str, int, float, float]] = []
+    t0 = 0.0
+    motions = [p for p in traj.pieces if isinstance(p, Motion)]
+    mi = 0
+    for move, path in enumerate(paths):
+        names, bounds = _leg_names(path)
+        if isinstance(path, ArchPath):
+            m = motions[mi]
+            cuts = [0.0] + [_law_time(m.law, float(b)) for b in bounds[1:-1]] + [m.duration]
+            spans += [(names[k], move, t0 + cuts[k], t0 + cuts[k + 1]) for k in range(len(names))]
+            t0 += m.duration
+            mi += 1
+        else:
+            for name in names:
+                m = motions[mi]
+                spans.append((name, move, t0, t0 + m.duration))
+                t0 += m.duration
+                mi += 1
+    legs: list[Leg] = []
+    worst: dict[str, float | None] = {k: None for k in _QUANTITIES}
+    for name, move, ta, tb in spans:
+        n = max(16, int(math.ceil((tb - ta) * rate * 8)))
+        t = np.linspace(ta, tb, n + 1)
+        ratio = _ratio_table(robot, traj, t, lim, jerk)
+        best = ("velocity", 0, -1.0)
+        for qty, r in ratio.items():
+            j = int(np.argmax(r.max(axis=0)))
+            val = float(r[:, j].max())
+            prev = worst[qty]
+            worst[qty] = val if prev is None else max(prev, val)
+            if val > best[2]:
+                best = (qty, j, val)
+        legs.append(Leg(name, move, float(ta), float(tb), best[0], JOINT_NAMES[best[1]], best[2]))
+    return tuple(legs), worst
+
+
+def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: np.ndarray | None) -> dict[str, Any]:
+    """|value| / limit per sample and joint, per quantity."""
+    q, qd, qdd = traj.sample(t)
+    out = {"velocity": np.abs(qd) / lim.velocity, "acceleration": np.abs(qdd) / lim.acceleration}
+    if lim.effort is not None:
+        out["torque"] = np.abs(_rnea(robot, q, qd, qdd)) / lim.effort
+    if jerk is not None:
+        out["jerk"] = np.abs(trajectory_jerk(traj, t)) / jerk
+    return out
+
+
+def trajectory_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
+    """Joint jerk (n, 4) of a trajectory of motions at times t (zero at rest outside)."""
+    t = np.asarray(t, dtype=float)
+    out = np.zeros((len(t), 4))
+    t0 = 0.0
+    for p in traj.pieces:
+        if not isinstance(p, Motion):
+            raise InvalidInputError("jerk needs a trajectory of motions")
+        sel = (t >= t0) & (t <= t0 + p.duration)
+        if sel.any():
+            out[sel] = joint_jerk(p, t[sel] - t0)
+        t0 += p.duration
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- the cycle
+def cycle_placement(
+    robot: Robot, span: float = STANDARD_SPAN, rise: float = STANDARD_RISE, branch: str = "right", n: int = 160
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """The default placement of the standard cycle (module docstring): (start pose, end pose, min |det J|).
+
+    Candidates: the chords of length ``span`` perpendicular to the arm's direction at the middle of
+    J1's range (q2 = 0), centred on it, at ``n`` distances d from the J1 axis; at each, 41 points of the
+    chord at the start height are solved (closed-form IK, ``branch``, nearest the middle of the ranges)
+    and scored by the smallest manipulability |det J|. The best d wins.
+
+    Raises:
+        InvalidInputError: ``span`` is longer than the diameter of the reach circle (no chord fits).
+        InfeasibleError: no candidate chord is reachable within the joint limits.
+    """
+    lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
+    mid = (lo + hi) / 2.0
+    q_stretched = mid.copy()
+    q_stretched[1] = 0.0 if lo[1] <= 0.0 <= hi[1] else mid[1]
+    centre = robot.tool_pose(q_stretched)
+    reach = float(np.hypot(centre[0], centre[1]))
+    if span >= 2.0 * reach:
+        raise InvalidInputError(f"span {span:.6g} m is beyond the reach: the tool reaches {reach:.6g} m from the J1 "
+                                f"axis, so no chord longer than {2 * reach:.6g} m fits")  # fmt: skip
+    radial = centre[:2] / reach
+    tangent = np.array([-radial[1], radial[0]])
+    z_lo = robot.tool_pose(np.where(np.arange(4) == 2, hi, mid))[2]  # the quill fully down: lowest z
+    z_hi = robot.tool_pose(np.where(np.arange(4) == 2, lo, mid))[2]
+    if rise >= abs(z_hi - z_lo):
+        raise InvalidInputError(f"rise {rise:.6g} m is beyond the vertical stroke {abs(z_hi - z_lo):.6g} m")
+    z = 0.5 * (z_lo + z_hi) - rise / 2.0
+    yaw = 0.0
+    u = np.linspace(-0.5, 0.5, 41) * span
+    best = (-1.0, 0.0)
+    for d in np.linspace(0.0, reach, n + 2)[1:-1]:
+        pts = d * radial[None, :] + u[:, None] * tangent[None, :]
+        score = math.inf
+        for x, y in pts:
+            res = robot.ik([x, y, z, yaw], branch=branch, reference=mid)
+            sol = res.nearest(mid, branch=branch) if res.success else None
+            if sol is None:
+                score = -1.0
+                break
+            score = min(score, robot.manipulability(sol.q))
+        if score > best[0]:
+            best = (score, float(d))
+    if best[0] <= 0.0:
+        raise InfeasibleError(f"no chord of {span:.6g} m perpendicular to the arm at mid J1 range is reachable "
+                              f"on the {branch} branch at z = {z:.6g} m")  # fmt: skip
+    d = best[1]
+    a = np.array([*(d * radial - 0.5 * span * tangent), z, yaw])
+    b = np.array([*(d * radial + 0.5 * span * tangent), z, yaw])
+    return a, b, best[0]
+
+
+def standard_cycle(
+    robot: Robot,
+    *,
+    start: ArrayLike | None = None,
+    direction: ArrayLike | None = None,
+    span: float = STANDARD_SPAN,
+    rise: float = STANDARD_RISE,
+    blend: float | None = None,
+    payload: Payload | None = None,
+    jerk: float | ArrayLike | None = None,
+    limits: JointLimits | None = None,
+    branch: str = "right",
+    options: TimingOptions | None = None,
+) -> CycleResult:
+    """The standard cycle: up ``rise``, across ``span``, down, and back the same way (rest at both ends).
+
+    Args:
+        robot: a SCARA.
+        start: the start pose (x, y, z, yaw) [m, rad]; default :func:`cycle_placement`.
+        direction: (dx, dy) of the traverse; with ``start`` (default: perpendicular to the arm direction
+            at mid J1 range).
+        span: [m] > 0, the horizontal stroke.
+        rise: [m] > 0, the vertical stroke.
+        blend: [m] >= 0, largest blend distance (None: as large as allowed, i.e. the whole rise; 0: none).
+        payload: carried by the tool (torque limits always apply, RNEA with the payload).
+        jerk: joint jerk limit, one or four numbers, or None.
+        limits: limits instead of ``robot.limits``.
+        branch: the elbow branch.
+        options: TOPP-RA grid and verification options.
+
+    Raises:
+        ParameterError, InvalidInputError: bad input (exit 2); InfeasibleError (PathError, TimingError): the
+        robot cannot do it (exit 3).
+    """
+    span = _nonneg("span", span, strict=True)
+    rise = _nonneg("rise", rise, strict=True)
+    if robot.kind != "scara":
+        raise InvalidInputError(f"the cycle is SCARA-only for now; robot {robot.name!r} is a {robot.kind} (the "
+                                "straight tool lines it is built on use the SCARA closed form)")  # fmt: skip
+    if start is None and direction is not None:
+        raise InvalidInputError("--direction needs --from (the start pose)")
+    if start is None:
+        a, b, wmin = cycle_placement(robot, span, rise, branch)
+        why = ("chord perpendicular to the arm at mid J1 range, centred on it, at mid-stroke height, at the distance "
+               "from the J1 axis that maximises the smallest manipulability |det J| along it")  # fmt: skip
+    else:
+        a = _vector("start", start)
+        dvec = np.array([1.0, 0.0]) if direction is None else _vector("direction", direction, 2)
+        norm = float(np.hypot(*dvec))
+        if norm == 0.0:
+            raise ParameterError("direction", dvec.tolist(), "must not be zero")
+        b = a.copy()
+        b[:2] += span * dvec / norm
+        why = "given by --from and --direction"
+        wmin = math.nan
+    move = arch_move(robot, np.array([a, b, a]), rise=rise, blend=blend, payload=payload, jerk=jerk, torque=True,
+                     limits=limits, branch=branch, options=options)  # fmt: skip
+    if wmin != wmin:  # the smallest manipulability along the traverse of the given placement
+        q0 = move.trajectory.q_start
+        pts = [np.array([*(a[:2] + f * (b[:2] - a[:2])), a[2], a[3]]) for f in np.linspace(0.0, 1.0, 41)]
+        wmin = min(robot.manipulability(robot.ik_nearest(p, q0)) for p in pts)
+    used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
+    return CycleResult(move, a, b, span, rise, used, why, float(wmin))
+
+
+def limits_dict(robot: Robot, limits: JointLimits | None, jerk: tuple[float, ...] | None) -> dict[str, Any]:
+    """The limits used, JSON-ready (per joint, SI)."""
+    lim = robot.limits if limits is None else limits
+    return {"velocity": list(lim.velocity), "acceleration": list(lim.acceleration), "effort": list(lim.effort),
+            "jerk": None if jerk is None else list(jerk)}  # fmt: skip
+

@@ -1,0 +1,91 @@
+"""PNG picture of an arch move or cycle: tool path in side and plan view, joint rates against their limits.
+
+Object-oriented matplotlib (a Figure on the Agg canvas, no pyplot, no global state), written atomically.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..description import JOINT_NAMES
+from ..files import atomic_output
+
+if TYPE_CHECKING:
+    from ..description import JointLimits
+    from ..model import Robot
+    from ..motion.cycle import ArchMove
+
+__all__ = ["plot_cycle"]
+
+_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
+_LEG_COLORS = {"lift": "tab:gray", "blend up": "tab:purple", "traverse": "tab:blue", "blend down": "tab:purple",
+               "descend": "tab:gray"}  # fmt: skip
+
+
+def plot_cycle(
+    robot: Robot,
+    move: ArchMove,
+    path: str | os.PathLike[str],
+    *,
+    limits: JointLimits | None = None,
+    title: str | None = None,
+    rate: float = 2000.0,
+    dpi: int = 110,
+) -> Path:
+    """Write a PNG of an arch move or cycle: the tool path, and the joint rates against their limits.
+
+    Side view (horizontal progress vs z) and plan view (x, y) with the legs coloured (blends in purple);
+    |qd|/vmax, |qdd|/amax (and |qddd|/jmax with a jerk limit) per joint against time, the limit at 1.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ..motion.cycle import trajectory_jerk
+
+    lim = robot.limits if limits is None else limits
+    traj = move.trajectory
+    t = np.linspace(0.0, traj.duration, max(2, int(traj.duration * rate) + 1))
+    q, qd, qdd = traj.sample(t)
+    poses = np.array([robot.tool_pose(qk) for qk in q])
+    rows = 3 if move.jerk is None else 4
+    fig = Figure(figsize=(12.0, 2.8 * rows), layout="constrained")
+    FigureCanvasAgg(fig)
+    grid = fig.add_gridspec(rows, 2)
+    side, plan = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1])
+    start = poses[0, :2]
+    direction = poses[np.argmax(np.linalg.norm(poses[:, :2] - start, axis=1)), :2] - start
+    norm = float(np.linalg.norm(direction)) or 1.0
+    progress = (poses[:, :2] - start) @ (direction / norm)
+    for leg in move.legs:
+        sel = (t >= leg.t_start) & (t <= leg.t_end)
+        color = _LEG_COLORS.get(leg.name, "k")
+        label = leg.name if leg.move == 0 else None
+        side.plot(progress[sel] * 1e3, poses[sel, 2] * 1e3, color=color, lw=2, label=label)
+        plan.plot(poses[sel, 0] * 1e3, poses[sel, 1] * 1e3, color=color, lw=2)
+    side.set(xlabel="along the traverse [mm]", ylabel="z [mm]", title="side view (tool path)")
+    side.legend(fontsize="small")
+    plan.plot([0.0], [0.0], "k+", ms=12)
+    plan.set(xlabel="x [mm]", ylabel="y [mm]", title="plan view (J1 axis at +)", aspect="equal")
+    quantities = [("|qd| / vmax", np.abs(qd) / np.array(lim.velocity)),
+                  ("|qdd| / amax", np.abs(qdd) / np.array(lim.acceleration))]  # fmt: skip
+    if move.jerk is not None:
+        quantities.append(("|qddd| / jmax", np.abs(trajectory_jerk(traj, t)) / np.array(move.jerk)))
+    for k, (name, ratio) in enumerate(quantities):
+        ax = fig.add_subplot(grid[1 + k, :])
+        for j in range(4):
+            ax.plot(t, ratio[:, j], color=_COLORS[j], label=JOINT_NAMES[j])
+        ax.axhline(1.0, color="k", ls="--", lw=1)
+        for leg in move.legs:
+            ax.axvline(leg.t_start, color="0.85", lw=0.8, zorder=0)
+        ax.set(ylabel=name, ylim=(0.0, 1.1))
+        ax.legend(fontsize="small", ncol=4, loc="upper right")
+    ax.set_xlabel("t [s]")
+    if title:
+        fig.suptitle(title)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=dpi)
+    return Path(path)

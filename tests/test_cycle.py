@@ -1,0 +1,182 @@
+"""The standard cycle and arch moves (scara_pin.motion.cycle, jerk, payload; scara-pin cycle / traj --arch).
+
+Independent routes: limits re-checked from the samples (numpy); torques by Pinocchio's RNEA on a model the
+test loads itself with the payload appended as a body (appendBodyToJoint, not the library's route); the
+geometry from FK of the sampled joints; the exported CSV checked by finite differences (q -> qd -> qdd ->
+jerk).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from scara_pin import load_robot
+from scara_pin.cli import main
+from scara_pin.motion.cycle import standard_cycle, trajectory_jerk
+from scara_pin.motion.jerk import FilteredLaw
+from scara_pin.motion.payload import Payload
+
+PROMISE = 1e-6
+JERK = [20000.0, 40000.0, 2000.0, 100000.0]  # rad/s^3, rad/s^3, m/s^3, rad/s^3
+MASS, COM = 2.0, (0.01, 0.0, 0.03)  # kg; m in the tool frame
+
+
+def _loaded_model(robot, mass, com):  # the test's own payload route
+    model = pin.Model(robot.model)
+    frame = model.frames[robot.tool_id]
+    model.appendBodyToJoint(frame.parentJoint, pin.Inertia(mass, frame.placement.act(np.array(com)), np.zeros((3, 3))),
+                            pin.SE3.Identity())
+    return model
+
+
+def _torques(model, q, qd, qdd):
+    data = model.createData()
+    return np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return load_robot("default")
+
+
+@pytest.fixture(scope="module")
+def jerk_cycle(robot):
+    return standard_cycle(robot, payload=Payload(MASS, COM), jerk=JERK)
+
+
+@pytest.fixture(scope="module")
+def plain(robot):
+    return standard_cycle(robot), standard_cycle(robot, blend=0.0)
+
+
+def _check_times(traj):
+    """1 kHz, and every breakpoint of the jerk laws (the path jerk's closed-form extrema) and each one's left side."""
+    t = [np.arange(0.0, traj.duration, 1e-3)]
+    t0 = 0.0
+    for m in traj.pieces:
+        assert isinstance(m.law, FilteredLaw)
+        bp = m.law.breakpoints()
+        t += [t0 + bp, t0 + bp[:-1] + np.diff(bp) * (1 - 1e-9)]
+        t0 += m.duration
+    return np.concatenate(t)
+
+
+def test_jerk_cycle_keeps_every_limit_with_payload(robot, jerk_cycle):
+    traj = jerk_cycle.move.trajectory
+    t = _check_times(traj)
+    q, qd, qdd = traj.sample(t)
+    lim = robot.limits
+    assert np.max(np.abs(qd) / lim.velocity) <= 1 + PROMISE
+    assert np.max(np.abs(qdd) / lim.acceleration) <= 1 + PROMISE
+    assert np.max(np.abs(trajectory_jerk(traj, t)) / JERK) <= 1 + PROMISE
+    tau = _torques(_loaded_model(robot, MASS, COM), q, qd, qdd)
+    assert np.max(np.abs(tau) / lim.effort) <= 1 + PROMISE
+    # the payload is really in: the quill carries its weight (2 kg * g more than without it)
+    tau0 = _torques(robot.model, q, qd, qdd)
+    assert np.abs(tau - tau0)[:, 2].max() > MASS * 9.0
+    # a limit is active somewhere (the jerk one, here): not a trivially slow result
+    assert max(v for v in jerk_cycle.move.ratios.values() if v is not None) > 0.999
+
+
+def test_geometry_up_across_back(robot, plain):
+    for result in plain:
+        traj = result.move.trajectory
+        t_mid = traj.pieces[0].duration if len(traj.pieces) == 2 else sum(p.duration for p in traj.pieces[:3])
+        t = np.concatenate([np.linspace(0.0, traj.duration, 3001), [t_mid]])
+        poses = np.array([robot.tool_pose(q) for q in traj.sample(t)[0]])
+        start = poses[0]
+        assert np.abs(poses[-2] - start).max() < 1e-9  # t = duration: back to the start
+        assert poses[:, 2].max() - start[2] == pytest.approx(0.025, abs=1e-6)
+        assert poses[:, 2].min() == pytest.approx(start[2], abs=1e-9)
+        across = np.linalg.norm(poses[:, :2] - start[:2], axis=1)
+        assert across.max() == pytest.approx(0.305, abs=1e-6)
+        assert np.linalg.norm(poses[-1, :2] - poses[-2, :2]) == pytest.approx(0.305, abs=1e-6)  # t_mid: at B
+
+
+def test_blended_strictly_faster(plain):
+    blended, corners = plain
+    assert blended.cycle_time < corners.cycle_time - 1e-3
+    assert [leg.name for leg in corners.move.legs][:3] == ["lift", "traverse", "descend"]
+
+
+def test_more_payload_never_faster(robot):
+    # effort limits low enough that the torque binds: the time must grow with the payload
+    lim = dataclasses.replace(robot.limits, effort=(12.0, 6.0, 150.0, 2.0))
+    times = [standard_cycle(robot, payload=Payload(m), limits=lim).cycle_time for m in (0.0, 1.0, 2.0)]
+    assert times[0] < times[1] < times[2]
+
+
+def test_csv_by_finite_differences(robot, jerk_cycle, tmp_path):
+    out = jerk_cycle.move.trajectory.to_csv(tmp_path / "cycle.csv", rate=1000.0)  # what cycle --out writes
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    t, q, qd, qdd = data[:, 0], data[:, 1:5], data[:, 5:9], data[:, 9:13]
+    dt = 1e-3
+    assert t[-1] == pytest.approx(jerk_cycle.cycle_time, abs=1e-3)
+    # central differences against the exported rates; with |jerk| <= J the exact bounds are
+    # |(q(t+h) - q(t-h)) / 2h - qd(t)| <= J h^2 / 6 and |(qd(t+h) - qd(t-h)) / 2h - qdd(t)| <= J h / 2
+    jmax = np.array(JERK)
+    slack = 1 + 1e-6
+    assert np.all(np.abs((q[2:] - q[:-2]) / (2 * dt) - qd[1:-1]) <= jmax * dt**2 / 6 * slack + 1e-12)
+    assert np.all(np.abs((qd[2:] - qd[:-2]) / (2 * dt) - qdd[1:-1]) <= jmax * dt / 2 * slack + 1e-12)
+    # jerk by differences of the exported accelerations: a mean of the true jerk, so within the limit
+    fd_jerk = np.diff(qdd, axis=0) / dt
+    assert np.max(np.abs(fd_jerk) / jmax) <= 1 + 1e-6
+    lim = robot.limits
+    assert np.max(np.abs(qd) / lim.velocity) <= 1 + PROMISE
+    assert np.max(np.abs(qdd) / lim.acceleration) <= 1 + PROMISE
+    tau = _torques(_loaded_model(robot, MASS, COM), q, qd, qdd)
+    assert np.max(np.abs(tau) / lim.effort) <= 1 + PROMISE
+
+
+def test_cli_plot_json_and_text(tmp_path, capsys):
+    png, csv = tmp_path / "c.png", tmp_path / "c.csv"
+    assert main(["cycle", "--no-blend", "--plot", str(png), "--out", str(csv), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert {"cycle_time", "legs", "limits"} <= summary.keys()
+    assert [leg["name"] for leg in summary["legs"]] == ["lift", "traverse", "descend"] * 2
+    assert abs(sum(leg["duration"] for leg in summary["legs"]) - summary["cycle_time"]) < 1e-9
+    assert np.loadtxt(csv, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(summary["cycle_time"], abs=1e-3)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+
+@pytest.mark.parametrize(
+    "argv, code, words",
+    [
+        (["--payload", "-1"], 2, "payload"),
+        (["--payload", "nan"], 2, "finite"),
+        (["--rise", "nan"], 2, "finite"),
+        (["--span", "2.0"], 2, "beyond the reach"),
+        (["--jerk-limit", "1", "2"], 2, "one number or 4"),
+        (["--arch", "0.01", "--no-blend"], 2, "exclude"),
+        (["--from", "0.3", "0", "-0.0875", "0", "--direction", "1", "0"], 3, "path fails"),
+    ],
+)
+def test_cli_errors(argv, code, words, capsys):
+    assert main(["cycle", *argv]) == code
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1 and words in err
+
+
+def test_urdf_needs_accelerations(tmp_path, capsys):
+    urdf = tmp_path / "r.urdf"
+    assert main(["urdf", "-o", str(urdf)]) == 0
+    capsys.readouterr()
+    assert main(["cycle", "--urdf", str(urdf)]) == 2
+    err = capsys.readouterr().err
+    assert "acceleration" in err and "URDF" in err
+
+
+def test_traj_arch_and_payload(tmp_path, capsys):
+    base = ["traj", "--from-pose", "0.3", "-0.1", "-0.1", "0", "--to-pose", "0.25", "0.15", "-0.08", "1"]
+    assert main([*base, "--arch", "--torque", "--payload", "1", "--json", "--out", str(tmp_path / "a.csv")]) == 0
+    arch = json.loads(capsys.readouterr().out)
+    assert arch["method"].startswith("arch") and arch["limit_ratios"]["torque"] > 0
+    assert main([*base, "--payload", "1"]) == 2  # payload without --torque
+    assert "--torque" in capsys.readouterr().err
