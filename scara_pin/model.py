@@ -32,9 +32,11 @@ from ._fast import nearest as _nearest_c
 from ._fast import speedups as _speedups
 from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
+from .urdf_rules import choose_frames, read_tree
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
+    from .description.packages import PackagePath
     from .kinematics.palletizer import PalletizerGeometry
     from .kinematics.scara import IKResult, ScaraGeometry
 
@@ -158,7 +160,10 @@ class Robot:
         parameters: the yaml parameters, when the robot was generated from them.
         kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file counts as a SCARA).
         continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
-        base_frame, tool_frame: names of the reference frame and of the tool frame.
+        base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
+        frame_note: the notice when the tool frame was chosen by default without a ``tool0`` (else None).
+        package_path: where ``package://`` names (meshes) are looked for (see
+            :mod:`scara_pin.description.packages`).
     """
 
     model: pin.Model
@@ -172,6 +177,8 @@ class Robot:
     has_continuous: bool
     base_frame: str
     tool_frame: str
+    frame_note: str | None
+    package_path: PackagePath
 
     def __init__(
         self,
@@ -179,9 +186,10 @@ class Robot:
         *,
         acceleration: Sequence[float] | None = None,
         parameters: RobotParameters | None = None,
-        base_frame: str = "base",
-        tool_frame: str = "tool0",
+        base_frame: str | None = None,
+        tool_frame: str | None = None,
         origin: str = "URDF",
+        package_path: PackagePath | None = None,
     ) -> None:
         """Load URDF text.
 
@@ -190,19 +198,26 @@ class Robot:
             acceleration: acceleration limits per joint [rad/s^2 or m/s^2]; URDF has none. Without it
                 (a URDF file) they are NaN, meaning unknown: commands that need them ask for them.
             parameters: the yaml parameters it was generated from, if any.
-            base_frame: the frame poses are expressed in; falls back to the root link if absent.
-            tool_frame: the tool frame (``tool0``).
+            base_frame: the link poses are expressed in; default ``base`` if present, else the root link.
+            tool_frame: the tool link; default ``tool0`` if present, else the chain's last link
+                (:func:`scara_pin.urdf_rules.choose_frames`, the rule ``scara-pin check`` reports).
             origin: how to name the source in error messages (a file name).
+            package_path: where ``package://`` names are looked for (meshes); default: none.
 
         Raises:
-            UrdfError: unreadable, invalid or disconnected URDF, or not a 4-joint robot.
+            UrdfError: unreadable, invalid or disconnected URDF, not a 4-joint robot, an unusable joint
+                (inverted limits, zero axis: :func:`scara_pin.urdf_rules.joint_problem`), or a frame
+                asked for that is not a link of the file.
         """
+        from .description.packages import PackagePath
+
         model = _parse_urdf(urdf, origin)
+        links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
         continuous = _continuous_joints(model, origin)
-        if not model.existFrame(tool_frame):
-            raise UrdfError(f"{origin}: no frame named {tool_frame!r}")
-        if not model.existFrame(base_frame):
-            base_frame = model.frames[1].name if len(model.frames) > 1 else "universe"
+        frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
+        base_frame, tool_frame = frames.base, frames.tool
+        self.frame_note = frames.note
+        self.package_path = package_path if package_path is not None else PackagePath()
         self.model = model
         self.data = model.createData()
         self.urdf = urdf
@@ -211,8 +226,8 @@ class Robot:
         self.kind = parameters.kind if parameters is not None else "scara"
         self.base_frame = base_frame
         self.tool_frame = tool_frame
-        self.base_id = model.getFrameId(base_frame)
-        self.tool_id = model.getFrameId(tool_frame)
+        self.base_id = model.getFrameId(base_frame, pin.FrameType.BODY)
+        self.tool_id = model.getFrameId(tool_frame, pin.FrameType.BODY)
         if parameters is not None:
             self.limits = parameters.limits
         else:  # a URDF file: record its limits as written (they may be placeholders; not checked here)
@@ -247,24 +262,35 @@ class Robot:
         cls,
         robot: str | Path | RobotParameters = "default",
         overrides: Mapping[str, object] | None = None,
+        **kwargs: Any,
     ) -> Robot:
-        """Generate the URDF of a configured robot (see :mod:`scara_pin.description`) and load it."""
+        """Generate the URDF of a configured robot (see :mod:`scara_pin.description`) and load it.
+
+        Keyword arguments (``tool_frame``, ``base_frame``) are passed to the constructor.
+        """
         params = load_parameters(robot, overrides)
         return cls(
             generate_urdf(params),
             parameters=params,
             origin=f"robot {params.name!r}",
+            **kwargs,
         )
 
     @classmethod
-    def from_file(cls, path: str | Path, **kwargs: Any) -> Robot:
-        """Load a URDF file (keyword arguments as for the constructor)."""
+    def from_file(cls, path: str | Path, *, package_dirs: Sequence[str | Path] = (), **kwargs: Any) -> Robot:
+        """Load a URDF file, or a xacro file (name ending in ``.xacro``) expanded first.
+
+        ``$(find pkg)`` and ``package://pkg/...`` are resolved in ``package_dirs`` (folders holding packages),
+        the folders above the file and ``ROS_PACKAGE_PATH`` / ``AMENT_PREFIX_PATH``
+        (:mod:`scara_pin.description.packages`). Expanding a xacro file runs the expressions written in
+        it: load only files you trust, as you would run them through ``xacro``. Other keyword arguments
+        are as for the constructor.
+        """
+        from .description.packages import PackagePath, read_robot_file
+
         path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise UrdfError(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
-        return cls(text, origin=str(path), **kwargs)
+        packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
+        return cls(read_robot_file(path, packages), origin=str(path), package_path=packages, **kwargs)
 
     # ----------------------------------------------------------------- geometry (lazy)
     @cached_property
@@ -574,19 +600,32 @@ def load_robot(
     overrides: Mapping[str, object] | None = None,
     *,
     urdf: str | Path | None = None,
+    tool: str | None = None,
+    base: str | None = None,
+    package_path: Sequence[str | Path] = (),
 ) -> Robot:
-    """Load a robot: a configured one (name or config folder, with overrides) or a URDF file.
+    """Load a robot: a configured one (name or config folder, with overrides) or a URDF / xacro file.
 
     Args:
         robot: shipped robot name, config folder, or parameters (ignored when ``urdf`` is given).
         overrides: parameter overrides (flat names), for configured robots only.
-        urdf: path of a URDF file to load instead.
+        urdf: path of a URDF file, or of a xacro file (``.xacro``), to load instead.
+        tool: the tool frame (a link); default ``tool0`` if present, else the chain's last link (then
+            ``robot.frame_note`` says so).
+        base: the base frame poses are expressed in (a link); default ``base`` if present, else the root.
+        package_path: folders holding ROS-style packages, for ``$(find pkg)`` and ``package://pkg/``.
+
+    Raises:
+        UrdfError: (exit code 2) among others a ``tool`` or ``base`` that is not a link of the robot.
     """
+    frames: dict[str, Any] = {"tool_frame": tool, "base_frame": base}
     if urdf is not None:
         if overrides:
             raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file")
-        return Robot.from_file(urdf)
-    return Robot.from_config(robot, overrides)
+        return Robot.from_file(urdf, package_dirs=package_path, **frames)
+    if package_path:
+        raise InvalidInputError("--package-path applies to a URDF or xacro file (--urdf), not to a configured robot")
+    return Robot.from_config(robot, overrides, **frames)
 
 
 def load_urdf(path: str | Path) -> Robot:
