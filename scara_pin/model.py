@@ -295,13 +295,21 @@ class Robot:
     # ----------------------------------------------------------------- geometry (lazy)
     @cached_property
     def visual_model(self) -> pin.GeometryModel:
-        """Visual geometry (primitives) of the URDF, built on first use."""
-        return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.VISUAL)
+        """Visual geometry of the URDF, built on first use; each mesh is a placeholder box.
+
+        Pinocchio never reads a mesh file: :func:`scara_pin.viz.meshes.visual_meshes` reads them (found
+        and checked as that module says) under the same geometry names.
+        """
+        from .viz.meshes import placeholder_urdf
+
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.VISUAL)
 
     @cached_property
     def collision_model(self) -> pin.GeometryModel:
-        """Collision geometry of the URDF, built on first use."""
-        return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.COLLISION)
+        """Collision geometry of the URDF, built on first use (meshes as placeholder boxes, as above)."""
+        from .viz.meshes import placeholder_urdf
+
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
 
     # ----------------------------------------------------------------- inverse kinematics
     @cached_property
