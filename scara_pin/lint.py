@@ -154,12 +154,14 @@ class CheckReport:
         findings: in the order found (structure, joints, geometry, loading).
         joints: movable joints in chain order (empty when the structure is broken).
         tool_frame: the frame taken as the tool (``tool0`` when present).
+        base_frame: the frame poses are expressed in (``base`` when present, else the root link).
     """
 
     source: str
     findings: tuple[Finding, ...]
     joints: tuple[JointInfo, ...] = ()
     tool_frame: str | None = None
+    base_frame: str | None = None
 
     @property
     def status(self) -> CheckStatus:
@@ -191,6 +193,7 @@ class CheckReport:
             "status": self.status.value,
             "exit_code": self.exit_code,
             "tool_frame": self.tool_frame,
+            "base_frame": self.base_frame,
             "joints": [j.to_dict() for j in self.joints],
             "findings": [f.to_dict() for f in self.findings],
         }
@@ -627,7 +630,7 @@ class _Checker:
             JointInfo(j.name, j.type, j.line, j.parent, j.child, getattr(self, "axes", {}).get(j.name))
             for j in self.chain
         )
-        return CheckReport(self.source, tuple(self.findings), joints, self.tool)
+        return CheckReport(self.source, tuple(self.findings), joints, self.tool, getattr(self, "base", None))
 
 
 def check_urdf(

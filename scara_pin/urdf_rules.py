@@ -69,6 +69,15 @@ def _dfs(links: Sequence[str], joints: Sequence[JointEdge]) -> tuple[str, list[J
     return root, order, children
 
 
+def _downstream_of_movable(order: Sequence[JointEdge]) -> set[str]:
+    """The links that a movable joint carries (``order``: depth-first from the root)."""
+    moving: set[str] = set()
+    for j in order:
+        if j.type in MOVABLE or j.parent in moving:
+            moving.add(j.child)
+    return moving
+
+
 def choose_frames(
     links: Sequence[str],
     joints: Sequence[JointEdge],
@@ -84,11 +93,13 @@ def choose_frames(
         joints: the joints, in file order.
         tool: the tool frame asked for (``--tool``); default: ``tool0`` if present, else the chain's last
             link (the deepest link below the last movable joint, the first in file order at each level).
-        base: the base frame asked for (``--base``); default: ``base`` if present, else the root link.
+        base: the base frame asked for (``--base``), a link fixed to the root; default: ``base`` if present,
+            else the root link.
         origin: how to name the source in error messages.
 
     Raises:
-        UrdfError: a frame asked for is not a link of the file (the message lists the links).
+        UrdfError: a frame asked for is not a link of the file (the message lists the links), or a base
+            that a movable joint carries.
     """
     for what, name in (("tool", tool), ("base", base)):
         if name is not None and name not in links:
@@ -97,6 +108,16 @@ def choose_frames(
     root, order, children = _dfs(links, joints)
     if base is None:
         base = "base" if "base" in links else root
+    else:  # the base is fixed: no movable joint between it and the root
+        parent_of = {j.child: j for j in order}
+        link = base
+        while link in parent_of:
+            if parent_of[link].type in MOVABLE:
+                fixed = ", ".join([root] + [j.child for j in order if j.child not in _downstream_of_movable(order)])
+                raise UrdfError(f"{origin}: the base frame (--base) {base!r} moves with joint "
+                                f"{parent_of[link].name}: the base must be fixed to the root link; "
+                                f"fixed links: {fixed}")  # fmt: skip
+            link = parent_of[link].parent
     note = None
     if tool is None:
         if "tool0" in links:
