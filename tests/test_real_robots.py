@@ -22,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import trimesh
-from browser import chromium, in_ci, next_frames, orange_pixels, unavailable_reason
+from browser import browser_for_tests, next_frames, orange_pixels
 
 from scara_pin import Robot, load_robot
 from scara_pin.cli import main
@@ -366,13 +366,7 @@ def test_missing_and_broken_meshes_are_warnings_with_a_placeholder(
 # ------------------------------------------------------------------------------------------ in a real browser
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    reason = unavailable_reason()
-    if reason is not None:
-        if in_ci():
-            pytest.fail(f"CI is set, so the browser tests must run, but: {reason}")
-        pytest.skip(reason)
-    with chromium(tmp_path_factory.mktemp("chromium-profile")) as context:
-        yield context
+    yield from browser_for_tests(tmp_path_factory)
 
 
 def render(browser: Any, html: Path) -> tuple[int, list[str], int]:
