@@ -12,7 +12,9 @@ Findings (``code``: severity):
   ``disconnected``, ``joint-type``, ``bad-number``, ``joint-count`` (a SCARA has 4 movable joints: the ROS
   tutorial's 3-joint RRP arm is unusable here; it would need a wrist joint), ``not-serial``,
   ``limit-missing``, ``limits-inverted`` (lower > upper), ``limits-empty`` (lower = upper),
-  ``not-loadable`` (Pinocchio or :class:`~scara_pin.model.Robot` refuses it; the reason is quoted);
+  ``not-loadable`` (Pinocchio or :class:`~scara_pin.model.Robot` refuses it; the reason is quoted),
+  ``frame-missing`` (``--tool`` / ``--base`` names no link), ``xacro-failed`` (a ``.xacro`` file that
+  cannot be expanded: a missing package, say), ``unreadable``;
 - ``warning`` (usable, but check it): ``continuous-joint`` (Pinocchio gives it nq = 2, cos/sin),
   ``velocity-zero``, ``velocity-placeholder`` (100, 1000, 10000, or one value on every joint),
   ``limits-implausible`` (revolute limits beyond +/-4 pi: degrees?; strokes beyond 5 m: millimetres?),
@@ -29,6 +31,9 @@ Findings (``code``: severity):
   convention), ``zero-pose-direction`` (the arm points along +y or elsewhere than +x at q = 0: handled
   by the zero offsets), ``zero-pose-bent``, ``tool-frame`` (no ``tool0``: the chain's last link is used).
 
+The tool and base frames, and the rules that make a joint unusable (inverted limits, zero axis), are the
+loader's own (:mod:`scara_pin.urdf_rules`): the frames ``check`` names are the frames the commands use.
+
 Status: ``unusable`` if any error (exit code 2), else ``warnings`` if any warning (exit code 4), else
 ``clean`` (exit code 0).
 """
@@ -37,12 +42,15 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 from xml.etree.ElementTree import Element, TreeBuilder
 
 import numpy as np
+
+from .urdf_rules import JointEdge, choose_frames, joint_problem
 
 __all__ = [
     "CheckReport",
@@ -146,12 +154,14 @@ class CheckReport:
         findings: in the order found (structure, joints, geometry, loading).
         joints: movable joints in chain order (empty when the structure is broken).
         tool_frame: the frame taken as the tool (``tool0`` when present).
+        base_frame: the frame poses are expressed in (``base`` when present, else the root link).
     """
 
     source: str
     findings: tuple[Finding, ...]
     joints: tuple[JointInfo, ...] = ()
     tool_frame: str | None = None
+    base_frame: str | None = None
 
     @property
     def status(self) -> CheckStatus:
@@ -183,6 +193,7 @@ class CheckReport:
             "status": self.status.value,
             "exit_code": self.exit_code,
             "tool_frame": self.tool_frame,
+            "base_frame": self.base_frame,
             "joints": [j.to_dict() for j in self.joints],
             "findings": [f.to_dict() for f in self.findings],
         }
@@ -252,9 +263,13 @@ class _Joint:
 
 
 class _Checker:
-    def __init__(self, text: str, source: str) -> None:
+    def __init__(self, text: str, source: str, tool: str | None = None, base: str | None = None,
+                 load_kwargs: dict[str, Any] | None = None) -> None:  # fmt: skip
         self.text = text
         self.source = source
+        self.tool_asked = tool
+        self.base_asked = base
+        self.load_kwargs = load_kwargs or {}
         self.findings: list[Finding] = []
         self.joints: dict[str, _Joint] = {}
         self.chain: list[_Joint] = []
@@ -343,7 +358,9 @@ class _Checker:
             j.axis = self._numbers(axis, "xyz", (1.0, 0.0, 0.0), "axis", lines.get(axis) if axis is not None else line,
                                    name)  # fmt: skip
             if kind in _MOVABLE and math.hypot(*j.axis) < 1e-12:
-                self.error("bad-number", f"joint {name}'s axis is the zero vector", line, name)
+                problem = joint_problem(name, kind, j.axis, None, None)  # the loader's rule (the zero axis)
+                if problem is not None:
+                    self.error(problem[0], problem[1], line, name)
             if limit is not None:
                 j.limit, j.limit_line = dict(limit.attrib), lines.get(limit)
             self.joints[name] = j
@@ -445,11 +462,9 @@ class _Checker:
                                    j.limit_line, j.name)  # fmt: skip
             lo, hi = nums.get("lower", 0.0), nums.get("upper", 0.0)
             if j.type != "continuous" and "lower" in nums and "upper" in nums:
-                if lo > hi:
-                    self.error("limits-inverted", f"joint {j.name}: lower {lo:g} > upper {hi:g}", j.limit_line, j.name)
-                elif lo == hi:
-                    self.error("limits-empty", f"joint {j.name}: lower = upper = {lo:g}: the joint cannot move",
-                               j.limit_line, j.name)  # fmt: skip
+                problem = joint_problem(j.name, j.type, j.axis, lo, hi)  # the loader's rule (scara_pin.urdf_rules)
+                if problem is not None and problem[0] != "bad-number":  # non-finite numbers: reported above
+                    self.error(problem[0], problem[1], j.limit_line, j.name)
                 if j.type == "revolute" and max(abs(lo), abs(hi)) > REVOLUTE_RANGE and math.isfinite(lo + hi):
                     self.add(Severity.WARNING, "limits-implausible",
                              f"joint {j.name}'s limits [{lo:g}, {hi:g}] rad are "
@@ -497,17 +512,22 @@ class _Checker:
 
     # ------------------------------------------------------------------------------------- geometry
     def geometry(self) -> None:
-        base = "base" if "base" in self.link_world else self.root
+        from .errors import UrdfError
+
+        # the frames the loader takes: the same function (scara_pin.urdf_rules.choose_frames)
+        try:
+            frames = choose_frames(list(self.links), [JointEdge(j.name, j.type, j.parent, j.child)
+                                                      for j in self.joints.values()],
+                                   tool=self.tool_asked, base=self.base_asked, origin=self.source)  # fmt: skip
+        except UrdfError as exc:
+            self.error("frame-missing", str(exc).removeprefix(f"{self.source}: "))
+            raise _Unusable from None
+        base = frames.base
         self.base = base
         bMo = np.linalg.inv(self.link_world[base])
-        tool = "tool0" if "tool0" in self.link_world else None
-        if tool is None and self.chain:  # the deepest link below the last movable joint (first in file order)
-            level = [self.chain[-1].child]
-            while level:
-                tool = level[0]
-                level = [j.child for link in level for j in self.children.get(link, [])]
-            self.add(Severity.INFO, "tool-frame",
-                     f"no tool0 frame: {tool} (the chain's last link) is taken as the tool")
+        tool: str | None = frames.tool if self.chain else None
+        if frames.note is not None and tool is not None:
+            self.add(Severity.INFO, "tool-frame", frames.note)
         self.tool = tool
         p_tool = (bMo @ self.link_world[tool])[:3, 3] if tool else np.zeros(3)
         revolute: list[tuple[_Joint, np.ndarray]] = []
@@ -586,7 +606,8 @@ class _Checker:
         from .robots import kinematics_for
 
         try:
-            robot = Robot(self.text, origin=self.source, tool_frame=self.tool or "tool0", kinematics=kinematics_for)
+            robot = Robot(self.text, origin=self.source, tool_frame=self.tool_asked, base_frame=self.base_asked,
+                          kinematics=kinematics_for, **self.load_kwargs)  # the frames: the same choose_frames
         except UrdfError as exc:
             self.error("not-loadable", f"the toolkit cannot load it: {exc}")
             return
@@ -610,28 +631,45 @@ class _Checker:
             JointInfo(j.name, j.type, j.line, j.parent, j.child, getattr(self, "axes", {}).get(j.name))
             for j in self.chain
         )
-        return CheckReport(self.source, tuple(self.findings), joints, self.tool)
+        return CheckReport(self.source, tuple(self.findings), joints, self.tool, getattr(self, "base", None))
 
 
-def check_urdf(text: str, *, origin: str = "URDF") -> CheckReport:
+def check_urdf(
+    text: str, *, origin: str = "URDF", tool: str | None = None, base: str | None = None
+) -> CheckReport:
     """Lint URDF text.
 
     Args:
         text: the URDF document.
         origin: how to name the source in the report (a file name).
+        tool: the tool frame asked for (``--tool``); default as the loader picks it
+            (:func:`scara_pin.urdf_rules.choose_frames`).
+        base: the base frame asked for (``--base``); likewise.
 
     Returns:
         The report; its ``status`` and ``exit_code`` give the verdict. Never raises for bad input.
     """
-    return _Checker(text, origin).run()
+    return _Checker(text, origin, tool, base).run()
 
 
-def check_urdf_file(path: str | Path) -> CheckReport:
-    """Lint a URDF file (an unreadable file gives an ``unreadable`` error finding, status unusable)."""
+def check_urdf_file(
+    path: str | Path, *, tool: str | None = None, base: str | None = None, package_dirs: Sequence[str | Path] = ()
+) -> CheckReport:
+    """Lint a URDF file, or a xacro file (``.xacro``: expanded first, the lines are the expanded text's).
+
+    An unreadable file gives an ``unreadable`` error finding, a xacro that cannot be expanded (a missing
+    package, say) a ``xacro-failed`` one: status unusable. Other arguments as :func:`check_urdf`; packages
+    are looked for as the loader does (:mod:`scara_pin.description.packages`).
+    """
+    from .description.packages import PackagePath, read_robot_file
+    from .errors import UrdfError
+
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = getattr(exc, "strerror", None) or str(exc)
-        return CheckReport(str(path), (Finding(Severity.ERROR, "unreadable", f"cannot be read ({reason})"),))
-    return check_urdf(text, origin=str(path))
+        packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
+        text = read_robot_file(path, packages)
+    except UrdfError as exc:
+        code = "xacro-failed" if path.name.endswith(".xacro") and path.is_file() else "unreadable"
+        reason = str(exc).removeprefix(f"{path}: ")
+        return CheckReport(str(path), (Finding(Severity.ERROR, code, reason),))
+    return _Checker(text, str(path), tool, base, {"package_path": packages}).run()

@@ -30,9 +30,11 @@ import pinocchio as pin
 from ._checks import MAGNITUDE_MAX
 from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
+from .urdf_rules import choose_frames, read_tree
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
+    from .description.packages import PackagePath
     from .kinematics.results import BatchIKResult, IKResult
 
 __all__ = ["Kinematics", "Robot", "pose_from_placement"]
@@ -198,7 +200,10 @@ class Robot:
         parameters: the yaml parameters, when the robot was generated from them.
         kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file counts as a SCARA).
         continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
-        base_frame, tool_frame: names of the reference frame and of the tool frame.
+        base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
+        frame_note: the notice when the tool frame was chosen by default without a ``tool0`` (else None).
+        package_path: where ``package://`` names (meshes) are looked for (see
+            :mod:`scara_pin.description.packages`).
     """
 
     model: pin.Model
@@ -212,6 +217,8 @@ class Robot:
     has_continuous: bool
     base_frame: str
     tool_frame: str
+    frame_note: str | None
+    package_path: PackagePath
 
     def __init__(
         self,
@@ -219,9 +226,10 @@ class Robot:
         *,
         acceleration: Sequence[float] | None = None,
         parameters: RobotParameters | None = None,
-        base_frame: str = "base",
-        tool_frame: str = "tool0",
+        base_frame: str | None = None,
+        tool_frame: str | None = None,
         origin: str = "URDF",
+        package_path: PackagePath | None = None,
         kinematics: KinematicsFactory | None = None,
     ) -> None:
         """Load URDF text.
@@ -231,21 +239,28 @@ class Robot:
             acceleration: acceleration limits per joint [rad/s^2 or m/s^2]; URDF has none. Without it
                 (a URDF file) they are NaN, meaning unknown: commands that need them ask for them.
             parameters: the yaml parameters it was generated from, if any.
-            base_frame: the frame poses are expressed in; falls back to the root link if absent.
-            tool_frame: the tool frame (``tool0``).
+            base_frame: the link poses are expressed in; default ``base`` if present, else the root link.
+            tool_frame: the tool link; default ``tool0`` if present, else the chain's last link
+                (:func:`scara_pin.urdf_rules.choose_frames`, the rule ``scara-pin check`` reports).
             origin: how to name the source in error messages (a file name).
+            package_path: where ``package://`` names are looked for (meshes); default: none.
             kinematics: builds the robot's kinematics object from the loaded robot (its kind's; see
                 :func:`scara_pin.robots.kinematics_for`, which :func:`scara_pin.load_robot` passes).
 
         Raises:
-            UrdfError: unreadable, invalid or disconnected URDF, or not a 4-joint robot.
+            UrdfError: unreadable, invalid or disconnected URDF, not a 4-joint robot, an unusable joint
+                (inverted limits, zero axis: :func:`scara_pin.urdf_rules.joint_problem`), or a frame
+                asked for that is not a link of the file.
         """
+        from .description.packages import PackagePath
+
         model = _parse_urdf(urdf, origin)
+        links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
         continuous = _continuous_joints(model, origin)
-        if not model.existFrame(tool_frame):
-            raise UrdfError(f"{origin}: no frame named {tool_frame!r}")
-        if not model.existFrame(base_frame):
-            base_frame = model.frames[1].name if len(model.frames) > 1 else "universe"
+        frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
+        base_frame, tool_frame = frames.base, frames.tool
+        self.frame_note = frames.note
+        self.package_path = package_path if package_path is not None else PackagePath()
         self.model = model
         self.data = model.createData()
         self.urdf = urdf
@@ -254,8 +269,8 @@ class Robot:
         self.kind = parameters.kind if parameters is not None else "scara"
         self.base_frame = base_frame
         self.tool_frame = tool_frame
-        self.base_id = model.getFrameId(base_frame)
-        self.tool_id = model.getFrameId(tool_frame)
+        self.base_id = model.getFrameId(base_frame, pin.FrameType.BODY)
+        self.tool_id = model.getFrameId(tool_frame, pin.FrameType.BODY)
         if parameters is not None:
             self.limits = parameters.limits
         else:  # a URDF file: record its limits as written (they may be placeholders; not checked here)
@@ -293,30 +308,47 @@ class Robot:
         overrides: Mapping[str, object] | None = None,
         **kwargs: Any,
     ) -> Robot:
-        """Generate the URDF of a configured robot (see :mod:`scara_pin.description`) and load it."""
+        """Generate the URDF of a configured robot (see :mod:`scara_pin.description`) and load it.
+
+        Keyword arguments (``tool_frame``, ``base_frame``) are passed to the constructor.
+        """
         params = load_parameters(robot, overrides)
         return cls(generate_urdf(params), parameters=params, origin=f"robot {params.name!r}", **kwargs)
 
     @classmethod
-    def from_file(cls, path: str | Path, **kwargs: Any) -> Robot:
-        """Load a URDF file (keyword arguments as for the constructor)."""
+    def from_file(cls, path: str | Path, *, package_dirs: Sequence[str | Path] = (), **kwargs: Any) -> Robot:
+        """Load a URDF file, or a xacro file (name ending in ``.xacro``) expanded first.
+
+        ``$(find pkg)`` and ``package://pkg/...`` are resolved in ``package_dirs`` (folders holding packages),
+        the folders above the file and ``ROS_PACKAGE_PATH`` / ``AMENT_PREFIX_PATH``
+        (:mod:`scara_pin.description.packages`). Expanding a xacro file runs the expressions written in
+        it: load only files you trust, as you would run them through ``xacro``. Other keyword arguments
+        are as for the constructor.
+        """
+        from .description.packages import PackagePath, read_robot_file
+
         path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise UrdfError(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
-        return cls(text, origin=str(path), **kwargs)
+        packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
+        return cls(read_robot_file(path, packages), origin=str(path), package_path=packages, **kwargs)
 
     # ----------------------------------------------------------------- geometry (lazy)
     @cached_property
     def visual_model(self) -> pin.GeometryModel:
-        """Visual geometry (primitives) of the URDF, built on first use."""
-        return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.VISUAL)
+        """Visual geometry of the URDF, built on first use; each mesh is a placeholder box.
+
+        Pinocchio never reads a mesh file: :func:`scara_pin.viz.meshes.visual_meshes` reads them (found
+        and checked as that module says) under the same geometry names.
+        """
+        from .viz.meshes import placeholder_urdf
+
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.VISUAL)
 
     @cached_property
     def collision_model(self) -> pin.GeometryModel:
-        """Collision geometry of the URDF, built on first use."""
-        return pin.buildGeomFromUrdfString(self.model, self.urdf, pin.GeometryType.COLLISION)
+        """Collision geometry of the URDF, built on first use (meshes as placeholder boxes, as above)."""
+        from .viz.meshes import placeholder_urdf
+
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
 
     # ----------------------------------------------------------------- inverse kinematics (delegated)
     @cached_property
@@ -523,7 +555,6 @@ class Robot:
             names = ", ".join(f.name for f in self.model.frames)
             raise InvalidInputError(f"no frame named {frame!r}; frames: {names}")
         return int(self.model.getFrameId(frame))
-
 
 
 def _q_ok(q: Any) -> bool:

@@ -15,7 +15,7 @@ Both read their geometry from the model, so the URDF is the single source of tru
 from __future__ import annotations
 
 import enum
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -137,24 +137,37 @@ def load_robot(
     overrides: Mapping[str, object] | None = None,
     *,
     urdf: str | Path | None = None,
+    tool: str | None = None,
+    base: str | None = None,
+    package_path: Sequence[str | Path] = (),
 ) -> Robot:
-    """Load a robot with the kinematics of its kind: a configured one (name or folder) or a URDF file.
+    """Load a robot with the kinematics of its kind: a configured one (name or folder) or a URDF / xacro file.
 
     Args:
         robot: shipped robot name, config folder, or parameters (ignored when ``urdf`` is given).
         overrides: parameter overrides (flat names), for configured robots only.
-        urdf: path of a URDF file to load instead.
+        urdf: path of a URDF file, or of a xacro file (``.xacro``), to load instead.
+        tool: the tool frame (a link); default ``tool0`` if present, else the chain's last link (then
+            ``robot.frame_note`` says so).
+        base: the base frame poses are expressed in (a link); default ``base`` if present, else the root.
+        package_path: folders holding ROS-style packages, for ``$(find pkg)`` and ``package://pkg/``.
+
+    Raises:
+        UrdfError: (exit code 2) among others a ``tool`` or ``base`` that is not a link of the robot.
     """
+    kwargs: dict[str, Any] = {"tool_frame": tool, "base_frame": base, "kinematics": kinematics_for}
     if urdf is not None:
         if overrides:
             raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file")
-        return Robot.from_file(urdf, kinematics=kinematics_for)
-    return Robot.from_config(robot, overrides, kinematics=kinematics_for)
+        return Robot.from_file(urdf, package_dirs=package_path, **kwargs)
+    if package_path:
+        raise InvalidInputError("--package-path applies to a URDF or xacro file (--urdf), not to a configured robot")
+    return Robot.from_config(robot, overrides, **kwargs)
 
 
-def load_urdf(path: str | Path) -> Robot:
-    """Load a 4-joint URDF file (a SCARA, or with ``<mimic>`` passive joints), with its kinematics."""
-    return Robot.from_file(path, kinematics=kinematics_for)
+def load_urdf(path: str | Path, **kwargs: Any) -> Robot:
+    """Load a 4-joint URDF (or xacro) file with its kinematics; keywords as for :func:`load_robot`."""
+    return load_robot(urdf=path, **kwargs)
 
 
 def robot_from_urdf(urdf: str, **kwargs: Any) -> Robot:

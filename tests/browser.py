@@ -73,6 +73,20 @@ def chromium(profile: Path) -> Iterator[Any]:
             context.close()
 
 
+def browser_for_tests(tmp_path_factory: Any) -> Iterator[Any]:
+    """The body of a module-scoped ``browser`` fixture: skipped only outside CI when Chromium or Playwright is
+    absent; in CI, or when Chromium is there but cannot start, the tests fail."""
+    import pytest
+
+    reason = unavailable_reason()
+    if reason is not None:
+        if in_ci():
+            pytest.fail(f"CI is set, so the browser tests must run, but: {reason}")
+        pytest.skip(reason)
+    with chromium(tmp_path_factory.mktemp("chromium-profile")) as context:
+        yield context
+
+
 def next_frames(page: Any, n: int = 3) -> None:
     """Let the page render ``n`` animation frames (meshcat renders on requestAnimationFrame when dirty)."""
     page.evaluate(

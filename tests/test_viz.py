@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 import psutil
 import pytest
-from browser import chromium, in_ci, next_frames, orange_pixels, unavailable_reason
+from browser import browser_for_tests, next_frames, orange_pixels
 
 from scara_pin import InvalidInputError, Robot
 from scara_pin.viz.meshcat import (
@@ -177,15 +177,8 @@ def viewer(robot: Robot) -> Iterator[Viewer]:
 
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    """A headless Chromium context with a fresh profile. Skipped only outside CI when Chromium or
-    Playwright is absent; in CI, or when Chromium is there but cannot start, the tests fail."""
-    reason = unavailable_reason()
-    if reason is not None:
-        if in_ci():
-            pytest.fail(f"CI is set, so the browser tests must run, but: {reason}")
-        pytest.skip(reason)
-    with chromium(tmp_path_factory.mktemp("chromium-profile")) as context:
-        yield context
+    """A headless Chromium context with a fresh profile (see browser.browser_for_tests)."""
+    yield from browser_for_tests(tmp_path_factory)
 
 
 @pytest.fixture

@@ -6,6 +6,7 @@ import argparse
 import logging
 import math
 import re
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
@@ -82,7 +83,10 @@ def _parse_sets(items: Sequence[str] | None) -> dict[str, str]:
 def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
     from ..robots import load_robot
 
-    robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf)
+    robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf, tool=args.tool, base=args.base,
+                       package_path=args.package_path or ())  # fmt: skip
+    if robot.frame_note is not None:  # the tool chosen without a tool0: said once
+        print(f"info: {robot.frame_note}", file=sys.stderr)
     if units is not None:  # what each joint value measures, read from the model (any joint order)
         units.q = robot.joint_kinds
     return robot
@@ -168,7 +172,21 @@ def _add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True) -> No
     g.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="override a parameter, SI units (e.g. --set l1=0.25); repeatable")  # fmt: skip
     if urdf_file:
-        g.add_argument("--urdf", metavar="FILE", help="load this URDF file instead of a configured robot")
+        g.add_argument("--urdf", metavar="FILE", help="load this URDF file (or .xacro file, expanded: it runs "
+                       "the expressions written in it) instead of a configured robot")  # fmt: skip
+        _add_frame_options(g)
+
+
+def _add_frame_options(g: Any) -> None:
+    """--tool, --base and --package-path (the robot's frames and where its packages are)."""
+    g.add_argument("--tool", metavar="FRAME", help="the tool frame (a link; default: tool0 if present, "
+                   "else the chain's last link)")  # fmt: skip
+    g.add_argument("--base", metavar="FRAME", help="the frame poses are expressed in (a link; default: base "
+                   "if present, else the root link)")  # fmt: skip
+    g.add_argument("--package-path", action="append", metavar="DIR",
+                   help="a folder holding ROS packages (folders with package.xml), for $(find pkg) and "
+                   "package://pkg/ in --urdf; repeatable; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are "
+                   "searched too")  # fmt: skip
 
 
 def _add_q(p: argparse.ArgumentParser) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
-from ._common import _add_robot_options, _parse_sets, write_atomic
+from ._common import _add_frame_options, _add_robot_options, _parse_sets, write_atomic
 
 if TYPE_CHECKING:
 
@@ -52,7 +52,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable."""
     from ..lint import check_urdf_file
 
-    report = check_urdf_file(args.file)
+    report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or ())
     print(report.to_json() if args.json else report.format_text())
     return int(report.exit_code)
 
@@ -70,6 +70,7 @@ def register(sub: Any) -> None:
     _add_robot_options(p, urdf_file=False)
     p.set_defaults(func=cmd_urdf)
     p = sub.add_parser("check", help="lint a third-party SCARA URDF: exit 0 clean, 4 warnings, 2 unusable")
-    p.add_argument("file", metavar="FILE.urdf", help="the URDF to check")
+    p.add_argument("file", metavar="FILE.urdf", help="the URDF (or .xacro, expanded) to check")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_frame_options(p.add_argument_group("robot"))
     p.set_defaults(func=cmd_check)

@@ -302,7 +302,7 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
-    p = sub.add_parser("fk", help="forward kinematics: pose of tool0 in the base frame")
+    p = sub.add_parser("fk", help="forward kinematics: pose of the tool frame (tool0; --tool) in the base frame")
     _add_q(p)
     p.set_defaults(func=cmd_fk)
     p = sub.add_parser("jacobian", help="task Jacobian d(x, y, z, yaw)/dq (or a 6 x 4 frame Jacobian)")

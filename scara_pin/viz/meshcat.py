@@ -487,6 +487,27 @@ class _Window:
         self._close_socket()
 
 
+# ------------------------------------------------------------------------------------------ meshes (issue 13)
+def _draw_meshes(vis: Any, robot: Robot) -> None:
+    """Set each readable mesh of the robot's visuals (:func:`scara_pin.viz.meshes.visual_meshes`) on its node.
+
+    Pinocchio's visualizer drew a placeholder box at ``<ROBOT_NODE>/visuals/<geometry name>`` and moves that
+    node; the mesh replaces the box there (vertices already scaled), in the colour the URDF gives it.
+    """
+    from .meshes import visual_meshes
+
+    mg = _meshcat().geometry
+    visuals = robot.visual_model
+    for mesh in visual_meshes(robot):
+        if not visuals.existGeometryName(mesh.name):
+            continue
+        rgba = visuals.geometryObjects[visuals.getGeometryId(mesh.name)].meshColor
+        color = int(rgba[0] * 255) * 65536 + int(rgba[1] * 255) * 256 + int(rgba[2] * 255)
+        material = mg.MeshPhongMaterial(color=color, opacity=float(rgba[3]), transparent=float(rgba[3]) < 1.0)
+        geometry = mg.TriangularMeshGeometry(mesh.vertices.astype(np.float32), mesh.faces.astype(np.uint32))
+        vis[f"{ROBOT_NODE}/visuals/{mesh.name}"].set_object(geometry, material)
+
+
 # ------------------------------------------------------------------------------------------ the scene
 class _Scene:
     """The robot and the overlays in a meshcat visualizer (live or recording)."""
@@ -498,6 +519,7 @@ class _Scene:
         viz = _pinocchio_visualizer()(robot.model, robot.collision_model, robot.visual_model)
         viz.initViewer(viewer=self.vis)
         viz.loadViewerModel(rootNodeName=ROBOT_NODE)
+        _draw_meshes(self.vis, robot)  # issue 13: the real meshes in place of their placeholder boxes
         self.viz = viz
         q0 = pin.neutral(robot.model)
         data = robot.model.createData()
