@@ -244,7 +244,7 @@ def _branches(
             worst = (_STAGE[status], status, message)
 
     for phi, r in candidates:
-        code, D, g, heading = arm.solve(v, r - geo.r0)  # the arm plane as (x, y) = (v, h)
+        code, D, g, heading, lean = arm.solve(v, r - geo.r0)  # the arm plane as (x, y) = (v, h)
         if code == Reach.OUT:
             failed(PalletizerIKStatus.OUT_OF_REACH,
                    f"the wrist would be {D:.9g} m from the shoulder axis, beyond a2 + a3 = {arm.l12:.9g} m")
@@ -254,7 +254,6 @@ def _branches(
                    f"the wrist would be {D:.9g} m from the shoulder axis, inside |a2 - a3| = {arm.d12:.9g} m")
             continue
         singular = arm.singular(g)
-        lean = arm.lean(g)
         wob = arm.wobble(g)
         if singular:
             elbows: list[tuple[float, float, str]] = [(g, heading - lean, "up" if g < 1.0 else "down")]

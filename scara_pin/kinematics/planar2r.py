@@ -10,8 +10,11 @@ theta1 the heading of link 1 and gamma the elbow angle (from link 1 to link 2, c
 r = |W|, the half-angle form of the law of cosines stays accurate at the stretched (gamma = 0) and folded
 (gamma = pi) boundaries, where the textbook acos loses half the digits:
 
-    tan(|gamma| / 2) = sqrt((l1 + l2 - r)(l1 + l2 + r)) / sqrt((r - l1 + l2)(r + l1 - l2)),
-    theta1 = atan2(wy, wx) -+ atan2(l2 sin|gamma|, l1 + l2 cos|gamma|)      (elbow +gamma / -gamma).
+    tan(|gamma| / 2) = sqrt(o) / sqrt(i),   o = (l1 + l2 - r)(l1 + l2 + r),   i = (r - l1 + l2)(r + l1 - l2),
+    theta1 = atan2(wy, wx) -+ lean,   lean = atan2(l2 sin|gamma|, l1 + l2 cos|gamma|)   (elbow +gamma / -gamma),
+
+with the lean read from the same square roots, without a sine or cosine (both sides times o + i > 0):
+lean = atan2(2 l2 sqrt(o) sqrt(i), (l1 + l2) i + (l1 - l2) o).
 
 Tolerances (one set for every caller):
 
@@ -30,7 +33,7 @@ arm with one angle fixed).
 Joint turns. A revolute joint value v is the same joint position as v + 2 pi k. Inside limits [lo, hi]
 the turns that fit are k in [k_min, k_max] = [ceil((lo - v) / 2 pi), floor((hi - v) / 2 pi)] (limits
 widened by ``LIMIT_TOL``). The turn nearest a reference is chosen PER JOINT in O(1), whatever the range:
-k = clip(round((ref - v) / 2 pi), k_min, k_max). A continuous joint (no limits) takes the unclipped k, so
+k = clip(floor((ref + pi - v) / 2 pi), k_min, k_max) (round((ref - v) / 2 pi), ties upwards). A continuous joint (no limits) takes the unclipped k, so
 distances to the reference are wrapped.
 
 Scalar functions use :mod:`math` (the per-call paths); ``*_array`` functions are the same formulas for numpy
@@ -40,6 +43,7 @@ arrays (the batch paths), with the same order of operations.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -71,6 +75,7 @@ FREE_R = 1e-12
 """[m] a wrist this close to the shoulder (possible when l1 = l2) leaves the shoulder angle free."""
 
 TWO_PI = 2.0 * math.pi
+_PI = math.pi
 _INV_TWO_PI = 1.0 / TWO_PI
 _atan2, _sin, _cos, _sqrt, _floor, _ceil = math.atan2, math.sin, math.cos, math.sqrt, math.floor, math.ceil
 
@@ -103,6 +108,8 @@ class Planar2R:
     d12: float = field(init=False)
     _snap: float = field(init=False, repr=False)
     _c: float = field(init=False, repr=False)
+    _2l2: float = field(init=False, repr=False)
+    _dl: float = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.l1) and math.isfinite(self.l2) and self.l1 > 0.0 and self.l2 > 0.0):
@@ -111,6 +118,8 @@ class Planar2R:
         object.__setattr__(self, "l12", l12)
         object.__setattr__(self, "d12", abs(self.l1 - self.l2))
         object.__setattr__(self, "_snap", SNAP_TOL * l12)
+        object.__setattr__(self, "_2l2", 2.0 * self.l2)
+        object.__setattr__(self, "_dl", self.l1 - self.l2)
         # the spread of gamma^2 that a radius within the snap tolerance leaves (see wobble)
         object.__setattr__(self, "_c", 4.0 * SNAP_TOL * l12 * l12 / (self.l1 * self.l2))
 
@@ -123,31 +132,28 @@ class Planar2R:
             return Reach.IN
         return Reach.OK
 
-    def elbow(self, r: float) -> float:
-        """|gamma| in [0, pi] for a wrist radius ``r`` inside the reach (half-angle law of cosines, snapped)."""
-        l12, d12, snap = self.l12, self.d12, self._snap
-        outer = l12 - r
-        if snap > outer:
-            outer = 0.0
-        inner = r - d12
-        if snap > inner:
-            inner = 0.0
-        return 2.0 * _atan2(_sqrt(outer * (l12 + r)), _sqrt(inner * (r + d12)))
-
     def lean(self, gamma: float) -> float:
         """atan2(l2 sin gamma, l1 + l2 cos gamma): the angle from link 1 to the wrist point [rad]."""
         return _atan2(self.l2 * _sin(gamma), self.l1 + self.l2 * _cos(gamma))
 
-    def solve(self, wx: float, wy: float) -> tuple[int, float, float, float]:
-        """(reach code, r, |gamma|, heading) of a wrist point; theta1 = heading -+ lean(|gamma|).
+    def solve(self, wx: float, wy: float) -> tuple[int, float, float, float, float]:
+        """(reach code, r, |gamma|, heading, lean) of a wrist point: theta1 = heading -+ lean for +/-|gamma|.
 
-        Outside the reach (code not OK) gamma and heading are NaN.
+        Outside the reach (code not OK) gamma, heading and lean are NaN.
         """
         r = _sqrt(wx * wx + wy * wy)
-        code = self.reach(r)
-        if code:
-            return code, r, math.nan, math.nan
-        return code, r, self.elbow(r), _atan2(wy, wx)
+        l12, d12, snap = self.l12, self.d12, self._snap
+        if r > l12 + REACH_TOL:
+            return Reach.OUT, r, math.nan, math.nan, math.nan
+        if r < d12 - REACH_TOL:
+            return Reach.IN, r, math.nan, math.nan, math.nan
+        o = l12 - r
+        o = 0.0 if o < snap else o * (l12 + r)
+        i = r - d12
+        i = 0.0 if i < snap else i * (r + d12)
+        so, si = _sqrt(o), _sqrt(i)
+        lean = _atan2(so * si * self._2l2, l12 * i + self._dl * o)
+        return Reach.OK, r, 2.0 * _atan2(so, si), _atan2(wy, wx), lean
 
     def radius(self, gamma: float) -> float:
         """The wrist radius at elbow angle ``gamma``: sqrt(l1^2 + l2^2 + 2 l1 l2 cos gamma) [m]."""
@@ -193,27 +199,44 @@ class Planar2R:
         return _atan2(ey, ex), abs(_sqrt(ex * ex + ey * ey) - self.l1)
 
     # ------------------------------------------------------------------------------------------ arrays
-    def solve_array(self, wx: np.ndarray, wy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`solve` for arrays: (reach codes, r, |gamma|, heading); gamma is NaN outside the reach."""
-        r = np.sqrt(wx * wx + wy * wy)
-        code = np.where(r > self.l12 + REACH_TOL, Reach.OUT, np.where(r < self.d12 - REACH_TOL, Reach.IN, Reach.OK))
-        return code, r, self.elbow_array(r, code), np.arctan2(wy, wx)
+    def solve_array(
+        self, wx: np.ndarray, wy: np.ndarray, out: Sequence[np.ndarray] | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`solve` for arrays: (r, |gamma|, heading, lean, scratch); the same formulas, in place.
 
-    def elbow_array(self, r: np.ndarray, code: np.ndarray | None = None) -> np.ndarray:
-        """:meth:`elbow` for an array of radii (NaN where ``code`` is not OK)."""
+        No reach codes: compare ``r`` with ``l12 + REACH_TOL`` and ``d12 - REACH_TOL`` (outside, the angles
+        are those of the nearest boundary circle). ``out``: five float arrays of the rows' length to write
+        into (nothing is allocated then).
+        """
+        r, g, heading, lean, t = (out if out is not None else [np.empty(np.shape(wx)) for _ in range(5)])
         l12, d12, snap = self.l12, self.d12, self._snap
-        outer = l12 - r
-        outer[outer < snap] = 0.0
-        inner = r - d12
-        inner[inner < snap] = 0.0
-        g = 2.0 * np.arctan2(np.sqrt(outer * (l12 + r)), np.sqrt(inner * (r + d12)))
-        if code is not None:
-            g[code != Reach.OK] = np.nan
-        return g
-
-    def lean_array(self, gamma: np.ndarray) -> np.ndarray:
-        """:meth:`lean` for arrays."""
-        return np.arctan2(self.l2 * np.sin(gamma), self.l1 + self.l2 * np.cos(gamma))
+        np.multiply(wx, wx, out=r)
+        np.multiply(wy, wy, out=t)
+        np.add(r, t, out=r)
+        np.sqrt(r, out=r)
+        o, i = heading, lean  # scratch until the end
+        np.subtract(l12, r, out=o)
+        mask = np.less(o, snap)
+        np.add(r, l12, out=t)
+        np.multiply(o, t, out=o)
+        np.copyto(o, 0.0, where=mask)
+        np.subtract(r, d12, out=i)
+        np.less(i, snap, out=mask)
+        np.add(r, d12, out=t)
+        np.multiply(i, t, out=i)
+        np.copyto(i, 0.0, where=mask)
+        np.multiply(i, l12, out=t)  # t: the lean's cosine side (l1 + l2) i + (l1 - l2) o
+        if self._dl != 0.0:
+            np.add(t, np.multiply(o, self._dl, out=g), out=t)
+        np.sqrt(o, out=o)
+        np.sqrt(i, out=i)
+        np.arctan2(o, i, out=g)
+        np.multiply(o, i, out=o)
+        np.multiply(o, self._2l2, out=o)
+        np.arctan2(o, t, out=lean)
+        np.add(g, g, out=g)
+        np.arctan2(wy, wx, out=heading)
+        return r, g, heading, lean, t
 
     def wobble_array(self, gamma: np.ndarray) -> np.ndarray:
         """:meth:`wobble` for arrays."""
@@ -257,12 +280,12 @@ def nearest_turn(
         None when no turn fits.
     """
     if continuous:
-        return value + TWO_PI * _floor((ref - value) * _INV_TWO_PI + 0.5), 0, 0
+        return value + TWO_PI * _floor((ref + _PI - value) * _INV_TWO_PI), 0, 0
     k_min = _ceil((lo - LIMIT_TOL - value) * _INV_TWO_PI)
     k_max = _floor((hi + LIMIT_TOL - value) * _INV_TWO_PI)
     if k_min > k_max:
         return None
-    k = _floor((ref - value) * _INV_TWO_PI + 0.5)
+    k = _floor((ref + _PI - value) * _INV_TWO_PI)
     k = k_min if k < k_min else (k_max if k > k_max else k)
     q = value + TWO_PI * k
     q = lo if q < lo else (hi if q > hi else q)
@@ -279,10 +302,10 @@ def nearest_turn_array(
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`nearest_turn` for arrays: (q, ok), q clamped onto the limits where ``ok``."""
     if continuous:
-        return value + TWO_PI * np.floor((ref - value) * _INV_TWO_PI + 0.5), np.ones(value.shape, dtype=bool)
+        return value + TWO_PI * np.floor((ref + _PI - value) * _INV_TWO_PI), np.ones(value.shape, dtype=bool)
     k_min = np.ceil((lo - LIMIT_TOL - value) * _INV_TWO_PI)
     k_max = np.floor((hi + LIMIT_TOL - value) * _INV_TWO_PI)
-    k = np.floor((ref - value) * _INV_TWO_PI + 0.5)
+    k = np.floor((ref + _PI - value) * _INV_TWO_PI)
     np.maximum(k, k_min, out=k)
     np.minimum(k, k_max, out=k)
     q = value + TWO_PI * k

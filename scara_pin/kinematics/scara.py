@@ -57,6 +57,7 @@ from .planar2r import (
     FREE_R,
     LIMIT_TOL,
     REACH_TOL,
+    SINGULAR,
     TWO_PI,
     Planar2R,
     Reach,
@@ -157,6 +158,7 @@ class ScaraGeometry:
     beta2: float = field(init=False)
     arm: Planar2R = field(init=False, repr=False, compare=False)
     _radius: tuple[float, float] = field(init=False, repr=False, compare=False)
+    _k: tuple[Any, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "l1", math.hypot(*self.u1))
@@ -171,6 +173,15 @@ class ScaraGeometry:
             if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
                 raise ParameterError(f"limits of {name}", (lo, hi), "must be finite numbers with lower <= upper")
         object.__setattr__(self, "_radius", self._radius_range())
+        # the numbers the per-call path reads, unpacked once per call (the geometry is frozen)
+        ra, rb, rc = self.revolute
+        ip = self.prismatic
+        s, lo, hi = self.signs, self.lower, self.upper
+        object.__setattr__(self, "_k", (
+            ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip], lo[ip] - LIMIT_TOL, hi[ip] + LIMIT_TOL,
+            self.z0, self.a1[0], self.a1[1], self.tool[0], self.tool[1], self._radius[0] - REACH_TOL,
+            self.beta1, self.beta2 - self.beta1,
+        ))  # fmt: skip
 
     @classmethod
     def from_robot(cls, robot: Robot) -> ScaraGeometry:
@@ -302,57 +313,52 @@ def _branches(
     geo: ScaraGeometry, x: float, y: float, z: float, alpha: float, ref: list[float], branch: str
 ) -> tuple[list[_Branch], _Failure | None]:
     """The solution of each requested branch, or the reason there is none (the most telling failure)."""
-    ra, rb, rc = geo.revolute
-    ip = geo.prismatic
-    lo, hi, names = geo.lower, geo.upper, geo.names
+    ra, rb, rc, ip, _, _, _, s_p, lt_p, ht_p, z0, a1x, a1y, tx, ty, r_min_tol, _, _ = geo._k
+    lo, hi = geo.lower, geo.upper
     arm = geo.arm
     # vertical joint
-    qp = (z - geo.z0) * geo.signs[ip]
-    if not lo[ip] - LIMIT_TOL <= qp <= hi[ip] + LIMIT_TOL:
-        return [], (IKStatus.J3_STROKE, f"z = {z:.9g} m needs {names[ip]} = {qp:.9g} m, outside its stroke "
+    qp = (z - z0) * s_p
+    if not lt_p <= qp <= ht_p:
+        return [], (IKStatus.J3_STROKE, f"z = {z:.9g} m needs {geo.names[ip]} = {qp:.9g} m, outside its stroke "
                                         f"[{lo[ip]:.9g}, {hi[ip]:.9g}] m")  # fmt: skip
     qp = lo[ip] if qp < lo[ip] else (hi[ip] if qp > hi[ip] else qp)
     # wrist point and the planar arm
-    tx, ty = geo.tool
     if tx or ty:
         ca, sa = _cos(alpha), _sin(alpha)
-        wx = x - (ca * tx - sa * ty) - geo.a1[0]
-        wy = y - (sa * tx + ca * ty) - geo.a1[1]
+        wx = x - (ca * tx - sa * ty) - a1x
+        wy = y - (sa * tx + ca * ty) - a1y
     else:
-        wx, wy = x - geo.a1[0], y - geo.a1[1]
-    code, r, gamma, heading = arm.solve(wx, wy)
+        wx, wy = x - a1x, y - a1y
+    code, r, gamma, heading, lean = arm.solve(wx, wy)
     if code == Reach.OUT:
         return [], (IKStatus.OUT_OF_REACH, f"the wrist axis would be {r:.9g} m from the shoulder axis, beyond "
                                            f"the reach l1 + l2 = {arm.l12:.9g} m")  # fmt: skip
-    r_min = geo._radius[0]
-    if code == Reach.IN or r < r_min - REACH_TOL:
-        return [], (IKStatus.INSIDE_INNER_LIMIT, _inside_message(geo, r, r_min))
-    singular = arm.singular(gamma)
-    wob = arm.wobble(gamma)
-    if r > FREE_R:
-        lean = arm.lean(gamma)
-    else:  # l1 = l2 and the wrist on the shoulder axis: the shoulder is free
+    if code == Reach.IN or r < r_min_tol:
+        return [], (IKStatus.INSIDE_INNER_LIMIT, _inside_message(geo, r, geo._radius[0]))
+    singular = gamma < SINGULAR or _PI - gamma < SINGULAR
+    if r <= FREE_R:  # l1 = l2 and the wrist on the shoulder axis: the shoulder is free
         heading = _free_shoulder(geo, alpha, gamma + geo.beta1 - geo.beta2, ref[ra]) + geo.beta1
-        lean = 0.0
+        lean = 0.0  # (the wrist on the shoulder axis: r = 0, no lean)
     if singular:
         elbows: tuple[tuple[float, float, str], ...] = ((gamma, heading - lean, "right" if gamma < 1.0 else "left"),)
     else:
         elbows = ((gamma, heading - lean, "right"), (-gamma, heading + lean, "left"))
     found: list[_Branch] = []
     failures: list[_Failure] = []
+    cont = geo.continuous
     for g, theta1, label in elbows:
         if branch == "all" or label == branch or singular:
-            out = _joints(geo, wx, wy, alpha, g, theta1, wob, ref, label)
-            if isinstance(out[0], IKStatus):
+            out = _joints(geo, wx, wy, alpha, g, theta1, ref, label)
+            if len(out) == 2:
                 failures.append(out)  # type: ignore[arg-type]
                 continue
-            qa, qb, qc = out  # type: ignore[misc]
+            qa, qb, qc = out
             q = [0.0] * 4
+            q[ra], q[rb], q[rc], q[ip] = qa[0], qb[0], qc[0], qp
             turns: list[tuple[int, int] | None] = [(0, 0)] * 4
-            for j, t in ((ra, qa), (rb, qb), (rc, qc)):
-                q[j] = t[0]
-                turns[j] = None if geo.continuous[j] else (t[1], t[2])
-            q[ip] = qp
+            turns[ra] = None if cont[ra] else (qa[1], qa[2])
+            turns[rb] = None if cont[rb] else (qb[1], qb[2])
+            turns[rc] = None if cont[rc] else (qc[1], qc[2])
             found.append((label, singular, q, turns))
     if found:
         return found, None
@@ -363,9 +369,8 @@ def _branches(
 
 
 def _joints(
-    geo: ScaraGeometry, wx: float, wy: float, alpha: float, gamma: float, theta1: float, wob: float,
-    ref: list[float], label: str,
-) -> tuple[Any, ...]:  # fmt: skip
+    geo: ScaraGeometry, wx: float, wy: float, alpha: float, gamma: float, theta1: float, ref: list[float], label: str
+) -> tuple[Any, ...]:
     """Shoulder, elbow and wrist of one branch at their turns nearest ``ref`` ((q, k_lo, k_hi) each).
 
     Or (status, message) when a joint has no turn inside its limits.
@@ -373,13 +378,14 @@ def _joints(
     A joint that rounding alone puts outside a limit (by less than ``wob``, the arm's ill-conditioning)
     is put on it and the arm re-solved with that angle fixed.
     """
-    ra, rb, rc = geo.revolute
-    s, lo, hi, cont, names = geo.signs, geo.lower, geo.upper, geo.continuous, geo.names
-    arm, b1, b2 = geo.arm, geo.beta1, geo.beta2
+    ra, rb, rc, _, s_a, s_b, s_c, _, _, _, _, _, _, _, _, _, b1, db = geo._k
+    lo, hi, cont = geo.lower, geo.upper, geo.continuous
     # elbow
-    vb = s[rb] * (gamma + b1 - b2)
+    vb = s_b * (gamma - db)
     tb = nearest_turn(vb, lo[rb], hi[rb], ref[rb], cont[rb])
     if tb is None:
+        s, names, arm, b2 = geo.signs, geo.names, geo.arm, geo.beta2
+        wob = arm.wobble(gamma)
         edge = turn_edge(vb, lo[rb], hi[rb], wob)
         if edge is not None:
             theta1, miss = arm.with_elbow(wx, wy, geo.elbow_angle(edge))
@@ -388,9 +394,11 @@ def _joints(
             return IKStatus.J2_LIMIT, f"{label}: {names[rb]} = {wrap(vb):.9g} rad (+2 pi k) outside [{lo[rb]:.9g}, " \
                                       f"{hi[rb]:.9g}]"  # fmt: skip
     # shoulder
-    va = s[ra] * (theta1 - b1)
+    va = s_a * (theta1 - b1)
     ta = nearest_turn(va, lo[ra], hi[ra], ref[ra], cont[ra])
     if ta is None:
+        s, names, arm, b2 = geo.signs, geo.names, geo.arm, geo.beta2
+        wob = arm.wobble(gamma)
         edge = turn_edge(va, lo[ra], hi[ra], wob)
         if edge is not None:
             g, miss = arm.with_link1(wx, wy, s[ra] * edge + b1)
@@ -400,9 +408,11 @@ def _joints(
             return IKStatus.J1_LIMIT, f"{label}: {names[ra]} = {wrap(va):.9g} rad (+2 pi k) outside [{lo[ra]:.9g}, " \
                                       f"{hi[ra]:.9g}]"  # fmt: skip
     # wrist: s_c (alpha - s_a q_a - s_b q_b), whatever turns the shoulder and elbow took
-    vc = s[rc] * (alpha - s[ra] * ta[0] - s[rb] * tb[0])
+    vc = s_c * (alpha - s_a * ta[0] - s_b * tb[0])
     tc = nearest_turn(vc, lo[rc], hi[rc], ref[rc], cont[rc])
     if tc is None:
+        s, names, arm, b2 = geo.signs, geo.names, geo.arm, geo.beta2
+        wob = arm.wobble(gamma)
         edge = turn_edge(vc, lo[rc], hi[rc], 2.0 * wob)
         if edge is not None:  # the wrist on its limit fixes link 2's heading
             sigma = alpha - s[rc] * edge + b2
@@ -550,6 +560,7 @@ def solve_nearest(
 
 # ------------------------------------------------------------------------------------------ batch
 _BATCH_ROWS = 16384
+_INV_TWO_PI = 1.0 / TWO_PI
 """Rows per block of :func:`solve_batch` (its arrays stay in the cache)."""
 
 
@@ -581,9 +592,8 @@ def solve_batch(
         raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
     if branch not in ("nearest", *BRANCHES):
         raise InvalidInputError(f"branch {branch!r} must be 'nearest', 'right' or 'left'")
-    bad = ~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)  # NaN fails the comparison
-    if bad.any():
-        i = int(np.argmax(bad))
+    if T.size and not (T.max() <= MAGNITUDE_MAX and T.min() >= -MAGNITUDE_MAX):  # NaN fails the comparisons
+        i = int(np.argmax(~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)))
         check_magnitude(T[i].tolist())
     ref = np.zeros(4) if reference is None else np.asarray(reference, dtype=float)
     if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
@@ -592,83 +602,248 @@ def solve_batch(
     q = np.empty((n, 4))
     status = np.empty(n, dtype=np.int64)
     sign = np.empty(n, dtype=np.int64)
+    if n == 0:
+        return BatchIKResult(q, status, sign)
+    const = ref.ndim == 1
+    work = _BatchWork(geo, min(n, _BATCH_ROWS), branch, ref.tolist() if const else None)
     for start in range(0, n, _BATCH_ROWS):
         stop = min(start + _BATCH_ROWS, n)
-        refs = ref if ref.ndim == 1 else ref[start:stop]
-        _block(geo, T[start:stop], refs, branch, q[start:stop], status[start:stop], sign[start:stop])
+        refs = ref if const else ref[start:stop]
+        work.block(T[start:stop], refs, q[start:stop], status[start:stop], sign[start:stop])
     return BatchIKResult(q, status, sign)
 
 
-def _block(geo: ScaraGeometry, T: np.ndarray, ref: np.ndarray, branch: str, q_out: np.ndarray,
-           st_out: np.ndarray, sg_out: np.ndarray) -> None:  # fmt: skip
-    """Solve one block of rows into q_out, st_out, sg_out (see :func:`solve_batch`)."""
-    ra, rb, rc = geo.revolute
-    ip = geo.prismatic
-    s, lo, hi, cont = geo.signs, geo.lower, geo.upper, geo.continuous
-    arm = geo.arm
-    refc = [ref[j] if ref.ndim == 1 else ref[:, j] for j in range(4)]
-    x, y, z = T[:, 0], T[:, 1], T[:, 2]
-    alpha = T[:, 3] - geo.yaw0
-    # vertical joint
-    qp = (z - geo.z0) * s[ip]
-    stroke = (qp < lo[ip] - LIMIT_TOL) | (qp > hi[ip] + LIMIT_TOL)
-    np.clip(qp, lo[ip], hi[ip], out=qp)
-    # wrist point and the planar arm
-    tx, ty = geo.tool
-    if tx or ty:
-        ca, sa = np.cos(alpha), np.sin(alpha)
-        wx = x - (ca * tx - sa * ty) - geo.a1[0]
-        wy = y - (sa * tx + ca * ty) - geo.a1[1]
-    else:
-        wx, wy = x - geo.a1[0], y - geo.a1[1]
-    code, r, gamma, heading = arm.solve_array(wx, wy)
-    inner = (code == Reach.IN) | ((code == Reach.OK) & (r < geo._radius[0] - REACH_TOL))
-    shared = np.where(stroke, IKStatus.J3_STROKE, np.where(code == Reach.OUT, IKStatus.OUT_OF_REACH,
-                      np.where(inner, IKStatus.INSIDE_INNER_LIMIT, IKStatus.OK)))  # fmt: skip
-    lean = arm.lean_array(gamma)
-    wob = arm.wobble_array(gamma)
-    signs = (1, -1) if branch == "nearest" else ((1,) if branch == "right" else (-1,))
-    best_q = best_st = best_d = None
-    for sg in signs:
-        g = gamma if sg > 0 else -gamma
-        qb, okb = nearest_turn_array(s[rb] * (g + (geo.beta1 - geo.beta2)), lo[rb], hi[rb], refc[rb], cont[rb])
-        qa, oka = nearest_turn_array(s[ra] * (heading - sg * lean - geo.beta1), lo[ra], hi[ra], refc[ra], cont[ra])
-        qc, okc = nearest_turn_array(s[rc] * (alpha - s[ra] * qa - s[rb] * qb), lo[rc], hi[rc], refc[rc], cont[rc])
-        st = np.where(shared != 0, shared, np.where(~okb, IKStatus.J2_LIMIT, np.where(
-            ~oka, IKStatus.J1_LIMIT, np.where(~okc, IKStatus.J4_LIMIT, IKStatus.OK))))  # fmt: skip
-        Q = np.empty((len(T), 4))
-        Q[:, ra], Q[:, rb], Q[:, rc], Q[:, ip] = qa, qb, qc, qp
-        if best_q is None or best_st is None:
-            best_q, best_st = Q, st
-            if len(signs) > 1:
-                best_d = np.where(st == 0, ((Q - ref) ** 2).sum(axis=1), np.inf)
-            sg_out[:] = sg
-            continue
-        d = np.where(st == 0, ((Q - ref) ** 2).sum(axis=1), np.inf)
-        # the other branch where it is strictly nearer, or where neither solves and it got further
-        take = (d < best_d) | ((best_d == np.inf) & (d == np.inf) & (_STAGE_OF[st] > _STAGE_OF[best_st]))
-        best_q[take] = Q[take]
-        best_st[take] = st[take]
-        sg_out[take] = sg
-    if best_q is None or best_st is None:  # pragma: no cover - one sign at least
-        return
-    best_q[best_st != 0] = np.nan
-    q_out[:] = best_q
-    st_out[:] = best_st
-    sg_out[best_st != 0] = 0
-    # the rare rows solve() decides: a free shoulder, or a limit within the arm's rounding (see _joints)
-    limits = (best_st == IKStatus.J1_LIMIT) | (best_st == IKStatus.J2_LIMIT) | (best_st == IKStatus.J4_LIMIT)
-    rare = np.flatnonzero(((code == Reach.OK) & (r <= FREE_R) & (shared == 0)) | (limits & (wob > LIMIT_TOL)))
-    for i in rare.tolist():
-        row_ref = ref if ref.ndim == 1 else ref[i]
-        res = solve(geo, T[i], branch="all" if branch == "nearest" else branch, reference=row_ref)
-        best = res.nearest(row_ref) if res.success else None
-        if best is None:
-            q_out[i], st_out[i], sg_out[i] = np.nan, res.status, 0
+class _BatchWork:
+    """:func:`solve`'s formulas for one block of rows at a time, every operation into a preallocated array.
+
+    The planar arm is :meth:`Planar2R.solve_array` (the same formulas as the scalar
+    :meth:`Planar2R.solve`); each joint's turn is :func:`~scara_pin.kinematics.planar2r.nearest_turn`'s
+    k = floor((ref - v) / 2 pi + 1/2), clamped into the limits. With one reference for every row the clamp
+    is decided once per joint: when [ref - pi, ref + pi] lies inside the limits the nearest turn always
+    fits ("inside": no check); when at most one turn can fit and it is the nearest one ("unique": a check,
+    no clamp of k); otherwise k is clamped between the first and last turns that fit ("clip"). Rows without
+    a solution get their status in a second pass over those rows only; the rare rows where the arm's
+    ill-conditioning decides a limit, or the shoulder is free, take :func:`solve`'s route.
+    """
+
+    def __init__(self, geo: ScaraGeometry, rows: int, branch: str, const_ref: list[float] | None) -> None:
+        self.geo = geo
+        self.branch = branch
+        self.signs = (1, -1) if branch == "nearest" else ((1,) if branch == "right" else (-1,))
+        self._f = np.empty((16, rows))
+        self._b = np.empty((8, rows), dtype=bool)
+        self._q = np.empty((len(self.signs), 4, rows))
+        self._mask = np.empty(rows, dtype=np.int64)
+        self._keep = np.empty(rows, dtype=np.int64)
+        lo, hi, cont = geo.lower, geo.upper, geo.continuous
+        self.modes: dict[int, str] = {}
+        for j in geo.revolute:
+            mode = "clip"
+            if cont[j]:
+                mode = "inside"
+            elif const_ref is not None:
+                ref, margin = const_ref[j], 1e-9
+                if lo[j] + margin <= ref - math.pi and ref + math.pi <= hi[j] - margin:
+                    mode = "inside"  # the turn nearest to ref is always inside the limits
+                elif lo[j] <= ref <= hi[j] and max(ref - lo[j], hi[j] - ref) + LIMIT_TOL < math.pi - margin:
+                    mode = "unique"  # no other turn than the nearest can be inside the limits
+            self.modes[j] = mode
+
+    def _turn(self, v: np.ndarray, j: int, ref: Any, out: np.ndarray, ok: np.ndarray, t: np.ndarray) -> bool:
+        """The turn of v nearest ``ref`` inside joint j's limits into ``out``; ``ok`` where it fits.
+
+        Returns False when every row fits (``ok`` not written).
+        """
+        geo, mode = self.geo, self.modes[j]
+        lo, hi = geo.lower[j], geo.upper[j]
+        if mode == "clip":
+            k_min, k_max = t, self._f[15][: len(v)]
+            np.subtract(lo - LIMIT_TOL, v, out=k_min)
+            np.multiply(k_min, _INV_TWO_PI, out=k_min)
+            np.ceil(k_min, out=k_min)
+            np.subtract(hi + LIMIT_TOL, v, out=k_max)
+            np.multiply(k_max, _INV_TWO_PI, out=k_max)
+            np.floor(k_max, out=k_max)
+            np.less_equal(k_min, k_max, out=ok)
+        np.subtract(ref + _PI, v, out=out)  # k = floor((ref + pi - v) / 2 pi), as nearest_turn
+        np.multiply(out, _INV_TWO_PI, out=out)
+        np.floor(out, out=out)
+        if mode == "clip":
+            np.maximum(out, k_min, out=out)
+            np.minimum(out, k_max, out=out)
+        np.multiply(out, TWO_PI, out=out)
+        np.add(out, v, out=out)
+        if mode == "inside":
+            return False
+        if mode == "unique":
+            np.greater_equal(out, lo - LIMIT_TOL, out=ok)
+            np.less_equal(out, hi + LIMIT_TOL, out=self._b[7][: len(v)])
+            np.logical_and(ok, self._b[7][: len(v)], out=ok)
+        np.maximum(out, lo, out=out)
+        np.minimum(out, hi, out=out)
+        return True
+
+    def block(self, T: np.ndarray, ref: np.ndarray, q_out: np.ndarray, st_out: np.ndarray, sg_out: np.ndarray) -> None:
+        """Solve the rows T (at most the rows given at construction) into q_out, st_out, sg_out."""
+        geo = self.geo
+        m = len(T)
+        f = [a[:m] for a in self._f]
+        b = [a[:m] for a in self._b]
+        Qs = [a[:, :m] for a in self._q]
+        ra, rb, rc = geo.revolute
+        ip = geo.prismatic
+        sgn, lo, hi = geo.signs, geo.lower, geo.upper
+        arm = geo.arm
+        refs = [ref[j] if ref.ndim == 1 else ref[:, j] for j in range(4)]
+        x, y, z, yaw = T[:, 0], T[:, 1], T[:, 2], T[:, 3]
+        # vertical joint (the same value on every branch) and the shared failures: stroke, reach
+        qp = Qs[0][ip]
+        np.subtract(z, geo.z0, out=qp)
+        if sgn[ip] < 0:
+            np.negative(qp, out=qp)
+        bad, t_b = b[0], b[1]
+        np.less(qp, lo[ip] - LIMIT_TOL, out=bad)
+        np.logical_or(bad, np.greater(qp, hi[ip] + LIMIT_TOL, out=t_b), out=bad)
+        np.maximum(qp, lo[ip], out=qp)
+        np.minimum(qp, hi[ip], out=qp)
+        for Q in Qs[1:]:
+            Q[ip] = qp
+        alpha = f[0]
+        np.subtract(yaw, geo.yaw0, out=alpha)
+        wx, wy = f[1], f[2]
+        tx, ty = geo.tool
+        if tx or ty:
+            ca, sa = np.cos(alpha, out=f[3]), np.sin(alpha, out=f[4])
+            np.subtract(x, np.subtract(np.multiply(ca, tx, out=f[5]), np.multiply(sa, ty, out=f[6]), out=f[5]), out=wx)
+            np.subtract(y, np.add(np.multiply(sa, tx, out=f[5]), np.multiply(ca, ty, out=f[6]), out=f[5]), out=wy)
+            if geo.a1[0] != 0.0:
+                np.subtract(wx, geo.a1[0], out=wx)
+            if geo.a1[1] != 0.0:
+                np.subtract(wy, geo.a1[1], out=wy)
         else:
-            q_out[i], st_out[i], sg_out[i] = best.q, IKStatus.OK, 1 if best.branch == "right" else -1
+            np.subtract(x, geo.a1[0], out=wx)
+            np.subtract(y, geo.a1[1], out=wy)
+        r, gamma, heading, lean, _ = arm.solve_array(wx, wy, out=f[3:8])
+        np.logical_or(bad, np.greater(r, arm.l12 + REACH_TOL, out=t_b), out=bad)
+        np.logical_or(bad, np.less(r, geo._radius[0] - REACH_TOL, out=t_b), out=bad)
+        # each branch: shoulder, elbow and wrist at their turns nearest the reference
+        dists, oks = [], []
+        c_b = geo.beta1 - geo.beta2
+        for n, sg in enumerate(self.signs):
+            Q, ok, t = Qs[n], b[2 + 2 * n], f[14]
+            va, vb, vc = f[8], f[9], f[10]
+            (np.subtract if sg > 0 else np.add)(heading, lean, out=va)
+            if geo.beta1 != 0.0:
+                np.subtract(va, geo.beta1, out=va)
+            if sgn[ra] < 0:
+                np.negative(va, out=va)
+            if sg * sgn[rb] > 0:
+                np.add(gamma, sgn[rb] * c_b, out=vb)
+            else:
+                np.subtract(sgn[rb] * c_b, gamma, out=vb)  # s_b (-gamma + c_b) = s_b c_b - gamma here
+            np.logical_not(bad, out=ok)
+            t_ok = b[3 + 2 * n]
+            if self._turn(vb, rb, refs[rb], Q[rb], t_ok, t):
+                np.logical_and(ok, t_ok, out=ok)
+            if self._turn(va, ra, refs[ra], Q[ra], t_ok, t):
+                np.logical_and(ok, t_ok, out=ok)
+            (np.subtract if sgn[ra] > 0 else np.add)(alpha, Q[ra], out=vc)
+            (np.subtract if sgn[rb] > 0 else np.add)(vc, Q[rb], out=vc)
+            if sgn[rc] < 0:
+                np.negative(vc, out=vc)
+            if self._turn(vc, rc, refs[rc], Q[rc], t_ok, t):
+                np.logical_and(ok, t_ok, out=ok)
+            oks.append(ok)
+            if len(self.signs) > 1:  # the squared distance of the revolute joints (the vertical one is shared)
+                d = f[11 + n]
+                np.subtract(Q[ra], refs[ra], out=d)
+                np.multiply(d, d, out=d)
+                for j in (rb, rc):
+                    np.subtract(Q[j], refs[j], out=t)
+                    np.multiply(t, t, out=t)
+                    np.add(d, t, out=d)
+                dists.append(d)
+        Q0 = Qs[0]
+        if len(self.signs) > 1:
+            # the second branch where it solves and the first does not or is farther (strictly: first on a tie)
+            use, t_b = b[6], b[1]
+            np.less(dists[1], dists[0], out=use)
+            np.logical_or(use, np.logical_not(oks[0], out=t_b), out=use)
+            np.logical_and(use, oks[1], out=use)
+            # select bit for bit (an exact blend without branches): mask = -1 where use, 0 elsewhere
+            mask = self._mask[:m]
+            np.negative(use.view(np.uint8), out=mask, dtype=np.int64, casting="unsafe")
+            keep = self._keep[:m]
+            np.invert(mask, out=keep)
+            t_i = f[14].view(np.int64)
+            for j in (ra, rb, rc):
+                q0 = Q0[j].view(np.int64)
+                np.bitwise_and(Qs[1][j].view(np.int64), mask, out=t_i)
+                np.bitwise_and(q0, keep, out=q0)
+                np.bitwise_or(q0, t_i, out=q0)
+            solved = np.logical_or(oks[0], oks[1], out=b[7])
+            np.multiply(use, -2, out=sg_out)
+            np.add(sg_out, 1, out=sg_out)
+        else:
+            solved = oks[0]
+            sg_out[:] = self.signs[0]
+        np.copyto(q_out, Q0.T)
+        st_out[:] = 0
+        if solved.all() and not (r <= FREE_R).any():
+            return
+        self._failures(T, ref, m, bad, oks, solved, qp, r, gamma, q_out, st_out, sg_out)
 
+    def _failures(self, T: np.ndarray, ref: np.ndarray, m: int, bad: np.ndarray, oks: list[np.ndarray],
+                  solved: np.ndarray, qp: np.ndarray, r: np.ndarray, gamma: np.ndarray, q_out: np.ndarray,
+                  st_out: np.ndarray, sg_out: np.ndarray) -> None:  # fmt: skip
+        """Statuses of the rows without a solution, and the rare rows :func:`solve` decides."""
+        geo = self.geo
+        ip = geo.prismatic
+        rows = np.flatnonzero(~solved)
+        if len(rows):
+            # the shared failures, in solve()'s order of precedence; then how far each branch got
+            qp_raw = (T[rows, 2] - geo.z0) * geo.signs[ip]
+            stroke = (qp_raw < geo.lower[ip] - LIMIT_TOL) | (qp_raw > geo.upper[ip] + LIMIT_TOL)
+            rr = r[rows]
+            status = np.where(stroke, IKStatus.J3_STROKE, np.where(rr > geo.arm.l12 + REACH_TOL, IKStatus.OUT_OF_REACH,
+                              np.where(bad[rows], IKStatus.INSIDE_INNER_LIMIT, IKStatus.J2_LIMIT)))  # fmt: skip
+            st_out[rows] = status
+            q_out[rows] = np.nan
+            sg_out[rows] = 0
+            lim = rows[status == IKStatus.J2_LIMIT]  # a joint limit: which one, branch by branch
+            if len(lim):
+                st_out[lim] = self._limit_status(T[lim], ref if ref.ndim == 1 else ref[lim], gamma[lim])
+        else:
+            lim = rows
+        # rows whose joint-limit failure may be rounding (near stretched/folded), and free shoulders
+        rare = set(lim[geo.arm.wobble_array(gamma[lim]) > LIMIT_TOL].tolist()) if len(lim) else set()
+        rare |= set(np.flatnonzero((r <= FREE_R) & ~bad).tolist())
+        for i in sorted(rare):
+            row_ref = ref if ref.ndim == 1 else ref[i]
+            res = solve(geo, T[i], branch="all" if self.branch == "nearest" else self.branch, reference=row_ref)
+            best = res.nearest(row_ref) if res.success else None
+            if best is None:
+                q_out[i], st_out[i], sg_out[i] = np.nan, res.status, 0
+            else:
+                q_out[i], st_out[i], sg_out[i] = best.q, IKStatus.OK, 1 if best.branch == "right" else -1
 
-_STAGE_OF = np.zeros(len(IKStatus), dtype=np.int64)
-_STAGE_OF[[IKStatus.J2_LIMIT, IKStatus.J1_LIMIT, IKStatus.J4_LIMIT]] = [1, 2, 3]
-"""Per status code, how far a branch got (as _STAGE)."""
+    def _limit_status(self, T: np.ndarray, ref: np.ndarray, gamma: np.ndarray) -> np.ndarray:
+        """J2_LIMIT, J1_LIMIT or J4_LIMIT of rows that reach but fit no branch: the furthest stage of a branch."""
+        geo = self.geo
+        ra, rb, rc = geo.revolute
+        sgn, lo, hi, cont = geo.signs, geo.lower, geo.upper, geo.continuous
+        refs = [ref[j] if ref.ndim == 1 else ref[:, j] for j in range(4)]
+        alpha = T[:, 3] - geo.yaw0
+        tx, ty = geo.tool
+        ca, sa = np.cos(alpha), np.sin(alpha)
+        wx = T[:, 0] - (ca * tx - sa * ty) - geo.a1[0]
+        wy = T[:, 1] - (sa * tx + ca * ty) - geo.a1[1]
+        _, g, heading, lean, _ = geo.arm.solve_array(wx, wy)
+        stage = np.zeros(len(T), dtype=np.int64)
+        for sg in self.signs:
+            qb, okb = nearest_turn_array(sgn[rb] * (sg * g + geo.beta1 - geo.beta2), lo[rb], hi[rb], refs[rb], cont[rb])
+            qa, oka = nearest_turn_array(sgn[ra] * (heading - sg * lean - geo.beta1), lo[ra], hi[ra], refs[ra], cont[ra])
+            _, okc = nearest_turn_array(sgn[rc] * (alpha - sgn[ra] * qa - sgn[rb] * qb), lo[rc], hi[rc], refs[rc],
+                                        cont[rc])  # fmt: skip
+            stage = np.maximum(stage, np.where(~okb, 1, np.where(~oka, 2, np.where(~okc, 3, 3))))
+        return np.array([IKStatus.J2_LIMIT, IKStatus.J2_LIMIT, IKStatus.J1_LIMIT, IKStatus.J4_LIMIT])[stage]

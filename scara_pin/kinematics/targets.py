@@ -32,7 +32,10 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
         ParameterError: not (x, y, z, yaw) or a 4 x 4 pose, a value not finite or beyond +/-MAGNITUDE_MAX.
     """
     kind = type(target)
-    if kind is tuple or kind is list or (kind is np.ndarray and target.dtype is _F64 and target.shape == (4,)):  # type: ignore[attr-defined]
+    if kind is np.ndarray and target.dtype is _F64 and target.shape == (4,):  # type: ignore[attr-defined]
+        target = target.tolist()  # type: ignore[attr-defined]
+        kind = list
+    if kind is tuple or kind is list:
         try:
             a: Any
             b: Any
@@ -79,8 +82,11 @@ def reference_floats(reference: object, n: int = 4) -> list[float]:
         return [0.0] * n
     if type(reference) is np.ndarray and reference.dtype is _F64 and reference.shape == (n,):  # type: ignore[attr-defined]
         out = reference.tolist()  # type: ignore[attr-defined]
-        if abs(sum(out)) <= MAGNITUDE_MAX and all(-MAGNITUDE_MAX <= v <= MAGNITUDE_MAX for v in out):
-            return out  # type: ignore[no-any-return]
+        if n == 4:
+            a, b, c, d = out
+            m = MAGNITUDE_MAX
+            if -m <= a <= m and -m <= b <= m and -m <= c <= m and -m <= d <= m:  # NaN fails
+                return out  # type: ignore[no-any-return]
     arr = _vector("reference", reference, n)
     if (np.abs(arr) > MAGNITUDE_MAX).any():
         raise ParameterError("reference", arr.tolist(), f"must be within +/-{MAGNITUDE_MAX:g} (rad or m)")

@@ -132,10 +132,9 @@ def reachable(geo: PalletizerGeometry, r: float, z: float) -> bool:
     with the IK's tolerances.
     """
     arm = geo.arm
-    code, _, g, heading = arm.solve(z - geo.h0, r - geo.r0)  # the arm plane as (x, y) = (v, h)
+    code, _, g, heading, lean = arm.solve(z - geo.h0, r - geo.r0)  # the arm plane as (x, y) = (v, h)
     if code != Reach.OK:
         return False
-    lean = arm.lean(g)
     lo, hi, cont = geo.lower, geo.upper, geo.continuous
     for q3, q2 in ((g, heading - lean), (-g, heading + lean)):
         if _fits(q2, lo[1], hi[1], cont[1]) and _fits(q2 + q3, lo[2], hi[2], cont[2]):

@@ -261,10 +261,7 @@ def _contains_xy(p: _Params, x: np.ndarray, y: np.ndarray, tol: float = LIMIT_TO
     """
     arm = p.arm
     dx, dy = np.asarray(x, dtype=float) - p.a1[0], np.asarray(y, dtype=float) - p.a1[1]
-    r = np.sqrt(dx * dx + dy * dy)
-    g0 = arm.elbow_array(r)
-    heading = np.arctan2(dy, dx)
-    lean = arm.lean_array(g0)
+    r, g0, heading, lean, _ = arm.solve_array(dx, dy)
     free = r < 1e-15  # l1 = l2 and the wrist on the shoulder axis: the shoulder angle is free
     inside = np.zeros(np.shape(r), dtype=bool)
     for sign in (1.0, -1.0):
