@@ -307,7 +307,7 @@ class TeachServer:
                 self.write({"error": message})
 
         def access(handler: Any) -> None:  # requests are logged at debug level (-v), not on stderr
-            log.debug("%d %s", handler.get_status(), handler.request.summary())
+            log.debug("%d %s %s", handler.get_status(), handler.request.method, handler.request.uri)
 
         return tornado.web.Application([(r"/", Page), (r"/api/(state|q|jog|goto)", Api)], log_function=access)
 
