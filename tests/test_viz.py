@@ -25,7 +25,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 import psutil
 import pytest
 from browser import chromium, in_ci, next_frames, orange_pixels, unavailable_reason
@@ -518,7 +517,8 @@ def test_live_animation_follows_the_trajectory(viewer: Viewer, robot: Robot, pag
     for k in (0, 10, 17, len(times) - 1):
         page.evaluate("(t) => viewer.animator.seek(t)", float(times[k]))
         expected = fk_tool(robot, qs[k])
-        np.testing.assert_allclose(tool_in_page(page, expected, robot), expected, rtol=0, atol=1e-6, err_msg=f"sample {k}")
+        shown = tool_in_page(page, expected, robot)
+        np.testing.assert_allclose(shown, expected, rtol=0, atol=1e-6, err_msg=f"sample {k}")
     assert t0 < t_played, (t0, t_played)
     assert 0.1 < t_played - t0 <= times[-1], (t0, t_played)
     assert page.errors == []

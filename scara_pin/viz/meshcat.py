@@ -32,9 +32,7 @@ solver module imports this one.
 from __future__ import annotations
 
 import atexit
-import base64
 import collections
-import html
 import logging
 import math
 import os
@@ -103,8 +101,11 @@ def _meshcat() -> Any:
 
 
 def _tree_visualizer(robot: Robot, paths: list[str]) -> Any:
-    """Pinocchio's ``MeshcatVisualizer`` (its geometry and mesh loaders), naming each geometry's node under
-    its joint's node of the scene tree (``<joint path>/visuals/<geometry>``) instead of one flat group."""
+    """Pinocchio's ``MeshcatVisualizer`` (its geometry and mesh loaders), with tree node names.
+
+    Each geometry's node is under its joint's node of the scene tree (``<joint path>/visuals/<geometry>``),
+    instead of one flat group.
+    """
     _meshcat()
     from pinocchio.visualize import MeshcatVisualizer
 
@@ -276,8 +277,10 @@ def _viewer_js() -> str:
 
 
 def _page(title: str, commands: list[bytes], data: dict[str, Any] | None = None) -> str:
-    """Make a self-contained HTML page: meshcat's viewer script, the scene's commands replayed at load, and
-    (with ``data``) the pendant panel (:func:`scara_pin.viz.page.render`)."""
+    """Make a self-contained HTML page: meshcat's viewer script and the scene's commands replayed at load.
+
+    With ``data``, also the pendant panel (:func:`scara_pin.viz.page.render`).
+    """
     from .page import render
 
     return render(title, _viewer_js(), commands, data)

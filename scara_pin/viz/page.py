@@ -1,5 +1,7 @@
-"""The HTML page of the browser viewer: meshcat's scene and a pendant panel (joint sliders, tool pose readout,
-motion player, and in the live teach page, Cartesian jog buttons and a go-to-pose form).
+"""The HTML page of the browser viewer: meshcat's scene and a pendant panel.
+
+The panel: joint sliders, the tool pose readout, a motion player, and in the live teach page, Cartesian jog
+buttons and a go-to-pose form.
 
 One page serves both uses: :func:`scara_pin.viz.meshcat.export_html` writes it to a file that renders offline
 (the panel's script reads the pose from the scene graph), and :mod:`scara_pin.viz.teach` serves it with a

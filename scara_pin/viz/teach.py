@@ -1,5 +1,7 @@
-"""The browser as a teach pendant: a session holding the robot's q, answered by the library's IK and FK, and
-a local web server (tornado, meshcat's own dependency) serving the pendant page and its JSON requests.
+"""The browser as a teach pendant: a session of the robot's q, and a local web server for it.
+
+The session is answered by the library's IK and FK; the server (tornado, meshcat's own dependency) serves
+the pendant page and its JSON requests.
 
 :class:`TeachSession` is the logic, without a browser: set the joints, jog the tool along x, y, z or about
 its yaw in the base frame, or go to a pose; each Cartesian request is answered by the closed-form IK nearest
