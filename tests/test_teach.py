@@ -16,15 +16,14 @@ import socket
 import subprocess
 import sys
 import urllib.request
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import browser as _browser
 import numpy as np
 import pinocchio as pin
 import psutil
 import pytest
-from browser import chromium, in_ci, unavailable_reason
 
 from scara_pin import InvalidInputError, Robot, load_robot
 from scara_pin.cli import main
@@ -32,6 +31,9 @@ from scara_pin.kinematics.scara import NotScaraError
 from scara_pin.viz.meshcat import export_html
 from scara_pin.viz.teach import JogAxis, Solver, TeachSession
 from scara_pin.viz.tree import FIELD_OF_VIEW, framing, joint_nodes
+
+browser = _browser.browser  # the shared fixtures (tests/browser.py)
+page = _browser.page
 
 NAMES = ("s1", "default", "palletizer")
 Q_S1 = np.array([0.3, 0.9, 0.02, -0.5])  # inside s1's workspace, 10 mm of x to spare either way
@@ -167,29 +169,6 @@ def test_numeric_fallback_where_the_closed_form_refuses(robot_s1: Robot, monkeyp
 
 
 # ------------------------------------------------------------------------------------------ browser
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    reason = unavailable_reason()
-    if reason is not None:
-        if in_ci():
-            pytest.fail(f"CI is set, so the browser tests must run, but: {reason}")
-        pytest.skip(reason)
-    with chromium(tmp_path_factory.mktemp("chromium-profile")) as context:
-        yield context
-
-
-@pytest.fixture
-def page(browser: Any) -> Iterator[Any]:
-    p = browser.new_page()
-    errors: list[str] = []
-    p.on("pageerror", lambda exc: errors.append(str(exc)))
-    p.errors = errors
-    try:
-        yield p
-    finally:
-        p.close()
-
-
 def fk_cli(capsys: pytest.CaptureFixture[str], robot: str, q: list[float]) -> np.ndarray:
     assert main(["fk", "--robot", robot, *map(repr, q), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

@@ -24,10 +24,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import browser as _browser
 import numpy as np
 import psutil
 import pytest
-from browser import chromium, in_ci, next_frames, orange_pixels, unavailable_reason
+from browser import next_frames, orange_pixels
 
 from scara_pin import InvalidInputError, Robot, load_robot
 from scara_pin.viz.meshcat import (
@@ -41,6 +42,8 @@ from scara_pin.viz.meshcat import (
 )
 from scara_pin.viz.tree import node_paths
 
+browser = _browser.browser  # the shared fixtures (tests/browser.py)
+page = _browser.page
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
 SERVER_MARK = "scara-pin-meshcat-server"
 FPS = 30
@@ -189,31 +192,6 @@ def viewer(robot: Robot) -> Iterator[Viewer]:
     finally:
         v.close()
         assert v.server_pid is not None and wait_dead(v.server_pid), "the viewer's server outlived close()"
-
-
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    """A headless Chromium context with a fresh profile. Skipped only outside CI when Chromium or
-    Playwright is absent; in CI, or when Chromium is there but cannot start, the tests fail."""
-    reason = unavailable_reason()
-    if reason is not None:
-        if in_ci():
-            pytest.fail(f"CI is set, so the browser tests must run, but: {reason}")
-        pytest.skip(reason)
-    with chromium(tmp_path_factory.mktemp("chromium-profile")) as context:
-        yield context
-
-
-@pytest.fixture
-def page(browser: Any) -> Iterator[Any]:
-    p = browser.new_page()
-    errors: list[str] = []
-    p.on("pageerror", lambda exc: errors.append(str(exc)))
-    p.errors = errors
-    try:
-        yield p
-    finally:
-        p.close()
 
 
 def screenshot(page: Any, name: str) -> bytes:
