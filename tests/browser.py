@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 CHROMIUM = os.environ.get("SCARA_PIN_CHROMIUM", "/usr/bin/chromium")
 
@@ -113,3 +114,22 @@ def orange_pixels(png: bytes | Path) -> int:
     ratio_b = np.divide(b, r, out=np.ones_like(b), where=r > 0)
     mask = (r > 60) & (ratio_g > 0.30) & (ratio_g < 0.62) & (ratio_b > 0.03) & (ratio_b < 0.30)
     return int(mask.sum())
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
+    """A headless Chromium context with a fresh profile (one per test module): see browser_for_tests."""
+    yield from browser_for_tests(tmp_path_factory)
+
+
+@pytest.fixture
+def page(browser: Any) -> Iterator[Any]:
+    """A new page of :func:`browser`; its uncaught errors collect in ``page.errors``."""
+    p = browser.new_page()
+    errors: list[str] = []
+    p.on("pageerror", lambda exc: errors.append(str(exc)))
+    p.errors = errors
+    try:
+        yield p
+    finally:
+        p.close()

@@ -378,14 +378,25 @@ def render(browser: Any, html: Path) -> tuple[int, list[str], int]:
         page.goto(html.as_uri())
         page.wait_for_function("() => window.scaraSceneCommands > 0")
         next_frames(page)
+        # every link's visuals, wherever its joint's node is in the robot's tree
         types = page.evaluate("""() => {
-            const node = viewer.scene_tree.children.meshcat.children.robot.children.visuals;
-            return Object.keys(node.children).sort().map((k) => {
-                const obj = node.children[k].children["<object>"].object;
-                const g = obj && obj.geometry;
-                const n = g && g.attributes.position ? g.attributes.position.count : 0;
-                return k + ":" + (g ? g.type : "none") + ":" + n;
-            });
+            const out = [];
+            const walk = (node) => {
+                for (const [name, child] of Object.entries(node.children)) {
+                    if (name === "visuals") {
+                        for (const [k, v] of Object.entries(child.children)) {
+                            const obj = v.children["<object>"] && v.children["<object>"].object;
+                            const g = obj && obj.geometry;
+                            const n = g && g.attributes.position ? g.attributes.position.count : 0;
+                            out.push(k + ":" + (g ? g.type : "none") + ":" + n);
+                        }
+                    } else if (name !== "<object>") {
+                        walk(child);
+                    }
+                }
+            };
+            walk(viewer.scene_tree.children.meshcat.children.robot);
+            return out.sort();
         }""")  # fmt: skip
         pixels = orange_pixels(page.screenshot())
     finally:

@@ -24,13 +24,13 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import browser as _browser
 import numpy as np
-import pinocchio as pin
 import psutil
 import pytest
-from browser import browser_for_tests, next_frames, orange_pixels
+from browser import next_frames, orange_pixels
 
-from scara_pin import InvalidInputError, Robot
+from scara_pin import InvalidInputError, Robot, load_robot
 from scara_pin.viz.meshcat import (
     ROBOT_NODE,
     Viewer,
@@ -40,7 +40,10 @@ from scara_pin.viz.meshcat import (
     static_html,
     tool_path,
 )
+from scara_pin.viz.tree import node_paths
 
+browser = _browser.browser  # the shared fixtures (tests/browser.py)
+page = _browser.page
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
 SERVER_MARK = "scara-pin-meshcat-server"
 FPS = 30
@@ -97,27 +100,33 @@ def scene_from_three(p: list[float]) -> np.ndarray:
     return np.array([x, -z, y])
 
 
-TOOL_JS = f"""() => {{
-    const c = (n, k) => (n && n.children[k]) || null;
-    const node = c(c(c(c(c(viewer.scene_tree, "meshcat"), "{ROBOT_NODE}"), "frames"), "tool0"), "<object>");
+TOOL_JS = """(path) => {
+    let node = viewer.scene_tree;
+    for (const k of path.split("/")) node = (node && node.children[k]) || null;
     if (node === null) return null;
     viewer.scene.updateMatrixWorld(true);
     const e = node.object.matrixWorld.elements;
     return [e[12], e[13], e[14]];
-}}"""
+}"""
+
+
+def frame_path(robot: Robot, frame: str = "tool0") -> str:
+    """The scene path of a frame's triad: under its joint's node of the tree (robot/joint1/.../frames/tool0)."""
+    f = robot.model.frames[robot.model.getFrameId(frame)]
+    return f"meshcat/{node_paths(robot, ROBOT_NODE)[f.parentJoint]}/frames/{frame}"
 
 SCENE_MATRIX_JS = (
     "() => { viewer.scene.updateMatrixWorld(true); return Array.from(viewer.scene.matrixWorld.elements); }"
 )
 
 
-def tool_in_page(page: Any, expected: np.ndarray, timeout: float = 15.0) -> np.ndarray:
+def tool_in_page(page: Any, expected: np.ndarray, robot: Robot, timeout: float = 15.0) -> np.ndarray:
     """The tool frame's scene position read from three.js, once it is within 1e-6 m of ``expected``
     (commands reach the page asynchronously) or when time is up (the caller's assertion then fails)."""
     deadline = time.monotonic() + timeout
     pos = None
     while time.monotonic() < deadline:
-        raw = page.evaluate(TOOL_JS)
+        raw = page.evaluate(TOOL_JS, frame_path(robot))
         if raw is not None:
             pos = scene_from_three(raw)
             if np.allclose(pos, expected, rtol=0, atol=1e-6):
@@ -134,6 +143,16 @@ def trajectory(robot: Robot, n: int = 31) -> tuple[np.ndarray, np.ndarray]:
     blend = (3 * s**2 - 2 * s**3)[:, None]
     qs = Q_A + blend * (Q_B - Q_A)
     return times, qs
+
+
+def page_data(text: str) -> dict[str, Any]:
+    """The pendant panel's data embedded in a page."""
+    import json
+    import re
+
+    match = re.search(r'<script type="application/json" id="scara-data">(.*?)</script>', text, re.S)
+    assert match, "the page has no pendant data"
+    return json.loads(match.group(1))  # type: ignore[no-any-return]
 
 
 def page_commands(text: str) -> list[dict[str, Any]]:
@@ -173,24 +192,6 @@ def viewer(robot: Robot) -> Iterator[Viewer]:
     finally:
         v.close()
         assert v.server_pid is not None and wait_dead(v.server_pid), "the viewer's server outlived close()"
-
-
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    """A headless Chromium context with a fresh profile (see browser.browser_for_tests)."""
-    yield from browser_for_tests(tmp_path_factory)
-
-
-@pytest.fixture
-def page(browser: Any) -> Iterator[Any]:
-    p = browser.new_page()
-    errors: list[str] = []
-    p.on("pageerror", lambda exc: errors.append(str(exc)))
-    p.errors = errors
-    try:
-        yield p
-    finally:
-        p.close()
 
 
 def screenshot(page: Any, name: str) -> bytes:
@@ -381,7 +382,9 @@ def test_export_html_is_atomic_and_self_contained(robot: Robot, tmp_path: Path) 
     path = export_html(robot, tmp_path / "s1.html", times=times, qs=qs)
     text = path.read_text(encoding="utf-8")
     assert 800_000 < len(text) < 3_000_000
-    assert "<script src" not in text and "fetch(" not in text.split("var viewer = new MeshCat.Viewer")[1]
+    assert "<script src" not in text
+    data = page_data(text)
+    assert "teach" not in data  # the offline page never calls the server (no request: see the browser test)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s1.html"]  # no temporary file left
     # a failed write leaves the old file as it was
     with pytest.raises(InvalidInputError, match="2 numbers"):
@@ -391,37 +394,51 @@ def test_export_html_is_atomic_and_self_contained(robot: Robot, tmp_path: Path) 
         export_html(robot, tmp_path / "missing" / "x.html")
 
 
-@pytest.mark.parametrize("name", ["default", "s1"])
+@pytest.mark.parametrize("name", ["default", "s1", "palletizer"])
 def test_static_scene_holds_the_motion_targets_and_workspace(robots: dict[str, Robot], name: str) -> None:
-    """The page's commands: tool0's animation keys are the FK of the samples; targets and the workspace
-    polyline are where they were asked for (base frame -> universe, polyline on the floor z = 0)."""
-    robot = robots[name]
+    """The page's data and commands: the player's samples are the motion's (resampled at FPS on sample times
+    here, so equal); the tool path is the FK of the samples; a target marker drawn at the FK pose of a q is
+    where tool0 is at that q, z axis included; the workspace polyline lies on the floor."""
+    robot = robots[name] if name in robots else load_robot(name)
     times, qs = trajectory(robot)
+    if name == "palletizer":
+        qs = qs + np.array([0.0, 0.0, 1.0, 0.0])  # inside the palletizer's theta3 range
     ring = np.array([[0.2 * math.cos(a), 0.2 * math.sin(a)] for a in np.linspace(0, 2 * math.pi, 60)])
-    target = np.array([0.1, 0.12, 0.03, 0.5])
-    commands = page_commands(static_html(robot, times=times, qs=qs, polylines=[ring], targets=[target]))
-    animations = [c for c in commands if c["type"] == "set_animation"]
-    assert len(animations) == 1
-    clips = {a["path"]: a["clip"] for a in animations[0]["animations"]}
-    clip = clips[f"/meshcat/{ROBOT_NODE}/frames/tool0"]
-    assert clip["fps"] == FPS
-    track = next(t for t in clip["tracks"] if t["name"] == ".position")
-    assert [k["time"] for k in track["keys"]] == list(range(len(times)))
-    got = np.array([k["value"] for k in track["keys"]])
-    np.testing.assert_allclose(got, [fk_tool(robot, q) for q in qs], rtol=0, atol=1e-12)
-    # the tool path drawn by default is that curve (float32 in the page)
-    np.testing.assert_allclose(line_points(commands, "/meshcat/overlays/path"), got, rtol=0, atol=1e-7)
+    q_target = qs[7]
+    target = robot.tool_pose(q_target)
+    text = static_html(robot, times=times, qs=qs, polylines=[ring], targets=[target])
+    commands = page_commands(text)
+    assert not [c for c in commands if c["type"] == "set_animation"]
+    motion = page_data(text)["motion"]
+    np.testing.assert_allclose(motion["times"], times, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(motion["qs"], qs, rtol=0, atol=1e-12)
+    assert motion["loop"] is True
+    # the tool path drawn by default is the FK curve (float32 in the page)
+    got = np.array([fk_tool(robot, q) for q in qs])
+    np.testing.assert_allclose(line_points(commands, "/meshcat/overlays/path"), got, rtol=0, atol=1e-6)
 
     oMb = robot.frame_placement(qs[0], robot.base_frame, relative_to="universe")
-    # tool_path gives the same curve in the base frame
     np.testing.assert_allclose(tool_path(robot, qs) @ oMb.rotation.T + oMb.translation, got, rtol=0, atol=1e-12)
-    bMt = pin.SE3(pin.utils.rotate("z", target[3]), target[:3])
     M = last_transform(commands, "/meshcat/overlays/targets/0")
-    np.testing.assert_allclose(M, (oMb * bMt).homogeneous, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(M, robot.frame_placement(q_target, "tool0", "universe").homogeneous, rtol=0, atol=1e-12)
 
     floor = line_points(commands, "/meshcat/overlays/workspace/0")
     np.testing.assert_allclose(floor[:, 2], 0.0, atol=1e-7)
     np.testing.assert_allclose(floor[:, :2], ring + oMb.translation[:2], rtol=0, atol=1e-7)
+
+
+def chain_placement(commands: list[dict[str, Any]], robot: Robot, frame: str) -> np.ndarray:
+    """A frame's placement in the universe composed from the last transforms of the nodes on its path."""
+    f = robot.model.frames[robot.model.getFrameId(frame)]
+    M = np.eye(4)
+    path = ""
+    for part in frame_path(robot, frame).split("/")[1:]:
+        path = f"{path}/{part}"
+        matrices = [c["matrix"] for c in commands if c["type"] == "set_transform" and c["path"] == "/meshcat" + path]
+        if matrices:
+            M = M @ np.array(matrices[-1]).reshape(4, 4).T
+    assert f.parentJoint > 0
+    return M
 
 
 def test_play_steps_in_real_time(viewer: Viewer, robot: Robot) -> None:
@@ -430,8 +447,8 @@ def test_play_steps_in_real_time(viewer: Viewer, robot: Robot) -> None:
     viewer.play(times, qs, speed=2.0)
     elapsed = time.monotonic() - start
     assert 0.45 < elapsed < 1.5, elapsed
-    M = last_transform(page_commands(viewer.static_html()), f"/meshcat/{ROBOT_NODE}/frames/tool0")
-    np.testing.assert_allclose(M[:3, 3], fk_tool(robot, qs[-1]), rtol=0, atol=1e-12)
+    M = chain_placement(page_commands(viewer.static_html()), robot, "tool0")
+    np.testing.assert_allclose(M, robot.frame_placement(qs[-1], "tool0", "universe").homogeneous, rtol=0, atol=1e-12)
 
 
 # ------------------------------------------------------------------------------------------ real browser
@@ -442,26 +459,24 @@ def test_live_page_shows_the_robot_where_pinocchio_puts_it(viewer: Viewer, robot
     page.wait_for_function("() => window.viewer && viewer.connection && viewer.connection.readyState === 1")
 
     expected_a = fk_tool(robot, Q_A)
-    np.testing.assert_allclose(tool_in_page(page, expected_a), expected_a, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(tool_in_page(page, expected_a, robot), expected_a, rtol=0, atol=1e-6)
     # meshcat's root turn, which the conversion above undoes: three.js world = Rx(-pi/2) scene
     m = np.array(page.evaluate(SCENE_MATRIX_JS)).reshape(4, 4).T
     np.testing.assert_allclose(m[:3, :3], [[1, 0, 0], [0, 0, 1], [0, -1, 0]], atol=1e-12)
 
     shown = orange_pixels(screenshot(page, "live_robot.png"))
     assert shown > 500, f"only {shown} robot-orange pixels in the live page"
-    viewer.visualizer[f"{ROBOT_NODE}/visuals"].set_property("visible", False)
-    page.wait_for_function(
-        f"() => viewer.scene_tree.children.meshcat.children.{ROBOT_NODE}.children.visuals.object.visible === false"
-    )
+    viewer.visualizer[ROBOT_NODE].set_property("visible", False)  # the whole tree: links and frames
+    page.wait_for_function(f"() => viewer.scene_tree.children.meshcat.children.{ROBOT_NODE}.object.visible === false")
     hidden = orange_pixels(screenshot(page, "live_robot_hidden.png"))
     assert hidden < 0.02 * shown, f"{hidden} orange pixels with the robot hidden (vs {shown})"
-    viewer.visualizer[f"{ROBOT_NODE}/visuals"].set_property("visible", True)
+    viewer.visualizer[ROBOT_NODE].set_property("visible", True)
 
     # an animation step: another configuration moves the tool accordingly
     viewer.display(Q_B)
     expected_b = fk_tool(robot, Q_B)
     assert np.linalg.norm(expected_b - expected_a) > 0.05
-    np.testing.assert_allclose(tool_in_page(page, expected_b), expected_b, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(tool_in_page(page, expected_b, robot), expected_b, rtol=0, atol=1e-6)
     assert orange_pixels(screenshot(page, "live_robot_moved.png")) > 500
     assert page.errors == []
 
@@ -480,7 +495,8 @@ def test_live_animation_follows_the_trajectory(viewer: Viewer, robot: Robot, pag
     for k in (0, 10, 17, len(times) - 1):
         page.evaluate("(t) => viewer.animator.seek(t)", float(times[k]))
         expected = fk_tool(robot, qs[k])
-        np.testing.assert_allclose(tool_in_page(page, expected), expected, rtol=0, atol=1e-6, err_msg=f"sample {k}")
+        shown = tool_in_page(page, expected, robot)
+        np.testing.assert_allclose(shown, expected, rtol=0, atol=1e-6, err_msg=f"sample {k}")
     assert t0 < t_played, (t0, t_played)
     assert 0.1 < t_played - t0 <= times[-1], (t0, t_played)
     assert page.errors == []
@@ -506,12 +522,11 @@ def test_static_page_renders_offline_without_any_request(robot: Robot, page: Any
     page.on("request", lambda r: requests.append(r.url))
     page.on("websocket", lambda ws: requests.append(ws.url))
     page.goto(path.as_uri())
-    page.wait_for_function("() => window.scaraSceneCommands > 0")
-    assert page.evaluate("() => viewer.animator.actions[0].repetitions") == math.inf  # loops
-    page.evaluate("() => viewer.animator.pause()")
-    page.evaluate("(t) => viewer.animator.seek(t)", float(times[-1]))
+    page.wait_for_function("() => window.scaraSceneCommands > 0 && window.scaraPlayer")
+    assert page.evaluate("() => scaraPlayer.playing()")  # plays at load
+    page.evaluate("(t) => scaraPlayer.seek(t)", float(times[-1]))
     expected = fk_tool(robot, qs[-1])
-    np.testing.assert_allclose(tool_in_page(page, expected), expected, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(tool_in_page(page, expected, robot), expected, rtol=0, atol=1e-6)
     shown = orange_pixels(screenshot(page, "static_robot.png"))
     assert shown > 500, f"only {shown} robot-orange pixels in the static page"
     assert requests == [path.as_uri()], requests

@@ -23,7 +23,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 from ..errors import ScaraError
-from . import cycle, describe, kinematics, motion, view, workspace
+from . import cycle, describe, kinematics, motion, teach, view, workspace
 from ._common import _Parser, _UsageError, log
 
 __all__ = ["build_parser", "main"]
@@ -42,7 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
-    for module in (describe, kinematics, motion, cycle, workspace, view):
+    for module in (describe, kinematics, motion, cycle, workspace, view, teach):
         module.register(sub)
     return parser
 

@@ -10,8 +10,8 @@ theta1 the heading of link 1 and gamma the elbow angle (from link 1 to link 2, c
 r = |W|, the half-angle form of the law of cosines stays accurate at the stretched (gamma = 0) and folded
 (gamma = pi) boundaries, where the textbook acos loses half the digits:
 
-    tan(|gamma| / 2) = sqrt(o) / sqrt(i),   o = (l1 + l2 - r)(l1 + l2 + r),   i = (r - l1 + l2)(r + l1 - l2),
-    theta1 = atan2(wy, wx) -+ lean,   lean = atan2(l2 sin|gamma|, l1 + l2 cos|gamma|)   (elbow +gamma / -gamma),
+    tan(|gamma| / 2) = sqrt(o) / sqrt(i),    o = (l1 + l2 - r)(l1 + l2 + r),    i = (r - l1 + l2)(r + l1 - l2),
+    theta1 = atan2(wy, wx) -+ lean,    lean = atan2(l2 sin|gamma|, l1 + l2 cos|gamma|)    (elbow +/-gamma),
 
 with the lean read from the same square roots, without a sine or cosine (both sides times o + i > 0):
 lean = atan2(2 l2 sqrt(o) sqrt(i), (l1 + l2) i + (l1 - l2) o).
@@ -33,8 +33,8 @@ arm with one angle fixed).
 Joint turns. A revolute joint value v is the same joint position as v + 2 pi k. Inside limits [lo, hi]
 the turns that fit are k in [k_min, k_max] = [ceil((lo - v) / 2 pi), floor((hi - v) / 2 pi)] (limits
 widened by ``LIMIT_TOL``). The turn nearest a reference is chosen PER JOINT in O(1), whatever the range:
-k = clip(floor((ref + pi - v) / 2 pi), k_min, k_max) (round((ref - v) / 2 pi), ties upwards). A continuous joint (no limits) takes the unclipped k, so
-distances to the reference are wrapped.
+k = clip(floor((ref + pi - v) / 2 pi), k_min, k_max) (round((ref - v) / 2 pi), ties upwards). A continuous
+joint (no limits) takes the unclipped k, so distances to the reference are wrapped.
 
 Scalar functions use :mod:`math` (the per-call paths); ``*_array`` functions are the same formulas for numpy
 arrays (the batch paths), with the same order of operations.

@@ -176,9 +176,9 @@ class ScaraGeometry:
         # the numbers the per-call path reads, unpacked once per call (the geometry is frozen)
         ra, rb, rc = self.revolute
         ip = self.prismatic
-        s, lo, hi = self.signs, self.lower, self.upper
+        s, lower, upper = self.signs, self.lower, self.upper
         object.__setattr__(self, "_k", (
-            ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip], lo[ip] - LIMIT_TOL, hi[ip] + LIMIT_TOL,
+            ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip], lower[ip] - LIMIT_TOL, upper[ip] + LIMIT_TOL,
             self.z0, self.a1[0], self.a1[1], self.tool[0], self.tool[1], self._radius[0] - REACH_TOL,
             self.beta1, self.beta2 - self.beta1,
         ))  # fmt: skip
@@ -842,7 +842,8 @@ class _BatchWork:
         stage = np.zeros(len(T), dtype=np.int64)
         for sg in self.signs:
             qb, okb = nearest_turn_array(sgn[rb] * (sg * g + geo.beta1 - geo.beta2), lo[rb], hi[rb], refs[rb], cont[rb])
-            qa, oka = nearest_turn_array(sgn[ra] * (heading - sg * lean - geo.beta1), lo[ra], hi[ra], refs[ra], cont[ra])
+            va = sgn[ra] * (heading - sg * lean - geo.beta1)
+            qa, oka = nearest_turn_array(va, lo[ra], hi[ra], refs[ra], cont[ra])
             _, okc = nearest_turn_array(sgn[rc] * (alpha - sgn[ra] * qa - sgn[rb] * qb), lo[rc], hi[rc], refs[rc],
                                         cont[rc])  # fmt: skip
             stage = np.maximum(stage, np.where(~okb, 1, np.where(~oka, 2, np.where(~okc, 3, 3))))

@@ -32,9 +32,7 @@ solver module imports this one.
 from __future__ import annotations
 
 import atexit
-import base64
 import collections
-import html
 import logging
 import math
 import os
@@ -77,6 +75,7 @@ _OVERLAYS = "overlays"
 _DEFAULT_FPS = 30
 _PATH_COLOR = 0x1E90FF  # dodger blue: the tool path
 _WORKSPACE_COLOR = 0x2E8B57  # sea green: the workspace boundary
+_GRID_COLOR = 0x8C96A0  # grey blue: the floor grid
 _SERVER_MARK = "scara-pin-meshcat-server"
 """Argument that marks our meshcat server processes (tests find leftovers by it)."""
 
@@ -101,11 +100,38 @@ def _meshcat() -> Any:
     return meshcat
 
 
-def _pinocchio_visualizer() -> Any:
+def _tree_visualizer(robot: Robot, paths: list[str]) -> Any:
+    """Pinocchio's ``MeshcatVisualizer`` (its geometry and mesh loaders), with tree node names.
+
+    Each geometry's node is under its joint's node of the scene tree (``<joint path>/visuals/<geometry>``),
+    instead of one flat group.
+    """
     _meshcat()
     from pinocchio.visualize import MeshcatVisualizer
 
-    return MeshcatVisualizer
+    class _TreeVisualizer(MeshcatVisualizer):  # type: ignore[misc]
+        def getViewerNodeName(self, geometry_object: Any, geometry_type: Any) -> str:  # noqa: N802 - Pinocchio's
+            group = "visuals" if geometry_type == pin.GeometryType.VISUAL else "collisions"
+            return f"{paths[geometry_object.parentJoint]}/{group}/{geometry_object.name}"
+
+    return _TreeVisualizer(robot.model, robot.collision_model, robot.visual_model)
+
+
+def _resample(times: np.ndarray, qs: np.ndarray, fps: int) -> tuple[np.ndarray, np.ndarray]:
+    """The motion on a grid of ``fps`` frames per second: (frame numbers, (F, 4) joint values).
+
+    Joint values are interpolated linearly between samples; the last frame is the last sample.
+    """
+    if not (isinstance(fps, int) and 1 <= fps <= 1000):
+        raise InvalidInputError(f"fps is {fps!r}; it must be a whole number of frames per second in [1, 1000]")
+    duration = float(times[-1] - times[0])
+    n = int(math.floor(duration * fps + 1e-9))
+    frames = np.arange(n + 1, dtype=float)
+    if duration * fps - n > 1e-9:
+        frames = np.append(frames, duration * fps)
+    grid = times[0] + frames / fps
+    q = np.column_stack([np.interp(grid, times, qs[:, j]) for j in range(qs.shape[1])])
+    return frames, q
 
 
 # ------------------------------------------------------------------------------------------ input checks
@@ -250,43 +276,14 @@ def _viewer_js() -> str:
     return js.replace("</script", "<\\/script")
 
 
-def _page(title: str, commands: list[bytes]) -> str:
-    """Make a self-contained HTML page: meshcat's viewer script and the scene's commands, replayed at load."""
-    encoded = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in commands)
-    return f"""<!DOCTYPE html>
-<html>
-<head>
-<meta charset="utf-8">
-<title>{html.escape(title)}</title>
-<style>
-body {{ margin: 0; }}
-#meshcat-pane {{ width: 100vw; height: 100vh; overflow: hidden; }}
-</style>
-</head>
-<body>
-<div id="meshcat-pane"></div>
-<script>
-{_viewer_js()}
-</script>
-<script>
-var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));
-(function () {{
-  // The scene, as msgpack commands (base64): decoded and applied synchronously, in order; no fetch.
-  var commands = [
-{encoded}
-  ];
-  function bytes(text) {{
-    var raw = atob(text), out = new Uint8Array(raw.length);
-    for (var i = 0; i < raw.length; i++) out[i] = raw.charCodeAt(i);
-    return out;
-  }}
-  for (var i = 0; i < commands.length; i++) viewer.handle_command_bytearray(bytes(commands[i]));
-  window.scaraSceneCommands = commands.length;
-}})();
-</script>
-</body>
-</html>
-"""
+def _page(title: str, commands: list[bytes], data: dict[str, Any] | None = None) -> str:
+    """Make a self-contained HTML page: meshcat's viewer script and the scene's commands replayed at load.
+
+    With ``data``, also the pendant panel (:func:`scara_pin.viz.page.render`).
+    """
+    from .page import render
+
+    return render(title, _viewer_js(), commands, data)
 
 
 # ------------------------------------------------------------------------------------------ server side
@@ -488,11 +485,11 @@ class _Window:
 
 
 # ------------------------------------------------------------------------------------------ meshes (issue 13)
-def _draw_meshes(vis: Any, robot: Robot) -> None:
+def _draw_meshes(vis: Any, robot: Robot, viz: Any) -> None:
     """Set each readable mesh of the robot's visuals (:func:`scara_pin.viz.meshes.visual_meshes`) on its node.
 
-    Pinocchio's visualizer drew a placeholder box at ``<ROBOT_NODE>/visuals/<geometry name>`` and moves that
-    node; the mesh replaces the box there (vertices already scaled), in the colour the URDF gives it.
+    The scene drew a placeholder box for each mesh at the geometry's node (``viz.getViewerNodeName``, under
+    its joint's node); the mesh replaces the box there (vertices already scaled), in the URDF's colour.
     """
     from .meshes import visual_meshes
 
@@ -501,47 +498,156 @@ def _draw_meshes(vis: Any, robot: Robot) -> None:
     for mesh in visual_meshes(robot):
         if not visuals.existGeometryName(mesh.name):
             continue
-        rgba = visuals.geometryObjects[visuals.getGeometryId(mesh.name)].meshColor
+        geometry_object = visuals.geometryObjects[visuals.getGeometryId(mesh.name)]
+        rgba = geometry_object.meshColor
         color = int(rgba[0] * 255) * 65536 + int(rgba[1] * 255) * 256 + int(rgba[2] * 255)
         material = mg.MeshPhongMaterial(color=color, opacity=float(rgba[3]), transparent=float(rgba[3]) < 1.0)
         geometry = mg.TriangularMeshGeometry(mesh.vertices.astype(np.float32), mesh.faces.astype(np.uint32))
-        vis[f"{ROBOT_NODE}/visuals/{mesh.name}"].set_object(geometry, material)
+        vis[viz.getViewerNodeName(geometry_object, pin.GeometryType.VISUAL)].set_object(geometry, material)
 
 
 # ------------------------------------------------------------------------------------------ the scene
 class _Scene:
-    """The robot and the overlays in a meshcat visualizer (live or recording)."""
+    """The robot and the overlays in a meshcat visualizer (live or recording).
+
+    The robot is a tree of nodes under ``/meshcat/robot``: one node per joint, nested as the kinematic tree
+    (``robot/joint1/joint2/...``), holding Pinocchio's ``liMi`` (see :mod:`scara_pin.viz.tree`); each
+    link's geometries in ``<joint node>/visuals/<geometry>`` and the frames' triads in
+    ``<joint node>/frames/<frame>``, at their constant placements. Showing a configuration sets the joint
+    nodes' transforms only. The floor grid lies at z = 0 of the root link; the camera frames the workspace.
+    """
 
     def __init__(self, robot: Robot, window: _Window) -> None:
+        from .tree import framing, joint_nodes, node_paths
+
         meshcat = _meshcat()
         self.robot = robot
         self.vis = meshcat.Visualizer(window=window)
-        viz = _pinocchio_visualizer()(robot.model, robot.collision_model, robot.visual_model)
-        viz.initViewer(viewer=self.vis)
-        viz.loadViewerModel(rootNodeName=ROBOT_NODE)
-        _draw_meshes(self.vis, robot)  # issue 13: the real meshes in place of their placeholder boxes
-        self.viz = viz
+        self.joints = joint_nodes(robot, ROBOT_NODE)
+        self.paths = node_paths(robot, ROBOT_NODE)
+        self.framing = framing(robot)
+        self._data = robot.model.createData()
         q0 = pin.neutral(robot.model)
-        data = robot.model.createData()
-        pin.framesForwardKinematics(robot.model, data, q0)
-        self.oMb: pin.SE3 = data.oMf[robot.base_id].copy()
-        # scene size [m]: the farthest frame from the root at the neutral configuration
-        self.size = max(0.05, max(float(np.linalg.norm(f.translation)) for f in data.oMf))
-        viz.displayFrames(True, frame_ids=[robot.tool_id], axis_length=0.25 * self.size, axis_width=2)
+        pin.framesForwardKinematics(robot.model, self._data, q0)
+        self.oMb: pin.SE3 = self._data.oMf[robot.base_id].copy()
+        # scene size [m]: the robot's reach (axes and markers scale with it)
+        self.size = max(0.05, self.framing.reach)
+        self.viz = _tree_visualizer(robot, self.paths)
+        self.viz.initViewer(viewer=self.vis)
+        for geometry in robot.visual_model.geometryObjects:
+            self._load_geometry(geometry)
+        _draw_meshes(self.vis, robot, self.viz)  # the real meshes in place of their placeholder boxes
+        self.frame_paths: dict[str, str] = {}
+        for frame_id in (robot.base_id, robot.tool_id):
+            self._triad(frame_id, 0.25 * self.size)
+        # the tool frame's zero-yaw rotation in the base frame: target markers are Rz(yaw) * R0
+        zero = robot.tool_placement(np.zeros(4))
+        yaw0 = math.atan2(zero.rotation[1, 0], zero.rotation[0, 0])
+        self.tool_r0 = pin.utils.rotate("z", -yaw0) @ zero.rotation
+        self._floor()
         self._camera()
-        self.display(robot.from_pinocchio_q(q0))  # q = 0 (Pinocchio's neutral, as the user's 4 values)
+        self.display(np.zeros(4))
+
+    def _load_geometry(self, geometry: pin.GeometryObject) -> None:
+        """Load one visual geometry (primitive or mesh, by Pinocchio's loader) under its joint's node."""
+        from pinocchio.visualize.meshcat_visualizer import applyScalingOnHomegeneousTransform
+
+        self.viz.loadViewerGeometryObject(geometry, pin.GeometryType.VISUAL)
+        path = self.viz.getViewerNodeName(geometry, pin.GeometryType.VISUAL)
+        matrix = applyScalingOnHomegeneousTransform(geometry.placement.homogeneous, geometry.meshScale)
+        self.vis[path].set_transform(matrix)
+
+    def _triad(self, frame_id: int, length: float) -> None:
+        """Draw a frame's axes (x red, y green, z blue) under its joint's node."""
+        mg = _meshcat().geometry
+        frame = self.robot.model.frames[frame_id]
+        path = f"{self.paths[frame.parentJoint]}/frames/{frame.name}"
+        self.vis[path].set_object(mg.triad(length))
+        self.vis[path].set_transform(frame.placement.homogeneous)
+        self.frame_paths[frame.name] = path
+
+    def _floor(self) -> None:
+        """A grid on the floor (z = 0 of the root link), sized to the reach, instead of meshcat's 20 m one."""
+        mg = _meshcat().geometry
+        cell, half = self.framing.grid_cell, self.framing.grid_half
+        ticks = np.arange(-half, half + 0.5 * cell, cell)
+        segments = []
+        for t in ticks.tolist():
+            segments += [[t, -half, 0.0], [t, half, 0.0], [-half, t, 0.0], [half, t, 0.0]]
+        geometry = mg.PointsGeometry(np.ascontiguousarray(np.array(segments).T, dtype=np.float32))
+        self.vis[f"{_OVERLAYS}/floor"].set_object(mg.LineSegments(geometry, mg.LineBasicMaterial(color=_GRID_COLOR)))
+        self.vis["/Grid"].set_property("visible", False)
+        # meshcat's world axes are 0.5 m long whatever the robot: the base frame's triad shows the axes
+        self.vis["/Axes"].set_property("visible", False)
+        self.vis["/Background"].set_property("top_color", [0.97, 0.97, 0.98])
+        self.vis["/Background"].set_property("bottom_color", [0.72, 0.76, 0.82])
 
     def _camera(self) -> None:
-        """Look at the root from the front right, from about 2 arm lengths (meshcat's default is 3 m away)."""
-        s = self.size
-        x, y, z = 1.0 * s, -1.3 * s, 1.0 * s  # scene (z-up) coordinates
+        """Frame the workspace from the front right, above (:func:`scara_pin.viz.tree.framing`).
+
+        meshcat's orbit controls turn about the origin, so the live viewer's camera is placed to frame the
+        workspace seen from there; the pages move the orbit target to the workspace's centre as well.
+        """
+        from .tree import FIELD_OF_VIEW
+
+        f = self.framing
+        target, position = np.array(f.target), np.array(f.position)
+        # seen from the origin: the same direction, farther by the target's distance from the origin
+        live = position - target
+        live = live * (1.0 + float(np.linalg.norm(target)) / float(np.linalg.norm(live)))
+        x, y, z = live.tolist()
         # the camera lives in /Cameras/default/rotated, turned by +pi/2 about x: scene (x, y, z) -> (x, z, -y)
-        self.vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
-        # meshcat's world axes are 0.5 m long, larger than a small arm: the tool frame's triad shows the axes
-        self.vis["/Axes"].set_property("visible", False)
+        camera = self.vis["/Cameras/default/rotated/<object>"]
+        camera.set_property("position", [x, z, -y])
+        camera.set_property("fov", FIELD_OF_VIEW)
+
+    def page_data(self) -> dict[str, Any]:
+        """What the page's script needs: the joint nodes, the sliders' ranges and units, frames, camera."""
+        robot = self.robot
+        kinds = robot.joint_kinds
+        f = self.framing
+        return {
+            "robot": robot.name,
+            "root": f"meshcat/{ROBOT_NODE}",
+            "joints": [
+                {
+                    "name": j.name,
+                    "path": f"meshcat/{j.path}",
+                    "kind": j.kind,
+                    "axis": list(j.axis),
+                    "placement": [x for row in j.placement for x in row],
+                    "source": j.source,
+                    "multiplier": j.multiplier,
+                    "offset": j.offset,
+                }
+                for j in self.joints
+            ],
+            "sliders": [
+                {
+                    "name": j.name,
+                    "index": j.source,
+                    "lower": robot.limits.lower[j.source],
+                    "upper": robot.limits.upper[j.source],
+                    "unit": "m" if kinds[j.source] == "length" else "rad",
+                    "continuous": robot.continuous[j.source],
+                }
+                for j in self.joints
+                if j.actuated
+            ],
+            "base": f"meshcat/{self.frame_paths[robot.base_frame]}",
+            "tool": f"meshcat/{self.frame_paths[robot.tool_frame]}",
+            "target": list(f.target),
+            "camera": list(f.position),
+        }
 
     def display(self, q: object) -> None:
-        self.viz.display(self.robot.to_pinocchio_q(q))  # continuous joints: their (cos, sin)
+        """Show the robot at the user's joint values ``q``: set every joint node's ``liMi``."""
+        self._set_joints(self.vis, self.robot.to_pinocchio_q(q))  # continuous joints: their (cos, sin)
+
+    def _set_joints(self, vis: Any, q_pin: np.ndarray) -> None:
+        pin.forwardKinematics(self.robot.model, self._data, q_pin)
+        for j in range(1, self.robot.model.njoints):
+            vis[self.paths[j]].set_transform(self._data.liMi[j].homogeneous)
 
     def animation(self, times: np.ndarray, qs: np.ndarray, fps: int) -> Any:
         """Build a meshcat animation of the motion, ``fps`` frames per second.
@@ -549,24 +655,11 @@ class _Scene:
         Joint values are interpolated linearly between the samples; three.js interpolates between frames.
         """
         meshcat = _meshcat()
-        if not (isinstance(fps, int) and 1 <= fps <= 1000):
-            raise InvalidInputError(f"fps is {fps!r}; it must be a whole number of frames per second in [1, 1000]")
-        duration = float(times[-1] - times[0])
-        n = int(math.floor(duration * fps + 1e-9))
-        frames = np.arange(n + 1, dtype=float)
-        if duration * fps - n > 1e-9:
-            frames = np.append(frames, duration * fps)
-        grid = times[0] + frames / fps
-        q = np.column_stack([np.interp(grid, times, qs[:, j]) for j in range(qs.shape[1])])
+        frames, q = _resample(times, qs, fps)
         anim = meshcat.animation.Animation(default_framerate=fps)
-        live = self.viz.viewer
-        try:
-            for frame, row in zip(frames.tolist(), q, strict=True):
-                with anim.at_frame(self.vis, frame) as at:
-                    self.viz.viewer = at  # Pinocchio's display() writes transforms into the frame
-                    self.viz.display(self.robot.to_pinocchio_q(row))
-        finally:
-            self.viz.viewer = live
+        for frame, row in zip(frames.tolist(), q, strict=True):
+            with anim.at_frame(self.vis, frame) as at:
+                self._set_joints(at, self.robot.to_pinocchio_q(row))
         return anim
 
     def _world(self, points_base: np.ndarray) -> np.ndarray:
@@ -583,6 +676,7 @@ class _Scene:
         self.line(f"{_OVERLAYS}/{name}", self._world(pts), color)
 
     def draw_targets(self, poses: object, name: str) -> None:
+        """Target poses as triads oriented as the tool frame would be there: ``Rz(yaw) * R0``."""
         mg = _meshcat().geometry
         arr = np.array(poses, dtype=float)
         if arr.ndim == 1:
@@ -592,7 +686,7 @@ class _Scene:
         node = self.vis[f"{_OVERLAYS}/{name}"]
         node.delete()
         for i, (x, y, z, yaw) in enumerate(arr.tolist()):
-            bMt = pin.SE3(pin.utils.rotate("z", yaw), np.array([x, y, z]))
+            bMt = pin.SE3(pin.utils.rotate("z", yaw) @ self.tool_r0, np.array([x, y, z]))
             node[str(i)].set_object(mg.triad(0.15 * self.size))
             node[str(i)].set_transform((self.oMb * bMt).homogeneous)
 
@@ -621,13 +715,17 @@ def _scene(
     draw_tool_path: bool,
     fps: int,
     loop: bool,
-) -> None:
-    """Fill a scene with what :func:`static_html` and :func:`export_html` take."""
+) -> dict[str, Any]:
+    """Fill a scene with what :func:`static_html` and :func:`export_html` take; return the page's data.
+
+    A motion is not a meshcat animation here: the page's player interpolates the joint values (resampled at
+    ``fps``) and moves the joints through the same code as the sliders.
+    """
     robot = scene.robot
     if (times is None) != (qs is None):
         raise InvalidInputError("times and qs go together: give both or neither")
-    if q is not None:
-        scene.display(q)
+    data = scene.page_data()
+    shown = np.zeros(4) if q is None else robot.check_q(q)
     if polylines is not None:
         scene.draw_polylines(polylines, "workspace", None, _WORKSPACE_COLOR)
     if path_points is not None:
@@ -637,11 +735,20 @@ def _scene(
     if times is not None:
         t, qq = _motion(robot, times, qs)
         if q is None:
-            scene.display(qq[0])
+            shown = qq[0]
         if path_points is None and draw_tool_path and len(t) >= 2:
             scene.draw_path(tool_path(robot, qq), "path", _PATH_COLOR)
         if len(t) >= 2:
-            scene.vis.set_animation(scene.animation(t, qq, fps), play=True, repetitions=math.inf if loop else 1)
+            frames, grid = _resample(t, qq, fps)
+            data["motion"] = {
+                "times": (frames / fps).tolist(),
+                "qs": grid.tolist(),
+                "loop": bool(loop),
+                "play": q is None,
+            }
+    scene.display(shown)
+    data["q"] = [float(v) for v in shown]
+    return data
 
 
 def static_html(
@@ -661,8 +768,10 @@ def static_html(
     """Make a self-contained HTML page of the robot (no server needed; arguments as :func:`export_html`)."""
     window = _Window()
     scene = _Scene(robot, window)
-    _scene(scene, q, times, qs, polylines, path_points, targets, draw_tool_path=draw_tool_path, fps=fps, loop=loop)
-    return _page(title or f"scara-pin: {robot.name}", window.recorder.commands())
+    data = _scene(
+        scene, q, times, qs, polylines, path_points, targets, draw_tool_path=draw_tool_path, fps=fps, loop=loop
+    )
+    return _page(title or f"scara-pin: {robot.name}", window.recorder.commands(), data)
 
 
 def export_html(
@@ -690,13 +799,14 @@ def export_html(
         q: the configuration shown [rad or m] (default: the first sample of the motion, else neutral).
         times: (N,) sample times of a motion [s], strictly increasing; with ``qs``.
         qs: (N, 4) joint values at those times; the page plays the motion in real time (looping unless
-            ``loop=False``), with meshcat's play / pause / time controls under "Animations".
+            ``loop=False``) with the panel's play / pause button and time slider, which drive the joint
+            sliders (a given ``q`` is shown first, paused).
         polylines: workspace boundary: (M, 2) arrays of (x, y) in the base frame [m], drawn on the floor.
         path_points: (K, 3) points of a tool path in the base frame [m]; by default the path of the tool
             along ``qs`` is drawn (``draw_tool_path=False`` turns that off).
         targets: (P, 4) target poses (x, y, z, yaw) in the base frame [m, rad], drawn as small frames.
         draw_tool_path: draw the path of the tool along ``qs`` when no ``path_points`` are given.
-        fps: animation frames per second (joint values are interpolated between samples).
+        fps: the player's samples per second (joint values are interpolated linearly between samples).
         loop: repeat the animation forever (else play it once and hold the last frame).
         title: the page title.
 
