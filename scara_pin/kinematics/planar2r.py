@@ -279,17 +279,19 @@ def nearest_turn(
         continuous joint q is the turn nearest ``ref`` and (k_lo, k_hi) = (0, 0) stands for "unbounded".
         None when no turn fits.
     """
+    k = _floor((ref + _PI - value) * _INV_TWO_PI)
     if continuous:
-        return value + TWO_PI * _floor((ref + _PI - value) * _INV_TWO_PI), 0, 0
+        return value + TWO_PI * k, 0, 0
     k_min = _ceil((lo - LIMIT_TOL - value) * _INV_TWO_PI)
     k_max = _floor((hi + LIMIT_TOL - value) * _INV_TWO_PI)
     if k_min > k_max:
         return None
-    k = _floor((ref + _PI - value) * _INV_TWO_PI)
-    k = k_min if k < k_min else (k_max if k > k_max else k)
+    if k < k_min:
+        k = k_min
+    elif k > k_max:
+        k = k_max
     q = value + TWO_PI * k
-    q = lo if q < lo else (hi if q > hi else q)
-    return q, k_min - k, k_max - k
+    return (lo if q < lo else (hi if q > hi else q)), k_min - k, k_max - k
 
 
 def fits_array(value: np.ndarray, lo: float, hi: float, tol: float = LIMIT_TOL) -> np.ndarray:

@@ -310,10 +310,14 @@ _Failure = tuple[IKStatus, str]
 
 
 def _branches(
-    geo: ScaraGeometry, x: float, y: float, z: float, alpha: float, ref: list[float], branch: str
-) -> tuple[list[_Branch], _Failure | None]:
-    """The solution of each requested branch, or the reason there is none (the most telling failure)."""
-    ra, rb, rc, ip, _, _, _, s_p, lt_p, ht_p, z0, a1x, a1y, tx, ty, r_min_tol, _, _ = geo._k
+    geo: ScaraGeometry, x: float, y: float, z: float, alpha: float, ref: list[float], branch: str,
+    turns: bool = True,
+) -> tuple[list[_Branch], _Failure | None]:  # fmt: skip
+    """The solution of each requested branch, or the reason there is none (the most telling failure).
+
+    ``turns=False`` leaves out the turn ranges (an empty list; the nearest-solution path needs none).
+    """
+    ra, rb, rc, ip, s_a, s_b, s_c, s_p, lt_p, ht_p, z0, a1x, a1y, tx, ty, r_min_tol, b1, db = geo._k
     lo, hi = geo.lower, geo.upper
     arm = geo.arm
     # vertical joint
@@ -346,20 +350,32 @@ def _branches(
     found: list[_Branch] = []
     failures: list[_Failure] = []
     cont = geo.continuous
+    c_a, c_b, c_c = cont[ra], cont[rb], cont[rc]
+    lo_a, hi_a, lo_b, hi_b, lo_c, hi_c = lo[ra], hi[ra], lo[rb], hi[rb], lo[rc], hi[rc]
+    ref_a, ref_b, ref_c = ref[ra], ref[rb], ref[rc]
     for g, theta1, label in elbows:
         if branch == "all" or label == branch or singular:
-            out = _joints(geo, wx, wy, alpha, g, theta1, ref, label)
-            if len(out) == 2:
-                failures.append(out)  # type: ignore[arg-type]
-                continue
-            qa, qb, qc = out
+            # the common case inline: every joint has a turn inside its limits (else _joints says why,
+            # or puts a joint that rounding alone moved out onto its limit)
+            qb = nearest_turn(s_b * (g - db), lo_b, hi_b, ref_b, c_b)
+            qa = nearest_turn(s_a * (theta1 - b1), lo_a, hi_a, ref_a, c_a) if qb is not None else None
+            qc = (nearest_turn(s_c * (alpha - s_a * qa[0] - s_b * qb[0]), lo_c, hi_c, ref_c, c_c)
+                  if qa is not None and qb is not None else None)  # fmt: skip
+            if qa is None or qb is None or qc is None:
+                out = _joints(geo, wx, wy, alpha, g, theta1, ref, label)
+                if len(out) == 2:
+                    failures.append(out)  # type: ignore[arg-type]
+                    continue
+                qa, qb, qc = out
             q = [0.0] * 4
             q[ra], q[rb], q[rc], q[ip] = qa[0], qb[0], qc[0], qp
-            turns: list[tuple[int, int] | None] = [(0, 0)] * 4
-            turns[ra] = None if cont[ra] else (qa[1], qa[2])
-            turns[rb] = None if cont[rb] else (qb[1], qb[2])
-            turns[rc] = None if cont[rc] else (qc[1], qc[2])
-            found.append((label, singular, q, turns))
+            k: list[tuple[int, int] | None] = []
+            if turns:
+                k = [(0, 0)] * 4
+                k[ra] = None if cont[ra] else (qa[1], qa[2])
+                k[rb] = None if cont[rb] else (qb[1], qb[2])
+                k[rc] = None if cont[rc] else (qc[1], qc[2])
+            found.append((label, singular, q, k))
     if found:
         return found, None
     if not failures:  # the requested branch was not among the elbows (cannot happen for "all")
@@ -538,7 +554,7 @@ def solve_nearest(
     if tilt > YAW_POSE_TOL:
         raise NoSolutionError(IKStatus.NOT_A_YAW_POSE, f"the target tilts the tool by {math.degrees(tilt):.6g} deg")
     ref = reference_floats(reference)
-    found, failure = _branches(geo, x, y, z, alpha, ref, branch)
+    found, failure = _branches(geo, x, y, z, alpha, ref, branch, turns=False)
     if failure is not None:
         raise NoSolutionError(*failure)
     q = found[0][2]
