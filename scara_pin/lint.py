@@ -284,6 +284,30 @@ class _Checker:
             return default
         return values
 
+    def _inertial(self, link: Element, name: str, line: int | None) -> None:
+        """A link's mass and inertia must be finite (NaN would poison every torque); mass >= 0."""
+        inertial = link.find("inertial")
+        if inertial is None:
+            return
+        checks: list[tuple[str, Element | None, tuple[str, ...]]] = [
+            ("mass", inertial.find("mass"), ("value",)),
+            ("inertia", inertial.find("inertia"), ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")),
+        ]
+        for what, el, attrs in checks:
+            if el is None:
+                continue
+            for attr in attrs:
+                raw = el.get(attr)
+                if raw is None:
+                    continue
+                try:
+                    value = float(raw)
+                except ValueError:
+                    value = math.nan
+                if not math.isfinite(value) or (what == "mass" and value < 0):
+                    rule = "must be a finite number >= 0" if what == "mass" else "must be a finite number"
+                    self.error("bad-inertial", f"link {name}'s {what} {attr}={raw!r} {rule}", line)
+
     def structure(self) -> None:
         try:
             root, lines = _parse(self.text)
@@ -309,6 +333,7 @@ class _Checker:
                            lines.get(el))  # fmt: skip
             else:
                 links[name] = lines.get(el)
+            self._inertial(el, name or "?", lines.get(el))
         for el in root.findall("joint"):
             name, kind, line = el.get("name"), el.get("type"), lines.get(el)
             if not name:
@@ -627,10 +652,12 @@ def check_urdf(text: str, *, origin: str = "URDF") -> CheckReport:
 
 def check_urdf_file(path: str | Path) -> CheckReport:
     """Lint a URDF file (an unreadable file gives an ``unreadable`` error finding, status unusable)."""
+    from .errors import InvalidInputError
+    from .limits import read_text
+
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = getattr(exc, "strerror", None) or str(exc)
-        return CheckReport(str(path), (Finding(Severity.ERROR, "unreadable", f"cannot be read ({reason})"),))
+        text = read_text(path, "URDF")  # bounded: /dev/zero or a huge file is refused, not read whole
+    except InvalidInputError as exc:
+        return CheckReport(str(path), (Finding(Severity.ERROR, "unreadable", f"cannot be read ({exc})"),))
     return check_urdf(text, origin=str(path))

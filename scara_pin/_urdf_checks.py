@@ -1,0 +1,114 @@
+"""What urdfdom would refuse in a URDF, checked in Python first (private).
+
+urdfdom reports its reasons on the C-level stderr and Pinocchio then raises a generic ``ValueError``.
+Capturing that stderr means redirecting file descriptor 2, which is process-wide state (another thread's
+messages are lost, a crash leaves fd 2 on a temporary file). Instead, the rules urdfdom enforces are
+checked here, on the parsed XML, with messages that name the element: urdfdom then only sees documents it
+accepts. The size is bounded too (:data:`scara_pin.limits.MAX_URDF_ELEMENTS`).
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+
+from .errors import UrdfError
+from .limits import MAX_URDF_ELEMENTS
+
+_JOINT_TYPES = frozenset(("revolute", "continuous", "prismatic", "fixed", "floating", "planar"))
+# (element path below a link or joint, attribute, number of values); numbers urdfdom parses
+_LINK_NUMBERS = (
+    ("inertial/origin", "xyz", 3), ("inertial/origin", "rpy", 3), ("inertial/mass", "value", 1),
+    *(("inertial/inertia", a, 1) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")),
+    *((f"{part}/origin", a, 3) for part in ("visual", "collision") for a in ("xyz", "rpy")),
+    *((f"{part}/geometry/box", "size", 3) for part in ("visual", "collision")),
+    *((f"{part}/geometry/{shape}", a, 1) for part in ("visual", "collision")
+      for shape, a in (("cylinder", "radius"), ("cylinder", "length"), ("sphere", "radius"))),
+    *((f"{part}/geometry/mesh", "scale", 3) for part in ("visual", "collision")),
+)  # fmt: skip
+_JOINT_NUMBERS = (
+    ("origin", "xyz", 3), ("origin", "rpy", 3), ("axis", "xyz", 3),
+    *(("limit", a, 1) for a in ("lower", "upper", "effort", "velocity")),
+    ("dynamics", "damping", 1), ("dynamics", "friction", 1),
+    ("mimic", "multiplier", 1), ("mimic", "offset", 1),
+)  # fmt: skip
+
+
+def _numbers(el: ET.Element, attr: str, n: int, where: str, origin: str) -> None:
+    raw = el.get(attr)
+    if raw is None:
+        return
+    parts = raw.split()
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        values = []
+    if len(values) != n or not all(math.isfinite(v) for v in values):
+        rule = "a finite number" if n == 1 else f"{n} finite numbers"
+        raise UrdfError(f"{origin}: not a valid URDF: {where} {attr}={raw[:60]!r} must be {rule}")
+
+
+def check_urdf_tree(root: ET.Element, origin: str) -> None:
+    """Refuse (:class:`UrdfError`) what urdfdom would refuse, with a message naming the element.
+
+    Links: named, unique, numbers finite (mass >= 0). Joints: named, unique, a known type, parent and
+    child links that exist, limits with effort and velocity where required, numbers finite. The tree: one
+    root link, each link the child of at most one joint (hence no cycle). At most
+    :data:`~scara_pin.limits.MAX_URDF_ELEMENTS` links and joints.
+    """
+    links = root.findall("link")
+    joints = root.findall("joint")
+    if len(links) + len(joints) > MAX_URDF_ELEMENTS:
+        raise UrdfError(f"{origin}: {len(links)} links and {len(joints)} joints, above the cap of "
+                        f"{MAX_URDF_ELEMENTS:,} elements; refused")  # fmt: skip
+    names: set[str] = set()
+    for el in links:
+        name = el.get("name")
+        if not name:
+            raise UrdfError(f"{origin}: not a valid URDF: a <link> has no name")
+        if name in names:
+            raise UrdfError(f"{origin}: not a valid URDF: link {name!r} is defined twice")
+        names.add(name)
+        for path, attr, n in _LINK_NUMBERS:
+            for sub in el.findall(path):
+                _numbers(sub, attr, n, f"link {name}'s <{path}>", origin)
+        mass = el.find("inertial/mass")
+        if mass is not None and float(mass.get("value", "0")) < 0:
+            raise UrdfError(f"{origin}: not a valid URDF: link {name}'s mass {mass.get('value')} must be >= 0")
+    seen: set[str] = set()
+    parent_of: dict[str, str] = {}
+    for el in joints:
+        name = el.get("name")
+        if not name:
+            raise UrdfError(f"{origin}: not a valid URDF: a <joint> has no name")
+        if name in seen:
+            raise UrdfError(f"{origin}: not a valid URDF: joint {name!r} is defined twice")
+        seen.add(name)
+        kind = el.get("type")
+        if kind not in _JOINT_TYPES:
+            raise UrdfError(f"{origin}: not a valid URDF: joint {name} has type {kind!r}")
+        for role in ("parent", "child"):
+            tag = el.find(role)
+            link = None if tag is None else tag.get("link")
+            if not link:
+                raise UrdfError(f"{origin}: not a valid URDF: joint {name} has no {role} link")
+            if link not in names:
+                raise UrdfError(f"{origin}: not a valid URDF: joint {name}'s {role} link {link!r} is not defined")
+        child = el.find("child").get("link")  # type: ignore[union-attr]
+        if child in parent_of:
+            raise UrdfError(f"{origin}: not a valid URDF: link {child!r} is the child of joints {parent_of[child]} "
+                            f"and {name}")  # fmt: skip
+        parent_of[child] = name  # type: ignore[index]
+        for path, attr, n in _JOINT_NUMBERS:
+            for sub in el.findall(path):
+                _numbers(sub, attr, n, f"joint {name}'s <{path}>", origin)
+        if kind in ("revolute", "prismatic"):
+            limit = el.find("limit")
+            if limit is None or limit.get("effort") is None or limit.get("velocity") is None:
+                raise UrdfError(f"{origin}: not a valid URDF: {kind} joint {name} needs <limit> with effort and "
+                                "velocity")  # fmt: skip
+    roots = [str(el.get("name")) for el in links if el.get("name") not in parent_of]
+    if len(roots) != 1 and links:
+        shown = ", ".join(roots[:5]) + (" ..." if len(roots) > 5 else "")
+        raise UrdfError(f"{origin}: not a valid URDF: {len(roots)} root links ({shown or 'none: a cycle'}); "
+                        "a URDF tree has exactly one root link")  # fmt: skip
