@@ -48,6 +48,21 @@ def _numbers(el: ET.Element, attr: str, n: int, where: str, origin: str) -> None
         raise UrdfError(f"{origin}: not a valid URDF: {where} {attr}={raw[:60]!r} must be {rule}")
 
 
+_SHAPES = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",), "mesh": ("filename",)}
+
+
+def _geometry(geometry: ET.Element | None, where: str, origin: str) -> None:
+    """One known shape with its attributes (urdfdom drops the element, with its own stderr lines, otherwise)."""
+    shapes = [] if geometry is None else list(geometry)
+    if len(shapes) != 1 or shapes[0].tag not in _SHAPES:
+        found = ", ".join(f"<{c.tag}>" for c in shapes) or "nothing"
+        raise UrdfError(f"{origin}: not a valid URDF: {where} <geometry> must hold one of <box>, <cylinder>, "
+                        f"<sphere>, <mesh>; it holds {found}")  # fmt: skip
+    for attr in _SHAPES[shapes[0].tag]:
+        if shapes[0].get(attr) is None:
+            raise UrdfError(f"{origin}: not a valid URDF: {where} <{shapes[0].tag}> has no {attr}")
+
+
 def check_urdf_tree(root: ET.Element, origin: str) -> None:
     """Refuse (:class:`UrdfError`) what urdfdom would refuse, with a message naming the element.
 
@@ -72,6 +87,13 @@ def check_urdf_tree(root: ET.Element, origin: str) -> None:
         for path, attr, n in _LINK_NUMBERS:
             for sub in el.findall(path):
                 _numbers(sub, attr, n, f"link {name}'s <{path}>", origin)
+        for inertial in el.findall("inertial"):
+            for part in ("mass", "inertia"):
+                if inertial.find(part) is None:
+                    raise UrdfError(f"{origin}: not a valid URDF: link {name}'s <inertial> has no <{part}>")
+        for part in ("visual", "collision"):
+            for item in el.findall(part):
+                _geometry(item.find("geometry"), f"link {name}'s <{part}>", origin)
         mass = el.find("inertial/mass")
         if mass is not None and float(mass.get("value", "0")) < 0:
             raise UrdfError(f"{origin}: not a valid URDF: link {name}'s mass {mass.get('value')} must be >= 0")

@@ -103,8 +103,8 @@ def number_type(name: str) -> Callable[[str], float]:
     def parse(text: str) -> float:
         try:
             return _number(name, text)
-        except ParameterError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
+        except ParameterError as exc:  # argparse names the option: "argument --rate: got 'x'; it must ..."
+            raise argparse.ArgumentTypeError(f"got {exc.value!r}; it {exc.rule}") from None
 
     return parse
 
@@ -116,7 +116,7 @@ def integer_type(name: str, low: int, high: int) -> Callable[[str], int]:
         try:
             return _integer(name, text, low, high)
         except ParameterError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
+            raise argparse.ArgumentTypeError(f"got {exc.value!r}; it {exc.rule}") from None
 
     return parse
 

@@ -659,7 +659,8 @@ class MotorUnits:
         """Integer steps (int64) of joint values q (..., 4), rounded from the absolute position."""
         x = np.asarray(q, dtype=float) * np.asarray(self.counts_per_unit)
         if not np.isfinite(x).all() or np.abs(x).max(initial=0.0) > 2.0**62:
-            raise ParameterError("q", "values", "give step counts beyond the int64 range")
+            raise ParameterError("motor steps", ParameterError.NOTHING, "would leave the int64 range (|q| x counts "
+                                 "per unit > 2^62): check --gear, --steps-per-rev and --screw-lead")  # fmt: skip
         return np.rint(x).astype(np.int64)
 
 

@@ -160,7 +160,7 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.nd
     Raises:
         InvalidInputError: unreadable file, missing columns, a bad number (the message gives the line).
     """
-    from ..limits import MAX_SAMPLES, text_lines
+    from ..limits import MAX_NUMBER, MAX_SAMPLES, text_lines
 
     path = Path(path)
     if path.is_dir():
@@ -192,8 +192,8 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.nd
                 values = [float(cells[c]) for c in cols]
             except ValueError as exc:
                 raise InvalidInputError(f"{path}, line {k}: {exc}") from None
-            if not all(math.isfinite(v) for v in values):
-                raise InvalidInputError(f"{path}, line {k}: values must be finite")
+            if not all(abs(v) <= MAX_NUMBER for v in values):  # NaN too
+                raise InvalidInputError(f"{path}, line {k}: values must be finite, within +/-{MAX_NUMBER:g}")
             rows.append(values)
     if header is None:
         raise InvalidInputError(f"{path}: empty file; expected a header with t,q1,q2,q3,q4")
