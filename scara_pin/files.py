@@ -70,17 +70,24 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     return path
 
 
-def _new_temp(folder: Path, name: str) -> Path:
-    """Create an empty temporary file in ``folder`` with mode 0o666 & ~umask (exclusive, never reused)."""
+def _new_temp(folder: Path, name: str, created: list[Path]) -> Path:
+    """Create an empty temporary file in ``folder`` with mode 0o666 & ~umask (exclusive, never reused).
+
+    Its name is put in ``created`` BEFORE it exists, so that a Ctrl-C or SIGTERM arriving at any point
+    after its creation finds it there and removes it.
+    """
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
     for _ in range(100):
         tmp = folder / f".{name[:64]}.{secrets.token_hex(6)}.tmp"
+        created.append(tmp)
         try:
             fd = os.open(tmp, flags, 0o666)
-        except FileExistsError:
+        except FileExistsError:  # someone else's: never ours to delete
+            created.remove(tmp)
             continue
-        except OSError as exc:
-            raise InvalidInputError(f"cannot write in {folder}: {exc.strerror or exc}") from None
+        except OSError:
+            created.remove(tmp)
+            raise
         os.close(fd)
         return tmp
     raise InvalidInputError(f"cannot write in {folder}: no free temporary name")  # pragma: no cover
@@ -108,8 +115,9 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     path = check_output_path(path)
     to_stdout = str(path) == STDOUT
     folder = Path(tempfile.gettempdir()) if to_stdout else (path.parent if str(path.parent) else Path("."))
-    tmp = _new_temp(folder, "stdout" if to_stdout else path.name)
+    created: list[Path] = []
     try:
+        tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created)
         yield tmp
         if to_stdout:
             sys.stdout.flush()
@@ -133,7 +141,8 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     except OSError as exc:
         raise InvalidInputError(f"cannot write {path}: {exc.strerror or exc}") from None
     finally:
-        tmp.unlink(missing_ok=True)  # after the rename: nothing there
+        for name in created:  # after the rename: nothing there
+            name.unlink(missing_ok=True)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:

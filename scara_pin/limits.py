@@ -27,6 +27,7 @@ from .errors import InvalidInputError
 
 __all__ = [
     "MAX_DOCUMENT_BYTES",
+    "MAX_CHECK_ELEMENTS",
     "MAX_FRAMES",
     "MAX_LINE_CHARS",
     "MAX_NUMBER",
@@ -51,8 +52,11 @@ MAX_LINE_CHARS = 65_536
 """Characters of one line of a CSV input."""
 MAX_DOCUMENT_BYTES = 64 * 1024 * 1024
 """Bytes of one document read whole: URDF, D-H table, trajectory JSON."""
-MAX_URDF_ELEMENTS = 10_000
-"""Links plus joints of one URDF (a SCARA has about 12)."""
+MAX_URDF_ELEMENTS = 2_000
+"""Links plus joints of one URDF (a SCARA has about 12). urdfdom and Pinocchio walk the tree recursively:
+a chain about 5,000 links deep overflows the C stack (a crash, not an error), 3,000 does not."""
+MAX_CHECK_ELEMENTS = 50_000
+"""Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
 
 
 def check_count(what: str, n: float, cap: int, hint: str = "") -> int:

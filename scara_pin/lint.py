@@ -318,6 +318,12 @@ class _Checker:
         if root.tag != "robot":
             self.error("root-not-robot", f"the root element is <{root.tag}>, not <robot>", lines.get(root))
             raise _Unusable
+        from .limits import MAX_CHECK_ELEMENTS
+
+        size = len(root.findall("link")) + len(root.findall("joint"))
+        if size > MAX_CHECK_ELEMENTS:
+            self.error("too-large", f"{size} links and joints, above the cap of {MAX_CHECK_ELEMENTS:,}")
+            raise _Unusable
         xacro = next((el for el in root.iter() if el.tag.startswith("xacro:")), None)
         if xacro is not None:
             self.error("xacro-not-expanded", f"<{xacro.tag}> found: this is a xacro file; expand it with xacro first",

@@ -180,6 +180,10 @@ ROWS = [
         files={"t.csv": lambda: traj_csv([[0] + [0] * 12, [1e5, 0.1] + [0] * 11])}, untouched=("v.html",)),
     Row("5-urdf-200k-links", ["fk", "--urdf", "{tmp}/big.urdf", "0", "0", "0", "0"],
         files={"big.urdf": lambda: many_links(200_000)}),
+    Row("5-check-200k-links", ["check", "{tmp}/big.urdf"], files={"big.urdf": lambda: many_links(200_000)},
+        report=True, seconds=10),
+    Row("5-urdf-5000-deep-chain", ["fk", "--urdf", "{tmp}/deep.urdf", "0", "0", "0", "0"],
+        files={"deep.urdf": lambda: many_links(5_000)}),  # once a segmentation fault in urdfdom/Pinocchio
     # 6. plain user input, never an internal error
     Row("6-ik-numeric-1e308", ["ik", "--numeric", "1e308", "0", "0", "0"]),
     Row("6-robot-5000-chars", ["fk", "--robot", "r" * 5000, "0", "0", "0", "0"]),
