@@ -31,6 +31,7 @@ __all__ = [
     "MAX_FRAMES",
     "MAX_LINE_CHARS",
     "MAX_NUMBER",
+    "MAX_PATH_POINTS",
     "MAX_ROWS",
     "MAX_SAMPLES",
     "MAX_URDF_ELEMENTS",
@@ -44,6 +45,8 @@ MAX_NUMBER = 1e12
 """Largest magnitude of a number typed on the command line or read from a batch file (in its units)."""
 MAX_SAMPLES = 2_000_000
 """Samples of one trajectory (``--out``, ``--json``, the limit checks at 1 kHz) or setpoints of one file."""
+MAX_PATH_POINTS = 1_000_000
+"""IK points of one straight tool-line segment (``traj --linear``, ``jog``)."""
 MAX_FRAMES = 200_000
 """Animation frames of one ``view`` page or live animation."""
 MAX_ROWS = 20_000_000

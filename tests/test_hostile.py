@@ -184,6 +184,8 @@ ROWS = [
         report=True, seconds=10),
     Row("5-urdf-5000-deep-chain", ["fk", "--urdf", "{tmp}/deep.urdf", "0", "0", "0", "0"],
         files={"deep.urdf": lambda: many_links(5_000)}),  # once a segmentation fault in urdfdom/Pinocchio
+    Row("5-linear-yaw-1e12", ["traj", "--linear", "--from-pose", "0.3", "0", "-0.1", "1e12", "--to-pose", "0.3", "0.1",
+                              "-0.1", "0.5"]),  # once a MemoryError (364 TiB)  # fmt: skip
     # 6. plain user input, never an internal error
     Row("6-ik-numeric-1e308", ["ik", "--numeric", "1e308", "0", "0", "0"]),
     Row("6-robot-5000-chars", ["fk", "--robot", "r" * 5000, "0", "0", "0", "0"]),

@@ -26,6 +26,7 @@ import pinocchio as pin
 from .._checks import _limit_vector, _positive, _rows, _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..kinematics.scara import IKStatus, branch_of, solve_batch
+from ..limits import MAX_PATH_POINTS, check_count
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -476,6 +477,8 @@ def cartesian_path(
             raise ParameterError(f"pose {k + 1}", b.tolist(), "must differ from the one before it")
         m = n - 1 if n is not None else max(1, math.ceil(np.linalg.norm(d[:3]) / step - 1e-9),
                                             math.ceil(abs(d[3]) / yaw_step - 1e-9))  # fmt: skip
+        check_count(f"path points of segment {k + 1} ({np.linalg.norm(d[:3]):.6g} m, {abs(d[3]):.6g} rad)", m + 1,
+                    MAX_PATH_POINTS, "a shorter move or a smaller yaw change")  # fmt: skip
         s_pts = np.linspace(0.0, 1.0, m + 1)
         q_pts = np.empty((m + 1, 4))
         _check_start(robot, a, seg_start, k)
