@@ -601,3 +601,21 @@ def test_what_urdfdom_would_refuse_is_one_clear_error_and_nothing_on_fd_2(
         Robot(text)
     assert needle in str(info.value) and "tool0" in str(info.value)
     assert capfd.readouterr() == ("", "")
+
+
+@pytest.mark.parametrize("hostile", ["bad-utf8", "dev-zero"])
+def test_a_config_folder_with_a_hostile_yaml_file(hostile: str, tmp_path: Path) -> None:
+    shipped = Path(__file__).resolve().parents[1] / "urdf" / "config" / "default"
+    folder = tmp_path / "cfg"
+    folder.mkdir()
+    for f in shipped.glob("*.yaml"):
+        (folder / f.name).write_bytes(f.read_bytes())
+    if hostile == "bad-utf8":
+        with (folder / "kinematics.yaml").open("ab") as handle:
+            handle.write(b"l1: \xff\n")
+    else:
+        (folder / "joint_limits.yaml").unlink()
+        (folder / "joint_limits.yaml").symlink_to("/dev/zero")
+    done = cli(["fk", "--robot", str(folder), "0", "0", "0", "0"], cwd=tmp_path)
+    assert_one_error(done, 2)
+    assert done.seconds < 20
