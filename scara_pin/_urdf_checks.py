@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
+from ._checks import number_text
 from .errors import UrdfError
 from .limits import MAX_URDF_ELEMENTS
 
@@ -38,11 +39,7 @@ def _numbers(el: ET.Element, attr: str, n: int, where: str, origin: str) -> None
     raw = el.get(attr)
     if raw is None:
         return
-    parts = raw.split()
-    try:
-        values = [float(p) for p in parts]
-    except ValueError:
-        values = []
+    values = [number_text(p) for p in raw.split()]  # urdfdom's grammar: no "1_0", no "0x1"
     if len(values) != n or not all(math.isfinite(v) for v in values):
         rule = "a finite number" if n == 1 else f"{n} finite numbers"
         raise UrdfError(f"{origin}: not a valid URDF: {where} {attr}={raw[:60]!r} must be {rule}")
@@ -73,6 +70,8 @@ def check_urdf_tree(root: ET.Element, origin: str) -> None:
     """
     links = root.findall("link")
     joints = root.findall("joint")
+    for color in root.iter("color"):  # in global and inline <material>s
+        _numbers(color, "rgba", 4, "a <material>'s <color>", origin)
     if len(links) + len(joints) > MAX_URDF_ELEMENTS:
         raise UrdfError(f"{origin}: {len(links)} links and {len(joints)} joints, above the cap of "
                         f"{MAX_URDF_ELEMENTS:,} elements; refused")  # fmt: skip

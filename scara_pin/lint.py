@@ -44,6 +44,8 @@ from xml.etree.ElementTree import Element, TreeBuilder
 
 import numpy as np
 
+from ._checks import number_text
+
 __all__ = [
     "CheckReport",
     "CheckStatus",
@@ -274,10 +276,7 @@ class _Checker:
         if el is None or el.get(attr) is None:
             return default
         raw = el.get(attr, "")
-        try:
-            values = tuple(float(v) for v in raw.split())
-        except ValueError:
-            values = ()
+        values = tuple(number_text(v) for v in raw.split())  # NaN unless urdfdom's grammar
         if len(values) != len(default) or not all(math.isfinite(v) for v in values):
             self.error("bad-number", f"{where} {attr}={raw!r} of joint {joint} must be {len(default)} finite numbers",
                        line, joint)  # fmt: skip
@@ -300,10 +299,7 @@ class _Checker:
                 raw = el.get(attr)
                 if raw is None:
                     continue
-                try:
-                    value = float(raw)
-                except ValueError:
-                    value = math.nan
+                value = number_text(raw)
                 if not math.isfinite(value) or (what == "mass" and value < 0):
                     rule = "must be a finite number >= 0" if what == "mass" else "must be a finite number"
                     self.error("bad-inertial", f"link {name}'s {what} {attr}={raw!r} {rule}", line)
@@ -467,10 +463,7 @@ class _Checker:
             nums = {}
             for attr in ("lower", "upper", "velocity", "effort"):
                 if attr in lim:
-                    try:
-                        nums[attr] = float(lim[attr])
-                    except ValueError:
-                        nums[attr] = math.nan
+                    nums[attr] = number_text(lim[attr])
                     if not math.isfinite(nums[attr]):
                         self.error("bad-number", f"joint {j.name}'s {attr} limit is {lim[attr]!r}: not a finite number",
                                    j.limit_line, j.name)  # fmt: skip

@@ -619,3 +619,18 @@ def test_a_config_folder_with_a_hostile_yaml_file(hostile: str, tmp_path: Path) 
     done = cli(["fk", "--robot", str(folder), "0", "0", "0", "0"], cwd=tmp_path)
     assert_one_error(done, 2)
     assert done.seconds < 20
+
+
+def _first_value(text: str, attr: str, new: str) -> str:
+    start = text.index(f'{attr}="') + len(attr) + 2
+    return text[:start] + new + text[text.index('"', start):]
+
+
+@pytest.mark.parametrize(("attr", "value"), [("ixz", "1_0"), ("rgba", "0x1"), ("effort", "1_0"), ("xyz", "0 0 1_0")])
+def test_numbers_urdfdom_refuses_are_refused_first(attr: str, value: str, capfd: pytest.CaptureFixture[str]) -> None:
+    """Python's float() takes "1_0" where urdfdom does not (found by a mutation fuzz of the shipped URDF)."""
+    text = _first_value(default_urdf(), attr, value)
+    with pytest.raises(UrdfError, match="not a valid URDF") as info:
+        Robot(text)
+    assert repr(value)[:10] in str(info.value)
+    assert capfd.readouterr() == ("", "")

@@ -10,6 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
+from .._checks import NUMBER_TEXT
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_text_atomic
 from ..limits import MAX_NUMBER
@@ -60,7 +61,6 @@ class Units:
         return [self.angle_name if k == "angle" else self.length_name for k in kinds]
 
 
-_NUMBER_TEXT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 _INTEGER_TEXT = re.compile(r"[+-]?\d+", re.ASCII)
 MIN_NUMBER = 1e-100
 """Smallest magnitude of a non-zero typed number (below it, 1 / x and x * x leave the float range)."""
@@ -74,7 +74,7 @@ def _number(name: str, text: str) -> float:
     ``0`` or ``[MIN_NUMBER, MAX_NUMBER]`` (1e-100 .. 1e12).
     """
     stripped = text.strip(" \t") if isinstance(text, str) else ""
-    if not _NUMBER_TEXT.fullmatch(stripped):
+    if not NUMBER_TEXT.fullmatch(stripped):
         shown = text if len(text) <= 40 else text[:40] + "..."
         if stripped.lower().lstrip("+-") in ("nan", "inf", "infinity"):
             raise ParameterError(name, shown, "must be finite")
