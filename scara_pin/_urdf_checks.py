@@ -60,6 +60,17 @@ def _geometry(geometry: ET.Element | None, where: str, origin: str) -> None:
             raise UrdfError(f"{origin}: not a valid URDF: {where} <{shapes[0].tag}> has no {attr}")
 
 
+def _unique_name(el: ET.Element, seen: set[str], origin: str) -> str:
+    """The ``name`` of a <link> or <joint>: present, and not seen before among its kind (then recorded)."""
+    name = el.get("name")
+    if not name:
+        raise UrdfError(f"{origin}: not a valid URDF: a <{el.tag}> has no name")
+    if name in seen:
+        raise UrdfError(f"{origin}: not a valid URDF: {el.tag} {name!r} is defined twice")
+    seen.add(name)
+    return name
+
+
 def check_urdf_tree(root: ET.Element, origin: str) -> None:
     """Refuse (:class:`UrdfError`) what urdfdom would refuse, with a message naming the element.
 
@@ -70,19 +81,14 @@ def check_urdf_tree(root: ET.Element, origin: str) -> None:
     """
     links = root.findall("link")
     joints = root.findall("joint")
-    for color in root.iter("color"):  # in global and inline <material>s
-        _numbers(color, "rgba", 4, "a <material>'s <color>", origin)
     if len(links) + len(joints) > MAX_URDF_ELEMENTS:
         raise UrdfError(f"{origin}: {len(links)} links and {len(joints)} joints, above the cap of "
                         f"{MAX_URDF_ELEMENTS:,} elements; refused")  # fmt: skip
+    for color in root.iter("color"):  # in global and inline <material>s
+        _numbers(color, "rgba", 4, "a <material>'s <color>", origin)
     names: set[str] = set()
     for el in links:
-        name = el.get("name")
-        if not name:
-            raise UrdfError(f"{origin}: not a valid URDF: a <link> has no name")
-        if name in names:
-            raise UrdfError(f"{origin}: not a valid URDF: link {name!r} is defined twice")
-        names.add(name)
+        name = _unique_name(el, names, origin)
         for path, attr, n in _LINK_NUMBERS:
             for sub in el.findall(path):
                 _numbers(sub, attr, n, f"link {name}'s <{path}>", origin)
@@ -99,12 +105,7 @@ def check_urdf_tree(root: ET.Element, origin: str) -> None:
     seen: set[str] = set()
     parent_of: dict[str, str] = {}
     for el in joints:
-        name = el.get("name")
-        if not name:
-            raise UrdfError(f"{origin}: not a valid URDF: a <joint> has no name")
-        if name in seen:
-            raise UrdfError(f"{origin}: not a valid URDF: joint {name!r} is defined twice")
-        seen.add(name)
+        name = _unique_name(el, seen, origin)
         kind = el.get("type")
         if kind not in _JOINT_TYPES:
             raise UrdfError(f"{origin}: not a valid URDF: joint {name} has type {kind!r}")
