@@ -86,6 +86,9 @@ def check_urdf_tree(root: ET.Element, origin: str) -> None:
                         f"{MAX_URDF_ELEMENTS:,} elements; refused")  # fmt: skip
     for color in root.iter("color"):  # in global and inline <material>s
         _numbers(color, "rgba", 4, "a <material>'s <color>", origin)
+        if not all(0.0 <= number_text(v) <= 1.0 for v in color.get("rgba", "0 0 0 0").split()):
+            raise UrdfError(f"{origin}: not a valid URDF: a <material>'s <color> rgba={color.get('rgba')!r} "
+                            "must be 4 numbers in [0, 1]")  # fmt: skip
     names: set[str] = set()
     for el in links:
         name = _unique_name(el, names, origin)

@@ -626,7 +626,8 @@ def _first_value(text: str, attr: str, new: str) -> str:
     return text[:start] + new + text[text.index('"', start):]
 
 
-@pytest.mark.parametrize(("attr", "value"), [("ixz", "1_0"), ("rgba", "0x1"), ("effort", "1_0"), ("xyz", "0 0 1_0")])
+@pytest.mark.parametrize(("attr", "value"), [("ixz", "1_0"), ("rgba", "0x1"), ("rgba", "1 2 3 4"),
+                                                 ("effort", "1_0"), ("xyz", "0 0 1_0")])
 def test_numbers_urdfdom_refuses_are_refused_first(attr: str, value: str, capfd: pytest.CaptureFixture[str]) -> None:
     """Python's float() takes "1_0" where urdfdom does not (found by a mutation fuzz of the shipped URDF)."""
     text = _first_value(default_urdf(), attr, value)
