@@ -635,3 +635,13 @@ def test_numbers_urdfdom_refuses_are_refused_first(attr: str, value: str, capfd:
         Robot(text)
     assert repr(value)[:10] in str(info.value)
     assert capfd.readouterr() == ("", "")
+
+
+def test_a_file_on_stdout_keeps_stdout_clean(tmp_path: Path) -> None:
+    """`--plot -`: the PNG alone on stdout, the summary on stderr; two outputs on stdout are refused."""
+    p = subprocess.run([sys.executable, "-c", RUN, "traj", *MOVE, "--plot", "-"], cwd=tmp_path, capture_output=True,
+                       timeout=WALL_SECONDS, preexec_fn=_limited, env=_env())  # fmt: skip
+    assert p.returncode == 0 and p.stdout.startswith(b"\x89PNG\r\n\x1a\n") and b"wrote     plot: -" in p.stderr
+    assert_one_error(cli(["traj", *MOVE, "--out", "-", "--json"], cwd=tmp_path), 2)
+    assert_one_error(cli(["traj", *MOVE, "--out", "-", "--setpoints", "-"], cwd=tmp_path), 2)
+    assert list(tmp_path.iterdir()) == []

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -32,6 +33,15 @@ if TYPE_CHECKING:
     pass
 
 
+def _check_outputs(args: argparse.Namespace, outputs: tuple[str | None, ...]) -> None:
+    """Refuse bad output names before any work: devices, folders, and two outputs on stdout."""
+    named = [out for out in outputs if out]
+    for out in named:
+        check_output_path(out)
+    if named.count("-") + bool(args.json) > 1:
+        raise InvalidInputError("only one output can go to standard output (-), and --json prints there too")
+
+
 def cmd_traj(args: argparse.Namespace) -> int:
     """A trajectory between configurations or poses: quintic, time-optimal, or a straight tool line."""
     import numpy as np
@@ -40,9 +50,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units(args.deg, args.mm)
-    for out in (args.out, args.setpoints, args.plot):  # refused before any work
-        if out:
-            check_output_path(out)
+    _check_outputs(args, (args.out, args.setpoints, args.plot))
     robot = _load(args, units)
     _acceleration(robot, args.acceleration, units)
     if (args.from_q is None) == (args.from_pose is None):
@@ -159,13 +167,15 @@ def cmd_traj(args: argparse.Namespace) -> int:
             summary["samples"] = traj.resample(args.rate).to_dict()
         print(json.dumps(summary))
         return 0
-    print(f"robot     {robot.name}: {method}")
-    print(f"duration  {traj.duration:.9g} s")
-    print(f"from      {_fmt(traj.q_start)}  [SI]")
-    print(f"to        {_fmt(traj.q_end)}  [SI]")
-    print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} (sampled at 1 kHz)")
+    text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
+    print(f"robot     {robot.name}: {method}", file=text)
+    print(f"duration  {traj.duration:.9g} s", file=text)
+    print(f"from      {_fmt(traj.q_start)}  [SI]", file=text)
+    print(f"to        {_fmt(traj.q_end)}  [SI]", file=text)
+    print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} "
+          "(exact for joint-line laws, else sampled)", file=text)  # fmt: skip
     for kind, where in outputs.items():
-        print(f"wrote     {kind}: {where}")
+        print(f"wrote     {kind}: {where}", file=text)
     return 0
 
 
@@ -174,9 +184,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     from ..motion.jog import jog_to_edge
 
     units = Units(args.deg, args.mm)
-    for out in (args.out, args.plot):  # refused before any work
-        if out:
-            check_output_path(out)
+    _check_outputs(args, (args.out, args.plot))
     robot = _load(args, units)
     _acceleration(robot, args.acceleration, units)
     if robot.kind != "scara":
@@ -202,14 +210,17 @@ def cmd_jog(args: argparse.Namespace) -> int:
                           "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
         return 0
     L = units.length
-    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}")
-    print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]")
-    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)")
-    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]")
-    print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)")
+    text = sys.stderr if "-" in (args.out, args.plot) else sys.stdout  # stdout carries a file
+    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}", file=text)
+    print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
+    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)",
+          file=text)  # fmt: skip
+    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]",
+          file=text)  # fmt: skip
+    print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)", file=text)
     for what in (args.out, args.plot):
         if what:
-            print(f"wrote     {what}")
+            print(f"wrote     {what}", file=text)
     return 0
 
 
