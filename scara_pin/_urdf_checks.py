@@ -84,7 +84,13 @@ def check_urdf_tree(root: ET.Element, origin: str) -> None:
     if len(links) + len(joints) > MAX_URDF_ELEMENTS:
         raise UrdfError(f"{origin}: {len(links)} links and {len(joints)} joints, above the cap of "
                         f"{MAX_URDF_ELEMENTS:,} elements; refused")  # fmt: skip
+    for material in root.findall("material"):  # a global one defines a colour or a texture
+        if material.find("color") is None and material.find("texture") is None:
+            raise UrdfError(f"{origin}: not a valid URDF: material {material.get('name')!r} has neither <color> "
+                            "nor <texture>")  # fmt: skip
     for color in root.iter("color"):  # in global and inline <material>s
+        if color.get("rgba") is None:
+            raise UrdfError(f"{origin}: not a valid URDF: a <material>'s <color> has no rgba")
         _numbers(color, "rgba", 4, "a <material>'s <color>", origin)
         if not all(0.0 <= number_text(v) <= 1.0 for v in color.get("rgba", "0 0 0 0").split()):
             raise UrdfError(f"{origin}: not a valid URDF: a <material>'s <color> rgba={color.get('rgba')!r} "

@@ -626,6 +626,15 @@ def _first_value(text: str, attr: str, new: str) -> str:
     return text[:start] + new + text[text.index('"', start):]
 
 
+def test_a_global_material_without_colour_is_refused_first(capfd: pytest.CaptureFixture[str]) -> None:
+    text = default_urdf()
+    start = text.index("<color ", text.index('<material name="scara_orange">'))
+    text = text[:start] + text[text.index("/>", start) + 2:]
+    with pytest.raises(UrdfError, match="scara_orange"):
+        Robot(text)
+    assert capfd.readouterr() == ("", "")
+
+
 @pytest.mark.parametrize(("attr", "value"), [("ixz", "1_0"), ("rgba", "0x1"), ("rgba", "1 2 3 4"),
                                                  ("effort", "1_0"), ("xyz", "0 0 1_0")])
 def test_numbers_urdfdom_refuses_are_refused_first(attr: str, value: str, capfd: pytest.CaptureFixture[str]) -> None:
