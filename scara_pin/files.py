@@ -1,12 +1,27 @@
-"""Output files written atomically: a temporary file in the same folder, then a rename.
+"""Output files written atomically: a temporary file in the same folder, flushed to disk, then a rename.
 
-An error or Ctrl-C leaves the old file or none, never a half-written one. Used by every command that
-writes a file (URDF, trajectories, setpoints, plots, HTML pages, batch IK results).
+An error, Ctrl-C or SIGTERM (the command line turns it into the same clean-up) leaves the old file or
+none, never a half-written one. Used by every command that writes a file (URDF, trajectories, setpoints,
+plots, HTML pages, batch IK results).
+
+Rules:
+
+- only regular files are written, or standard output for the name ``-``; an existing character device
+  (``/dev/null``), block device, FIFO, socket or folder is refused with an
+  :class:`~scara_pin.errors.InvalidInputError` (exit code 2), never replaced;
+- a symbolic link is replaced by the new file (its target is never written through);
+- the temporary file is created with mode ``0o666`` filtered by the process umask, as ``open()`` would;
+  the umask is never read or changed (no process-wide state is touched, so threads may write at once);
+- the data is ``fsync``-ed before the rename, and the folder after it (where the system allows).
 """
 
 from __future__ import annotations
 
 import os
+import secrets
+import shutil
+import stat
+import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -15,46 +30,123 @@ from typing import IO, Any
 
 from .errors import InvalidInputError
 
-__all__ = ["atomic_output", "write_atomic_with", "write_text_atomic"]
+__all__ = ["STDOUT", "atomic_output", "check_output_path", "write_atomic_with", "write_text_atomic"]
+
+STDOUT = "-"
+"""The output name that means standard output."""
+
+_KINDS = (
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISDIR, "a folder"),
+)
+
+
+def check_output_path(path: str | os.PathLike[str]) -> Path:
+    """``path`` as a :class:`Path` if a regular file may be written there (or ``-``), else refuse it.
+
+    Raises:
+        InvalidInputError: the folder does not exist, or ``path`` exists and is not a regular file or a
+            symbolic link (a device, FIFO, socket or folder).
+    """
+    path = Path(path)
+    if str(path) == STDOUT:
+        return path
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise InvalidInputError(f"cannot write {path}: folder {folder} does not exist")
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return path
+    except OSError as exc:
+        raise InvalidInputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    for test, kind in _KINDS:
+        if test(mode):
+            raise InvalidInputError(f"cannot write {path}: it is {kind}; scara-pin writes regular files only "
+                                    "(or - for standard output)")  # fmt: skip
+    return path
+
+
+def _new_temp(folder: Path, name: str, created: list[Path]) -> Path:
+    """Create an empty temporary file in ``folder`` with mode 0o666 & ~umask (exclusive, never reused).
+
+    Its name is put in ``created`` BEFORE it exists, so that a Ctrl-C or SIGTERM arriving at any point
+    after its creation finds it there and removes it.
+    """
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
+    for _ in range(100):
+        tmp = folder / f".{name[:64]}.{secrets.token_hex(6)}.tmp"
+        created.append(tmp)
+        try:
+            fd = os.open(tmp, flags, 0o666)
+        except FileExistsError:  # someone else's: never ours to delete
+            created.remove(tmp)
+            continue
+        except OSError:
+            created.remove(tmp)
+            raise
+        os.close(fd)
+        return tmp
+    raise InvalidInputError(f"cannot write in {folder}: no free temporary name")  # pragma: no cover
+
+
+def _fsync(path: Path, flags: int) -> None:
+    fd = os.open(path, flags)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 @contextmanager
 def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """Yield a temporary file next to ``path``; on success rename it onto ``path``, else delete it.
+    """Yield a temporary file's path; on success move it onto ``path`` (``-``: copy it to stdout), else delete it.
 
-    An error (or Ctrl-C) leaves the old file or none, never a partial one.
+    Write to the yielded path (``open(tmp, "w")``, ``figure.savefig(tmp, format="png")``...). An error,
+    Ctrl-C or SIGTERM (under the command line) leaves the old file or none, never a partial one.
 
     Raises:
-        InvalidInputError: the folder does not exist or cannot be written, or ``path`` is a folder.
+        InvalidInputError: the folder does not exist or cannot be written, ``path`` is not a regular file
+            (see the module docstring), the disk is full...
     """
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise InvalidInputError(f"cannot write {path}: folder {folder} does not exist")
-    if path.is_dir():
-        raise InvalidInputError(f"cannot write {path}: it is a folder")
+    path = check_output_path(path)
+    to_stdout = str(path) == STDOUT
+    folder = Path(tempfile.gettempdir()) if to_stdout else (path.parent if str(path.parent) else Path("."))
+    created: list[Path] = []
     try:
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    except OSError as exc:
-        raise InvalidInputError(f"cannot write in {folder}: {exc.strerror}") from None
-    os.close(fd)
-    tmp = Path(name)
-    try:
+        tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created)
         yield tmp
-        mask = os.umask(0o022)  # mkstemp makes the file private: give it the usual permissions
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
+        if to_stdout:
+            sys.stdout.flush()
+            with tmp.open("rb") as src:
+                out = getattr(sys.stdout, "buffer", None)
+                if out is None:  # a text stream (tests): text outputs only
+                    sys.stdout.write(src.read().decode("utf-8"))
+                else:
+                    shutil.copyfileobj(src, out)
+            sys.stdout.flush()
+            return
+        _fsync(tmp, os.O_RDONLY)
+        check_output_path(path)  # again, just before the rename: it may have changed meanwhile
         os.replace(tmp, path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise InvalidInputError(f"cannot write {path}: {exc.strerror or exc}") from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
+        try:  # the rename itself, on disk
+            _fsync(folder, os.O_RDONLY)
+        except OSError:  # some systems cannot fsync a folder
+            pass
+    except BrokenPipeError:  # the reader of stdout went away: the command line handles it
         raise
+    except OSError as exc:
+        raise InvalidInputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    finally:
+        for name in created:  # after the rename: nothing there
+            name.unlink(missing_ok=True)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically; return the path."""
+    """Write ``text`` (UTF-8) to ``path`` atomically (``-``: standard output); return the path."""
     path = Path(path)
     with atomic_output(path) as tmp:
         tmp.write_text(text, encoding="utf-8", newline="")

@@ -50,6 +50,7 @@ from xml.etree.ElementTree import Element, TreeBuilder
 
 import numpy as np
 
+from ._checks import number_text
 from .urdf_rules import JointEdge, choose_frames, joint_problem
 
 __all__ = [
@@ -289,15 +290,33 @@ class _Checker:
         if el is None or el.get(attr) is None:
             return default
         raw = el.get(attr, "")
-        try:
-            values = tuple(float(v) for v in raw.split())
-        except ValueError:
-            values = ()
+        values = tuple(number_text(v) for v in raw.split())  # NaN unless urdfdom's grammar
         if len(values) != len(default) or not all(math.isfinite(v) for v in values):
             self.error("bad-number", f"{where} {attr}={raw!r} of joint {joint} must be {len(default)} finite numbers",
                        line, joint)  # fmt: skip
             return default
         return values
+
+    def _inertial(self, link: Element, name: str, line: int | None) -> None:
+        """A link's mass and inertia must be finite (NaN would poison every torque); mass >= 0."""
+        inertial = link.find("inertial")
+        if inertial is None:
+            return
+        checks: list[tuple[str, Element | None, tuple[str, ...]]] = [
+            ("mass", inertial.find("mass"), ("value",)),
+            ("inertia", inertial.find("inertia"), ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")),
+        ]
+        for what, el, attrs in checks:
+            if el is None:
+                continue
+            for attr in attrs:
+                raw = el.get(attr)
+                if raw is None:
+                    continue
+                value = number_text(raw)
+                if not math.isfinite(value) or (what == "mass" and value < 0):
+                    rule = "must be a finite number >= 0" if what == "mass" else "must be a finite number"
+                    self.error("bad-inertial", f"link {name}'s {what} {attr}={raw!r} {rule}", line)
 
     def structure(self) -> None:
         try:
@@ -308,6 +327,12 @@ class _Checker:
             raise _Unusable from None
         if root.tag != "robot":
             self.error("root-not-robot", f"the root element is <{root.tag}>, not <robot>", lines.get(root))
+            raise _Unusable
+        from .limits import MAX_CHECK_ELEMENTS
+
+        size = len(root.findall("link")) + len(root.findall("joint"))
+        if size > MAX_CHECK_ELEMENTS:
+            self.error("too-large", f"{size} links and joints, above the cap of {MAX_CHECK_ELEMENTS:,}")
             raise _Unusable
         xacro = next((el for el in root.iter() if el.tag.startswith("xacro:")), None)
         if xacro is not None:
@@ -324,6 +349,7 @@ class _Checker:
                            lines.get(el))  # fmt: skip
             else:
                 links[name] = lines.get(el)
+            self._inertial(el, name or "?", lines.get(el))
         for el in root.findall("joint"):
             name, kind, line = el.get("name"), el.get("type"), lines.get(el)
             if not name:
@@ -453,10 +479,7 @@ class _Checker:
             nums = {}
             for attr in ("lower", "upper", "velocity", "effort"):
                 if attr in lim:
-                    try:
-                        nums[attr] = float(lim[attr])
-                    except ValueError:
-                        nums[attr] = math.nan
+                    nums[attr] = number_text(lim[attr])
                     if not math.isfinite(nums[attr]):
                         self.error("bad-number", f"joint {j.name}'s {attr} limit is {lim[attr]!r}: not a finite number",
                                    j.limit_line, j.name)  # fmt: skip
@@ -662,9 +685,14 @@ def check_urdf_file(
     are looked for as the loader does (:mod:`scara_pin.description.packages`).
     """
     from .description.packages import PackagePath, read_robot_file
-    from .errors import UrdfError
+    from .errors import InvalidInputError, UrdfError
+    from .limits import check_input_file
 
     path = Path(path)
+    try:  # bounded: /dev/zero or a huge file is refused, not read whole
+        check_input_file(path, "URDF")
+    except InvalidInputError as exc:
+        return CheckReport(str(path), (Finding(Severity.ERROR, "unreadable", f"cannot be read ({exc})"),))
     try:
         packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
         text = read_robot_file(path, packages)

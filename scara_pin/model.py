@@ -17,8 +17,6 @@ from __future__ import annotations
 
 import enum
 import math
-import os
-import sys
 from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
@@ -113,8 +111,9 @@ def pose_from_placement(aMb: pin.SE3) -> np.ndarray:
 
 def _parse_urdf(urdf: str, origin: str) -> pin.Model:
     """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
-    import tempfile
     import xml.etree.ElementTree as ET
+
+    from ._urdf_checks import check_urdf_tree
 
     try:
         root = ET.fromstring(urdf)
@@ -123,29 +122,15 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
         raise UrdfError(f"{origin}: malformed XML at line {line}, column {column + 1}") from None
     if root.tag != "robot":
         raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
+    # urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state):
+    # its rules are checked first, in Python, so that it only sees documents it accepts.
+    check_urdf_tree(root, origin)
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
     mimic = root.find("joint/mimic") is not None
-    # urdfdom reports the reason on the C stderr and Pinocchio raises a generic ValueError: capture it.
-    sys.stderr.flush()
-    saved = os.dup(2)
-    with tempfile.TemporaryFile() as captured:
-        os.dup2(captured.fileno(), 2)
-        try:
-            model = pin.buildModelFromXML(urdf, mimic=True) if mimic else pin.buildModelFromXML(urdf)
-            failure = None
-        except (ValueError, RuntimeError) as exc:
-            failure = exc
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-        captured.seek(0)
-        report = captured.read().decode(errors="replace")
-    if failure is not None:
-        reasons = [ln.split("Error:", 1)[1].strip() for ln in report.splitlines() if "Error:" in ln]
-        reason = "; ".join(reasons) if reasons else str(failure)
-        raise UrdfError(f"{origin}: not a valid URDF: {reason}")
-    if report.strip():
-        sys.stderr.write(report)
+    try:
+        model = pin.buildModelFromXML(urdf, mimic=True) if mimic else pin.buildModelFromXML(urdf)
+    except (ValueError, RuntimeError) as exc:
+        raise UrdfError(f"{origin}: not a valid URDF: {exc}") from None
     if model.nq == 0:
         raise UrdfError(
             f"{origin}: the URDF has no movable joint connected to its root link "

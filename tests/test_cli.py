@@ -145,24 +145,25 @@ def test_fk_random_poses_against_closed_form(robot: str, capsys: pytest.CaptureF
     ],
 )
 def test_fk_units(flags: list[str], argv_q: list[str], q_si: list[float], capsys: pytest.CaptureFixture[str]) -> None:
+    # --deg/--mm scale the inputs; JSON is always SI (README: "JSON output")
     data = fk_json(capsys, ["fk", "--json", *flags, "--", *argv_q])
-    deg, mm = "--deg" in flags, "--mm" in flags
     pos, yaw, M = closed_form_pose("default", np.array(q_si))
-    length = 1000.0 if mm else 1.0
-    angle = 180.0 / math.pi if deg else 1.0
-    assert data["units"] == {"length": "mm" if mm else "m", "angle": "deg" if deg else "rad"}
-    assert data["q"] == pytest.approx([float(v) for v in argv_q], rel=1e-12, abs=1e-12)
-    assert data["position"] == pytest.approx((pos * length).tolist(), abs=1e-9)
-    assert data["yaw"] == pytest.approx(yaw * angle, abs=1e-9)
+    assert data["units"] == {"length": "m", "angle": "rad"}
+    assert data["q"] == pytest.approx(q_si, rel=1e-12, abs=1e-12)
+    assert data["position"] == pytest.approx(pos.tolist(), abs=1e-12)
+    assert data["yaw"] == pytest.approx(yaw, abs=1e-12)
     matrix = np.array(data["matrix"])
-    assert matrix[:3, :3] == pytest.approx(M[:3, :3], abs=1e-12)  # rotations have no unit
-    assert matrix[:3, 3] == pytest.approx(pos * length, abs=1e-9)
+    assert matrix == pytest.approx(M, abs=1e-12)
 
 
 def test_fk_deg_mm_quarter_turn(capsys: pytest.CaptureFixture[str]) -> None:
     data = fk_json(capsys, ["fk", "--deg", "--mm", "--json", "90", "0", "10", "0"])
-    assert data["position"] == pytest.approx([0.0, 400.0, -60.0], abs=1e-9)
-    assert data["yaw"] == pytest.approx(90.0, abs=1e-12)
+    assert data["position"] == pytest.approx([0.0, 0.4, -0.06], abs=1e-12)  # JSON: SI
+    assert data["yaw"] == pytest.approx(math.pi / 2, abs=1e-12)
+    rc, out, _ = run(capsys, ["fk", "--deg", "--mm", "90", "0", "10", "0"])  # text: the user's units
+    line = next(ln for ln in out.splitlines() if ln.startswith("position"))
+    assert rc == 0 and line.endswith("[mm]")
+    assert [float(v) for v in line.split("[")[1].split("]")[0].split(",")] == pytest.approx([0, 400, -60], abs=1e-9)
 
 
 def test_fk_text_output(capsys: pytest.CaptureFixture[str]) -> None:
@@ -221,12 +222,9 @@ def test_jacobian_random_against_closed_form(robot: str, capsys: pytest.CaptureF
 def test_jacobian_units(capsys: pytest.CaptureFixture[str]) -> None:
     q_si = np.array([math.radians(30), math.radians(60), 0.02, math.radians(-10)])
     data = fk_json(capsys, ["jacobian", "--json", "--deg", "--mm", "30", "60", "20", "-10"])
-    assert data["units"] == {"length": "mm", "angle": "deg"}
+    assert data["units"] == {"length": "m", "angle": "rad"}  # JSON: SI, whatever --deg/--mm
     J = closed_form_task_jacobian("default", q_si)
-    # row unit / column unit: [mm/deg] for x, y vs q1, q2; [mm/mm] for z vs q3; [deg/deg] for yaw
-    expected = J.copy()
-    expected[:2, :2] *= 1000.0 * math.pi / 180.0
-    assert np.array(data["jacobian"]) == pytest.approx(expected, abs=1e-9)
+    assert np.array(data["jacobian"]) == pytest.approx(J, abs=1e-12)
     assert data["jacobian"][2][2] == pytest.approx(-1.0, abs=1e-12)
     assert data["jacobian"][3] == pytest.approx([1.0, 1.0, 0.0, 1.0], abs=1e-12)
     l1, l2, _ = GEOMETRY["default"]

@@ -158,15 +158,16 @@ def test_ik_degrees_and_millimetres(capsys: pytest.CaptureFixture[str]) -> None:
     args = [repr(float(target[i] * 1000)) for i in range(3)] + [repr(math.degrees(target[3]))]
     rc, out, _ = run(capsys, ["ik", *args, "--deg", "--mm", "--json", "--all-turns"])
     assert rc == 0
-    data = json.loads(out)
-    assert data["target"]["x"] == pytest.approx(target[0] * 1000, abs=1e-9)
-    assert data["target"]["yaw"] == pytest.approx(math.degrees(target[3]), abs=1e-9)
+    data = json.loads(out)  # --deg/--mm scale the inputs; JSON is always SI
+    assert data["units"] == {"length": "m", "angle": "rad"}
+    assert data["target"]["x"] == pytest.approx(target[0], abs=1e-12)
+    assert data["target"]["yaw"] == pytest.approx(target[3], abs=1e-12)
     assert len(data["solutions"]) == 4
     for sol in data["solutions"]:
-        q_deg = np.array(sol["q"])
-        q = np.array([math.radians(q_deg[0]), math.radians(q_deg[1]), q_deg[2] / 1000, math.radians(q_deg[3])])
-        assert pose_error(s4_pose(q), target) <= POSE_TOL
-    assert min(abs(s["q"][2] - 30.0) for s in data["solutions"]) <= 1e-9  # q3 = 0.03 m = 30 mm
+        assert pose_error(s4_pose(np.array(sol["q"])), target) <= POSE_TOL
+    assert min(abs(s["q"][2] - 0.03) for s in data["solutions"]) <= 1e-12  # q3 = 0.03 m = 30 mm
+    rc, out, _ = run(capsys, ["ik", *args, "--deg", "--mm"])  # the text output is in the user's units
+    assert rc == 0 and "[deg, deg, mm, deg]" in out
 
 
 def test_ik_unreachable_json_exit_3(capsys: pytest.CaptureFixture[str]) -> None:

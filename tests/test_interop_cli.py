@@ -98,13 +98,13 @@ def test_human_units_follow_the_joint_kinds_of_the_urdf(capsys: pytest.CaptureFi
     q_human = [q_si[0] * 1000, *(math.degrees(v) for v in q_si[1:])]
     rc, out_h, err = run(capsys, ["fk", "--json", "--deg", "--mm", "--urdf", str(path), *map(str, q_human)])
     assert rc == 0, err
-    si, human = json.loads(out_si), json.loads(out_h)
-    assert np.allclose(np.array(human["position"]) / 1000, si["position"], atol=1e-12)
-    assert math.radians(human["yaw"]) == pytest.approx(si["yaw"], abs=1e-12)
-    assert human["q"] == pytest.approx(q_human, abs=1e-9)
-    # and IK answers in the same units: its first value is the lift in mm
-    target = [*(v * 1000 for v in si["position"]), human["yaw"]]
+    si, human = json.loads(out_si), json.loads(out_h)  # JSON is always SI: the same answer
+    assert np.allclose(human["position"], si["position"], atol=1e-12)
+    assert human["yaw"] == pytest.approx(si["yaw"], abs=1e-12)
+    assert human["q"] == pytest.approx(q_si, abs=1e-12)
+    # and IK reads its target in the same units (the lift in mm), answering in SI
+    target = [*(v * 1000 for v in si["position"]), math.degrees(si["yaw"])]
     rc, out, err = run(capsys, ["ik", "--json", "--deg", "--mm", "--urdf", str(path), *map(str, target)])
     assert rc == 0, err
     qs = [s["q"] for s in json.loads(out)["solutions"]]
-    assert any(np.allclose(q, q_human, atol=1e-6) for q in qs), qs
+    assert any(np.allclose(q, q_si, atol=1e-9) for q in qs), qs

@@ -7,7 +7,10 @@ Conventions shared by every command:
   q is (q1, q2, theta3, q4), four angles, theta3 the small arm's absolute angle (scara_pin.palletizer).
 - ``--json`` prints one JSON object on stdout.
 - Exit codes: 0 ok, 2 invalid input, 3 infeasible request (unreachable, limits), 1 internal error;
-  ``check`` also exits 4 when the URDF is usable but has warnings.
+  ``check`` also exits 4 when the URDF is usable but has warnings; ``validate-ik`` exits 5 when the
+  validation fails; 130 after Ctrl-C, 143 after SIGTERM (temporary files removed in both cases).
+- ``--json`` output is always in SI units (m, rad, s), whatever ``--deg``/``--mm`` (which scale the inputs
+  and the text output); its ``units`` field says so.
   Errors are one line on stderr starting with ``error:``; warnings start with ``warning:``.
 
 Heavy packages (toppra, matplotlib, yourdfpy, meshcat) are imported only inside the commands that need
@@ -19,8 +22,12 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import signal
 import sys
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from types import FrameType
 
 from ..errors import ScaraError
 from . import cycle, describe, kinematics, motion, teach, view, workspace
@@ -36,7 +43,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="scara-pin",
         description="Kinematics of SCARA robots from one xacro/URDF description (Pinocchio inside). "
-        "SI units unless --deg/--mm; exit codes: 0 ok, 2 invalid input, 3 infeasible, 1 internal error.",
+        "SI units unless --deg/--mm (JSON output always SI); exit codes: 0 ok, 2 invalid input, 3 infeasible, "
+        "4 check: warnings, 5 validate-ik: failed, 1 internal error.",
     )
     parser.add_argument("--version", action="version", version=f"scara-pin {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
@@ -45,6 +53,27 @@ def build_parser() -> argparse.ArgumentParser:
     for module in (describe, kinematics, motion, cycle, workspace, view, teach):
         module.register(sub)
     return parser
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that the same clean-up runs (temporary files removed)."""
+
+
+def _on_sigterm(signum: int, frame: FrameType | None) -> None:
+    raise _Terminated()
+
+
+@contextmanager
+def _sigterm_as_interrupt() -> Iterator[None]:
+    """While a command runs: SIGTERM raises :class:`_Terminated` (main thread only; restored after)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 class _Formatter(logging.Formatter):
@@ -71,10 +100,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         if func is None:
             print("error: no command given (see scara-pin --help)", file=sys.stderr)
             return 2
-        return func(args)
+        with _sigterm_as_interrupt():
+            return func(args)
     except ScaraError as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
+    except _Terminated:
+        print("error: terminated (SIGTERM)", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130

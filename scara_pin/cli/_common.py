@@ -7,12 +7,14 @@ import logging
 import math
 import re
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
+from .._checks import NUMBER_TEXT
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_text_atomic
+from ..limits import MAX_NUMBER
 
 if TYPE_CHECKING:
     import numpy as np
@@ -60,29 +62,91 @@ class Units:
         return [self.angle_name if k == "angle" else self.length_name for k in kinds]
 
 
+_INTEGER_TEXT = re.compile(r"[+-]?\d+", re.ASCII)
+MIN_NUMBER = 1e-100
+"""Smallest magnitude of a non-zero typed number (below it, 1 / x and x * x leave the float range)."""
+
+
 def _number(name: str, text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise ParameterError(name, text, "must be a number") from None
-    if not math.isfinite(value):
-        raise ParameterError(name, text, "must be finite")
+    """The one parser of the numbers users type (arguments, --set values, batch CSV cells).
+
+    Accepted: what a robotics user types, ``0.25``, ``-1.5e-3``, ``+2``, ``.5``, ``3.``, surrounding
+    blanks. Refused: ``1_000``, non-ASCII digits, hex, ``nan``, ``inf``, and magnitudes outside
+    ``0`` or ``[MIN_NUMBER, MAX_NUMBER]`` (1e-100 .. 1e12).
+    """
+    stripped = text.strip(" \t") if isinstance(text, str) else ""
+    if not NUMBER_TEXT.fullmatch(stripped):
+        shown = text if len(text) <= 40 else text[:40] + "..."
+        if stripped.lower().lstrip("+-") in ("nan", "inf", "infinity"):
+            raise ParameterError(name, shown, "must be finite")
+        raise ParameterError(name, shown, "must be a plain number such as 0.25, -3, 1.5e-3 (ASCII digits, "
+                             "no _ separators)")  # fmt: skip
+    value = float(stripped)
+    if not (value == 0.0 or MIN_NUMBER <= abs(value) <= MAX_NUMBER):
+        raise ParameterError(name, stripped, f"must be 0 or of magnitude within [{MIN_NUMBER:g}, {MAX_NUMBER:g}]")
     return value
 
 
-def _parse_sets(items: Sequence[str] | None) -> dict[str, str]:
-    overrides: dict[str, str] = {}
+def _integer(name: str, text: str, low: int, high: int) -> int:
+    """A typed whole number in ``[low, high]`` (ASCII digits, optional sign)."""
+    stripped = text.strip(" \t")
+    if not _INTEGER_TEXT.fullmatch(stripped) or len(stripped) > 30:
+        raise ParameterError(name, text[:40], "must be a whole number (ASCII digits)")
+    value = int(stripped)
+    if not low <= value <= high:
+        raise ParameterError(name, value, f"must be within [{low}, {high}]")
+    return value
+
+
+def number_type(name: str) -> Callable[[str], float]:
+    """An argparse ``type=`` that parses with :func:`_number` (errors become the one-line usage error)."""
+
+    def parse(text: str) -> float:
+        try:
+            return _number(name, text)
+        except ParameterError as exc:  # argparse names the option: "argument --rate: got 'x'; it must ..."
+            raise argparse.ArgumentTypeError(f"got {exc.value!r}; it {exc.rule}") from None
+
+    return parse
+
+
+def integer_type(name: str, low: int, high: int) -> Callable[[str], int]:
+    """An argparse ``type=`` for a whole number in ``[low, high]``."""
+
+    def parse(text: str) -> int:
+        try:
+            return _integer(name, text, low, high)
+        except ParameterError as exc:
+            raise argparse.ArgumentTypeError(f"got {exc.value!r}; it {exc.rule}") from None
+
+    return parse
+
+
+def _parse_sets(items: Sequence[str] | None) -> dict[str, float]:
+    """``--set KEY=VALUE`` items; each value goes through :func:`_number` (never to xacro as text)."""
+    overrides: dict[str, float] = {}
     for item in items or ():
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise InvalidInputError(f"--set {item!r} must have the form key=value (e.g. l1=0.25)")
-        overrides[key.strip()] = value
+            raise InvalidInputError(f"--set {item[:80]!r} must have the form key=value (e.g. l1=0.25)")
+        overrides[key.strip()] = _number(f"--set {key.strip()[:80]}", value)
     return overrides
+
+
+_MAX_NAME = 4096
+"""Longest --robot name or folder path (the system's PATH_MAX)."""
 
 
 def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
     from ..robots import load_robot
 
+    if len(args.robot) > _MAX_NAME or "\0" in args.robot:
+        raise InvalidInputError(f"--robot {args.robot[:40]!r}...: not a robot name nor a folder "
+                                f"(longer than {_MAX_NAME} characters or with a NUL)")  # fmt: skip
+    if args.urdf is not None:  # a regular file under the size cap, or refused before it is read
+        from ..limits import check_input_file
+
+        check_input_file(args.urdf, "URDF")
     robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf, tool=args.tool, base=args.base,
                        package_path=args.package_path or ())  # fmt: skip
     if robot.frame_note is not None:  # the tool chosen without a tool0: said once
@@ -90,6 +154,33 @@ def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
     if units is not None:  # what each joint value measures, read from the model (any joint order)
         units.q = robot.joint_kinds
     return robot
+
+
+def _add_acceleration(p: Any) -> None:
+    """``--acceleration A1 A2 A3 A4``: the joint acceleration limits (a URDF file has none)."""
+    p.add_argument("--acceleration", nargs=4, metavar="A",
+                   help="joint acceleration limits [rad/s^2, m/s^2; deg/s^2, mm/s^2 with --deg/--mm]; needed "
+                   "for a robot loaded from a URDF file (URDF has none); replaces the configured ones")  # fmt: skip
+
+
+def _acceleration(robot: Robot, texts: Sequence[str] | None, units: Units) -> None:
+    """Set ``robot.limits.acceleration`` from ``--acceleration``; refuse a robot without them.
+
+    Raises:
+        InvalidInputError: no acceleration limits known (a URDF file) and none given.
+    """
+    from ..description import JointLimits
+
+    lim = robot.limits
+    if texts:
+        acc = [_number(f"--acceleration {n}", t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
+        for name, value in zip(_Q_NAMES, acc):
+            if not value > 0:
+                raise ParameterError(f"--acceleration {name}", value, "must be > 0")
+        robot.limits = JointLimits(lim.lower, lim.upper, lim.velocity, tuple(acc), lim.effort, validate=False)
+    elif not all(math.isfinite(v) for v in lim.acceleration):
+        raise InvalidInputError(f"robot {robot.name!r} has no acceleration limits (a URDF file has none): give "
+                                "--acceleration A1 A2 A3 A4 [rad/s^2, m/s^2]")  # fmt: skip
 
 
 def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
@@ -107,6 +198,7 @@ def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]
 
 
 def _check_limits(robot: Robot, q: np.ndarray, strict: bool) -> None:
+    robot.check_q(q)  # a q that cannot be computed is an error, never first a "computed anyway" warning
     outside = robot.outside_limits(q)
     if outside and strict:
         raise InfeasibleError("q outside the joint limits (--strict): " + "; ".join(outside))

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..errors import InfeasibleError, InvalidInputError
 from ..files import write_atomic_with
 from ._common import (
     _POSE_KINDS,
@@ -27,6 +27,7 @@ from ._common import (
     _read_pose,
     _read_q,
     _scaled,
+    integer_type,
     log,
 )
 
@@ -35,6 +36,10 @@ if TYPE_CHECKING:
 
     from .._typing import ArrayLike
     from ..model import Robot
+
+
+_SI_UNITS = {"length": "m", "angle": "rad"}
+"""The ``units`` of every JSON output: SI, whatever --deg/--mm (they scale inputs and text)."""
 
 
 def cmd_fk(args: argparse.Namespace) -> int:
@@ -52,16 +57,16 @@ def cmd_fk(args: argparse.Namespace) -> int:
     yaw = float(pose[3]) * units.angle
     matrix = M.homogeneous.copy()
     matrix[:3, 3] *= units.length
-    if args.json:
+    if args.json:  # always SI (README: "JSON output")
         out = {
             "robot": robot.name,
-            "q": q_out,
-            "position": pos,
-            "yaw": yaw,
-            "matrix": matrix.tolist(),
+            "q": q.tolist(),
+            "position": [float(v) for v in pose[:3]],
+            "yaw": float(pose[3]),
+            "matrix": M.homogeneous.tolist(),
             "frame": robot.tool_frame,
             "reference": robot.base_frame,
-            "units": {"length": units.length_name, "angle": units.angle_name},
+            "units": _SI_UNITS,
         }
         print(json.dumps(out))
         return 0
@@ -93,22 +98,22 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         J = robot.frame_jacobian(q, args.frame, args.reference)
         rows = ["vx", "vy", "vz", "wx", "wy", "wz"]
         row_kinds = ("length",) * 3 + ("angle",) * 3
-    # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j)
-    J = J * np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
     w = robot.manipulability(q)
-    if args.json:
+    if args.json:  # always SI (README: "JSON output")
         out = {
             "robot": robot.name,
-            "q": _scaled(q, units.scale(units.q)),
+            "q": q.tolist(),
             "reference": args.reference,
             "frame": args.frame or robot.tool_frame,
             "rows": rows,
             "jacobian": J.tolist(),
             "manipulability": w,
-            "units": {"length": units.length_name, "angle": units.angle_name},
+            "units": _SI_UNITS,
         }
         print(json.dumps(out))
         return 0
+    # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j)
+    J = J * np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
     print(f"robot     {robot.name}: {args.reference} Jacobian of {args.frame or robot.tool_frame}")
     print(f"q         {_fmt(_scaled(q, units.scale(units.q)))}  [{', '.join(units.names(units.q))}]")
     print("          " + "".join(f"{n:>16}" for n in ("d/dq1", "d/dq2", "d/dq3", "d/dq4")))
@@ -128,6 +133,8 @@ def cmd_ik(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     robot = _load(args, units)
     if args.input:
+        if args.numeric:
+            raise InvalidInputError("--numeric goes with one target X Y Z YAW; ik --input (batch) is closed-form only")
         return _ik_batch(args, robot, units)
     if args.input is None and args.output:
         raise InvalidInputError("--output goes with --input (batch mode)")
@@ -171,13 +178,14 @@ def cmd_ik(args: argparse.Namespace) -> int:
     scale = units.scale(_POSE_KINDS)
     tgt = dict(zip(("x", "y", "z", "yaw"), _scaled(target, scale)))
     code = 0 if status == "OK" else 3
-    if args.json:
-        solutions = _solutions_json(qs, branches, units)
+    if args.json:  # always SI (README: "JSON output")
+        si = Units(False, False)
+        solutions = _solutions_json(qs, branches, si)
         for sol, t in zip(solutions, turns):
             sol["turns"] = t
-        print(json.dumps({"robot": robot.name, "target": tgt, "solutions": solutions,
-                          "status": status, "message": message, "method": "numeric" if numeric else "closed-form",
-                          "units": {"length": units.length_name, "angle": units.angle_name}}))  # fmt: skip
+        print(json.dumps({"robot": robot.name, "target": dict(zip(("x", "y", "z", "yaw"), map(float, target))),
+                          "solutions": solutions, "status": status, "message": message,
+                          "method": "numeric" if numeric else "closed-form", "units": _SI_UNITS}))  # fmt: skip
         return code
     if code:
         raise InfeasibleError(f"{status}: {message}")
@@ -210,10 +218,17 @@ def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) 
 
 
 def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
-    """Stream a CSV of targets (x, y, z, yaw) through the vectorised closed form, in bounded memory."""
+    """Stream a CSV of targets (x, y, z, yaw) through the vectorised closed form, in bounded memory.
+
+    Lines are read one at a time (:func:`scara_pin.limits.text_lines`: bounded length and count, UTF-8);
+    a progress bar (tqdm) shows on a terminal only.
+    """
     import csv
 
     import numpy as np
+
+    from ..files import check_output_path
+    from ..limits import MAX_ROWS, text_lines
 
     if args.target:
         raise InvalidInputError("give either X Y Z YAW or --input FILE, not both")
@@ -226,42 +241,54 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     reference = None
     if args.near:
         reference = _q_values(args.near, units)
-    in_path, out_path = Path(args.input), Path(args.output)
+    in_path, out_path = Path(args.input), check_output_path(args.output)
+    if in_path.is_dir():
+        raise InvalidInputError(f"cannot read {in_path}: it is a folder")
     try:
-        handle = in_path.open(newline="", encoding="utf-8")
+        handle = in_path.open("rb")
+        size = in_path.stat().st_size if in_path.is_file() else None
     except OSError as exc:
         raise InvalidInputError(f"cannot read {in_path}: {exc.strerror}") from None
     total = failed = 0
     pose_scale = np.array(units.scale(_POSE_KINDS))
     q_scale = np.array(units.scale(units.q))
-    show_progress = sys.stderr.isatty()
-    size = max(in_path.stat().st_size, 1)
 
     def rows_out(writer: Any) -> None:
         nonlocal total, failed
-        reader = csv.reader(handle)
-        header = next(reader, None)
-        if header is None or [h.strip().lower() for h in header[:4]] != ["x", "y", "z", "yaw"]:
-            raise InvalidInputError(f"{in_path}: the first row must be the header x,y,z,yaw")
-        writer.writerow(["x", "y", "z", "yaw", "q1", "q2", "q3", "q4", "branch", "status"])
-        chunk: list[list[float]] = []
-        line = 1
-        for row in reader:
-            line += 1
-            if not row or all(not c.strip() for c in row):
-                continue
-            if len(row) < 4:
-                raise InvalidInputError(f"{in_path} line {line}: expected 4 values x,y,z,yaw, got {len(row)}")
-            chunk.append([_number(f"{in_path.name} line {line} {n}", c) for n, c in zip("xyz", row[:3])]
-                         + [_number(f"{in_path.name} line {line} yaw", row[3])])  # fmt: skip
-            if len(chunk) == 65536:
-                flush(writer, chunk)
-                chunk = []
-                if show_progress:
-                    print(f"\r{total} targets ({100 * handle.tell() / size:.0f} %)", end="", file=sys.stderr)
-        flush(writer, chunk)
-        if show_progress:
-            print(f"\r{total} targets (100 %)", file=sys.stderr)
+        from tqdm import tqdm
+
+        with tqdm(total=size, unit="B", unit_scale=True, desc=f"ik {in_path.name}", file=sys.stderr,
+                  disable=not sys.stderr.isatty(), leave=False) as bar:  # fmt: skip
+            numbered = text_lines(handle, str(in_path), MAX_ROWS)
+            line = 0
+
+            def texts() -> Any:
+                nonlocal line
+                for number, text in numbered:
+                    line = number
+                    bar.update(len(text) + 1)
+                    yield text
+
+            reader = csv.reader(texts())
+            try:
+                header = next(reader, None)
+                if header is None or [h.strip().lower() for h in header[:4]] != ["x", "y", "z", "yaw"]:
+                    raise InvalidInputError(f"{in_path}: the first row must be the header x,y,z,yaw")
+                writer.writerow(["x", "y", "z", "yaw", "q1", "q2", "q3", "q4", "branch", "status"])
+                chunk: list[list[float]] = []
+                for row in reader:
+                    if not row or all(not c.strip() for c in row):
+                        continue
+                    if len(row) < 4:
+                        raise InvalidInputError(f"{in_path} line {line}: expected 4 values x,y,z,yaw, got {len(row)}")
+                    chunk.append([_number(f"{in_path.name} line {line} {n}", c) for n, c in zip("xyz", row[:3])]
+                                 + [_number(f"{in_path.name} line {line} yaw", row[3])])  # fmt: skip
+                    if len(chunk) == 65536:
+                        flush(writer, chunk)
+                        chunk = []
+            except csv.Error as exc:
+                raise InvalidInputError(f"{in_path} line {line}: not CSV ({exc})") from None
+            flush(writer, chunk)
 
     def flush(writer: Any, chunk: list[list[float]]) -> None:
         nonlocal total, failed
@@ -283,12 +310,15 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     return 3 if failed else 0
 
 
+VALIDATION_FAILED = 5
+"""Exit code of ``validate-ik`` when the validation fails (1 stays "internal error")."""
+MAX_VALIDATION_SAMPLES = 1_000_000
+
+
 def cmd_validate_ik(args: argparse.Namespace) -> int:
     """Cross-validate the closed-form IK against Pinocchio FK and the numeric IK."""
     from ..kinematics.validate import validate_ik
 
-    if args.samples < 1:
-        raise ParameterError("--samples", args.samples, "must be >= 1")
     robot = _load(args)
     report = validate_ik(robot, args.samples, args.seed)
     if args.json:
@@ -297,7 +327,7 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
         print(json.dumps(out))
     else:
         print(report.table())
-    return 0 if report.ok else 1
+    return 0 if report.ok else VALIDATION_FAILED
 
 
 def register(sub: Any) -> None:
@@ -328,8 +358,10 @@ def register(sub: Any) -> None:
     _add_robot_options(p)
     p.set_defaults(func=cmd_ik)
     p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
-    p.add_argument("--samples", type=int, default=1000, help="configurations sampled within limits (default 1000)")
-    p.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    p.add_argument("--samples", type=integer_type("--samples", 1, MAX_VALIDATION_SAMPLES), default=1000,
+                   help=f"configurations sampled within limits, 1..{MAX_VALIDATION_SAMPLES} (default 1000)")
+    p.add_argument("--seed", type=integer_type("--seed", 0, 2**63 - 1), default=0,
+                   help="sampling seed, >= 0 (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_robot_options(p)
     p.set_defaults(func=cmd_validate_ik)

@@ -5,13 +5,16 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import math
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..files import check_output_path
 from ._common import (
     Units,
+    _acceleration,
+    _add_acceleration,
     _add_robot_options,
     _add_units,
     _fmt,
@@ -21,6 +24,7 @@ from ._common import (
     _pose_to_q,
     _read_pose,
     log,
+    number_type,
     write_atomic,
 )
 from .cycle import _payload
@@ -28,6 +32,15 @@ from .cycle import _payload
 if TYPE_CHECKING:
 
     pass
+
+
+def _check_outputs(args: argparse.Namespace, outputs: tuple[str | None, ...]) -> None:
+    """Refuse bad output names before any work: devices, folders, and two outputs on stdout."""
+    named = [out for out in outputs if out]
+    for out in named:
+        check_output_path(out)
+    if named.count("-") + bool(args.json) > 1:
+        raise InvalidInputError("only one output can go to standard output (-), and --json prints there too")
 
 
 def cmd_traj(args: argparse.Namespace) -> int:
@@ -38,17 +51,20 @@ def cmd_traj(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units(args.deg, args.mm)
+    _check_outputs(args, (args.out, args.setpoints, args.plot))
     robot = _load(args, units)
+    _acceleration(robot, args.acceleration, units)
     if (args.from_q is None) == (args.from_pose is None):
         raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
     if (args.to_q is None) == (args.to_pose is None):
         raise InvalidInputError("give the end as either --to Q1 Q2 Q3 Q4 or --to-pose X Y Z YAW")
     if args.duration is not None and args.optimal:
         raise InvalidInputError("--duration and --optimal exclude each other")
-    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
-        raise ParameterError("--duration", args.duration, "must be a finite number > 0", "s")
-    if not (math.isfinite(args.rate) and args.rate > 0):
-        raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
+    if args.duration is not None and not args.duration > 0:
+        raise ParameterError("--duration", args.duration, "must be > 0", "s")
+    for name, rate in (("--rate", args.rate), ("--setpoint-rate", args.setpoint_rate)):
+        if rate is not None and not rate > 0:
+            raise ParameterError(name, rate, "must be > 0", "Hz")
     vias = [_joint_arg(robot, v, units, f"--via #{i + 1}") for i, v in enumerate(args.via or [])]
     mid = (np.asarray(robot.limits.lower) + np.asarray(robot.limits.upper)) / 2
     pose_from = _read_pose(args.from_pose, units, "--from-pose") if args.from_pose else None
@@ -57,7 +73,9 @@ def cmd_traj(args: argparse.Namespace) -> int:
     q_to = _joint_arg(robot, args.to_q, units, "--to") if args.to_q else None
     tool_speed = None
     if args.tool_speed is not None:
-        tool_speed = _number("--tool-speed", str(args.tool_speed)) / units.length
+        if not args.tool_speed > 0:
+            raise ParameterError("--tool-speed", args.tool_speed, "must be > 0")
+        tool_speed = args.tool_speed / units.length
     if args.linear and robot.kind != "scara":
         raise InvalidInputError(f"traj --linear is SCARA-only for now; robot {robot.name!r} is a {robot.kind} "
                                 "(joint-space --duration and TOPP-RA timing work)")  # fmt: skip
@@ -113,7 +131,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     from ..motion.timing import limit_ratios
 
     ratios = limit_ratios(robot, traj, rate=1000.0, tool_speed=tool_speed, torque=args.torque)
-    if ratios.worst > 1 + 1e-6:
+    if not ratios.worst <= 1 + 1e-6:  # NaN (an unknown limit) fails too
         message = (f"the trajectory exceeds a limit: worst ratio {ratios.worst:.6g} (velocity "
                    f"{ratios.velocity:.6g}, acceleration {ratios.acceleration:.6g}); a longer --duration, or "
                    "--optimal, respects them")  # fmt: skip
@@ -137,7 +155,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
                 prismatic=robot.joint_kinds.index("length"),
             )
         delays = [_number("--delays", d) for d in args.delays] if args.delays else None
-        sp = traj.setpoints(args.setpoint_rate or args.rate, delays=delays, motor=motor)
+        rate = args.setpoint_rate if args.setpoint_rate is not None else args.rate
+        sp = traj.setpoints(rate, delays=delays, motor=motor)
         write_atomic(Path(args.setpoints), sp.csv_text())
         outputs["setpoints"] = args.setpoints
     if args.plot:
@@ -161,13 +180,15 @@ def cmd_traj(args: argparse.Namespace) -> int:
             summary["samples"] = traj.resample(args.rate).to_dict()
         print(json.dumps(summary))
         return 0
-    print(f"robot     {robot.name}: {method}")
-    print(f"duration  {traj.duration:.9g} s")
-    print(f"from      {_fmt(traj.q_start)}  [SI]")
-    print(f"to        {_fmt(traj.q_end)}  [SI]")
-    print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} (sampled at 1 kHz)")
+    text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
+    print(f"robot     {robot.name}: {method}", file=text)
+    print(f"duration  {traj.duration:.9g} s", file=text)
+    print(f"from      {_fmt(traj.q_start)}  [SI]", file=text)
+    print(f"to        {_fmt(traj.q_end)}  [SI]", file=text)
+    print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} "
+          "(exact for joint-line laws, else sampled)", file=text)  # fmt: skip
     for kind, where in outputs.items():
-        print(f"wrote     {kind}: {where}")
+        print(f"wrote     {kind}: {where}", file=text)
     return 0
 
 
@@ -223,7 +244,9 @@ def cmd_jog(args: argparse.Namespace) -> int:
     from ..motion.jog import jog_to_edge
 
     units = Units(args.deg, args.mm)
+    _check_outputs(args, (args.out, args.plot))
     robot = _load(args, units)
+    _acceleration(robot, args.acceleration, units)
     if robot.kind != "scara":
         raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     q0 = _joint_arg(robot, args.from_q, units, "--from")
@@ -247,14 +270,17 @@ def cmd_jog(args: argparse.Namespace) -> int:
                           "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
         return 0
     L = units.length
-    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}")
-    print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]")
-    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)")
-    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]")
-    print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)")
+    text = sys.stderr if "-" in (args.out, args.plot) else sys.stdout  # stdout carries a file
+    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}", file=text)
+    print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
+    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)",
+          file=text)  # fmt: skip
+    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]",
+          file=text)  # fmt: skip
+    print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)", file=text)
     for what in (args.out, args.plot):
         if what:
-            print(f"wrote     {what}")
+            print(f"wrote     {what}", file=text)
     return 0
 
 
@@ -268,11 +294,12 @@ def register(sub: Any) -> None:
     g.add_argument("--to-pose", nargs=4, metavar="P", help="end pose (IK: the solution nearest the previous point)")
     g.add_argument("--via", nargs=4, action="append", metavar="Q", help="via configuration (repeatable)")
     g = p.add_argument_group("timing")
-    g.add_argument("--duration", type=float, metavar="T",
+    g.add_argument("--duration", type=number_type("--duration"), metavar="T",
                    help="quintic time law over T seconds (checked against the limits)")  # fmt: skip
     g.add_argument("--optimal", action="store_true", help="time-optimal under the joint limits (the default)")
     g.add_argument("--linear", action="store_true", help="straight tool line (S4), one elbow branch, J4 continuous")
-    g.add_argument("--tool-speed", type=float, metavar="V", help="also limit the tool speed [m/s, or mm/s with --mm]")
+    g.add_argument("--tool-speed", type=number_type("--tool-speed"), metavar="V",
+                   help="also limit the tool speed [m/s, or mm/s with --mm]")  # fmt: skip
     g.add_argument("--torque", action="store_true", help="also respect the effort limits (RNEA, URDF inertias)")
     g.add_argument("--strict", action="store_true", help="refuse (exit 3) a --duration that exceeds a limit")
     g.add_argument("--payload", metavar="KG", help="payload at the tool, for --torque (and --arch) [kg]")
@@ -281,13 +308,15 @@ def register(sub: Any) -> None:
     g.add_argument("--arch", action="store_true", help="lift, traverse, descend, corners blended (time-optimal)")
     g.add_argument("--rise", default="0.025", metavar="H", help="traverse height above the higher pose (0.025 m)")
     g.add_argument("--blend", metavar="B", help="blend distance at each corner (default: as large as allowed)")
+    _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
-    g.add_argument("--rate", type=float, default=1000.0, metavar="HZ",
+    g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out and --json (default 1000)")  # fmt: skip
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
     g.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time with limits, and the tool path")
     g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
-    g.add_argument("--setpoint-rate", type=float, metavar="HZ", help="setpoint rate (default: --rate)")
+    g.add_argument("--setpoint-rate", type=number_type("--setpoint-rate"), metavar="HZ",
+                   help="setpoint rate (default: --rate)")  # fmt: skip
     g.add_argument("--delays", nargs=4, metavar="S", help="per-axis command latency [s], compensated")
     g.add_argument("--gear", nargs=4, metavar="G", help="gear ratios (motor turns per joint/screw turn)")
     g.add_argument("--steps-per-rev", nargs=4, metavar="N", help="motor steps per motor turn")
@@ -299,7 +328,9 @@ def register(sub: Any) -> None:
     p.add_argument("--from", dest="from_q", nargs=4, metavar="Q", required=True, help="current configuration")
     p.add_argument("--direction", nargs="+", metavar="D", required=True, help="DX DY (plan) or DX DY DZ")
     p.add_argument("--margin", default="0", metavar="M", help="stop this far before the edge [m or mm] (default 0)")
-    p.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out (default 1000)")
+    p.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
+                   help="sampling rate of --out (default 1000)")  # fmt: skip
+    _add_acceleration(p)
     p.add_argument("--out", metavar="FILE", help="samples as CSV (or JSON for *.json), atomically")
     p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
     _add_units(p, inputs=True)

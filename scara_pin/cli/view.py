@@ -8,6 +8,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
+from ..files import check_output_path
 from ._common import Units, _add_robot_options, _add_units, _load, _q_values, log
 
 if TYPE_CHECKING:
@@ -22,6 +23,8 @@ def cmd_view(args: argparse.Namespace) -> int:
     from ..viz import meshcat as viz
 
     units = Units(args.deg, args.mm)
+    if args.html:  # refused before any work
+        check_output_path(args.html)
     robot = _load(args, units)
     q = None
     if args.q:

@@ -8,6 +8,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
+from ..files import check_output_path
 from ._common import Units, _add_robot_options, _add_units, _fmt, _load, _number
 
 if TYPE_CHECKING:
@@ -21,6 +22,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
     units = Units(False, args.mm)
     L = units.length
+    if args.plot:  # refused before any work
+        check_output_path(args.plot)
     robot = _load(args, units)
     if robot.kind == "palletizer":
         return _palletizer_workspace(args, robot, units)

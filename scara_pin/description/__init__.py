@@ -327,6 +327,16 @@ def _flatten(tree: object, prefix: str, out: dict[str, object]) -> None:
         out[prefix] = tree
 
 
+def _read_yaml_text(path: Path) -> str:
+    from ..errors import InvalidInputError
+    from ..limits import check_input_file, read_text
+
+    try:
+        return read_text(check_input_file(path, "yaml file"), "yaml file")
+    except InvalidInputError as exc:
+        raise ParameterError(str(path), ParameterError.NOTHING, f"cannot be read ({exc})") from None
+
+
 def _read_config(folder: Path) -> tuple[str, dict[str, float]]:
     """(kind, flat values) of a config folder; the kind is the ``kind:`` key of kinematics.yaml."""
     import yaml
@@ -336,10 +346,8 @@ def _read_config(folder: Path) -> tuple[str, dict[str, float]]:
     schema = SCHEMAS["scara"]
     for filename in ("kinematics.yaml", "joint_limits.yaml", "physical_parameters.yaml"):
         path = folder / filename
-        try:
-            tree = yaml.load(path.read_text(encoding="utf-8"), Loader=loader)  # noqa: S506 (safe loader)
-        except OSError as exc:
-            raise ParameterError(str(path), ParameterError.NOTHING, f"cannot be read ({exc.strerror})") from None
+        try:  # bounded read (a FIFO or /dev/zero is refused), UTF-8 checked
+            tree = yaml.load(_read_yaml_text(path), Loader=loader)  # noqa: S506 (safe loader)
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f" line {mark.line + 1}" if mark is not None else ""

@@ -201,11 +201,14 @@ def load_dh_table(path: str | Path) -> DHTable:
 
     path = Path(path)
     origin = str(path)
+    from ..errors import InvalidInputError
+    from ..limits import read_text
+
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
+        text = read_text(path, "D-H table")  # bounded: /dev/zero or a huge file is refused, not read whole
+    except InvalidInputError as exc:
         raise DHTableError(origin, None, None, "file", ParameterError.NOTHING,
-                           f"cannot be read ({getattr(exc, 'strerror', None) or exc})") from None  # fmt: skip
+                           f"cannot be read ({exc})") from None  # fmt: skip
     try:
         data = yaml.load(text, Loader=_yaml_loader())  # noqa: S506 (a SafeLoader subclass)
     except yaml.YAMLError as exc:

@@ -27,6 +27,7 @@ import pinocchio as pin
 from .._checks import _limit_vector, _positive, _rows, _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..kinematics.scara import IKStatus, branch_of, solve_batch
+from ..limits import MAX_PATH_POINTS, check_count
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -482,6 +483,8 @@ def cartesian_path(
             raise ParameterError(f"pose {k + 1}", b.tolist(), "must differ from the one before it")
         m = n - 1 if n is not None else max(1, math.ceil(np.linalg.norm(d[:3]) / step - 1e-9),
                                             math.ceil(abs(d[3]) / yaw_step - 1e-9))  # fmt: skip
+        check_count(f"path points of segment {k + 1} ({np.linalg.norm(d[:3]):.6g} m, {abs(d[3]):.6g} rad)", m + 1,
+                    MAX_PATH_POINTS, "a shorter move or a smaller yaw change")  # fmt: skip
         line = _Line(a, d)
         s_pts, q_pts, s_ref, q_ref = follow_curve(robot, branch, line, seg_start, m, k)
         segments.append(CartesianSegment(robot, branch, a.copy(), b.copy(), s_ref, q_ref))

@@ -47,6 +47,7 @@ import pinocchio as pin
 
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, ParameterError
+from ..limits import MAX_SAMPLES, check_count
 from .trajectory import (
     CartesianPath,
     GeometricPath,
@@ -146,8 +147,9 @@ class LimitRatios:
 
     @property
     def worst(self) -> float:
-        """The largest of the ratios."""
-        return max(v for v in (self.velocity, self.acceleration, self.tool_speed, self.torque) if v is not None)
+        """The largest of the ratios (NaN if any is NaN: an unknown limit passes no check)."""
+        present = [v for v in (self.velocity, self.acceleration, self.tool_speed, self.torque) if v is not None]
+        return math.nan if any(math.isnan(v) for v in present) else max(present)
 
     @staticmethod
     def combine(items: Sequence[LimitRatios]) -> LimitRatios:
@@ -477,6 +479,8 @@ def _check_times(law: ProfileLaw, opts: TimingOptions, sub: bool, t_start: float
         parts.append((law.t[:-1, None] + np.diff(law.t)[:, None] * (np.arange(1, M) / M)[None, :]).ravel())
     if t_start is not None:
         rate = opts.check_rate
+        check_count(f"checked samples ({law.duration:.6g} s at {rate:.6g} Hz)", law.duration * rate + 2.0,
+                    MAX_SAMPLES, "the motion is too slow (a tiny --tool-speed or effort limit?)")
         k0 = math.ceil(t_start * rate - 1e-9)
         k1 = math.floor((t_start + law.duration) * rate + 1e-9)
         parts.append(np.clip(np.arange(k0, k1 + 1) / rate - t_start, 0.0, law.duration))
@@ -575,13 +579,45 @@ def limit_ratios(
     torque: bool = False,
     limits: JointLimits | None = None,
 ) -> LimitRatios:
-    """Worst |value| / limit of a trajectory sampled at ``rate`` (velocity, acceleration, tool speed, torque)."""
+    """Worst |value| / limit of a trajectory (velocity, acceleration, tool speed, torque).
+
+    Joint velocity and acceleration of a straight joint move under a closed-form law (quintic, trapezoid)
+    are checked on the law's exact maxima (:meth:`~scara_pin.motion.trajectory.TimeLaw.peaks`), never only
+    on samples: a move shorter than one sample period is checked as well as a long one. Everything else
+    is checked at ``rate`` and at 65 points inside every piece (however short). An unknown limit (NaN, a
+    URDF's acceleration) gives a NaN ratio, which no check passes.
+    """
     lim = _limits(robot, limits, tool_speed, torque)
-    t = trajectory.times(rate)
+    times = [trajectory.times(rate)]
+    peak_v = np.zeros(4)
+    peak_a = np.zeros(4)
+    for start, piece in zip(trajectory.starts.tolist(), trajectory.pieces):
+        times.append(start + np.linspace(0.0, piece.duration, 65))
+        exact = _exact_peaks(piece)
+        if exact is not None:
+            peak_v, peak_a = np.maximum(peak_v, exact[0]), np.maximum(peak_a, exact[1])
+    t = np.unique(np.clip(np.concatenate(times), 0.0, trajectory.duration))
     q, qd, qdd = trajectory.sample(t)
     rt = None if lim.tool_speed is None else float(np.max(_tool_rows(robot, q, qd)) / lim.tool_speed)
     rtau = None
     if lim.effort is not None:
         rtau = float(np.max(np.abs(_rnea(robot, q, qd, qdd)) / lim.effort))
-    rv, ra = float(np.max(np.abs(qd) / lim.velocity)), float(np.max(np.abs(qdd) / lim.acceleration))
+    v = np.maximum(np.max(np.abs(qd), axis=0), peak_v)
+    a = np.maximum(np.max(np.abs(qdd), axis=0), peak_a)
+    rv, ra = float(np.max(v / lim.velocity)), float(np.max(a / lim.acceleration))
     return LimitRatios(rv, ra, rt, rtau)
+
+
+def _exact_peaks(piece: object) -> tuple[np.ndarray, np.ndarray] | None:
+    """Per joint (max |qd|, max |qdd|) of a straight joint move under a closed-form law, else None.
+
+    On a :class:`JointLine` q = q0 + s dq: qd = dq sd and qdd = dq sdd, so the maxima are |dq| times the
+    law's (:meth:`TimeLaw.peaks`).
+    """
+    if not (isinstance(piece, Motion) and isinstance(piece.path, JointLine)):
+        return None
+    peaks = piece.law.peaks()
+    if peaks is None:
+        return None
+    dq = np.abs(piece.path.q1 - piece.path.q0)
+    return dq * peaks[0], dq * peaks[1]

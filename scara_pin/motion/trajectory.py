@@ -38,6 +38,7 @@ from .._checks import _limit_vector, _positive, _vector
 from ..description import JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_text_atomic
+from ..limits import MAX_SAMPLES, check_count, read_text
 from .paths import (
     SINGULAR_TOL,
     CartesianPath,
@@ -88,6 +89,10 @@ logger = logging.getLogger(__name__)
 CSV_HEADER: tuple[str, ...] = ("t",) + tuple(f"{k}{i}" for k in ("q", "qd", "qdd") for i in range(1, 5))
 """Columns of the trajectory CSV: t, q1..q4, qd1..qd4, qdd1..qdd4 (SI units)."""
 _FORMAT = "scara-pin/trajectory"
+_QUINTIC_PEAK_SD = 1.875
+"""max of s'(x) = 30 x^2 (1 - x)^2 on [0, 1], at x = 1/2."""
+_QUINTIC_PEAK_SDD = 10.0 / math.sqrt(3.0)
+"""max of |s''(x)| = |60 x (1 - x) (1 - 2 x)| on [0, 1], at x = 1/2 -/+ sqrt(3) / 6."""
 
 
 # ---------------------------------------------------------------------------------------------- time laws
@@ -104,6 +109,14 @@ class TimeLaw(abc.ABC):
         """The same law ``k`` times slower: s_k(t) = s(t / k), so sd / k and sdd / k^2."""
         return _ScaledLaw(self, _positive("k", k))
 
+    def peaks(self) -> tuple[float, float] | None:
+        """The exact maxima (max sd, max |sdd|) over [0, duration] in closed form, or None if unknown.
+
+        Limit checks use them instead of samples (a move shorter than a sample period has no sample
+        inside it).
+        """
+        return None
+
 
 @dataclass(frozen=True)
 class _ScaledLaw(TimeLaw):
@@ -117,6 +130,10 @@ class _ScaledLaw(TimeLaw):
     def evaluate(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         s, sd, sdd = self.base.evaluate(np.asarray(tau) / self.k)
         return s, sd / self.k, sdd / (self.k * self.k)
+
+    def peaks(self) -> tuple[float, float] | None:  # noqa: D102
+        base = self.base.peaks()
+        return None if base is None else (base[0] / self.k, base[1] / (self.k * self.k))
 
 
 @dataclass(frozen=True)
@@ -142,6 +159,11 @@ class QuinticLaw(TimeLaw):
         sd = 30.0 * x2 * (1.0 + x * (-2.0 + x)) / T
         sdd = 60.0 * x * (1.0 + x * (-3.0 + 2.0 * x)) / (T * T)
         return s, sd, sdd
+
+    def peaks(self) -> tuple[float, float]:
+        """(1.875 / T, (10 / sqrt(3)) / T^2): sd'' = 0 at x = 1/2, sdd' = 0 at x = 1/2 -/+ sqrt(3) / 6."""
+        T = self.duration
+        return _QUINTIC_PEAK_SD / T, _QUINTIC_PEAK_SDD / (T * T)
 
 
 @dataclass(frozen=True)
@@ -195,6 +217,10 @@ class TrapezoidLaw(TimeLaw):
         sd = np.where(up, A * t, np.where(down, A * r, V))
         sdd = np.where(up, A, np.where(down, -A, 0.0))
         return np.minimum(s, 1.0), sd, sdd
+
+    def peaks(self) -> tuple[float, float]:
+        """(peak velocity, A): the coast (or triangle top) velocity and the bang acceleration."""
+        return self.peak, self.acceleration
 
 
 @dataclass(frozen=True, eq=False)
@@ -458,11 +484,11 @@ class Trajectory:
     def times(self, rate: float) -> np.ndarray:
         """The fixed-rate grid k / rate, k = 0, 1, ..., through T (the last sample is at or just after T)."""
         rate = _positive("rate", rate, "Hz")
+        check_count(f"samples ({self.duration:.6g} s at {rate:.6g} Hz)", self.duration * rate + 1.0, MAX_SAMPLES,
+                    "lower the rate or shorten the motion")  # fmt: skip
         n = math.floor(self.duration * rate + 1e-9)
         if n / rate < self.duration * (1 - 1e-12):
             n += 1
-        if n > 50_000_000:
-            raise ParameterError("rate", rate, f"gives {n} samples over {self.duration:.6g} s; lower it", "Hz")
         return np.arange(n + 1) / rate
 
     def resample(self, rate: float) -> Samples:
@@ -521,6 +547,8 @@ class Trajectory:
         d = np.zeros(4) if delays is None else _vector("delays", delays)
         if (d < 0).any():
             raise ParameterError("delays", d.tolist(), "must be >= 0", "s")
+        check_count(f"setpoints ({float(d.max()) + self.duration:.6g} s at {rate:.6g} Hz)",
+                    (float(d.max()) + self.duration) * rate + 2.0, MAX_SAMPLES, "lower the rate or the delays")
         lead = math.ceil(float(d.max()) * rate - 1e-9)
         t = np.concatenate([np.arange(-lead, 0) / rate, self.times(rate)])
         q = np.empty((len(t), 4))
@@ -540,9 +568,9 @@ def load_trajectory(path: str | os.PathLike[str]) -> Trajectory:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InvalidInputError(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+        text = read_text(path, "trajectory")  # bounded: /dev/zero or a huge file is refused, not read whole
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{path}: cannot be read ({exc})") from None
     if path.suffix.lower() == ".json":
         return Trajectory.from_samples(_samples_from_json(text, str(path)))
     return Trajectory.from_samples(_samples_from_csv(text, str(path)))
@@ -631,7 +659,8 @@ class MotorUnits:
         """Integer steps (int64) of joint values q (..., 4), rounded from the absolute position."""
         x = np.asarray(q, dtype=float) * np.asarray(self.counts_per_unit)
         if not np.isfinite(x).all() or np.abs(x).max(initial=0.0) > 2.0**62:
-            raise ParameterError("q", "values", "give step counts beyond the int64 range")
+            raise ParameterError("motor steps", ParameterError.NOTHING, "would leave the int64 range (|q| x counts "
+                                 "per unit > 2^62): check --gear, --steps-per-rev and --screw-lead")  # fmt: skip
         return np.rint(x).astype(np.int64)
 
 
@@ -718,7 +747,7 @@ def quintic_min_duration(
     v = _limit_vector("velocity", velocity, "rad/s or m/s")
     a = _limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
     dq = np.abs(line.q1 - line.q0)
-    return float(max(np.max(1.875 * dq / v), np.max(np.sqrt(10.0 / math.sqrt(3.0) * dq / a))))
+    return float(max(np.max(_QUINTIC_PEAK_SD * dq / v), np.max(np.sqrt(_QUINTIC_PEAK_SDD * dq / a))))
 
 
 def line_optimal_duration(

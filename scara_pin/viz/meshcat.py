@@ -51,6 +51,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInputError, ScaraError
+from ..limits import MAX_FRAMES, check_count
 
 if TYPE_CHECKING:
     from ..model import Robot
@@ -125,6 +126,8 @@ def _resample(times: np.ndarray, qs: np.ndarray, fps: int) -> tuple[np.ndarray, 
     if not (isinstance(fps, int) and 1 <= fps <= 1000):
         raise InvalidInputError(f"fps is {fps!r}; it must be a whole number of frames per second in [1, 1000]")
     duration = float(times[-1] - times[0])
+    check_count(f"animation frames ({duration:.6g} s at {fps} fps)", duration * fps + 2.0, MAX_FRAMES,
+                "shorten the motion")  # fmt: skip
     n = int(math.floor(duration * fps + 1e-9))
     frames = np.arange(n + 1, dtype=float)
     if duration * fps - n > 1e-9:
@@ -185,29 +188,43 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.nd
     Raises:
         InvalidInputError: unreadable file, missing columns, a bad number (the message gives the line).
     """
+    from ..limits import MAX_NUMBER, MAX_SAMPLES, text_lines
+
     path = Path(path)
+    if path.is_dir():
+        raise InvalidInputError(f"{path}: cannot be read (it is a folder)")
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InvalidInputError(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
-    lines = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1) if ln.strip() and not ln.startswith("#")]
-    if not lines:
-        raise InvalidInputError(f"{path}: empty file; expected a header with t,q1,q2,q3,q4")
-    header = [c.strip() for c in lines[0][1].split(",")]
-    wanted = ("t", "q1", "q2", "q3", "q4")
-    missing = [c for c in wanted if c not in header]
-    if missing:
-        raise InvalidInputError(f"{path}: the header has no column {', '.join(missing)} (header: {lines[0][1]})")
-    cols = [header.index(c) for c in wanted]
+        handle = path.open("rb")
+    except OSError as exc:
+        raise InvalidInputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    header: list[str] | None = None
+    cols: list[int] = []
     rows = []
-    for k, line in lines[1:]:
-        cells = line.split(",")
-        if len(cells) != len(header):
-            raise InvalidInputError(f"{path}, line {k}: {len(cells)} values, expected {len(header)}")
-        try:
-            rows.append([float(cells[c]) for c in cols])
-        except ValueError as exc:
-            raise InvalidInputError(f"{path}, line {k}: {exc}") from None
+    with handle:  # streamed: bounded line length and count (an endless /dev/zero is refused early)
+        for k, line in text_lines(handle, str(path), MAX_SAMPLES):
+            if not line.strip() or line.startswith("#"):
+                continue
+            if header is None:
+                header = [c.strip() for c in line.split(",")]
+                wanted = ("t", "q1", "q2", "q3", "q4")
+                missing = [c for c in wanted if c not in header]
+                if missing:
+                    raise InvalidInputError(f"{path}: the header has no column {', '.join(missing)} "
+                                            f"(header: {line[:200]})")  # fmt: skip
+                cols = [header.index(c) for c in wanted]
+                continue
+            cells = line.split(",")
+            if len(cells) != len(header):
+                raise InvalidInputError(f"{path}, line {k}: {len(cells)} values, expected {len(header)}")
+            try:
+                values = [float(cells[c]) for c in cols]
+            except ValueError as exc:
+                raise InvalidInputError(f"{path}, line {k}: {exc}") from None
+            if not all(abs(v) <= MAX_NUMBER for v in values):  # NaN too
+                raise InvalidInputError(f"{path}, line {k}: values must be finite, within +/-{MAX_NUMBER:g}")
+            rows.append(values)
+    if header is None:
+        raise InvalidInputError(f"{path}: empty file; expected a header with t,q1,q2,q3,q4")
     if not rows:
         raise InvalidInputError(f"{path}: no samples after the header")
     table = np.array(rows)
@@ -534,8 +551,11 @@ class _Scene:
         self.size = max(0.05, self.framing.reach)
         self.viz = _tree_visualizer(robot, self.paths)
         self.viz.initViewer(viewer=self.vis)
-        for geometry in robot.visual_model.geometryObjects:
-            self._load_geometry(geometry)
+        try:  # an unreadable geometry: the user's file, not a bug
+            for geometry in robot.visual_model.geometryObjects:
+                self._load_geometry(geometry)
+        except (ValueError, RuntimeError, OSError) as exc:
+            raise InvalidInputError(f"cannot show the robot's geometry: {' '.join(str(exc).split())}") from None
         _draw_meshes(self.vis, robot, self.viz)  # the real meshes in place of their placeholder boxes
         self.frame_paths: dict[str, str] = {}
         for frame_id in (robot.base_id, robot.tool_id):
