@@ -548,7 +548,7 @@ def _q_ok(q: Any) -> bool:
     False only means "run the full check" (``Robot.check_q``); it never lets a bad ``q`` through (NaN and
     inf fail the comparison; a wrong length fails the unpacking).
     """
-    if type(q) is np.ndarray and q.dtype is _F64:  # _F64: native byte order
+    if type(q) is np.ndarray and q.dtype is _F64 and q.ndim == 1:  # _F64: native byte order
         try:
             a, b, c, d = q.tolist()
         except (ValueError, TypeError):
