@@ -15,6 +15,7 @@ Both read their geometry from the model, so the URDF is the single source of tru
 from __future__ import annotations
 
 import enum
+import functools
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -49,6 +50,8 @@ class ScaraKinematics:
 
     def __init__(self, geometry: scara.ScaraGeometry) -> None:
         self.geometry = geometry
+        # the per-call path: one call less (a partial is called like the method below)
+        self.nearest = functools.partial(scara.solve_nearest, geometry)  # type: ignore[method-assign]
 
     @classmethod
     def from_robot(cls, robot: Robot) -> ScaraKinematics:

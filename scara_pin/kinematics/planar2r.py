@@ -43,7 +43,7 @@ arrays (the batch paths), with the same order of operations.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -60,6 +60,7 @@ __all__ = [
     "nearest_turn_array",
     "turn_edge",
     "turn_range",
+    "turner",
     "wrap",
 ]
 
@@ -268,10 +269,38 @@ def turn_edge(value: float, lo: float, hi: float, slack: float) -> float | None:
     return None
 
 
+def turner(lo: float, hi: float, continuous: bool = False) -> Callable[[float, float], tuple[float, int, int] | None]:
+    """:func:`nearest_turn` with a joint's limits bound once: ``turn(value, ref)`` (the per-call paths)."""
+    if continuous:
+
+        def turn_continuous(value: float, ref: float) -> tuple[float, int, int] | None:
+            return value + TWO_PI * _floor((ref + _PI - value) * _INV_TWO_PI), 0, 0
+
+        return turn_continuous
+    lo_t, hi_t = lo - LIMIT_TOL, hi + LIMIT_TOL
+
+    def turn(value: float, ref: float) -> tuple[float, int, int] | None:
+        k_min = _ceil((lo_t - value) * _INV_TWO_PI)
+        k_max = _floor((hi_t - value) * _INV_TWO_PI)
+        if k_min > k_max:
+            return None
+        k = _floor((ref + _PI - value) * _INV_TWO_PI)
+        if k < k_min:
+            k = k_min
+        elif k > k_max:
+            k = k_max
+        q = value + TWO_PI * k
+        return (lo if q < lo else (hi if q > hi else q)), k_min - k, k_max - k
+
+    return turn
+
+
 def nearest_turn(
     value: float, lo: float, hi: float, ref: float, continuous: bool = False
 ) -> tuple[float, int, int] | None:
     """The turn of ``value`` nearest ``ref`` inside [lo, hi], and the turns that fit relative to it.
+
+    k = floor((ref + pi - value) / 2 pi) clamped into [k_min, k_max] (see the module docstring).
 
     Returns:
         (q, k_lo, k_hi): q = value + 2 pi k clamped onto [lo, hi] (it may be LIMIT_TOL outside), and
@@ -279,19 +308,7 @@ def nearest_turn(
         continuous joint q is the turn nearest ``ref`` and (k_lo, k_hi) = (0, 0) stands for "unbounded".
         None when no turn fits.
     """
-    k = _floor((ref + _PI - value) * _INV_TWO_PI)
-    if continuous:
-        return value + TWO_PI * k, 0, 0
-    k_min = _ceil((lo - LIMIT_TOL - value) * _INV_TWO_PI)
-    k_max = _floor((hi + LIMIT_TOL - value) * _INV_TWO_PI)
-    if k_min > k_max:
-        return None
-    if k < k_min:
-        k = k_min
-    elif k > k_max:
-        k = k_max
-    q = value + TWO_PI * k
-    return (lo if q < lo else (hi if q > hi else q)), k_min - k, k_max - k
+    return turner(lo, hi, continuous)(value, ref)
 
 
 def fits_array(value: np.ndarray, lo: float, hi: float, tol: float = LIMIT_TOL) -> np.ndarray:

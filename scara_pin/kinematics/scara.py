@@ -64,6 +64,7 @@ from .planar2r import (
     nearest_turn,
     nearest_turn_array,
     turn_edge,
+    turner,
     wrap,
 )
 from .results import BatchIKResult, IKResult, IKSolution
@@ -159,6 +160,7 @@ class ScaraGeometry:
     arm: Planar2R = field(init=False, repr=False, compare=False)
     _radius: tuple[float, float] = field(init=False, repr=False, compare=False)
     _k: tuple[Any, ...] = field(init=False, repr=False, compare=False)
+    _turn: tuple[Any, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "l1", math.hypot(*self.u1))
@@ -182,6 +184,9 @@ class ScaraGeometry:
             self.z0, self.a1[0], self.a1[1], self.tool[0], self.tool[1], self._radius[0] - REACH_TOL,
             self.beta1, self.beta2 - self.beta1,
         ))  # fmt: skip
+        # each joint's turn choice with its limits bound (planar2r.turner), in q order (None: prismatic)
+        object.__setattr__(self, "_turn", tuple(turner(lower[j], upper[j], self.continuous[j]) if j != ip else None
+                                                for j in range(4)))  # fmt: skip
 
     @classmethod
     def from_robot(cls, robot: Robot) -> ScaraGeometry:
@@ -350,17 +355,16 @@ def _branches(
     found: list[_Branch] = []
     failures: list[_Failure] = []
     cont = geo.continuous
-    c_a, c_b, c_c = cont[ra], cont[rb], cont[rc]
-    lo_a, hi_a, lo_b, hi_b, lo_c, hi_c = lo[ra], hi[ra], lo[rb], hi[rb], lo[rc], hi[rc]
+    turn = geo._turn
+    turn_a, turn_b, turn_c = turn[ra], turn[rb], turn[rc]
     ref_a, ref_b, ref_c = ref[ra], ref[rb], ref[rc]
     for g, theta1, label in elbows:
         if branch == "all" or label == branch or singular:
             # the common case inline: every joint has a turn inside its limits (else _joints says why,
             # or puts a joint that rounding alone moved out onto its limit)
-            qb = nearest_turn(s_b * (g - db), lo_b, hi_b, ref_b, c_b)
-            qa = nearest_turn(s_a * (theta1 - b1), lo_a, hi_a, ref_a, c_a) if qb is not None else None
-            qc = (nearest_turn(s_c * (alpha - s_a * qa[0] - s_b * qb[0]), lo_c, hi_c, ref_c, c_c)
-                  if qa is not None and qb is not None else None)  # fmt: skip
+            qb = turn_b(s_b * (g - db), ref_b)
+            qa = turn_a(s_a * (theta1 - b1), ref_a) if qb is not None else None
+            qc = turn_c(s_c * (alpha - s_a * qa[0] - s_b * qb[0]), ref_c) if qa is not None and qb is not None else None
             if qa is None or qb is None or qc is None:
                 out = _joints(geo, wx, wy, alpha, g, theta1, ref, label)
                 if len(out) == 2:
@@ -559,15 +563,14 @@ def solve_nearest(
         raise NoSolutionError(*failure)
     q = found[0][2]
     if len(found) > 1:
-        w = [1.0] * 4 if weights is None else weight_floats(weights)
-        other = found[1][2]
-        d0 = d1 = 0.0
-        for i in range(4):
-            e0, e1 = q[i] - ref[i], other[i] - ref[i]
-            d0 += w[i] * e0 * e0
-            d1 += w[i] * e1 * e1
-        if d1 < d0:
-            q = other
+        w0, w1, w2, w3 = (1.0, 1.0, 1.0, 1.0) if weights is None else weight_floats(weights)
+        a0, a1, a2, a3 = q
+        b0, b1, b2, b3 = found[1][2]
+        r0, r1, r2, r3 = ref
+        d_first = w0 * (a0 - r0) ** 2 + w1 * (a1 - r1) ** 2 + w2 * (a2 - r2) ** 2 + w3 * (a3 - r3) ** 2
+        d_second = w0 * (b0 - r0) ** 2 + w1 * (b1 - r1) ** 2 + w2 * (b2 - r2) ** 2 + w3 * (b3 - r3) ** 2
+        if d_second < d_first:
+            q = found[1][2]
     elif weights is not None:
         weight_floats(weights)
     return np.array(q)

@@ -32,10 +32,12 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
         ParameterError: not (x, y, z, yaw) or a 4 x 4 pose, a value not finite or beyond +/-MAGNITUDE_MAX.
     """
     kind = type(target)
+    m = MAGNITUDE_MAX
     if kind is np.ndarray and target.dtype is _F64 and target.shape == (4,):  # type: ignore[attr-defined]
-        target = target.tolist()  # type: ignore[attr-defined]
-        kind = list
-    if kind is tuple or kind is list:
+        x, y, z, yaw = target.tolist()  # type: ignore[attr-defined]
+        if -m <= x <= m and -m <= y <= m and -m <= z <= m and -m <= yaw <= m:  # NaN fails every comparison
+            return x, y, z, yaw - yaw0, 0.0
+    elif kind is tuple or kind is list:
         try:
             a: Any
             b: Any
@@ -48,7 +50,6 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
                 x, y, z, yaw = float(a), float(b), float(c), float(d)
         except (TypeError, ValueError):
             raise ParameterError("target", target, "must be 4 numbers (x, y, z, yaw)") from None
-        m = MAGNITUDE_MAX
         if -m <= x <= m and -m <= y <= m and -m <= z <= m and -m <= yaw <= m:  # NaN fails every comparison
             return x, y, z, yaw - yaw0, 0.0
     M = target.homogeneous if isinstance(target, pin.SE3) else np.asarray(target, dtype=float)  # type: ignore[arg-type]
