@@ -317,10 +317,14 @@ MAX_VALIDATION_SAMPLES = 1_000_000
 
 def cmd_validate_ik(args: argparse.Namespace) -> int:
     """Cross-validate the closed-form IK against Pinocchio FK and the numeric IK."""
+    from tqdm import tqdm
+
     from ..kinematics.validate import validate_ik
 
     robot = _load(args)
-    report = validate_ik(robot, args.samples, args.seed)
+    # a progress bar on a terminal only (tqdm's own test of stderr)
+    with tqdm(total=args.samples, desc="validate-ik", file=sys.stderr, disable=None, leave=False) as bar:
+        report = validate_ik(robot, args.samples, args.seed, progress=bar.update)
     if args.json:
         out = {k: v for k, v in vars(report).items()}
         out["ok"] = report.ok

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -91,8 +92,14 @@ def _pose_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
     return float(np.abs(e).max())
 
 
-def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: int = 10) -> ValidationReport:
-    """Run the three checks on ``samples`` seeded configurations (see the module docstring)."""
+def validate_ik(
+    robot: Robot, samples: int = 1000, seed: int = 0, max_failures: int = 10,
+    progress: Callable[[int], object] | None = None,
+) -> ValidationReport:  # fmt: skip
+    """Run the three checks on ``samples`` seeded configurations (see the module docstring).
+
+    ``progress(1)`` is called after each sample (a progress bar's ``update``, say).
+    """
     kin = robot.kinematics
     rng = np.random.default_rng(seed)
     lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
@@ -135,6 +142,8 @@ def validate_ik(robot: Robot, samples: int = 1000, seed: int = 0, max_failures: 
         if dist > Q_TOL:
             report.numeric_mismatch += 1
             fail(f"q = {q.tolist()}: numeric {num.q.tolist()} ({branch}) is {dist:.3g} from every {branch} solution")
+        if progress is not None:
+            progress(1)
     report.time_closed = t_closed / max(samples, 1)
     report.time_numeric = t_numeric / max(samples, 1)
     return report
