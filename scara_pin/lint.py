@@ -422,7 +422,7 @@ class _Checker:
         if len(movable) > 12:
             listing += f", ... ({len(movable) - 12} more)"
         self.add(Severity.INFO, "joints", f"{len(movable)} movable joints in chain order: {listing or 'none'}")
-        from .model import JOINT_COUNTS  # the loader's rule
+        from .description import JOINT_COUNTS  # the loader's rule
 
         if len(movable) not in JOINT_COUNTS:
             self.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic), or 3 without a "

@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._checks import MAGNITUDE_MAX
-from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
+from .description import JOINT_COUNTS, JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
 from .urdf_rules import choose_frames, read_tree
 
@@ -153,10 +153,6 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
         )
     return model
 
-
-JOINT_COUNTS = (4, 3)
-"""The joint counts of q a robot may have (THE rule, read from the model as ``Robot.dof``): 4 (SCARA with a
-wrist, palletizer), or 3 (a SCARA without a wrist: two revolute joints and a prismatic one)."""
 
 _CONTINUOUS = frozenset(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"))
 """Pinocchio's continuous (unbounded revolute) joints: nq = 2 (cos, sin), nv = 1."""

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError, ParameterError
-from ._common import Units, _add_robot_options, _add_units, _load, _number
+from ._common import Units, _add_robot_options, _add_units, _load, _needs_wrist, _number
 
 if TYPE_CHECKING:
     from ..description import JointLimits
@@ -30,14 +30,14 @@ def _payload(args: argparse.Namespace, units: Units) -> Any:
 
 
 def _acceleration_limits(robot: Robot, args: argparse.Namespace) -> JointLimits | None:
-    """``--acceleration A1..A4`` replacing the robot's (a URDF file has none)."""
+    """``--acceleration A1..A4`` (one per joint) replacing the robot's (a URDF file has none)."""
     import dataclasses
 
     if args.acceleration is None:
         return None
     acc = tuple(_number(f"--acceleration {i + 1}", v) for i, v in enumerate(args.acceleration))
-    if not all(v > 0 for v in acc):
-        raise ParameterError("--acceleration", list(acc), "must be 4 numbers > 0 (rad/s^2, m/s^2)")
+    if len(acc) != robot.dof or not all(v > 0 for v in acc):
+        raise ParameterError("--acceleration", list(acc), f"must be {robot.dof} numbers > 0 (rad/s^2, m/s^2)")
     return dataclasses.replace(robot.limits, acceleration=acc, validate=False)  # type: ignore[call-arg]
 
 
@@ -60,6 +60,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     L = units.length
     robot = _load(args, units)
+    _needs_wrist(robot, "cycle")
     if not (math.isfinite(args.rate) and args.rate > 0):
         raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
     span = _number("--span", args.span) / L
