@@ -111,6 +111,8 @@ def _needs_wrist(robot: Robot, what: str) -> None:
 def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]:
     """Joint values as typed (units per --deg/--mm and the robot's joint kinds) in SI, each a finite number."""
     prefix = f"{what} " if what else ""
+    if len(texts) != len(units.q):  # never truncated by the zip below
+        raise ParameterError(what or "q", " ".join(texts), f"must be {len(units.q)} joint values (got {len(texts)})")
     return [_number(prefix + n, t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
 
 
