@@ -187,7 +187,7 @@ def _row_solver(kin: Any, T: np.ndarray, reference: ArrayLike | None, branch: st
     return solve_row
 
 
-class Scara3Kinematics:
+class Scara3Kinematics(ScaraKinematics):
     """A SCARA without a wrist: two revolute joints and a prismatic one, in any order (``robot.dof == 3``).
 
     Its geometry is :meth:`ScaraGeometry.without_wrist <scara_pin.kinematics.scara.ScaraGeometry.without_wrist>`:
@@ -196,22 +196,12 @@ class Scara3Kinematics:
     the tool point in the base frame: the tool's yaw is not free (it follows q1 and q2), and a 4th value
     is refused. Solutions and batches hold 3 joint values; the virtual wrist's is dropped.
 
-    Attributes:
+    Attributes (as :class:`ScaraKinematics`'s):
         geometry: the geometry read from the model (with its virtual wrist).
         robot: the robot, for refinement when its axes are near-parallel (else None).
     """
 
-    kind: str = "scara"
     dof: int = 3
-    branches: tuple[str, ...] = scara.BRANCHES
-    status: type[enum.IntEnum] = scara.IKStatus
-    geometry: scara.ScaraGeometry
-    robot: Robot | None
-
-    def __init__(self, geometry: scara.ScaraGeometry, robot: Robot | None = None) -> None:
-        self.geometry = geometry
-        self.robot = robot if geometry.tilt > scara.EXACT_TILT else None
-        self._seeds = seed_geometry(geometry) if self.robot is not None else geometry
 
     @classmethod
     def from_robot(cls, robot: Robot) -> Scara3Kinematics:
@@ -302,10 +292,6 @@ class Scara3Kinematics:
         if self.robot is None:
             return out
         return polish_batch(self.robot, self.geometry, T, out, _row_solver(self, T, reference, branch))
-
-    def branch_of(self, q: ArrayLike) -> str:
-        """:func:`scara_pin.kinematics.scara.branch_of` (the elbow's side)."""
-        return scara.branch_of(self.geometry, q)
 
     def workspace(self, **kwargs: Any) -> Workspace:
         """:func:`scara_pin.workspace.scara.workspace`: the planar two-link region of the tool point.
