@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .description import JOINT_NAMES
+from .description import JOINT_COUNTS, JOINT_NAMES
 from .errors import ParameterError
 
 if TYPE_CHECKING:
@@ -31,14 +31,16 @@ def number_text(text: str) -> float:
     return float(stripped) if NUMBER_TEXT.fullmatch(stripped) else math.nan
 
 
-def _vector(name: str, value: object, n: int = 4) -> np.ndarray:
-    """``value`` as ``n`` finite floats, or a :class:`ParameterError`."""
+def _vector(name: str, value: object, n: int | None = 4) -> np.ndarray:
+    """``value`` as ``n`` finite floats (None: one per joint, 4 or 3: JOINT_COUNTS), or a ParameterError."""
+    counts = JOINT_COUNTS if n is None else (n,)
+    what = " or ".join(map(str, counts))
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError):
-        raise ParameterError(name, value, f"must be {n} numbers") from None
-    if arr.shape != (n,):
-        raise ParameterError(name, value, f"must be {n} numbers (got shape {arr.shape})")
+        raise ParameterError(name, value, f"must be {what} numbers") from None
+    if arr.ndim != 1 or len(arr) not in counts:
+        raise ParameterError(name, value, f"must be {what} numbers (got shape {arr.shape})")
     if not np.isfinite(arr).all():
         raise ParameterError(name, arr.tolist(), "must be finite")
     return arr
@@ -56,13 +58,14 @@ def _positive(name: str, value: object, unit: str = "") -> float:
 
 
 def _rows(name: str, value: object) -> np.ndarray:
-    """``value`` as an (m, 4) float array of finite numbers, m >= 2, or a :class:`ParameterError`."""
+    """``value`` as an (m, n) float array of finite numbers, m >= 2, n a joint count (4, or 3), or a ParameterError."""
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError):
-        raise ParameterError(name, value, "must be rows of 4 numbers") from None
-    if arr.ndim != 2 or arr.shape[1] != 4 or arr.shape[0] < 2:
-        raise ParameterError(name, f"array of shape {arr.shape}", "must have shape (m, 4) with m >= 2")
+        raise ParameterError(name, value, "must be rows of 4 numbers (3 without a wrist)") from None
+    if arr.ndim != 2 or arr.shape[1] not in JOINT_COUNTS or arr.shape[0] < 2:
+        raise ParameterError(name, f"array of shape {arr.shape}", "must have shape (m, 4), or (m, 3) without a "
+                             "wrist, with m >= 2")  # fmt: skip
     if not np.isfinite(arr).all():
         raise ParameterError(name, arr.tolist(), "must be finite")
     return arr
@@ -71,8 +74,8 @@ def _rows(name: str, value: object) -> np.ndarray:
 def _limit_vector(name: str, values: ArrayLike, unit: str) -> np.ndarray:
     """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0."""
     arr = np.array(values, dtype=float)
-    if arr.shape != (4,):
-        raise ParameterError(name, values, "must hold 4 values")
+    if arr.ndim != 1 or len(arr) not in JOINT_COUNTS:
+        raise ParameterError(name, values, "must hold one value per joint (4, or 3 without a wrist)")
     for joint, v in zip(JOINT_NAMES, arr.tolist()):
         if math.isnan(v):
             raise ParameterError(f"{joint}_{name}", v, "must be given (a URDF file has no acceleration limits)")

@@ -9,8 +9,8 @@ Findings (``code``: severity):
 
 - structure, each one ``error`` (the file is unusable): ``malformed-xml``, ``root-not-robot``,
   ``xacro-not-expanded``, ``missing-name``, ``duplicate-name``, ``missing-link``, ``two-parents``,
-  ``disconnected``, ``joint-type``, ``bad-number``, ``joint-count`` (a SCARA has 4 movable joints: the ROS
-  tutorial's 3-joint RRP arm is unusable here; it would need a wrist joint), ``not-serial``,
+  ``disconnected``, ``joint-type``, ``bad-number``, ``joint-count`` (a SCARA has 4 movable joints, or 3 without
+  a wrist like the ROS tutorial's RRP arm), ``not-serial``,
   ``limit-missing``, ``limits-inverted`` (lower > upper), ``limits-empty`` (lower = upper),
   ``not-loadable`` (Pinocchio or :class:`~scara_pin.model.Robot` refuses it; the reason is quoted),
   ``frame-missing`` (``--tool`` / ``--base`` names no link), ``xacro-failed`` (a ``.xacro`` file that
@@ -21,13 +21,17 @@ Findings (``code``: severity):
   ``length-implausible`` (an origin offset beyond 10 m: millimetres?),
   ``velocity-implausible`` (revolute outside 0.05..50 rad/s, prismatic outside 0.05..10 m/s; a
   deg/s reading is offered), ``axis-flipped`` (a revolute axis along base -z: handled, q turns
-  clockwise), ``axis-tilted`` (more than 1e-6 rad from vertical, angle in degrees: the closed-form IK
+  clockwise), ``axis-tilted`` (more than 1e-2 rad from vertical, angle in degrees: the closed-form IK
   refuses; only numeric IK applies), ``closed-form-refused`` (the closed form's own reason),
   ``prismatic-position`` (not third in the chain, e.g. a lifting column first: supported),
+  ``near-parallel`` (axes 1e-6 .. 1e-2 rad from vertical, e.g. pi written as 3.14: the tilt and the tool
+  position error the closed form would make without refinement, measured on sampled configurations;
+  the toolkit refines its solutions on the model; ``info`` below 1 micrometre),
   ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an ``rpy`` value such as
   3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle error times the
   distance from that joint to the tool at q = 0; ``info`` below 1 micrometre);
-- ``info``: ``joints`` (types and order), ``axis-down`` (a quill whose q grows downward: the usual
+- ``info``: ``joints`` (types and order), ``no-wrist`` (3 joints), ``axis-near-parallel`` (per joint, its
+  tilt up to 1e-2 rad), ``axis-down`` (a quill whose q grows downward: the usual
   convention), ``zero-pose-direction`` (the arm points along +y or elsewhere than +x at q = 0: handled
   by the zero offsets), ``zero-pose-bent``, ``tool-frame`` (no ``tool0``: the chain's last link is used).
 
@@ -51,6 +55,7 @@ from xml.etree.ElementTree import Element, TreeBuilder
 import numpy as np
 
 from ._checks import number_text
+from .kinematics.scara import NEAR_PARALLEL_TOL  # beyond it an axis is tilted: the closed form refuses it
 from .urdf_rules import JointEdge, choose_frames, joint_problem
 
 __all__ = [
@@ -64,7 +69,7 @@ __all__ = [
 ]
 
 TILT_TOL = 1e-6
-"""[rad] an axis further than this from the base z axis is tilted (the closed-form IK refuses it)."""
+"""[rad] an axis further than this from the base z axis is not vertical (near-parallel up to NEAR_PARALLEL_TOL)."""
 RPY_NEAR = 0.01
 """[rad] an rpy value this close to a nonzero multiple of pi/2 (but not equal to it) is an approximation."""
 RPY_EXACT = 1e-12
@@ -443,9 +448,15 @@ class _Checker:
         if len(movable) > 12:
             listing += f", ... ({len(movable) - 12} more)"
         self.add(Severity.INFO, "joints", f"{len(movable)} movable joints in chain order: {listing or 'none'}")
-        if len(movable) != 4:
-            self.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic); this file has "
-                       f"{len(movable)}: {listing or 'none'}")  # fmt: skip
+        from .description import JOINT_COUNTS  # the loader's rule
+
+        if len(movable) not in JOINT_COUNTS:
+            self.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic), or 3 without a "
+                       f"wrist (2 revolute, 1 prismatic); this file has {len(movable)}: "
+                       f"{listing or 'none'}")  # fmt: skip
+        elif len(movable) == 3:
+            self.add(Severity.INFO, "no-wrist", "3 movable joints: a SCARA without a wrist (2 revolute, 1 prismatic); "
+                     "fk takes 3 joint values and ik a tool point X Y Z (the tool's yaw follows the arm)")  # fmt: skip
         for a, b in zip(movable, movable[1:]):
             if not self._is_ancestor(a, b):
                 self.error("not-serial", f"joint {b.name} is not downstream of {a.name}: not a serial chain",
@@ -561,11 +572,16 @@ class _Checker:
             axis = M[:3, :3] @ (np.asarray(j.axis) / np.linalg.norm(j.axis))
             self.axes[j.name] = (float(axis[0]), float(axis[1]), float(axis[2]))
             tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
-            if tilt > TILT_TOL:
+            if tilt > NEAR_PARALLEL_TOL:
                 self.add(Severity.WARNING, "axis-tilted",
                          f"joint {j.name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
-                         f"axis (more than {TILT_TOL:g} rad): the closed-form IK refuses it; only numeric IK applies",
-                         j.line, j.name)  # fmt: skip
+                         f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the closed-form IK refuses it; only numeric IK "
+                         "applies", j.line, j.name)  # fmt: skip
+            elif tilt > TILT_TOL:
+                self.add(Severity.INFO, "axis-near-parallel",
+                         f"joint {j.name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
+                         f"axis (at most {NEAR_PARALLEL_TOL:g} rad: near-parallel; the closed form's solutions are "
+                         "refined on the model, see near-parallel)", j.line, j.name)  # fmt: skip
             elif axis[2] < 0:
                 if j.type == "prismatic":
                     self.add(Severity.INFO, "axis-down", f"joint {j.name} (prismatic) moves along base -z: q grows "
@@ -635,11 +651,31 @@ class _Checker:
             self.error("not-loadable", f"the toolkit cannot load it: {exc}")
             return
         try:
-            robot.kinematics  # noqa: B018 - reading the geometry is the check
+            kinematics = robot.kinematics
         except NotScaraError as exc:
             if not any(f.code == "axis-tilted" for f in self.findings):
                 self.add(Severity.WARNING, "closed-form-refused",
                          f"the closed-form IK refuses it: {exc}; only numeric IK applies")
+            return
+        self.near_parallel(robot, kinematics)
+
+    def near_parallel(self, robot: Any, kinematics: Any) -> None:
+        """The ``near-parallel`` finding: the axes' tilt, and the error of the closed form without refinement."""
+        from .kinematics.polish import unrefined_error
+        from .kinematics.scara import EXACT_TILT
+
+        geo = getattr(kinematics, "geometry", None)
+        tilt = getattr(geo, "tilt", 0.0)
+        if tilt <= EXACT_TILT:
+            return
+        err = unrefined_error(robot)
+        sev = Severity.WARNING if err.position >= 1e-6 else Severity.INFO
+        yaw = f" and {err.yaw:.3g} rad of yaw" if robot.dof == 4 else ""
+        self.add(sev, "near-parallel",
+                 f"the joint axes are up to {tilt:.3g} rad ({math.degrees(tilt):.3g} deg) from the base z axis: "
+                 f"near-parallel; unrefined, the closed form (ideal vertical axes) would miss the tool pose by up "
+                 f"to {err.position * 1000:.3g} mm{yaw} (max over {err.samples} sampled configurations, seed "
+                 f"{err.seed}); the toolkit refines every solution on the model as written (Newton, to 1e-9)")
 
     def run(self) -> CheckReport:
         try:

@@ -26,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._checks import MAGNITUDE_MAX
-from .description import JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
+from .description import JOINT_COUNTS, JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
 from .urdf_rules import choose_frames, read_tree
 
@@ -147,10 +147,11 @@ def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
     """Per joint of q (nv = 1 each; passive mimic joints, nv = 0, skipped): whether it is continuous.
 
     Raises:
-        UrdfError: not 4 single-DOF joints (nv = 4, each nq = 1, or nq = 2 for a continuous joint).
+        UrdfError: not 3 or 4 single-DOF joints (:data:`JOINT_COUNTS`; nv = 3 or 4, each nq = 1, or nq = 2
+            for a continuous joint).
     """
     out = []
-    ok = model.nv == len(JOINT_NAMES)
+    ok = model.nv in JOINT_COUNTS
     for j in range(1, model.njoints):
         jm = model.joints[j]
         if jm.nv == 0 and jm.nq == 0:  # a mimic joint: follows its joint, not in q
@@ -158,10 +159,10 @@ def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
         cont = jm.nq == 2 and jm.nv == 1 and jm.shortname() in _CONTINUOUS
         ok = ok and (cont or (jm.nq == 1 and jm.nv == 1))
         out.append(cont)
-    if not ok or len(out) != len(JOINT_NAMES) or model.nq != len(JOINT_NAMES) + sum(out):
+    if not ok or len(out) != model.nv or model.nq != model.nv + sum(out):
         joints = ", ".join(f"{model.names[i]} (nq {model.joints[i].nq})" for i in range(1, model.njoints))
         raise UrdfError(
-            f"{origin}: a SCARA has 4 single-DOF joints; this model has nq = {model.nq}, "
+            f"{origin}: a SCARA has 4 single-DOF joints (or 3 without a wrist); this model has nq = {model.nq}, "
             f"nv = {model.nv}: {joints}"
         )
     return tuple(out)
@@ -185,6 +186,7 @@ class Robot:
         parameters: the yaml parameters, when the robot was generated from them.
         kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file counts as a SCARA).
         continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
+        dof: the number of joint values in q, 4 or 3 (a SCARA without a wrist; :data:`JOINT_COUNTS`).
         base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
         frame_note: the notice when the tool frame was chosen by default without a ``tool0`` (else None).
         package_path: where ``package://`` names (meshes) are looked for (see
@@ -199,6 +201,7 @@ class Robot:
     parameters: RobotParameters | None
     kind: str
     continuous: tuple[bool, ...]
+    dof: int
     has_continuous: bool
     base_frame: str
     tool_frame: str
@@ -266,7 +269,7 @@ class Robot:
                 lower=tuple(-math.pi if c else float(model.lowerPositionLimit[i]) for i, c in zip(iq, continuous)),
                 upper=tuple(math.pi if c else float(model.upperPositionLimit[i]) for i, c in zip(iq, continuous)),
                 velocity=tuple(float(v) for v in model.velocityLimit),
-                acceleration=tuple(math.nan for _ in JOINT_NAMES) if acceleration is None
+                acceleration=tuple(math.nan for _ in continuous) if acceleration is None
                 else tuple(float(v) for v in acceleration),
                 effort=tuple(float(v) for v in model.effortLimit),
                 validate=False,
@@ -278,12 +281,15 @@ class Robot:
         self._base_model = _rerooted(model, self.data.oMf[self.base_id].inverse())
         self._base_data = self._base_model.createData()
         self.continuous = continuous
+        self.dof = len(continuous)
         self.has_continuous = any(continuous)
+        # the per-call paths take q as it is when the cheap check passes: 4 plain joints only
+        self._slow_q = self.has_continuous or self.dof != 4
         self._kinematics_factory = kinematics
         if self.has_continuous:
             # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
             iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
-            self._q_map = tuple(zip(range(len(JOINT_NAMES)), iq, continuous))
+            self._q_map = tuple(zip(range(self.dof), iq, continuous))
 
     # ----------------------------------------------------------------- construction helpers
     @classmethod
@@ -376,17 +382,18 @@ class Robot:
 
     # ----------------------------------------------------------------- input checks
     def check_q(self, q: object) -> np.ndarray:
-        """Return ``q`` as a float array of 4 finite values, or raise :class:`ParameterError`."""
+        """Return ``q`` as a float array of ``dof`` (4, or 3) finite values, or raise :class:`ParameterError`."""
+        n = self.dof
         try:
             arr = np.asarray(q)
         except (TypeError, ValueError):
-            raise ParameterError("q", q, "must be 4 numbers") from None
+            raise ParameterError("q", q, f"must be {n} numbers") from None
         if arr.dtype != np.float64:
             if arr.dtype.kind not in "fiu":  # strings, objects, booleans: refused, never converted
-                raise ParameterError("q", q, "must be 4 numbers")
+                raise ParameterError("q", q, f"must be {n} numbers")
             arr = arr.astype(np.float64)
-        if arr.shape != (4,):
-            raise ParameterError("q", q, f"must be 4 numbers (got shape {arr.shape})")
+        if arr.shape != (n,):
+            raise ParameterError("q", q, f"must be {n} numbers (got shape {arr.shape})")
         if not all(-MAGNITUDE_MAX <= v <= MAGNITUDE_MAX for v in arr.tolist()):  # NaN fails every comparison
             for joint, value in zip(JOINT_NAMES, arr.tolist()):
                 if not math.isfinite(value):
@@ -413,7 +420,7 @@ class Robot:
     def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:
         """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
         out = []
-        for i, joint in enumerate(JOINT_NAMES):
+        for i, joint in enumerate(JOINT_NAMES[: self.dof]):
             if self.continuous[i]:  # no position limit
                 continue
             lo, hi = self.limits.lower[i], self.limits.upper[i]
@@ -471,7 +478,7 @@ class Robot:
             raise ParameterError("q_pin", q_pin, f"must be {self.model.nq} finite numbers")
         if not self.has_continuous:
             return arr.copy()
-        out = np.empty(len(JOINT_NAMES))
+        out = np.empty(self.dof)
         for i, iq, cont in self._q_map:
             out[i] = math.atan2(arr[iq + 1], arr[iq]) if cont else arr[iq]
         return out
@@ -481,7 +488,7 @@ class Robot:
 
         Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
         """
-        if self.has_continuous or not _q_ok(q):
+        if self._slow_q or not _q_ok(q):
             q = self._pin_q(q)
         model, data = self._base_model, self._base_data
         pin.forwardKinematics(model, data, q)
@@ -526,14 +533,17 @@ class Robot:
         Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
         base z axis, which equals d(yaw)/dt while the tool stays level).
         """
-        if self.has_continuous or not _q_ok(q):
+        if self._slow_q or not _q_ok(q):
             q = self._pin_q(q)
         return pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id,
                                         pin.LOCAL_WORLD_ALIGNED).take(_TASK_ROWS, 0)  # fmt: skip
 
     def manipulability(self, q: np.ndarray) -> float:
-        """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4)."""
-        return float(abs(np.linalg.det(self.task_jacobian(q))))
+        """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4).
+
+        Without a wrist (3 joints) the task is (x, y, z): the 3 x 3 Jacobian of the tool position.
+        """
+        return float(abs(np.linalg.det(self.task_jacobian(q)[: self.dof])))
 
     def _frame_id(self, frame: str) -> int:
         if not self.model.existFrame(frame):

@@ -545,7 +545,7 @@ def test_validate_ik_failure_has_its_own_exit_code(monkeypatch: pytest.MonkeyPat
         def table(self) -> str:
             return "failed"
 
-    monkeypatch.setattr(validate, "validate_ik", lambda *args: Failed())
+    monkeypatch.setattr(validate, "validate_ik", lambda *args, **kwargs: Failed())
     assert main(["validate-ik", "--samples", "3"]) == 5
 
 

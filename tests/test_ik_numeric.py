@@ -86,18 +86,19 @@ def test_converges_on_a_robot_with_wide_limits_and_a_tool_offset() -> None:
 
 
 def _tilted_urdf() -> str:
-    """A SCARA whose elbow axis is tilted by 1e-3 rad: the closed form refuses it, the numeric IK must not."""
+    """A SCARA whose elbow axis is tilted by 0.02 rad (beyond near-parallel): the closed form refuses it, the
+    numeric IK must not."""
     return load_robot("default").urdf.replace(
         '<joint name="joint2" type="revolute">\n    <parent link="link1"/>\n    <child link="link2"/>\n    '
         '<origin rpy="0 0 0"',
         '<joint name="joint2" type="revolute">\n    <parent link="link1"/>\n    <child link="link2"/>\n    '
-        '<origin rpy="0.001 0 0"',
+        '<origin rpy="0.02 0 0"',
     )
 
 
 def test_numeric_is_the_fallback_for_a_model_the_closed_form_refuses() -> None:
     urdf = _tilted_urdf()
-    assert 'rpy="0.001 0 0"' in urdf  # the fixture really is tilted
+    assert 'rpy="0.02 0 0"' in urdf  # the fixture really is tilted
     robot = robot_from_urdf(urdf, origin="tilted")
     with pytest.raises(NotScaraError):
         _ = robot.kinematics.geometry

@@ -246,7 +246,8 @@ def test_random_scaras_round_trip(case: tuple[sp.Robot, dict], seed: int, kind: 
         q = sample_q(rng, g, kind)
         target = robot.tool_pose(q)
         ref = q + TWO_PI * rng.integers(-2, 3, 4) * np.array([1, 1, 0, 1])  # a reference a few turns away
-        ref = np.where(np.isfinite(lo) & np.isfinite(hi), np.clip(ref, np.maximum(lo, -1e6), np.minimum(hi, 1e6)), ref)
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        ref = np.where(finite, np.clip(ref, np.maximum(lo, -1e6), np.minimum(hi, 1e6)), ref)
         res = robot.ik(target, reference=ref)
         assert res.success, (q.tolist(), res.message)
         for s in res.solutions:
@@ -264,7 +265,8 @@ def test_random_scaras_round_trip(case: tuple[sp.Robot, dict], seed: int, kind: 
                     assert abs(s.q[j] - ref[j]) <= math.pi + 1e-9  # continuous: wrapped
         # the sampled q is among the solutions (at one of a solution's turns; mod 2 pi on continuous joints)
         tol = singular_tol(g, q)
-        assert min(s.distance(q) for s in res.solutions) <= tol, (kind, q.tolist(), [s.q.tolist() for s in res.solutions])
+        listed = [s.q.tolist() for s in res.solutions]
+        assert min(s.distance(q) for s in res.solutions) <= tol, (kind, q.tolist(), listed)
         # each branch's solution is the textbook one (well-conditioned cases)
         gamma = q[1] + g["b2"] - g["b1"]
         if abs(math.sin(gamma)) > 1e-3 and kind == "inside":
@@ -420,7 +422,8 @@ def test_no_import_cycle() -> None:
     assert not any(m.startswith(("scara_pin.kinematics.scara", "scara_pin.kinematics.palletizer", "scara_pin.robots",
                                  "scara_pin.workspace")) for m in model), model  # fmt: skip
     for f in (root / "kinematics").glob("*.py"):
-        assert not any(m.startswith(("scara_pin.workspace", "scara_pin.robots", "scara_pin.motion")) for m in imports(f)), f
+        upward = ("scara_pin.workspace", "scara_pin.robots", "scara_pin.motion")
+        assert not any(m.startswith(upward) for m in imports(f)), f
 
 
 def test_no_compiled_twin() -> None:

@@ -126,7 +126,8 @@ BAD_URDFS = {
     ),
     "lonely-link": (f'<robot name="r">{_link("alone")}</robot>', ["nq = 0"]),
     "fixed-only": (_chain(["fixed", "fixed"]), ["nq = 0"]),
-    "three-joints": (_chain(["revolute", "revolute", "prismatic"]), ["nq = 3", "4 single-DOF"]),
+    # 3 joints (a SCARA without a wrist) are accepted: tests/test_three_joints.py
+    "two-joints": (_chain(["revolute", "prismatic"]), ["nq = 2", "4 single-DOF", "3 without a wrist"]),
     "five-joints": (_chain(["revolute"] * 5), ["nq = 5"]),
     # a continuous joint (nq = 2, nv = 1) is accepted since continuous-joint support (tests/test_continuous.py);
     # a planar one (nq = 4, nv = 3) is not a single-DOF joint

@@ -157,8 +157,8 @@ def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
 
 
 def _add_acceleration(p: Any) -> None:
-    """``--acceleration A1 A2 A3 A4``: the joint acceleration limits (a URDF file has none)."""
-    p.add_argument("--acceleration", nargs=4, metavar="A",
+    """``--acceleration A1 A2 A3 A4`` (one per joint): the joint acceleration limits (a URDF file has none)."""
+    p.add_argument("--acceleration", nargs="+", metavar="A",
                    help="joint acceleration limits [rad/s^2, m/s^2; deg/s^2, mm/s^2 with --deg/--mm]; needed "
                    "for a robot loaded from a URDF file (URDF has none); replaces the configured ones")  # fmt: skip
 
@@ -173,6 +173,8 @@ def _acceleration(robot: Robot, texts: Sequence[str] | None, units: Units) -> No
 
     lim = robot.limits
     if texts:
+        if len(texts) != len(units.q):
+            raise ParameterError("--acceleration", " ".join(texts), f"must be {len(units.q)} values, one per joint")
         acc = [_number(f"--acceleration {n}", t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
         for name, value in zip(_Q_NAMES, acc):
             if not value > 0:
@@ -180,20 +182,30 @@ def _acceleration(robot: Robot, texts: Sequence[str] | None, units: Units) -> No
         robot.limits = JointLimits(lim.lower, lim.upper, lim.velocity, tuple(acc), lim.effort, validate=False)
     elif not all(math.isfinite(v) for v in lim.acceleration):
         raise InvalidInputError(f"robot {robot.name!r} has no acceleration limits (a URDF file has none): give "
-                                "--acceleration A1 A2 A3 A4 [rad/s^2, m/s^2]")  # fmt: skip
+                                "--acceleration with one value per joint [rad/s^2, m/s^2]")  # fmt: skip
 
 
 def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
     import numpy as np
 
-    if len(args.q) != 4:
-        raise ParameterError("q", " ".join(args.q), f"must be 4 joint values (got {len(args.q)})")
+    n = len(units.q)  # the robot's joint count once loaded (_load): 4, or 3 without a wrist
+    if len(args.q) != n:
+        raise ParameterError("q", " ".join(args.q), f"must be {n} joint values (got {len(args.q)})")
     return np.array(_q_values(args.q, units))
+
+
+def _needs_wrist(robot: Robot, what: str) -> None:
+    """Refuse (exit 2) a command or option that supports 4-joint robots only, for a 3-joint SCARA."""
+    if robot.dof != 4:
+        raise InvalidInputError(f"{what} supports 4-joint robots only; {robot.name!r} has {robot.dof} joints "
+                                "(a SCARA without a wrist)")  # fmt: skip
 
 
 def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]:
     """Joint values as typed (units per --deg/--mm and the robot's joint kinds) in SI, each a finite number."""
     prefix = f"{what} " if what else ""
+    if len(texts) != len(units.q):  # never truncated by the zip below
+        raise ParameterError(what or "q", " ".join(texts), f"must be {len(units.q)} joint values (got {len(texts)})")
     return [_number(prefix + n, t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
 
 
@@ -214,8 +226,15 @@ def _scaled(values: ArrayLike, scale: Sequence[float]) -> list[float]:
     return [float(v) * s for v, s in zip(values, scale)]
 
 
-def _read_pose(texts: Sequence[str], units: Units, what: str = "target") -> list[float]:
-    if len(texts) != 4:
+def _read_pose(texts: Sequence[str], units: Units, what: str = "target", dof: int = 4) -> list[float]:
+    """A tool pose as typed: X Y Z YAW, or X Y Z for a 3-joint SCARA (``dof`` 3: no wrist, no yaw to choose)."""
+    if dof == 3:
+        if len(texts) == 4:
+            raise InvalidInputError(f"this robot has 3 joints and no wrist: the tool's yaw cannot be chosen; "
+                                    f"{what} takes X Y Z for such an arm (got 4 values)")  # fmt: skip
+        if len(texts) != 3:
+            raise ParameterError(what, " ".join(texts), f"must be 3 values X Y Z (got {len(texts)})")
+    elif len(texts) != 4:
         raise ParameterError(what, " ".join(texts), f"must be 4 values X Y Z YAW (got {len(texts)})")
     return [_number(n, t) / sc for n, t, sc in zip(("x", "y", "z", "yaw"), texts, units.scale(_POSE_KINDS))]
 

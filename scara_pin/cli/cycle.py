@@ -10,11 +10,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError, ParameterError
-from ._common import Units, _add_robot_options, _add_units, _load, _number
+from ._common import (
+    Units,
+    _acceleration,
+    _add_acceleration,
+    _add_robot_options,
+    _add_units,
+    _load,
+    _needs_wrist,
+    _number,
+)
 
 if TYPE_CHECKING:
-    from ..description import JointLimits
-    from ..model import Robot
+    pass
 
 
 def _payload(args: argparse.Namespace, units: Units) -> Any:
@@ -27,18 +35,6 @@ def _payload(args: argparse.Namespace, units: Units) -> Any:
     if args.payload_com is not None:
         com = tuple(_number(f"--payload-com {n}", v) / units.length for n, v in zip("XYZ", args.payload_com))
     return Payload(mass, com)  # type: ignore[arg-type]
-
-
-def _acceleration_limits(robot: Robot, args: argparse.Namespace) -> JointLimits | None:
-    """``--acceleration A1..A4`` replacing the robot's (a URDF file has none)."""
-    import dataclasses
-
-    if args.acceleration is None:
-        return None
-    acc = tuple(_number(f"--acceleration {i + 1}", v) for i, v in enumerate(args.acceleration))
-    if not all(v > 0 for v in acc):
-        raise ParameterError("--acceleration", list(acc), "must be 4 numbers > 0 (rad/s^2, m/s^2)")
-    return dataclasses.replace(robot.limits, acceleration=acc, validate=False)  # type: ignore[call-arg]
 
 
 def _jerk(args: argparse.Namespace) -> list[float] | None:
@@ -60,6 +56,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     L = units.length
     robot = _load(args, units)
+    _needs_wrist(robot, "cycle")
     if not (math.isfinite(args.rate) and args.rate > 0):
         raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
     span = _number("--span", args.span) / L
@@ -71,7 +68,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     if args.from_pose is not None:
         start = [_number(n, t) / s for n, t, s in zip(("x", "y", "z", "yaw"), args.from_pose, (L, L, L, units.angle))]
     direction = None if args.direction is None else [_number("--direction", d) for d in args.direction]
-    limits = _acceleration_limits(robot, args)
+    _acceleration(robot, args.acceleration, units)  # a URDF file has none: given, or refused
+    limits = robot.limits
     jerk = _jerk(args)
     result = standard_cycle(robot, start=start, direction=direction, span=span, rise=rise, blend=blend,
                             payload=_payload(args, units), jerk=jerk, limits=limits)  # fmt: skip
@@ -134,8 +132,7 @@ def register(sub: Any) -> None:
     g.add_argument("--payload", metavar="KG", help="payload mass at the tool (default 0)")
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")
     g.add_argument("--jerk-limit", nargs="+", metavar="J", help="joint jerk limit, one or 4 (rad/s^3, m/s^3)")
-    g.add_argument("--acceleration", nargs=4, metavar="A",
-                   help="acceleration limits (rad/s^2, m/s^2): needed for a URDF file, which has none")
+    _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out (default 1000)")
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import InfeasibleError, InvalidInputError
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_atomic_with
 from ._common import (
     _POSE_KINDS,
@@ -22,6 +22,7 @@ from ._common import (
     _check_limits,
     _fmt,
     _load,
+    _needs_wrist,
     _number,
     _q_values,
     _read_pose,
@@ -116,7 +117,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     J = J * np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
     print(f"robot     {robot.name}: {args.reference} Jacobian of {args.frame or robot.tool_frame}")
     print(f"q         {_fmt(_scaled(q, units.scale(units.q)))}  [{', '.join(units.names(units.q))}]")
-    print("          " + "".join(f"{n:>16}" for n in ("d/dq1", "d/dq2", "d/dq3", "d/dq4")))
+    print("          " + "".join(f"{f'd/dq{i + 1}':>16}" for i in range(robot.dof)))
     for name, row in zip(rows, J):
         print(f"{name:<10}" + "".join(f"{v:16.9g}" for v in row))
     print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {w:.9g}")
@@ -138,11 +139,15 @@ def cmd_ik(args: argparse.Namespace) -> int:
         return _ik_batch(args, robot, units)
     if args.input is None and args.output:
         raise InvalidInputError("--output goes with --input (batch mode)")
-    target = _read_pose(args.target, units)
+    target = _read_pose(args.target, units, dof=robot.dof)
     near = None
     if args.near:
+        if len(args.near) != robot.dof:
+            raise ParameterError("--near", " ".join(args.near), f"must be {robot.dof} joint values")
         near = robot.check_q(_q_values(args.near, units))
     numeric = args.numeric
+    if numeric:
+        _needs_wrist(robot, "ik --numeric")
     if robot.kind == "palletizer":
         if args.branch in ("left", "right"):
             raise InvalidInputError(f"--branch {args.branch} is a SCARA branch; a palletizer's are up and down")
@@ -191,7 +196,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
         raise InfeasibleError(f"{status}: {message}")
     method = "numeric" if numeric else "closed-form"
     print(f"robot     {robot.name}: {method} IK of {robot.tool_frame} in {robot.base_frame}")
-    print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS))}]")
+    print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS[: len(tgt)]))}]")
     print(f"units     q = [{', '.join(units.names(units.q))}]")
     for i, (q, b) in enumerate(zip(qs, branches)):
         extra = ""
@@ -230,6 +235,7 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     from ..files import check_output_path
     from ..limits import MAX_ROWS, text_lines
 
+    _needs_wrist(robot, "ik --input (batch)")
     if args.target:
         raise InvalidInputError("give either X Y Z YAW or --input FILE, not both")
     if not args.output:
@@ -322,6 +328,7 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
     from ..kinematics.validate import validate_ik
 
     robot = _load(args)
+    _needs_wrist(robot, "validate-ik")
     # a progress bar on a terminal only (tqdm's own test of stderr)
     with tqdm(total=args.samples, desc="validate-ik", file=sys.stderr, disable=None, leave=False) as bar:
         report = validate_ik(robot, args.samples, args.seed, progress=bar.update)
@@ -346,11 +353,13 @@ def register(sub: Any) -> None:
     p.add_argument("--frame", default=None, help="frame of the 6 x 4 Jacobian (default: tool0)")
     p.set_defaults(func=cmd_jacobian)
     p = sub.add_parser("ik", help="inverse kinematics: every joint solution for a tool pose X Y Z YAW")
-    p.add_argument("target", nargs="*", metavar="X Y Z YAW", help="tool0 pose in the base frame")
+    p.add_argument("target", nargs="*", metavar="X Y Z YAW", help="tool0 pose in the base frame (X Y Z for a "
+                   "3-joint SCARA: without a wrist the yaw follows the arm)")  # fmt: skip
     p.add_argument("--branch", default="all", choices=["all", "left", "right", "up", "down"],
                    help="elbow branch: a SCARA's right (elbow turns counterclockwise seen from above) or left; "
                    "a palletizer's up (sin q3 > 0, S2's q3) or down; default all")  # fmt: skip
-    p.add_argument("--near", nargs=4, metavar="Q", help="return only the solution nearest to this configuration")
+    p.add_argument("--near", nargs="+", metavar="Q", help="return only the solution nearest to this configuration "
+                   "(one value per joint)")  # fmt: skip
     p.add_argument("--numeric", action="store_true", help="use Pinocchio-based numeric IK instead of the closed form")
     p.add_argument("--all-turns", action="store_true",
                    help="list every 2 pi turn of every joint inside the limits as its own solution (at most "

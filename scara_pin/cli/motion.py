@@ -20,6 +20,7 @@ from ._common import (
     _fmt,
     _joint_arg,
     _load,
+    _needs_wrist,
     _number,
     _pose_to_q,
     _read_pose,
@@ -53,6 +54,9 @@ def cmd_traj(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     _check_outputs(args, (args.out, args.setpoints, args.plot))
     robot = _load(args, units)
+    for flag in ("linear", "arch", "plot", "payload"):
+        if getattr(args, flag, None):
+            _needs_wrist(robot, f"traj --{flag}")  # 3-joint arms: joint-space trajectories (quintic, TOPP-RA)
     _acceleration(robot, args.acceleration, units)
     if (args.from_q is None) == (args.from_pose is None):
         raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
@@ -67,8 +71,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
             raise ParameterError(name, rate, "must be > 0", "Hz")
     vias = [_joint_arg(robot, v, units, f"--via #{i + 1}") for i, v in enumerate(args.via or [])]
     mid = (np.asarray(robot.limits.lower) + np.asarray(robot.limits.upper)) / 2
-    pose_from = _read_pose(args.from_pose, units, "--from-pose") if args.from_pose else None
-    pose_to = _read_pose(args.to_pose, units, "--to-pose") if args.to_pose else None
+    pose_from = _read_pose(args.from_pose, units, "--from-pose", robot.dof) if args.from_pose else None
+    pose_to = _read_pose(args.to_pose, units, "--to-pose", robot.dof) if args.to_pose else None
     q_from = _joint_arg(robot, args.from_q, units, "--from") if args.from_q else None
     q_to = _joint_arg(robot, args.to_q, units, "--to") if args.to_q else None
     tool_speed = None
@@ -246,9 +250,10 @@ def cmd_jog(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     _check_outputs(args, (args.out, args.plot))
     robot = _load(args, units)
-    _acceleration(robot, args.acceleration, units)
     if robot.kind != "scara":
         raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
+    _needs_wrist(robot, "jog")
+    _acceleration(robot, args.acceleration, units)
     q0 = _joint_arg(robot, args.from_q, units, "--from")
     direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
     if len(direction) not in (2, 3):
@@ -287,12 +292,12 @@ def cmd_jog(args: argparse.Namespace) -> int:
 def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
     p = sub.add_parser("traj", help="trajectory: quintic, time-optimal (TOPP-RA) or straight tool line; export, plot")
-    g = p.add_argument_group("endpoints (joint values in URDF order, or tool poses X Y Z YAW)")
-    g.add_argument("--from", dest="from_q", nargs=4, metavar="Q", help="start configuration")
-    g.add_argument("--to", dest="to_q", nargs=4, metavar="Q", help="end configuration")
-    g.add_argument("--from-pose", nargs=4, metavar="P", help="start pose (IK: the solution nearest mid-range)")
-    g.add_argument("--to-pose", nargs=4, metavar="P", help="end pose (IK: the solution nearest the previous point)")
-    g.add_argument("--via", nargs=4, action="append", metavar="Q", help="via configuration (repeatable)")
+    g = p.add_argument_group("endpoints (joint values in URDF order, or tool poses X Y Z YAW; X Y Z without a wrist)")
+    g.add_argument("--from", dest="from_q", nargs="+", metavar="Q", help="start configuration")
+    g.add_argument("--to", dest="to_q", nargs="+", metavar="Q", help="end configuration")
+    g.add_argument("--from-pose", nargs="+", metavar="P", help="start pose (IK: the solution nearest mid-range)")
+    g.add_argument("--to-pose", nargs="+", metavar="P", help="end pose (IK: the solution nearest the previous point)")
+    g.add_argument("--via", nargs="+", action="append", metavar="Q", help="via configuration (repeatable)")
     g = p.add_argument_group("timing")
     g.add_argument("--duration", type=number_type("--duration"), metavar="T",
                    help="quintic time law over T seconds (checked against the limits)")  # fmt: skip
@@ -317,7 +322,7 @@ def register(sub: Any) -> None:
     g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
     g.add_argument("--setpoint-rate", type=number_type("--setpoint-rate"), metavar="HZ",
                    help="setpoint rate (default: --rate)")  # fmt: skip
-    g.add_argument("--delays", nargs=4, metavar="S", help="per-axis command latency [s], compensated")
+    g.add_argument("--delays", nargs="+", metavar="S", help="per-axis command latency [s], compensated")
     g.add_argument("--gear", nargs=4, metavar="G", help="gear ratios (motor turns per joint/screw turn)")
     g.add_argument("--steps-per-rev", nargs=4, metavar="N", help="motor steps per motor turn")
     g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")

@@ -54,7 +54,7 @@ def cmd_view(args: argparse.Namespace) -> int:
             viewer.draw_tool_path(qs)
             viewer.animate(times, qs, loop=True)
         else:
-            viewer.display(q if q is not None else np.zeros(4))
+            viewer.display(q if q is not None else np.zeros(robot.dof))
         print(f"meshcat viewer: {viewer.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
         try:
             viewer.serve()
@@ -66,7 +66,7 @@ def cmd_view(args: argparse.Namespace) -> int:
 def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
     p = sub.add_parser("view", help="show the robot in the browser (meshcat); --html writes a standalone page")
-    p.add_argument("--q", nargs=4, metavar="Q", help="configuration to show (default: zero)")
+    p.add_argument("--q", nargs="+", metavar="Q", help="configuration to show, one value per joint (default: zero)")
     p.add_argument("--traj", metavar="CSV", help="animate a trajectory (a `traj --out` CSV) and draw the tool path")
     p.add_argument("--workspace", action="store_true", help="draw the workspace boundary on the floor")
     p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")

@@ -36,6 +36,7 @@ from typing import Any
 from ..errors import DescriptionError, ParameterError, UnknownRobotError
 
 __all__ = [
+    "JOINT_COUNTS",
     "JOINT_NAMES",
     "PALLETIZER_PARAMETER_NAMES",
     "PARAMETER_NAMES",
@@ -50,6 +51,9 @@ __all__ = [
 ]
 
 JOINT_NAMES: tuple[str, ...] = ("joint1", "joint2", "joint3", "joint4")
+JOINT_COUNTS: tuple[int, ...] = (4, 3)
+"""The joint counts of q a robot may have (THE rule; ``Robot.dof`` reads it from the model): 4 (a SCARA with
+a wrist, a palletizer) or 3 (a SCARA without a wrist: two revolute joints and a prismatic one)."""
 """The four joints, in URDF (and q) order."""
 
 _KINEMATICS = ("base_height", "d1", "l1", "d2", "l2", "d3", "tool_x", "tool_y", "tool_z", "tool_yaw")

@@ -75,7 +75,9 @@ if TYPE_CHECKING:
     from ..model import Robot
 
 __all__ = [
+    "EXACT_TILT",
     "LIMIT_TOL",
+    "NEAR_PARALLEL_TOL",
     "REACH_TOL",
     "YAW_POSE_TOL",
     "IKStatus",
@@ -90,7 +92,13 @@ __all__ = [
 YAW_POSE_TOL = 1e-9
 """[rad] the largest tilt of a target rotation still taken as a pure yaw."""
 PARALLEL_TOL = 1e-6
-"""[rad] the largest angle between a joint axis and the base z axis for a SCARA."""
+"""[rad] axes this close to the base z axis are vertical for the closed form's purposes (``check``'s rule)."""
+NEAR_PARALLEL_TOL = 1e-2
+"""[rad] the largest angle between a joint axis and the base z axis for a SCARA: beyond PARALLEL_TOL the
+axes are near-parallel (pi written as 3.14 in an rpy) and the closed form's solutions are refined on the
+model (:mod:`scara_pin.kinematics.polish`)."""
+EXACT_TILT = 1e-12
+"""[rad] a model whose axes tilt less than this is solved by the closed form alone (no refinement)."""
 BRANCHES = ("right", "left")
 """The SCARA's elbow branches, in the order solutions are listed."""
 
@@ -114,6 +122,8 @@ class IKStatus(enum.IntEnum):
     J3_STROKE = 5
     J4_LIMIT = 6
     NOT_A_YAW_POSE = 7
+    NOT_REFINED = 8
+    """Near-parallel axes: the closed form's seed did not converge on the model, or left its branch."""
 
 
 _STAGE = {IKStatus.J2_LIMIT: 1, IKStatus.J1_LIMIT: 2, IKStatus.J4_LIMIT: 3}
@@ -137,6 +147,8 @@ class ScaraGeometry:
         lower, upper: joint limits in q order (a continuous joint: -inf, inf).
         continuous: per joint in q order, whether it is continuous (no limits).
         arm: the planar two-link arm (l1, l2).
+        tilt: the largest angle between a joint axis of the model and the base z axis [rad] (0 for the
+            ideal geometry; up to NEAR_PARALLEL_TOL: the closed form seeds a refinement on the model).
     """
 
     revolute: tuple[int, int, int]
@@ -153,6 +165,7 @@ class ScaraGeometry:
     lower: tuple[float, ...]
     upper: tuple[float, ...]
     continuous: tuple[bool, ...] = (False, False, False, False)
+    tilt: float = 0.0
     l1: float = field(init=False)
     l2: float = field(init=False)
     beta1: float = field(init=False)
@@ -190,12 +203,33 @@ class ScaraGeometry:
 
     @classmethod
     def from_robot(cls, robot: Robot) -> ScaraGeometry:
-        """Read the geometry from a loaded robot; raise :class:`NotScaraError` naming what is wrong."""
+        """Read the geometry from a loaded robot; raise :class:`NotScaraError` naming what is wrong.
+
+        Axes up to ``NEAR_PARALLEL_TOL`` from the base z axis are accepted: the geometry is then the ideal
+        vertical-axis one read at q = 0 (plan-view positions of the axes), ``tilt`` says how far the model
+        departs from it, and :mod:`scara_pin.kinematics.polish` refines the closed form on the model.
+        """
+        return cls._read(robot, wrist=True)
+
+    @classmethod
+    def without_wrist(cls, robot: Robot) -> ScaraGeometry:
+        """The geometry of a 3-joint SCARA (two revolute joints and one prismatic, in any order, no wrist).
+
+        It is read as a 4-joint SCARA whose wrist, virtual and continuous, is index 3 of q and turns about
+        the tool point (tool offset 0): arm 2 runs from the elbow axis to the tool point. The closed form
+        and the workspace then apply unchanged; the virtual wrist's value is the tool's free yaw, dropped
+        by :class:`scara_pin.robots.Scara3Kinematics`.
+        """
+        return cls._read(robot, wrist=False)
+
+    @classmethod
+    def _read(cls, robot: Robot, wrist: bool) -> ScaraGeometry:
         model = robot.model
         data = model.createData()
         names = tuple(model.names[j] for j in range(1, model.njoints))
-        if model.njoints - 1 != 4:
-            raise NotScaraError(f"a SCARA has 4 joints; this model has {model.njoints - 1}: {', '.join(names)}")
+        n = 4 if wrist else 3
+        if model.njoints - 1 != n:
+            raise NotScaraError(f"a SCARA has {n} joints; this model has {model.njoints - 1}: {', '.join(names)}")
         for j in range(2, model.njoints):
             if model.parents[j] != j - 1:
                 raise NotScaraError(f"joint {model.names[j]} does not follow {model.names[j - 1]}: not a serial chain")
@@ -211,6 +245,7 @@ class ScaraGeometry:
         prismatic: list[int] = []
         signs = [0.0] * 4
         points: dict[int, np.ndarray] = {}
+        worst = 0.0
         for j in range(1, model.njoints):
             jm = model.joints[j]
             name = model.names[j]
@@ -227,32 +262,39 @@ class ScaraGeometry:
             else:
                 raise NotScaraError(f"joint {name} ({jm.shortname()}) is neither revolute nor prismatic")
             tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
-            if tilt > PARALLEL_TOL:
+            if tilt > NEAR_PARALLEL_TOL:
                 raise NotScaraError(
-                    f"joint {name}'s axis is {math.degrees(tilt):.6g} deg away from the base z axis "
-                    f"(more than {PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
+                    f"joint {name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
+                    f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
                 )
+            worst = max(worst, tilt)
             signs[j - 1] = 1.0 if axis[2] > 0 else -1.0
             kind.append(j - 1)
             points[j - 1] = oMb.actInv(data.oMi[j]).translation
-        if len(revolute) != 3 or len(prismatic) != 1:
+        if len(revolute) != n - 1 or len(prismatic) != 1:
             kinds = ", ".join(f"{n} ({'revolute' if i in revolute else 'prismatic'})" for i, n in enumerate(names))
-            raise NotScaraError(f"a SCARA has 3 revolute joints and 1 prismatic joint; this model has {kinds}")
+            raise NotScaraError(f"a SCARA has {n - 1} revolute joints and 1 prismatic joint; this model has {kinds}")
         bMt = oMb.actInv(data.oMf[robot.tool_id])
+        if not wrist:  # the virtual wrist: index 3, on the tool point, continuous, +z
+            revolute.append(3)
+            points[3] = bMt.translation
+            signs[3] = 1.0
         ra, rb, rc = revolute
         a1, a2, a4 = points[ra][:2], points[rb][:2], points[rc][:2]
         u1, u2, t = a2 - a1, a4 - a2, bMt.translation[:2] - a4
+        wrist_name = names[rc] if wrist else f"the tool point ({robot.tool_frame})"
         for vec, what in ((u1, f"{names[rb]}'s axis coincides with {names[ra]}'s"),
-                          (u2, f"{names[rc]}'s axis coincides with {names[rb]}'s")):  # fmt: skip
+                          (u2, f"{wrist_name} lies on {names[rb]}'s axis")):  # fmt: skip
             if math.hypot(*vec) < 1e-9:
                 raise NotScaraError(f"{what}: the arm has no length")
         R0 = bMt.rotation.copy()
         if math.hypot(R0[0, 0], R0[1, 0]) < 1e-6:
             raise NotScaraError("the tool frame's x axis is vertical at q = 0: its yaw is undefined")
+        cont = tuple(robot.continuous) + (() if wrist else (True,))
         return cls(
             revolute=(ra, rb, rc),
             prismatic=prismatic[0],
-            names=names,
+            names=names if wrist else (*names, "(no wrist)"),
             signs=tuple(signs),
             a1=(float(a1[0]), float(a1[1])),
             u1=(float(u1[0]), float(u1[1])),
@@ -262,11 +304,12 @@ class ScaraGeometry:
             yaw0=math.atan2(R0[1, 0], R0[0, 0]),
             R0=R0,
             # continuous joints have no limits; others: the model's limits
-            lower=tuple(-math.inf if robot.continuous[j - 1]
-                        else float(model.lowerPositionLimit[model.joints[j].idx_q]) for j in range(1, 5)),
-            upper=tuple(math.inf if robot.continuous[j - 1]
-                        else float(model.upperPositionLimit[model.joints[j].idx_q]) for j in range(1, 5)),
-            continuous=tuple(robot.continuous),
+            lower=tuple(-math.inf if cont[i] else float(model.lowerPositionLimit[model.joints[i + 1].idx_q])
+                        for i in range(4)),
+            upper=tuple(math.inf if cont[i] else float(model.upperPositionLimit[model.joints[i + 1].idx_q])
+                        for i in range(4)),
+            continuous=cont,
+            tilt=worst,
         )  # fmt: skip
 
     # ---------------------------------------------------------------------------------------- derived
@@ -306,6 +349,13 @@ def branch_of(geo: ScaraGeometry, q: ArrayLike) -> str:
     if abs(g) < 1e-12:
         return "right"
     return "right" if 0.0 < g < math.pi else "left"
+
+
+def wrist_point(geo: ScaraGeometry, x: float, y: float, alpha: float) -> tuple[float, float]:
+    """W = p - R(alpha) t - A1: the wrist axis relative to the shoulder axis for a tool at (x, y), yaw0 + alpha."""
+    tx, ty = geo.tool
+    ca, sa = _cos(alpha), _sin(alpha)
+    return x - (ca * tx - sa * ty) - geo.a1[0], y - (sa * tx + ca * ty) - geo.a1[1]
 
 
 # ------------------------------------------------------------------------------------------ scalar core

@@ -140,13 +140,13 @@ class JointLine(GeometricPath):
     q1: np.ndarray
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "q0", _vector("q0", self.q0))
-        object.__setattr__(self, "q1", _vector("q1", self.q1))
+        object.__setattr__(self, "q0", _vector("q0", self.q0, None))
+        object.__setattr__(self, "q1", _vector("q1", self.q1, len(self.q0)))
 
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
         s = np.asarray(s, dtype=float).reshape(-1, 1)
         dq = self.q1 - self.q0
-        out = [self.q0 + s * dq, np.broadcast_to(dq, (s.shape[0], 4)).copy(), np.zeros((s.shape[0], 4))]
+        out = [self.q0 + s * dq, np.broadcast_to(dq, (s.shape[0], len(dq))).copy(), np.zeros((s.shape[0], len(dq)))]
         return tuple(out[: order + 1])
 
 
@@ -266,7 +266,7 @@ class _Kinematics:
         self.Rbo = self.data.oMf[robot.base_id].rotation.T.copy()  # base axes from world axes
 
     def _task(self, J6: np.ndarray) -> np.ndarray:
-        out = np.empty((4, 4))
+        out = np.empty((4, J6.shape[1]))
         out[:3] = self.Rbo @ J6[:3]
         out[3] = self.Rbo[2] @ J6[3:]
         return out

@@ -271,10 +271,10 @@ def parameterize(
 class _ToppraPath:
     """The path in toppra's units s' = L s (only what toppra's algorithm reads)."""
 
-    def __init__(self, path: GeometricPath, L: float) -> None:
+    def __init__(self, path: GeometricPath, L: float, dof: int = 4) -> None:
         self.path = path
         self.L = L
-        self.dof = 4
+        self.dof = dof
         self.path_interval = np.array([0.0, L])
 
     def __call__(self, s: Any, order: int = 0) -> np.ndarray:
@@ -346,7 +346,7 @@ def _time_segment(
     # acceleration: q' u + q'' (x + tw u)
     blocks_a.append((dq + tw[:, None] * ddq).reshape(rows, -1))
     blocks_b.append(ddq.reshape(rows, -1))
-    blocks_c.append(np.zeros((rows, 4 * (m + 1))))
+    blocks_c.append(np.zeros((rows, dq.shape[1] * (m + 1))))
     two_sided.append(np.tile(a, m + 1))
     g_static = None
     if lim.effort is not None:
@@ -372,7 +372,8 @@ def _time_segment(
     constraint = _precomputed_constraint(A_, B_, C_, F, g)
     # 3. toppra
     try:
-        inst = toppra.algorithm.TOPPRA([constraint], _ToppraPath(path, L), gridpoints=grid * L, solver_wrapper="seidel")
+        inst = toppra.algorithm.TOPPRA([constraint], _ToppraPath(path, L, q.shape[1]), gridpoints=grid * L,
+                                       solver_wrapper="seidel")  # fmt: skip
         inst.compute_parameterization(0.0, 0.0)
         data = inst.problem_data
     except Exception as exc:  # toppra raises assorted exceptions: report them typed
@@ -559,11 +560,12 @@ def _polynomial_extremes(path: GeometricPath, law: ProfileLaw) -> tuple[np.ndarr
         r2 = np.where(quad, (-b + disc) / (2.0 * c), np.nan)
     ends = np.full_like(vertex, _END)  # each segment's end: the left limit of qdd at the next grid point
     sig = np.concatenate([vertex, r1, r2, ends]).ravel()  # (4 n 4,), segment index = (row // 4) % n
-    seg = np.tile(np.repeat(np.arange(n), 4), 4)
+    dof = d1.shape[1]
+    seg = np.tile(np.repeat(np.arange(n), dof), 4)
     keep = np.isfinite(sig) & (sig > 0.0) & (sig < 1.0)
     sig, seg = sig[keep], seg[keep]
     if not len(sig):
-        return np.zeros((0, 4)), np.zeros((0, 4))
+        return np.zeros((0, dof)), np.zeros((0, dof))
     s = s0[seg] + sig * (s1 - s0)[seg]
     x = np.maximum(x0[seg] + 2.0 * u[seg] * (s - s0[seg]), 0.0)
     _, e1, e2 = path.evaluate(s, 2)
@@ -589,8 +591,8 @@ def limit_ratios(
     """
     lim = _limits(robot, limits, tool_speed, torque)
     times = [trajectory.times(rate)]
-    peak_v = np.zeros(4)
-    peak_a = np.zeros(4)
+    peak_v = np.zeros(trajectory.q_start.shape[0])
+    peak_a = np.zeros(trajectory.q_start.shape[0])
     for start, piece in zip(trajectory.starts.tolist(), trajectory.pieces):
         times.append(start + np.linspace(0.0, piece.duration, 65))
         exact = _exact_peaks(piece)

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import _limit_vector, _positive, _vector
-from ..description import JOINT_NAMES
+from ..description import JOINT_COUNTS, JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_text_atomic
 from ..limits import MAX_SAMPLES, check_count, read_text
@@ -86,8 +86,13 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-CSV_HEADER: tuple[str, ...] = ("t",) + tuple(f"{k}{i}" for k in ("q", "qd", "qdd") for i in range(1, 5))
-"""Columns of the trajectory CSV: t, q1..q4, qd1..qd4, qdd1..qdd4 (SI units)."""
+def csv_header(dof: int = 4) -> tuple[str, ...]:
+    """Columns of the trajectory CSV of a robot with ``dof`` joints: t, q1..q<dof>, qd1.., qdd1.. (SI units)."""
+    return ("t",) + tuple(f"{k}{i}" for k in ("q", "qd", "qdd") for i in range(1, dof + 1))
+
+
+CSV_HEADER: tuple[str, ...] = csv_header(4)
+"""Columns of the trajectory CSV: t, q1..q4, qd1..qd4, qdd1..qdd4 (SI units); 3-joint arms: csv_header(3)."""
 _FORMAT = "scara-pin/trajectory"
 _QUINTIC_PEAK_SD = 1.875
 """max of s'(x) = 30 x^2 (1 - x)^2 on [0, 1], at x = 1/2."""
@@ -340,21 +345,22 @@ class Samples:
         if not np.isfinite(t).all() or t[0] != 0.0 or not (np.diff(t) > 0).all():
             raise ParameterError("t", f"[{t[0]}, ..., {t[-1]}]", "must be finite, start at 0 and increase strictly")
         object.__setattr__(self, "t", t)
+        dof = np.shape(self.q)[-1] if np.ndim(self.q) == 2 and np.shape(self.q)[-1] in JOINT_COUNTS else 4
         for name in ("q", "qd", "qdd"):
             arr = np.array(getattr(self, name), dtype=float)
-            if arr.shape != (len(t), 4):
-                raise ParameterError(name, f"array of shape {arr.shape}", f"must have shape ({len(t)}, 4)")
+            if arr.shape != (len(t), dof):
+                raise ParameterError(name, f"array of shape {arr.shape}", f"must have shape ({len(t)}, {dof})")
             if not np.isfinite(arr).all():
                 raise ParameterError(name, "non-finite values", "must be finite")
             object.__setattr__(self, name, arr)
 
     def table(self) -> np.ndarray:
-        """(n, 13) array in :data:`CSV_HEADER` order."""
+        """(n, 1 + 3 dof) array in :func:`csv_header` order (13 columns for 4 joints)."""
         return np.column_stack([self.t, self.q, self.qd, self.qdd])
 
     def csv_text(self) -> str:
         """The CSV text (header, then one row per sample; shortest round-trip float text)."""
-        lines = [",".join(CSV_HEADER)]
+        lines = [",".join(csv_header(self.q.shape[1]))]
         lines += [",".join(map(repr, row)) for row in self.table().tolist()]
         return "\n".join(lines) + "\n"
 
@@ -364,7 +370,7 @@ class Samples:
             "format": _FORMAT,
             "version": 1,
             "units": "SI: s; rad or m; per s; per s^2",
-            "joints": list(JOINT_NAMES),
+            "joints": list(JOINT_NAMES[: self.q.shape[1]]),
             "duration": float(self.t[-1]),
             "t": self.t.tolist(),
             "q": self.q.tolist(),
@@ -420,11 +426,13 @@ class Trajectory:
         pieces: the motions (or imported samples), in order; each starts where the previous ends.
         duration: total duration T [s].
         starts: (len(pieces) + 1,) start time of each piece, then T.
+        dof: the number of joints (4, or 3 for a SCARA without a wrist).
     """
 
     pieces: tuple[Piece, ...]
     duration: float = field(init=False)
     starts: np.ndarray = field(init=False, repr=False)
+    dof: int = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         pieces = tuple(self.pieces)
@@ -443,6 +451,7 @@ class Trajectory:
         object.__setattr__(self, "pieces", pieces)
         object.__setattr__(self, "starts", starts)
         object.__setattr__(self, "duration", float(starts[-1]))
+        object.__setattr__(self, "dof", int(pieces[0].evaluate(np.array([0.0]))[0].shape[1]))
 
     # --------------------------------------------------------------------------------- sampling
     def sample(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -454,9 +463,10 @@ class Trajectory:
         tt = np.atleast_1d(arr).ravel()
         if not np.isfinite(tt).all():
             raise ParameterError("t", "non-finite times", "must be finite")
-        q = np.empty((len(tt), 4))
-        qd = np.zeros((len(tt), 4))
-        qdd = np.zeros((len(tt), 4))
+        dof = self.dof
+        q = np.empty((len(tt), dof))
+        qd = np.zeros((len(tt), dof))
+        qdd = np.zeros((len(tt), dof))
         k = np.clip(np.searchsorted(self.starts, tt, side="right") - 1, 0, len(self.pieces) - 1)
         inside = (tt >= 0.0) & (tt <= self.duration)
         for j, piece in enumerate(self.pieces):
@@ -544,14 +554,14 @@ class Trajectory:
             motor: conversion to integer motor steps (optional).
         """
         rate = _positive("rate", rate, "Hz")
-        d = np.zeros(4) if delays is None else _vector("delays", delays)
+        d = np.zeros(self.dof) if delays is None else _vector("delays", delays, self.dof)
         if (d < 0).any():
             raise ParameterError("delays", d.tolist(), "must be >= 0", "s")
         check_count(f"setpoints ({float(d.max()) + self.duration:.6g} s at {rate:.6g} Hz)",
                     (float(d.max()) + self.duration) * rate + 2.0, MAX_SAMPLES, "lower the rate or the delays")
         lead = math.ceil(float(d.max()) * rate - 1e-9)
         t = np.concatenate([np.arange(-lead, 0) / rate, self.times(rate)])
-        q = np.empty((len(t), 4))
+        q = np.empty((len(t), self.dof))
         shifted: dict[float, np.ndarray] = {}  # one evaluation per distinct delay
         for i, di in enumerate(d.tolist()):
             if di not in shifted:
@@ -691,7 +701,9 @@ class Setpoints:
 
     def csv_text(self) -> str:
         """CSV: t, q1..q4 and, with motor units, steps1..steps4."""
-        head = ["t", "q1", "q2", "q3", "q4"] + ([f"steps{i}" for i in range(1, 5)] if self.steps is not None else [])
+        n = self.q.shape[1]
+        head = ["t"] + [f"q{i}" for i in range(1, n + 1)] + ([f"steps{i}" for i in range(1, n + 1)]
+                                                            if self.steps is not None else [])  # fmt: skip
         lines = [",".join(head)]
         for k in range(len(self.t)):
             row = [repr(float(self.t[k]))] + [repr(v) for v in self.q[k].tolist()]
@@ -717,13 +729,13 @@ def quintic(q0: ArrayLike, q1: ArrayLike, duration: float) -> Trajectory:
         q1: end [rad, m].
         duration: T [s] > 0.
     """
-    return Trajectory((Motion(JointLine(_vector("q0", q0), _vector("q1", q1)), QuinticLaw(duration)),))
+    return Trajectory((Motion(JointLine(_vector("q0", q0, None), _vector("q1", q1, len(q0))), QuinticLaw(duration)),))
 
 
 def _line_rates(
     q0: ArrayLike, q1: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> tuple[JointLine, float, float]:
-    line = JointLine(_vector("q0", q0), _vector("q1", q1))
+    line = JointLine(_vector("q0", q0, None), _vector("q1", q1, len(q0)))
     v = _limit_vector("velocity", velocity, "rad/s or m/s")
     a = _limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
     dq = np.abs(line.q1 - line.q0)
@@ -743,7 +755,7 @@ def quintic_min_duration(
     The peaks 1.875 |dq| / T and (10 / sqrt(3)) |dq| / T^2 reach a limit:
     T = max_i max(1.875 |dq_i| / v_i, sqrt(10 / sqrt(3) |dq_i| / a_i)).
     """
-    line = JointLine(_vector("q0", q0), _vector("q1", q1))
+    line = JointLine(_vector("q0", q0, None), _vector("q1", q1, len(q0)))
     v = _limit_vector("velocity", velocity, "rad/s or m/s")
     a = _limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
     dq = np.abs(line.q1 - line.q0)

@@ -561,12 +561,12 @@ class _Scene:
         for frame_id in (robot.base_id, robot.tool_id):
             self._triad(frame_id, 0.25 * self.size)
         # the tool frame's zero-yaw rotation in the base frame: target markers are Rz(yaw) * R0
-        zero = robot.tool_placement(np.zeros(4))
+        zero = robot.tool_placement(np.zeros(robot.dof))
         yaw0 = math.atan2(zero.rotation[1, 0], zero.rotation[0, 0])
         self.tool_r0 = pin.utils.rotate("z", -yaw0) @ zero.rotation
         self._floor()
         self._camera()
-        self.display(np.zeros(4))
+        self.display(np.zeros(robot.dof))
 
     def _load_geometry(self, geometry: pin.GeometryObject) -> None:
         """Load one visual geometry (primitive or mesh, by Pinocchio's loader) under its joint's node."""
@@ -745,7 +745,7 @@ def _scene(
     if (times is None) != (qs is None):
         raise InvalidInputError("times and qs go together: give both or neither")
     data = scene.page_data()
-    shown = np.zeros(4) if q is None else robot.check_q(q)
+    shown = np.zeros(robot.dof) if q is None else robot.check_q(q)
     if polylines is not None:
         scene.draw_polylines(polylines, "workspace", None, _WORKSPACE_COLOR)
     if path_points is not None:

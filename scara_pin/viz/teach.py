@@ -112,7 +112,7 @@ class TeachSession:
             InvalidInputError: ``q`` is not 4 finite numbers, or is outside the limits.
         """
         self.robot = robot
-        start = np.zeros(4) if q is None else robot.check_q(q)
+        start = np.zeros(robot.dof) if q is None else robot.check_q(q)
         outside = robot.outside_limits(start)
         if outside:
             raise InvalidInputError(f"the start configuration is outside the limits: {'; '.join(outside)}")

@@ -24,8 +24,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from ..description import JOINT_NAMES
-
 if TYPE_CHECKING:
     from ..model import Robot
 
@@ -97,7 +95,7 @@ def joint_nodes(robot: Robot, root: str) -> tuple[JointNode, ...]:
         pin.forwardKinematics(model, data, robot.to_pinocchio_q(q))
         return [data.liMi[j].copy() for j in range(model.njoints)]
 
-    zero = li_mi(np.zeros(len(JOINT_NAMES)))
+    zero = li_mi(np.zeros(robot.dof))
     out = []
     for j in range(1, model.njoints):
         jm = model.joints[j]
@@ -106,7 +104,7 @@ def joint_nodes(robot: Robot, root: str) -> tuple[JointNode, ...]:
         else:  # a mimic joint follows the joint that owns its configuration index
             mimic = jm.extract()
             source, multiplier, offset = user_index[jm.idx_q], float(mimic.scaling), float(mimic.offset)
-        step = np.zeros(len(JOINT_NAMES))
+        step = np.zeros(robot.dof)
         step[source] = 1.0
         # the joint's own motion over a unit step of its source: exp(axis * multiplier)
         motion = pin.log6(zero[j].actInv(li_mi(step)[j]))
