@@ -430,8 +430,8 @@ class Robot:
 
     # ----------------------------------------------------------------- kinematics
     def _valid_q(self, q: Any) -> np.ndarray:
-        """``q`` itself when it is obviously valid (4 moderate float64 values), else ``check_q(q)``."""
-        if _q_ok(q):
+        """``q`` itself when it is obviously valid (4 moderate float64 values, 4 joints), else ``check_q(q)``."""
+        if self.dof == 4 and _q_ok(q):
             return q  # type: ignore[no-any-return]
         return self.check_q(q)
 

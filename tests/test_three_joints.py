@@ -202,3 +202,13 @@ def test_cli_view_html(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> No
     assert len(text) > 1000
     rc, _, err = run(capsys, ["view", "--urdf", str(PRR), "--html", str(page), "--q", "0.1", "0.2", "0.3", "0"])
     assert rc == 2 and "must be 3 joint values" in err
+
+
+def test_four_values_are_refused_by_a_three_joint_robot() -> None:
+    """The per-call paths never take a q of the wrong length (no value silently dropped)."""
+    import scara_pin
+
+    robot = scara_pin.load_urdf(Path(__file__).parent / "data" / "three_joint" / "arm3_rrp.urdf")
+    for call in (robot.tool_placement, robot.task_jacobian, robot.tool_pose):
+        with pytest.raises(scara_pin.ParameterError, match="3 numbers"):
+            call(np.zeros(4))
