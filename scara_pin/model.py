@@ -41,6 +41,9 @@ _Q_MAX2 = (0.5 * MAGNITUDE_MAX) ** 2
 """The largest sum of squares of q that the cheap input test waves through (NaN and inf never pass)."""
 _F64 = np.dtype(np.float64)
 _TASK_ROWS = np.array([0, 1, 2, 5])  # x, y, z, wz of a 6-row Jacobian
+# bound once for the per-call paths
+_forward, _frame_placement, _frame_jacobian = pin.forwardKinematics, pin.updateFramePlacement, pin.computeFrameJacobian
+_LWA = pin.LOCAL_WORLD_ALIGNED
 
 
 class Kinematics(Protocol):
@@ -491,8 +494,8 @@ class Robot:
         if self._slow_q or not _q_ok(q):
             q = self._pin_q(q)
         model, data = self._base_model, self._base_data
-        pin.forwardKinematics(model, data, q)
-        return pin.updateFramePlacement(model, data, self.tool_id)
+        _forward(model, data, q)
+        return _frame_placement(model, data, self.tool_id)
 
     def tool_pose(self, q: np.ndarray) -> np.ndarray:
         """(x, y, z, yaw) of the tool frame in the base frame [m, m, m, rad]."""
@@ -535,8 +538,7 @@ class Robot:
         """
         if self._slow_q or not _q_ok(q):
             q = self._pin_q(q)
-        return pin.computeFrameJacobian(self._base_model, self._base_data, q, self.tool_id,
-                                        pin.LOCAL_WORLD_ALIGNED).take(_TASK_ROWS, 0)  # fmt: skip
+        return _frame_jacobian(self._base_model, self._base_data, q, self.tool_id, _LWA).take(_TASK_ROWS, 0)
 
     def manipulability(self, q: np.ndarray) -> float:
         """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4).
