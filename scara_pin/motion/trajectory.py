@@ -567,32 +567,19 @@ def load_trajectory(path: str | os.PathLike[str]) -> Trajectory:
         InvalidInputError: unreadable file, wrong header or format, or bad values (with the line).
     """
     path = Path(path)
+    if path.suffix.lower() != ".json":
+        from ..tables import read_csv
+
+        table = read_csv(path, CSV_HEADER, exact=True, max_rows=MAX_SAMPLES)
+        try:
+            return Trajectory.from_samples(Samples.from_table(table))
+        except ParameterError as exc:
+            raise InvalidInputError(f"{path}: {exc}") from None
     try:
         text = read_text(path, "trajectory")  # bounded: /dev/zero or a huge file is refused, not read whole
     except InvalidInputError as exc:
         raise InvalidInputError(f"{path}: cannot be read ({exc})") from None
-    if path.suffix.lower() == ".json":
-        return Trajectory.from_samples(_samples_from_json(text, str(path)))
-    return Trajectory.from_samples(_samples_from_csv(text, str(path)))
-
-
-def _samples_from_csv(text: str, origin: str) -> Samples:
-    lines = [ln for ln in text.splitlines() if ln.strip()]
-    if not lines or tuple(c.strip() for c in lines[0].split(",")) != CSV_HEADER:
-        raise InvalidInputError(f"{origin}: the first line must be the header {','.join(CSV_HEADER)}")
-    rows = []
-    for k, line in enumerate(lines[1:], start=2):
-        cells = line.split(",")
-        try:
-            if len(cells) != len(CSV_HEADER):
-                raise ValueError(f"{len(cells)} values, expected {len(CSV_HEADER)}")
-            rows.append([float(c) for c in cells])
-        except ValueError as exc:
-            raise InvalidInputError(f"{origin}, line {k}: {exc}") from None
-    try:
-        return Samples.from_table(np.array(rows).reshape(-1, len(CSV_HEADER)))
-    except ParameterError as exc:
-        raise InvalidInputError(f"{origin}: {exc}") from None
+    return Trajectory.from_samples(_samples_from_json(text, str(path)))
 
 
 def _samples_from_json(text: str, origin: str) -> Samples:
