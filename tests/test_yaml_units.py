@@ -52,4 +52,8 @@ def test_safe_loader_only() -> None:
 
     with pytest.raises(yaml.YAMLError):
         load_yaml("a: !!python/object/apply:os.system ['true']")
-    assert "!degrees" not in yaml.SafeLoader.yaml_constructors  # PyYAML's own loader is left untouched
+    # PyYAML's own SafeLoader is left untouched (xacro's load_yaml changes it: checked in a fresh process)
+    code = ("import yaml; from scara_pin.description.yaml_units import load_yaml; load_yaml('a: !degrees 1'); "
+            "print('!degrees' in yaml.SafeLoader.yaml_constructors)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert (proc.returncode, proc.stdout.strip()) == (0, "False"), proc.stderr
