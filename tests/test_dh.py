@@ -13,20 +13,19 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from scara_pin import UrdfError, load_urdf, robot_from_urdf
 from scara_pin.description.dh import (
     DHTableError,
-    _yaml_loader,
     dh_example,
     dh_examples,
     dh_to_urdf,
     load_dh_table,
     parse_dh_table,
 )
+from scara_pin.description.yaml_units import load_yaml
 from scara_pin.errors import InvalidInputError, ParameterError
 
 TOL = 1e-12  # [m] and rotation entries: FK of the URDF vs the D-H product
@@ -149,9 +148,7 @@ def test_the_dh_product_is_not_trivially_matched() -> None:
 
 # ------------------------------------------------------------------ the shipped examples (S1, S3)
 def _load(name: str) -> dict:
-    from scara_pin.description.dh import _yaml_loader
-
-    data = yaml.load(dh_example(name).read_text(encoding="utf-8"), Loader=_yaml_loader())
+    data = load_yaml(dh_example(name).read_text(encoding="utf-8"))
     for row in data["joints"]:  # the examples write alpha = pi as text; the test's product needs the number
         row.update({k: math.pi for k, v in row.items() if v == "pi"})
     return data
@@ -249,7 +246,7 @@ def test_pi_expressions_and_tags() -> None:
     for text, value in cases:
         data["joints"][1]["alpha"] = text
         assert parse_dh_table(data).rows[1].alpha == pytest.approx(value, abs=1e-15)
-    raw = yaml.load("a: !millimeters 50\nb: !degrees 90", Loader=_yaml_loader())
+    raw = load_yaml("a: !millimeters 50\nb: !degrees 90")
     assert raw == {"a": pytest.approx(0.05, abs=1e-17), "b": pytest.approx(math.pi / 2, abs=1e-16)}
 
 

@@ -247,15 +247,6 @@ def _joint_arg(robot: Robot, texts: Sequence[str], units: Units, what: str) -> n
     return q
 
 
-def _pose_to_q(robot: Robot, pose: ArrayLike, near: np.ndarray, what: str) -> np.ndarray:
-    result = robot.ik(pose)
-    if not result.success:
-        raise InfeasibleError(f"{what} {list(pose)}: {result.status.name}: {result.message}")
-    best = result.nearest(near)
-    assert best is not None  # success means at least one solution
-    return best.q
-
-
 def write_atomic(path: Path, text: str) -> None:
     """Write a text file atomically (see :mod:`scara_pin.files`)."""
     write_text_atomic(path, text)

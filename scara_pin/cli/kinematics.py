@@ -4,14 +4,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from collections.abc import Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..files import write_atomic_with
 from ._common import (
     _POSE_KINDS,
     _Q_NAMES,
@@ -23,7 +20,6 @@ from ._common import (
     _fmt,
     _load,
     _needs_wrist,
-    _number,
     _q_values,
     _read_pose,
     _read_q,
@@ -223,97 +219,20 @@ def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) 
 
 
 def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
-    """Stream a CSV of targets (x, y, z, yaw) through the vectorised closed form, in bounded memory.
-
-    Lines are read one at a time (:func:`scara_pin.limits.text_lines`: bounded length and count, UTF-8);
-    a progress bar (tqdm) shows on a terminal only.
-    """
-    import csv
-
-    import numpy as np
-
-    from ..files import check_output_path
-    from ..limits import MAX_ROWS, text_lines
+    """``ik --input CSV --output CSV``: :func:`scara_pin.kinematics.batch_io.solve_csv`, then one line."""
+    from ..kinematics.batch_io import solve_csv
 
     _needs_wrist(robot, "ik --input (batch)")
     if args.target:
         raise InvalidInputError("give either X Y Z YAW or --input FILE, not both")
     if not args.output:
         raise InvalidInputError("--input needs --output FILE")
-    kin = robot.kinematics
-    if args.branch != "all" and args.branch not in kin.branches:
-        raise InvalidInputError(f"--branch {args.branch} is not a branch of a {robot.kind} ({', '.join(kin.branches)})")
-    branch = "nearest" if args.branch == "all" else args.branch
-    reference = None
-    if args.near:
-        reference = _q_values(args.near, units)
-    in_path, out_path = Path(args.input), check_output_path(args.output)
-    if in_path.is_dir():
-        raise InvalidInputError(f"cannot read {in_path}: it is a folder")
-    try:
-        handle = in_path.open("rb")
-        size = in_path.stat().st_size if in_path.is_file() else None
-    except OSError as exc:
-        raise InvalidInputError(f"cannot read {in_path}: {exc.strerror}") from None
-    total = failed = 0
-    pose_scale = np.array(units.scale(_POSE_KINDS))
-    q_scale = np.array(units.scale(units.q))
-
-    def rows_out(writer: Any) -> None:
-        nonlocal total, failed
-        from tqdm import tqdm
-
-        with tqdm(total=size, unit="B", unit_scale=True, desc=f"ik {in_path.name}", file=sys.stderr,
-                  disable=not sys.stderr.isatty(), leave=False) as bar:  # fmt: skip
-            numbered = text_lines(handle, str(in_path), MAX_ROWS)
-            line = 0
-
-            def texts() -> Any:
-                nonlocal line
-                for number, text in numbered:
-                    line = number
-                    bar.update(len(text) + 1)
-                    yield text
-
-            reader = csv.reader(texts())
-            try:
-                header = next(reader, None)
-                if header is None or [h.strip().lower() for h in header[:4]] != ["x", "y", "z", "yaw"]:
-                    raise InvalidInputError(f"{in_path}: the first row must be the header x,y,z,yaw")
-                writer.writerow(["x", "y", "z", "yaw", "q1", "q2", "q3", "q4", "branch", "status"])
-                chunk: list[list[float]] = []
-                for row in reader:
-                    if not row or all(not c.strip() for c in row):
-                        continue
-                    if len(row) < 4:
-                        raise InvalidInputError(f"{in_path} line {line}: expected 4 values x,y,z,yaw, got {len(row)}")
-                    chunk.append([_number(f"{in_path.name} line {line} {n}", c) for n, c in zip("xyz", row[:3])]
-                                 + [_number(f"{in_path.name} line {line} yaw", row[3])])  # fmt: skip
-                    if len(chunk) == 65536:
-                        flush(writer, chunk)
-                        chunk = []
-            except csv.Error as exc:
-                raise InvalidInputError(f"{in_path} line {line}: not CSV ({exc})") from None
-            flush(writer, chunk)
-
-    def flush(writer: Any, chunk: list[list[float]]) -> None:
-        nonlocal total, failed
-        if not chunk:
-            return
-        T = np.array(chunk) / pose_scale
-        res = robot.ik_batch(T, reference, branch=branch)
-        names = {int(c): c.name for c in kin.status}
-        labels = {1: kin.branches[0], -1: kin.branches[1], 0: ""}
-        for t, q, b, st in zip(T * pose_scale, res.q * q_scale, res.branch, res.status):
-            writer.writerow([*(repr(float(v)) for v in t), *("" if math.isnan(v) else repr(float(v)) for v in q),
-                             labels[int(b)], names[int(st)]])  # fmt: skip
-        total += len(chunk)
-        failed += int((res.status != 0).sum())
-
-    with handle:
-        write_atomic_with(out_path, lambda f: rows_out(csv.writer(f)))
-    print(f"wrote {out_path}: {total} targets, {total - failed} solved, {failed} without solution", file=sys.stderr)
-    return 3 if failed else 0
+    summary = solve_csv(robot, args.input, args.output, pose_scale=units.scale(_POSE_KINDS),
+                        q_scale=units.scale(units.q), branch=None if args.branch == "all" else args.branch,
+                        reference=_q_values(args.near, units) if args.near else None, progress=True)  # fmt: skip
+    print(f"wrote {summary.output}: {summary.total} targets, {summary.solved} solved, {summary.failed} without "
+          "solution", file=sys.stderr)  # fmt: skip
+    return 3 if summary.failed else 0
 
 
 VALIDATION_FAILED = 5

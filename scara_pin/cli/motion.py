@@ -22,7 +22,6 @@ from ._common import (
     _load,
     _needs_wrist,
     _number,
-    _pose_to_q,
     _read_pose,
     log,
     number_type,
@@ -49,6 +48,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..motion import trajectory as tr
+    from ..motion.plan import MotionRequest, plan_motion
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units(args.deg, args.mm)
@@ -70,68 +70,33 @@ def cmd_traj(args: argparse.Namespace) -> int:
         if rate is not None and not rate > 0:
             raise ParameterError(name, rate, "must be > 0", "Hz")
     vias = [_joint_arg(robot, v, units, f"--via #{i + 1}") for i, v in enumerate(args.via or [])]
-    mid = (np.asarray(robot.limits.lower) + np.asarray(robot.limits.upper)) / 2
     pose_from = _read_pose(args.from_pose, units, "--from-pose", robot.dof) if args.from_pose else None
     pose_to = _read_pose(args.to_pose, units, "--to-pose", robot.dof) if args.to_pose else None
     q_from = _joint_arg(robot, args.from_q, units, "--from") if args.from_q else None
-    q_to = _joint_arg(robot, args.to_q, units, "--to") if args.to_q else None
     tool_speed = None
     if args.tool_speed is not None:
         if not args.tool_speed > 0:
             raise ParameterError("--tool-speed", args.tool_speed, "must be > 0")
         tool_speed = args.tool_speed / units.length
-    if args.linear and robot.kind != "scara":
-        raise InvalidInputError(f"traj --linear is SCARA-only for now; robot {robot.name!r} is a {robot.kind} "
-                                "(joint-space --duration and TOPP-RA timing work)")  # fmt: skip
     if args.arch and not args.linear and robot.kind == "scara":
-        return _traj_arch(args, robot, units, pose_from, pose_to, q_from)
-    if args.arch:
-        raise InvalidInputError("--arch is a SCARA move on its own (not with --linear)" if args.linear
-                                else f"traj --arch is SCARA-only; robot {robot.name!r} is a {robot.kind}")
-    payload = _payload(args, units)
-    if payload.mass and not args.torque:
-        raise InvalidInputError("--payload changes only the torques: give --torque too")
-    if payload.mass:
-        from ..motion.payload import with_payload
-
-        robot = with_payload(robot, payload)
-    if args.plot and robot.kind != "scara":
+        if args.via:
+            raise InvalidInputError("--arch takes no --via (one arch between two poses)")
+        if args.duration is not None:
+            raise InvalidInputError("--arch is time-optimal: --duration does not apply")
+    request = MotionRequest(
+        start_q=q_from, end_q=_joint_arg(robot, args.to_q, units, "--to") if args.to_q else None,
+        start_pose=None if pose_from is None else np.array(pose_from),
+        end_pose=None if pose_to is None else np.array(pose_to), vias=tuple(vias), duration=args.duration,
+        linear=args.linear, arch=args.arch, tool_speed=tool_speed, torque=args.torque, payload=_payload(args, units),
+        rise=_number("--rise", args.rise) / units.length if args.arch else None,
+        blend=None if args.blend is None or not args.arch else _number("--blend", args.blend) / units.length,
+    )
+    if args.plot and robot.kind != "scara" and not args.arch:
         raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
-    if args.linear:
-        first = pose_from if q_from is None else tr.joint_pose(robot, q_from)
-        assert first is not None  # --from or --from-pose, checked above
-        poses = [first]
-        poses += [tr.joint_pose(robot, v) for v in vias]
-        last = pose_to if q_to is None else tr.joint_pose(robot, q_to)
-        assert last is not None  # --to or --to-pose, checked above
-        poses.append(last)
-        path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
-        if args.duration is not None:
-            traj, method = tr.timed(path, args.duration), "straight line, quintic time law"
-        else:
-            from ..motion.timing import time_optimal
-
-            traj = time_optimal(robot, path, tool_speed=tool_speed, torque=args.torque)
-            method = "straight line, time-optimal (TOPP-RA)"
-    else:
-        if q_from is None:
-            q_from = _pose_to_q(robot, pose_from, mid, "--from-pose")  # type: ignore[arg-type]
-        if q_to is None:
-            q_to = _pose_to_q(robot, pose_to, vias[-1] if vias else q_from, "--to-pose")  # type: ignore[arg-type]
-        waypoints = [q_from, *vias, q_to]
-        lim = robot.limits
-        if args.duration is not None:
-            if vias:
-                traj, method = tr.timed(tr.joint_path(robot, waypoints), args.duration), "joint spline, quintic law"
-            else:
-                traj, method = tr.quintic(q_from, q_to, args.duration), "joint quintic (jtraj)"
-        elif not vias and tool_speed is None and not args.torque:
-            traj, method = tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), "joint line, time-optimal"
-        else:
-            from ..motion.timing import time_optimal
-
-            traj = time_optimal(robot, waypoints, tool_speed=tool_speed, torque=args.torque)
-            method = "joint path, time-optimal (TOPP-RA)"
+    plan = plan_motion(robot, request)
+    if plan.arch is not None:
+        return _print_arch(args, plan.robot, plan.arch)
+    robot, traj, method = plan.robot, plan.trajectory, plan.method.value
     from ..motion.timing import limit_ratios
 
     ratios = limit_ratios(robot, traj, rate=1000.0, tool_speed=tool_speed, torque=args.torque)
@@ -196,23 +161,10 @@ def cmd_traj(args: argparse.Namespace) -> int:
     return 0
 
 
-def _traj_arch(args: argparse.Namespace, robot: Any, units: Units, pose_from: Any, pose_to: Any, q_from: Any) -> int:
-    """``traj --arch``: the arch (jump) move between two poses (lift, traverse, descend, blended corners)."""
-    import numpy as np
+def _print_arch(args: argparse.Namespace, robot: Any, move: Any) -> int:
+    """``traj --arch``: write and print the arch (jump) move (lift, traverse, descend, blended corners)."""
+    from ..motion.plan import Method
 
-    from ..motion import trajectory as tr
-    from ..motion.cycle import arch_move
-
-    if args.via:
-        raise InvalidInputError("--arch takes no --via (one arch between two poses)")
-    if args.duration is not None:
-        raise InvalidInputError("--arch is time-optimal: --duration does not apply")
-    first = pose_from if q_from is None else tr.joint_pose(robot, q_from)
-    last = pose_to if args.to_q is None else tr.joint_pose(robot, _joint_arg(robot, args.to_q, units, "--to"))
-    rise = _number("--rise", args.rise) / units.length
-    blend = None if args.blend is None else _number("--blend", args.blend) / units.length
-    move = arch_move(robot, np.array([first, last], dtype=float), rise=rise, blend=blend, payload=_payload(args, units),
-                     torque=args.torque, start=q_from)  # fmt: skip
     traj = move.trajectory
     outputs: dict[str, str] = {}
     if args.out:
@@ -225,7 +177,7 @@ def _traj_arch(args: argparse.Namespace, robot: Any, units: Units, pose_from: An
         plot_cycle(robot, move, args.plot, title=f"{robot.name}: arch move {traj.duration:.4g} s")
         outputs["plot"] = args.plot
     if args.json:
-        summary = {"robot": robot.name, "method": "arch (jump) move, time-optimal (TOPP-RA)",
+        summary = {"robot": robot.name, "method": Method.ARCH.value,
                    "duration": traj.duration, "q_from": traj.q_start.tolist(), "q_to": traj.q_end.tolist(),
                    "legs": [leg.to_dict() for leg in move.legs], "limit_ratios": move.ratios,
                    "payload": move.payload.to_dict(), "outputs": outputs,
@@ -234,7 +186,7 @@ def _traj_arch(args: argparse.Namespace, robot: Any, units: Units, pose_from: An
             summary["samples"] = traj.resample(args.rate).to_dict()
         print(json.dumps(summary))
         return 0
-    print(f"robot     {robot.name}: arch (jump) move, time-optimal (TOPP-RA)")
+    print(f"robot     {robot.name}: {Method.ARCH.value}")
     print(f"duration  {traj.duration:.9g} s")
     for leg in move.legs:
         print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit")

@@ -299,30 +299,6 @@ def _to_float(name: str, raw: object) -> float:
     return value
 
 
-def _yaml_loader() -> type:
-    """A safe yaml loader that also reads xacro's unit tags (``!degrees``, ``!millimeters``, ...)."""
-    import yaml
-
-    base = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when available: ~10x faster
-
-    class Loader(base):  # type: ignore[valid-type, misc]
-        pass
-
-    scales = {"!radians": 1.0, "!degrees": math.pi / 180.0, "!meters": 1.0, "!millimeters": 1e-3,
-              "!foot": 0.3048, "!inches": 0.0254}  # fmt: skip
-    for tag, scale in scales.items():
-
-        def construct(loader: yaml.SafeLoader, node: yaml.Node, scale: float = scale) -> float | str:
-            text = loader.construct_scalar(node)  # type: ignore[arg-type]
-            try:
-                return float(text) * scale
-            except ValueError:  # left as text: the caller refuses it, naming the parameter and file
-                return f"{node.tag} {text}"
-
-        Loader.add_constructor(tag, construct)
-    return Loader
-
-
 def _flatten(tree: object, prefix: str, out: dict[str, object]) -> None:
     if isinstance(tree, dict):
         for key, value in tree.items():
@@ -345,13 +321,14 @@ def _read_config(folder: Path) -> tuple[str, dict[str, float]]:
     """(kind, flat values) of a config folder; the kind is the ``kind:`` key of kinematics.yaml."""
     import yaml
 
-    loader = _yaml_loader()
+    from .yaml_units import load_yaml
+
     values: dict[str, float] = {}
     schema = SCHEMAS["scara"]
     for filename in ("kinematics.yaml", "joint_limits.yaml", "physical_parameters.yaml"):
         path = folder / filename
         try:  # bounded read (a FIFO or /dev/zero is refused), UTF-8 checked
-            tree = yaml.load(_read_yaml_text(path), Loader=loader)  # noqa: S506 (safe loader)
+            tree = load_yaml(_read_yaml_text(path))
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f" line {mark.line + 1}" if mark is not None else ""

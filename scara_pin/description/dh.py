@@ -71,7 +71,6 @@ _TOP_KEYS = ("name", "convention", "units", "joints", "tool", "description")
 _ROW_KEYS = ("name", "type", "theta", "d", "a", "alpha", "offset", "lower", "upper", "velocity", "effort")
 _MAX_ROWS = 64
 _MAX_ABS = 1e6
-_SCALES = {"!radians": 1.0, "!degrees": math.pi / 180.0, "!meters": 1.0, "!millimeters": 1e-3}
 
 
 class DHTableError(ParameterError):
@@ -171,26 +170,6 @@ class DHTable:
 
 
 # --------------------------------------------------------------------------------------------- reading
-def _yaml_loader() -> type:
-    """A safe yaml loader that reads xacro's unit tags as numbers in SI units."""
-    import yaml
-
-    class Loader(yaml.SafeLoader):
-        pass
-
-    for tag, scale in _SCALES.items():
-
-        def construct(loader: yaml.SafeLoader, node: yaml.Node, scale: float = scale) -> float | str:
-            text = loader.construct_scalar(node)  # type: ignore[arg-type]
-            try:
-                return float(text) * scale
-            except ValueError:  # left as text: refused later, naming the row and field
-                return f"{node.tag} {text}"
-
-        Loader.add_constructor(tag, construct)
-    return Loader
-
-
 def load_dh_table(path: str | Path) -> DHTable:
     """Read and validate a D-H table from a yaml file.
 
@@ -203,6 +182,7 @@ def load_dh_table(path: str | Path) -> DHTable:
     origin = str(path)
     from ..errors import InvalidInputError
     from ..limits import read_text
+    from .yaml_units import load_yaml
 
     try:
         text = read_text(path, "D-H table")  # bounded: /dev/zero or a huge file is refused, not read whole
@@ -210,7 +190,7 @@ def load_dh_table(path: str | Path) -> DHTable:
         raise DHTableError(origin, None, None, "file", ParameterError.NOTHING,
                            f"cannot be read ({exc})") from None  # fmt: skip
     try:
-        data = yaml.load(text, Loader=_yaml_loader())  # noqa: S506 (a SafeLoader subclass)
+        data = load_yaml(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" (line {mark.line + 1})" if mark is not None else ""

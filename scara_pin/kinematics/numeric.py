@@ -42,6 +42,8 @@ _atan2, _sqrt = math.atan2, math.sqrt
 _array = np.array
 _fk, _frame = pin.forwardKinematics, pin.updateFramePlacement
 _jac, _LWA = pin.computeFrameJacobian, pin.LOCAL_WORLD_ALIGNED
+_TASK_ROWS = [0, 1, 2, 5]  # x, y, z and the yaw rate (angular z) of a 6-D Jacobian
+_EYE4 = np.eye(4)
 _POLISHED = 1e-9
 """[rad, m] a Gauss-Newton step this small ends the polish: the next one would be ~its square."""
 _STALL_WINDOW = 6
@@ -190,9 +192,9 @@ class _Task:
 
     Works on the robot's private model re-rooted at the base frame (its ``oMf`` are placements in
     ``base``, its LOCAL_WORLD_ALIGNED Jacobians are in base axes), with the tool frame id: no input
-    re-validation per iteration (q stays a float64 4-vector inside the limits), no 4 x 4 numpy algebra
-    (the normal equations are formed and solved by hand), and the Jacobian and J^T J, J^T e are reused
-    while a rejected step leaves q unchanged.
+    re-validation per iteration (q stays a float64 4-vector inside the limits); the 4 x 4 systems are
+    LAPACK's (``np.linalg.solve``), and the Jacobian and J^T J, J^T e are reused while a rejected step
+    leaves q unchanged.
     """
 
     def __init__(self, robot: Robot, target: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: list[bool],
@@ -225,12 +227,11 @@ class _Task:
         ew = (self.yaw - _atan2(r1[0], r0[0]) + _PI) % _TWO_PI - _PI
         return [ex, ey, ez, ew], _sqrt(ex * ex + ey * ey + ez * ez + ew * ew)
 
-    def jacobian(self, q: np.ndarray) -> list[list[float]]:
-        """Return the rows (x, y, z, yaw) of the 4 x 4 task Jacobian at q, in base axes."""
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Return the 4 x 4 task Jacobian (rows x, y, z, yaw) at q, in base axes."""
         if self.model is None:
-            return self.robot.task_jacobian(q).tolist()
-        J = _jac(self.model, self.data, q, self.tool, _LWA).tolist()
-        return [J[0], J[1], J[2], J[5]]
+            return np.asarray(self.robot.task_jacobian(q), dtype=float)
+        return _jac(self.model, self.data, q, self.tool, _LWA)[_TASK_ROWS]
 
     def project(self, q: np.ndarray) -> np.ndarray:
         """Into the limits: revolute joints by a 2 pi turn when that lands inside, then clipping."""
@@ -274,9 +275,9 @@ class _Task:
                 return self.polish(q, e, res, it - 1, normal)
             if normal is None:
                 J = jacobian(q)
-                normal = (J, _gram(J), _transposed_times(J, e))
-            g = normal[2]
-            d0, d1, d2, d3 = _damped_solve(normal[1], mu, g)
+                normal = (J, J.T @ J, J.T @ np.array(e))
+            g = normal[2].tolist()
+            d0, d1, d2, d3 = _damped_solve(normal[1], mu, normal[2])
             q0, q1, q2, q3 = q.tolist()
             q_new, clipped = clip([q0 + d0, q1 + d1, q2 + d2, q3 + d3])
             e_new, res_new = error(q_new)
@@ -311,7 +312,7 @@ class _Task:
                 break
             J = normal[0] if normal is not None else self.jacobian(q)
             normal = None
-            dq = _solve4([row[:] for row in J], e)
+            dq = _solve(J, np.asarray(e))
             if dq is None:
                 break
             a, b, c, d = q.tolist()
@@ -326,91 +327,15 @@ class _Task:
         return q, res, its
 
 
-def _gram(J: list[list[float]]) -> list[float]:
-    """Return the 10 entries g00, g01, g02, g03, g11, g12, g13, g22, g23, g33 of J^T J (J given by rows)."""
-    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3) = J
-    return [a0 * a0 + b0 * b0 + c0 * c0 + d0 * d0, a0 * a1 + b0 * b1 + c0 * c1 + d0 * d1,
-            a0 * a2 + b0 * b2 + c0 * c2 + d0 * d2, a0 * a3 + b0 * b3 + c0 * c3 + d0 * d3,
-            a1 * a1 + b1 * b1 + c1 * c1 + d1 * d1, a1 * a2 + b1 * b2 + c1 * c2 + d1 * d2,
-            a1 * a3 + b1 * b3 + c1 * c3 + d1 * d3, a2 * a2 + b2 * b2 + c2 * c2 + d2 * d2,
-            a2 * a3 + b2 * b3 + c2 * c3 + d2 * d3, a3 * a3 + b3 * b3 + c3 * c3 + d3 * d3]  # fmt: skip
+def _damped_solve(G: np.ndarray, l2: float, g: np.ndarray) -> list[float]:
+    """Solve (J^T J + l2 I) x = g (J^T J given); no step (zeros, rejected) when it is exactly singular."""
+    x = _solve(G + l2 * _EYE4, g)
+    return [0.0, 0.0, 0.0, 0.0] if x is None else x
 
 
-def _transposed_times(J: list[list[float]], e: list[float]) -> list[float]:
-    """J^T e (J given by rows)."""
-    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3) = J
-    e0, e1, e2, e3 = e
-    return [a0 * e0 + b0 * e1 + c0 * e2 + d0 * e3, a1 * e0 + b1 * e1 + c1 * e2 + d1 * e3,
-            a2 * e0 + b2 * e1 + c2 * e2 + d2 * e3, a3 * e0 + b3 * e1 + c3 * e2 + d3 * e3]  # fmt: skip
-
-
-def _damped_solve(G: list[float], l2: float, g: list[float]) -> list[float]:
-    """Solve (J^T J + l2 I) x = g, J^T J given by ``_gram``.
-
-    By Cholesky when the matrix is numerically positive definite (always, but for a rank-deficient J with a
-    tiny l2), by Gaussian elimination otherwise.
-    """
-    g00, g01, g02, g03, g11, g12, g13, g22, g23, g33 = G
-    d0 = g00 + l2
-    if d0 > 0.0:
-        l00 = math.sqrt(d0)
-        l10, l20, l30 = g01 / l00, g02 / l00, g03 / l00
-        d1 = g11 + l2 - l10 * l10
-        if d1 > 0.0:
-            l11 = math.sqrt(d1)
-            l21 = (g12 - l20 * l10) / l11
-            l31 = (g13 - l30 * l10) / l11
-            d2 = g22 + l2 - l20 * l20 - l21 * l21
-            if d2 > 0.0:
-                l22 = math.sqrt(d2)
-                l32 = (g23 - l30 * l20 - l31 * l21) / l22
-                d3 = g33 + l2 - l30 * l30 - l31 * l31 - l32 * l32
-                if d3 > 0.0:
-                    l33 = math.sqrt(d3)
-                    y0 = g[0] / l00
-                    y1 = (g[1] - l10 * y0) / l11
-                    y2 = (g[2] - l20 * y0 - l21 * y1) / l22
-                    y3 = (g[3] - l30 * y0 - l31 * y1 - l32 * y2) / l33
-                    x3 = y3 / l33
-                    x2 = (y2 - l32 * x3) / l22
-                    x1 = (y1 - l21 * x2 - l31 * x3) / l11
-                    return [(y0 - l10 * x1 - l20 * x2 - l30 * x3) / l00, x1, x2, x3]
-    A = [[g00 + l2, g01, g02, g03], [g01, g11 + l2, g12, g13], [g02, g12, g22 + l2, g23], [g03, g13, g23, g33 + l2]]
-    x = _solve4(A, g)
-    return x if x is not None else [0.0, 0.0, 0.0, 0.0]  # exactly singular: no step (it is rejected)
-
-
-def _solve4(A: list[list[float]], b: list[float]) -> list[float] | None:
-    """Solve A x = b for a 4 x 4 A (rows; overwritten); ``None`` when A is singular.
-
-    Gaussian elimination with partial pivoting (the algorithm of LAPACK's gesv); singular means a pivot is
-    exactly zero, as for ``np.linalg.solve``.
-    """
-    b = list(b)
-    for k in range(4):
-        p = k
-        for i in range(k + 1, 4):
-            if abs(A[i][k]) > abs(A[p][k]):
-                p = i
-        if A[p][k] == 0.0:
-            return None
-        if p != k:
-            A[k], A[p] = A[p], A[k]
-            b[k], b[p] = b[p], b[k]
-        rk = A[k]
-        pivot = rk[k]
-        for i in range(k + 1, 4):
-            ri = A[i]
-            f = ri[k] / pivot
-            if f != 0.0:
-                for j in range(k + 1, 4):
-                    ri[j] -= f * rk[j]
-                b[i] -= f * b[k]
-    x = [0.0] * 4
-    for k in range(3, -1, -1):
-        s = b[k]
-        rk = A[k]
-        for j in range(k + 1, 4):
-            s -= rk[j] * x[j]
-        x[k] = s / rk[k]
-    return x
+def _solve(A: np.ndarray, b: np.ndarray) -> list[float] | None:
+    """Solve the 4 x 4 system A x = b (LAPACK's gesv); ``None`` when A is exactly singular."""
+    try:
+        return np.linalg.solve(A, b).tolist()
+    except np.linalg.LinAlgError:
+        return None

@@ -188,14 +188,8 @@ class JointSpline(GeometricPath):
         return self._knots.copy()
 
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
-        # the spline's piecewise cubic coefficients, evaluated for all orders at once (one interval search)
         s = np.asarray(s, dtype=float).ravel()
-        x, c = self._spline.x, self._spline.c  # c[k, i, j]: coefficient of (s - x_i)^(3 - k), joint j
-        i = np.clip(np.searchsorted(x, s, side="right") - 1, 0, len(x) - 2)
-        d = (s - x[i])[:, None]
-        c0, c1, c2, c3 = c[0, i], c[1, i], c[2, i], c[3, i]
-        out = [((c0 * d + c1) * d + c2) * d + c3, (3.0 * c0 * d + 2.0 * c1) * d + c2, 6.0 * c0 * d + 2.0 * c1]
-        return tuple(out[: order + 1])
+        return tuple(self._spline(s, nu) for nu in range(order + 1))
 
 
 def joint_path(robot: Robot, waypoints: Sequence[ArrayLike] | np.ndarray) -> JointLine | JointSpline:

@@ -179,8 +179,9 @@ def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.nda
 def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
     """Read the times and joint values of a trajectory CSV (columns ``t,q1,q2,q3,q4``; others ignored).
 
-    Reads the files of :meth:`scara_pin.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``).
-    Blank lines and lines starting with ``#`` are skipped.
+    Reads the files of :meth:`scara_pin.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``)
+    with the package's one CSV reader (:func:`scara_pin.tables.read_csv`: bounded, blank lines and lines
+    starting with ``#`` skipped).
 
     Returns:
         ``(times, qs)``: (N,) times [s] and (N, 4) joint values [rad or m].
@@ -188,46 +189,10 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.nd
     Raises:
         InvalidInputError: unreadable file, missing columns, a bad number (the message gives the line).
     """
-    from ..limits import MAX_NUMBER, MAX_SAMPLES, text_lines
+    from ..limits import MAX_SAMPLES
+    from ..tables import read_csv
 
-    path = Path(path)
-    if path.is_dir():
-        raise InvalidInputError(f"{path}: cannot be read (it is a folder)")
-    try:
-        handle = path.open("rb")
-    except OSError as exc:
-        raise InvalidInputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
-    header: list[str] | None = None
-    cols: list[int] = []
-    rows = []
-    with handle:  # streamed: bounded line length and count (an endless /dev/zero is refused early)
-        for k, line in text_lines(handle, str(path), MAX_SAMPLES):
-            if not line.strip() or line.startswith("#"):
-                continue
-            if header is None:
-                header = [c.strip() for c in line.split(",")]
-                wanted = ("t", "q1", "q2", "q3", "q4")
-                missing = [c for c in wanted if c not in header]
-                if missing:
-                    raise InvalidInputError(f"{path}: the header has no column {', '.join(missing)} "
-                                            f"(header: {line[:200]})")  # fmt: skip
-                cols = [header.index(c) for c in wanted]
-                continue
-            cells = line.split(",")
-            if len(cells) != len(header):
-                raise InvalidInputError(f"{path}, line {k}: {len(cells)} values, expected {len(header)}")
-            try:
-                values = [float(cells[c]) for c in cols]
-            except ValueError as exc:
-                raise InvalidInputError(f"{path}, line {k}: {exc}") from None
-            if not all(abs(v) <= MAX_NUMBER for v in values):  # NaN too
-                raise InvalidInputError(f"{path}, line {k}: values must be finite, within +/-{MAX_NUMBER:g}")
-            rows.append(values)
-    if header is None:
-        raise InvalidInputError(f"{path}: empty file; expected a header with t,q1,q2,q3,q4")
-    if not rows:
-        raise InvalidInputError(f"{path}: no samples after the header")
-    table = np.array(rows)
+    table = read_csv(path, ("t", "q1", "q2", "q3", "q4"), max_rows=MAX_SAMPLES)
     return table[:, 0], table[:, 1:]
 
 

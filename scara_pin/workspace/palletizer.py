@@ -233,15 +233,15 @@ def _merge(arcs: list[EnvelopeArc]) -> list[EnvelopeArc]:
 
 def plot_envelope(env: ArmPlaneEnvelope, path: str, q: np.ndarray | None = None) -> None:
     """Draw the envelope to a PNG: arcs coloured by their limit, and the arm at ``q`` (default mid-range)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     colours = {"joint2_lower": "tab:green", "joint2_upper": "tab:olive", "joint3_lower": "tab:red",
                "joint3_upper": "tab:orange", "stretched": "tab:blue", "folded": "tab:purple"}  # fmt: skip
     geo = env.geometry
-    fig, ax = plt.subplots(figsize=(7, 7))
+    fig = Figure(figsize=(7, 7))  # object-oriented: no pyplot, no global backend or figure state
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
     seen: set[str] = set()
     for a in env.arcs:
         pts = a.points(max(8, int(a.sweep * 90)))
@@ -264,8 +264,5 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str, q: np.ndarray | None = None)
     ax.grid(True, alpha=0.3)
     from ..files import atomic_output  # written atomically: never through a symlink, never a device
 
-    try:
-        with atomic_output(path) as tmp:
-            fig.savefig(tmp, format="png", dpi=120, bbox_inches="tight")
-    finally:
-        plt.close(fig)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120, bbox_inches="tight")

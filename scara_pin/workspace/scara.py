@@ -818,16 +818,16 @@ def plot_workspace(
         q: a joint configuration (q order) to draw the arm at; default the limits' midpoints (finite ones).
         ray: (start, direction) of a ray to draw with its edge point.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path as MPath
 
     colours = {Limit.OUTER: "tab:blue", Limit.FOLDED: "tab:purple", Limit.J1_LOWER: "tab:red",
                Limit.J1_UPPER: "tab:orange", Limit.J2_LOWER: "tab:green", Limit.J2_UPPER: "tab:olive"}  # fmt: skip
-    fig, ax = plt.subplots(figsize=(7, 7))
+    fig = Figure(figsize=(7, 7))  # object-oriented: no pyplot, no global backend or figure state
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
     verts: list[np.ndarray] = []
     codes: list[int] = []
     for loop in ws.loops:
@@ -877,8 +877,5 @@ def plot_workspace(
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=7, framealpha=0.8)
     from ..files import atomic_output  # written atomically: never through a symlink, never a device
 
-    try:
-        with atomic_output(path) as tmp:
-            fig.savefig(tmp, format="png", dpi=120, bbox_inches="tight")
-    finally:
-        plt.close(fig)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120, bbox_inches="tight")

@@ -1,0 +1,214 @@
+"""One move, planned: from a :class:`MotionRequest` (endpoints, vias, timing wishes) to a timed trajectory.
+
+:func:`plan_motion` chooses the method, the one place where that choice is made (``scara-pin traj`` only
+parses its arguments into a request and prints the plan):
+
+==============================  ==========================================  =========================
+request                         path                                        time law
+==============================  ==========================================  =========================
+``arch``                        lift, traverse, descend (SCARA)             TOPP-RA, blended corners
+``linear`` and ``duration``     straight tool line through the poses        quintic
+``linear``                      straight tool line through the poses        TOPP-RA
+``duration``, vias              joint spline through the waypoints          quintic
+``duration``, no via            joint line                                  quintic (``jtraj``)
+no via, no tool speed, torque   joint line                                  trapezoid (time-optimal)
+otherwise                       joint line or spline                        TOPP-RA
+==============================  ==========================================  =========================
+
+Poses given as endpoints of a joint-space move are solved by the closed-form IK: the start nearest the
+middle of the joint ranges, the end nearest the previous waypoint. SI units: [rad, m, s].
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .._checks import _vector
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from . import trajectory as tr
+
+if TYPE_CHECKING:
+    from ..model import Robot
+    from .cycle import ArchMove
+    from .payload import Payload
+
+__all__ = ["Method", "MotionPlan", "MotionRequest", "plan_motion"]
+
+class Method(enum.Enum):
+    """How a move is made; the value is the sentence ``scara-pin traj`` prints."""
+
+    JOINT_QUINTIC = "joint quintic (jtraj)"
+    JOINT_SPLINE_QUINTIC = "joint spline, quintic law"
+    JOINT_TRAPEZOID = "joint line, time-optimal"
+    JOINT_TOPPRA = "joint path, time-optimal (TOPP-RA)"
+    LINE_QUINTIC = "straight line, quintic time law"
+    LINE_TOPPRA = "straight line, time-optimal (TOPP-RA)"
+    ARCH = "arch (jump) move, time-optimal (TOPP-RA)"
+
+
+def _optional_vector(name: str, value: object) -> np.ndarray | None:
+    return None if value is None else _vector(name, value, None)  # one per joint (4, or 3 without a wrist)
+
+
+@dataclass(frozen=True, eq=False)
+class MotionRequest:
+    """What a move should do. Exactly one start (``start_q`` or ``start_pose``) and one end.
+
+    Attributes:
+        start_q, end_q: joint values [rad, m] (URDF order).
+        start_pose, end_pose: tool poses (x, y, z, yaw) in the base frame [m, rad].
+        vias: joint waypoints between start and end [rad, m] (not with ``arch``).
+        duration: a quintic time law over this many seconds; None: time-optimal.
+        linear: a straight tool line (SCARA) through the start, the vias' poses and the end.
+        arch: an arch (jump) move between the two poses (SCARA; not with ``linear``, vias or a duration).
+        tool_speed: a tool speed limit [m/s] for time-optimal moves; None: no limit.
+        torque: respect the effort limits (time-optimal moves).
+        rise: [m] the arch's traverse height above the higher pose; None: the standard one.
+        blend: [m] the arch's corner blend distance; None: as large as allowed.
+        payload: a payload at the tool (``torque`` moves and arches); None: none.
+    """
+
+    start_q: np.ndarray | None = None
+    end_q: np.ndarray | None = None
+    start_pose: np.ndarray | None = None
+    end_pose: np.ndarray | None = None
+    vias: tuple[np.ndarray, ...] = ()
+    duration: float | None = None
+    linear: bool = False
+    arch: bool = False
+    tool_speed: float | None = None
+    torque: bool = False
+    rise: float | None = None
+    blend: float | None = None
+    payload: Payload | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        for name in ("start_q", "end_q", "start_pose", "end_pose"):
+            object.__setattr__(self, name, _optional_vector(name, getattr(self, name)))
+        object.__setattr__(self, "vias", tuple(_vector(f"via {i + 1}", v, None) for i, v in enumerate(self.vias)))
+        if (self.start_q is None) == (self.start_pose is None):
+            raise InvalidInputError("a move needs exactly one start: start_q or start_pose")
+        if (self.end_q is None) == (self.end_pose is None):
+            raise InvalidInputError("a move needs exactly one end: end_q or end_pose")
+        for name in ("duration", "tool_speed"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and value > 0):
+                raise ParameterError(name, value, "must be finite and > 0", "s" if name == "duration" else "m/s")
+        if self.rise is not None and not math.isfinite(self.rise):
+            raise ParameterError("rise", self.rise, "must be finite", "m")
+        if self.arch and self.vias:
+            raise InvalidInputError("an arch move takes no via (one arch between two poses)")
+        if self.arch and self.duration is not None:
+            raise InvalidInputError("an arch move is time-optimal: a duration does not apply")
+
+
+@dataclass(frozen=True, eq=False)
+class MotionPlan:
+    """A planned move.
+
+    Attributes:
+        trajectory: the timed joint trajectory.
+        method: how it was made.
+        robot: the robot it was planned for (the request's payload attached, when one was given).
+        arch: the arch move (its legs, ratios and payload) for ``Method.ARCH``; else None.
+    """
+
+    trajectory: tr.Trajectory
+    method: Method
+    robot: Robot
+    arch: ArchMove | None = None
+
+
+def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
+    """Choose the method for ``request`` (see the module docstring) and make the trajectory.
+
+    Raises:
+        InvalidInputError: a straight line or an arch asked of a robot other than a SCARA, an arch with
+            ``linear``, a payload without ``torque`` outside an arch.
+        InfeasibleError: a pose out of reach, a path the robot cannot follow, or a timing failure.
+    """
+    if request.linear and robot.kind != "scara":
+        raise InvalidInputError(f"a straight tool line (--linear) is SCARA-only for now; robot {robot.name!r} is a "
+                                f"{robot.kind} (joint-space --duration and TOPP-RA timing work)")  # fmt: skip
+    if request.arch:
+        if request.linear:
+            raise InvalidInputError("--arch is a SCARA move on its own (not with --linear)")
+        if robot.kind != "scara":
+            raise InvalidInputError(f"traj --arch is SCARA-only; robot {robot.name!r} is a {robot.kind}")
+        return _arch(robot, request)
+    payload = request.payload
+    if payload is not None and payload.mass:
+        if not request.torque:
+            raise InvalidInputError("--payload changes only the torques: give --torque too")
+        from .payload import with_payload
+
+        robot = with_payload(robot, payload)
+    if request.linear:
+        return _line(robot, request)
+    return _joint(robot, request)
+
+
+def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Trajectory:
+    from .timing import time_optimal
+
+    return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque)  # type: ignore[arg-type]
+
+
+def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
+    q_from, q_to = request.start_q, request.end_q
+    first = request.start_pose if q_from is None else tr.joint_pose(robot, q_from)
+    last = request.end_pose if q_to is None else tr.joint_pose(robot, q_to)
+    poses: list[np.ndarray] = [first, *(tr.joint_pose(robot, v) for v in request.vias), last]  # type: ignore[list-item]
+    path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
+    if request.duration is not None:
+        return MotionPlan(tr.timed(path, request.duration), Method.LINE_QUINTIC, robot)
+    return MotionPlan(_time_optimal(robot, path, request), Method.LINE_TOPPRA, robot)
+
+
+def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
+    vias = list(request.vias)
+    q_from, q_to = request.start_q, request.end_q
+    if q_from is None:
+        mid = (np.asarray(robot.limits.lower) + np.asarray(robot.limits.upper)) / 2
+        q_from = _pose_to_q(robot, request.start_pose, mid, "--from-pose")
+    if q_to is None:
+        q_to = _pose_to_q(robot, request.end_pose, vias[-1] if vias else q_from, "--to-pose")
+    if request.duration is not None:
+        if vias:
+            path = tr.joint_path(robot, [q_from, *vias, q_to])
+            return MotionPlan(tr.timed(path, request.duration), Method.JOINT_SPLINE_QUINTIC, robot)
+        return MotionPlan(tr.quintic(q_from, q_to, request.duration), Method.JOINT_QUINTIC, robot)
+    if not vias and request.tool_speed is None and not request.torque:
+        lim = robot.limits
+        return MotionPlan(tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), Method.JOINT_TRAPEZOID, robot)
+    return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), Method.JOINT_TOPPRA, robot)
+
+
+def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
+    from .cycle import arch_move
+
+    first = request.start_pose if request.start_q is None else tr.joint_pose(robot, request.start_q)
+    last = request.end_pose if request.end_q is None else tr.joint_pose(robot, request.end_q)
+    poses = np.array([first, last], dtype=float)
+    if request.rise is None:
+        move = arch_move(robot, poses, blend=request.blend, payload=request.payload, torque=request.torque,
+                         start=request.start_q)  # fmt: skip
+    else:
+        move = arch_move(robot, poses, rise=request.rise, blend=request.blend, payload=request.payload,
+                         torque=request.torque, start=request.start_q)  # fmt: skip
+    return MotionPlan(move.trajectory, Method.ARCH, robot, move)
+
+
+def _pose_to_q(robot: Robot, pose: np.ndarray | None, near: np.ndarray, what: str) -> np.ndarray:
+    """The closed-form IK solution of ``pose`` nearest ``near``; an :class:`InfeasibleError` if none."""
+    result = robot.ik(pose)
+    best = result.nearest(near) if result.success else None
+    if best is None:
+        shown = np.asarray(pose).tolist()
+        raise InfeasibleError(f"{what} {shown}: {result.status.name}: {result.message}")
+    return best.q
