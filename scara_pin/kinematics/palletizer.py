@@ -47,7 +47,7 @@ import pinocchio as pin
 from .._checks import _vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 from .planar2r import FREE_R, REACH_TOL, Planar2R, Reach, nearest_turn, turn_edge, wrap
-from .results import BatchIKResult, IKResult, IKSolution
+from .results import BatchIKResult, IKResult, result_of
 from .targets import parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:
@@ -342,11 +342,7 @@ def solve(
                         f"the target's z axis is tilted by {tilt:.3g} rad from the vertical; the palletizer's "
                         "flange stays level", geo.continuous)  # fmt: skip
     found, failure = _branches(geo, x, y, z, yaw, reference_floats(reference), branch)
-    if failure is not None:
-        return IKResult(pose, (), failure[0], failure[1], geo.continuous)
-    sols = tuple(IKSolution(np.array(q), label, singular, tuple(turns)) for label, singular, q, turns in found)
-    result = IKResult(pose, sols, PalletizerIKStatus.OK, f"{len(sols)} solution(s)", geo.continuous)
-    return result.expand(geo.lower, geo.upper) if all_turns else result
+    return result_of(pose, found, failure, PalletizerIKStatus.OK, geo.continuous, geo.lower, geo.upper, all_turns)
 
 
 def solve_nearest(

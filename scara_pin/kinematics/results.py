@@ -21,7 +21,7 @@ from ..errors import InvalidInputError
 if TYPE_CHECKING:
     from .._typing import ArrayLike
 
-__all__ = ["MAX_SOLUTIONS", "BatchIKResult", "IKResult", "IKSolution", "joint_distance"]
+__all__ = ["MAX_SOLUTIONS", "BatchIKResult", "IKResult", "IKSolution", "joint_distance", "result_of"]
 
 MAX_SOLUTIONS = 100_000
 """The most solutions :meth:`IKResult.expand` lists (``ik --all-turns``); beyond it: InvalidInputError."""
@@ -165,6 +165,19 @@ class IKResult:
                 out.append(replace(s, q=q, turns=tuple(None if t is None else (t[0] - k, t[1] - k)
                                                        for t, k in zip(s.turns, ks))))  # fmt: skip
         return replace(self, solutions=tuple(out))
+
+
+def result_of(
+    pose: np.ndarray, found: list[tuple[str, bool, list[float], list[tuple[int, int] | None]]],
+    failure: tuple[enum.IntEnum, str] | None, ok: enum.IntEnum, continuous: tuple[bool, ...],
+    lower: ArrayLike, upper: ArrayLike, all_turns: bool,
+) -> IKResult:  # fmt: skip
+    """An IKResult from a closed form's branches ((label, singular, q, turns) each) or its failure."""
+    if failure is not None:
+        return IKResult(pose, (), failure[0], failure[1], continuous)
+    sols = tuple(IKSolution(np.array(q), label, singular, tuple(turns)) for label, singular, q, turns in found)
+    result = IKResult(pose, sols, ok, f"{len(sols)} solution(s)", continuous)
+    return result.expand(lower, upper) if all_turns else result
 
 
 @dataclass(frozen=True)

@@ -67,7 +67,7 @@ from .planar2r import (
     turner,
     wrap,
 )
-from .results import BatchIKResult, IKResult, IKSolution
+from .results import BatchIKResult, IKResult, result_of
 from .targets import check_magnitude, parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:
@@ -567,11 +567,7 @@ def solve(
                         f"the target tilts the tool by {math.degrees(tilt):.6g} deg (roll/pitch); a SCARA can only "
                         "turn it about the vertical axis", geo.continuous)  # fmt: skip
     found, failure = _branches(geo, x, y, z, alpha, reference_floats(reference), branch)
-    if failure is not None:
-        return IKResult(pose, (), failure[0], failure[1], geo.continuous)
-    sols = tuple(IKSolution(np.array(q), label, singular, tuple(turns)) for label, singular, q, turns in found)
-    result = IKResult(pose, sols, IKStatus.OK, f"{len(sols)} solution(s)", geo.continuous)
-    return result.expand(geo.lower, geo.upper) if all_turns else result
+    return result_of(pose, found, failure, IKStatus.OK, geo.continuous, geo.lower, geo.upper, all_turns)
 
 
 def solve_nearest(
