@@ -42,6 +42,7 @@ _LABELS = {Role.STRETCHED: ("stretched", 0), Role.FOLDED: ("folded", 1), Role.SE
 """The engine's candidate roles as limit names (first joint q2, second theta3), and their rank between
 coincident candidates (lowest wins)."""
 
+
 @dataclass(frozen=True)
 class EnvelopeArc:
     """One boundary arc ``c + R (sin phi, cos phi)``, phi from ``start`` to ``start + sweep``.
