@@ -48,7 +48,7 @@ SEED = 0
 
 def limit_sets() -> dict[str, ScaraGeometry]:
     """The shipped robots, and the S5 robot (l1 = 0.325, l2 = 0.275) under several limit sets."""
-    out = {name: load_robot(name).kinematics for name in ("default", "s1")}
+    out = {name: load_robot(name).kinematics.geometry for name in ("default", "s1")}
     base = out["default"]
     d = math.radians
 

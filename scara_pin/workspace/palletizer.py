@@ -6,19 +6,22 @@ In the arm plane (the vertical plane of the turret, turned by q1) the tool point
     r0 = a1 + a4,   z0 = d1 + d2 + d5,
 
 (r the signed distance from the waist axis, forwards positive), over the box of joint limits
-q2 in [lo2, hi2], theta3 in [lo3, hi3]. The boundary of the image of a box lies on the images of its
-edges and of the critical set, det d(r, z)/d(q2, theta3) = -a2 a3 sin(theta3 - q2) = 0. All are circle
-arcs, written ``c + R (sin phi, cos phi)`` with ``phi`` measured from the vertical like the joints:
+q2 in [lo2, hi2], theta3 in [lo3, hi3]. In the coordinates of the IK, (x, y) = (z - z0, r - r0), this is
+the planar two-link arm (a2, a3) of :mod:`scara_pin.kinematics.planar2r` at the origin with ABSOLUTE joint
+angles q2 and theta3, measured from the x axis: the image of a box, computed by the package's one arc
+engine (:mod:`scara_pin.workspace.arcs`: candidate arcs, their exact crossings, the side test with the
+IK's membership, merging, Green's area). Its arcs are turned back into (r, z) here, written
+``c + R (sin phi, cos phi)`` with ``phi`` measured from the vertical like the joints (phi is the engine's
+angle from the x axis), each labelled with what bounds the region there:
 
-- q2 fixed at a limit: centre the elbow, radius a3, phi = theta3 over its range;
-- theta3 fixed at a limit: centre r0 + a3 e(theta3), radius a2, phi = q2 over its range;
-- stretched (theta3 = q2): centre the shoulder, radius a2 + a3, phi over the common range;
-- folded (theta3 = q2 + pi): centre the shoulder, radius |a2 - a3|.
+- q2 fixed at a limit (``joint2_lower``/``joint2_upper``): centre the elbow, radius a3, phi = theta3;
+- theta3 fixed at a limit (``joint3_lower``/``joint3_upper``): centre r0 + a3 e(theta3), radius a2, phi = q2;
+- ``stretched`` (theta3 = q2): centre the shoulder, radius a2 + a3, phi = q2;
+- ``folded`` (theta3 = q2 + pi): centre the shoulder, radius |a2 - a3|.
 
-Every candidate arc is split at its intersections with the others; a piece is on the boundary when a
-point just outside it on one side is reachable and on the other side is not (membership by the planar
-law-of-cosines solution with the joint limits, :func:`reachable`). The area follows from Green's
-theorem over the boundary pieces, each traversed with the region on its left.
+The start of an arc is given as the joint angle of its candidate (e.g. theta3 on a q2-limit arc).
+Membership (:func:`reachable`) is the planar law-of-cosines solution with the joint limits and the IK's
+tolerances.
 """
 
 from __future__ import annotations
@@ -30,16 +33,14 @@ from typing import Any
 import numpy as np
 
 from ..kinematics.palletizer import PalletizerGeometry
-from ..kinematics.planar2r import Reach, nearest_turn
+from .arcs import ArmBox, JointRange, Role, box_region, green
 
 __all__ = ["ArmPlaneEnvelope", "EnvelopeArc", "arm_plane_envelope", "plot_envelope", "reachable"]
 
-_TWO_PI = 2.0 * math.pi
-_TANGENT = 1e-12
-"""Relative tolerance of a tangency between two candidate circles (the stretched circle touches the
-theta3-limit arcs at theta3 = q2: exactly in theory, within rounding in floating point)."""
-_PROBE = 1e-7
-"""[m] distance of the membership probes from a candidate piece (far above rounding, far below features)."""
+_LABELS = {Role.STRETCHED: ("stretched", 0), Role.FOLDED: ("folded", 1), Role.SECOND_LO: ("joint3_lower", 2),
+           Role.SECOND_HI: ("joint3_upper", 3), Role.FIRST_LO: ("joint2_lower", 4), Role.FIRST_HI: ("joint2_upper", 5)}
+"""The engine's candidate roles as limit names (first joint q2, second theta3), and their rank between
+coincident candidates (lowest wins)."""
 
 
 @dataclass(frozen=True)
@@ -77,12 +78,9 @@ class EnvelopeArc:
 
     def green(self) -> float:
         """The arc's term of the area integral 1/2 (r dz - z dr), traversed with the region on its left."""
-        cx, cy = self.center
-        R = self.radius
-        a, b = self.start, self.start + self.sweep
-        if self.inside_toward_center:  # phi grows clockwise: the region on the left means decreasing phi
-            a, b = b, a
-        return 0.5 * (-R * R * (b - a) + R * cx * (math.cos(b) - math.cos(a)) - R * cy * (math.sin(b) - math.sin(a)))
+        # in (r, z) the arc is c + R e(pi/2 - phi): the engine's term over that angle, phi growing clockwise
+        term = green(self.center, self.radius, 0.5 * math.pi - self.start, -self.sweep)
+        return -term if self.inside_toward_center else term
 
 
 @dataclass(frozen=True)
@@ -117,12 +115,11 @@ class ArmPlaneEnvelope:
         }
 
 
-def _origin(geo: PalletizerGeometry) -> tuple[float, float]:
-    return geo.r0, geo.h0
-
-
-def _fits(value: float, lo: float, hi: float, continuous: bool) -> bool:
-    return continuous or nearest_turn(value, lo, hi, value) is not None
+def _box(geo: PalletizerGeometry) -> ArmBox:
+    """The arm (a2, a3) in (x, y) = (z - h0, r - r0) and its box of absolute angles (q2, theta3)."""
+    q2, t3 = ((JointRange(-math.pi, math.pi, True) if geo.continuous[j] else JointRange.of(geo.lower[j], geo.upper[j]))
+              for j in (1, 2))  # fmt: skip
+    return ArmBox((0.0, 0.0), geo.arm, q2, t3, relative=False)
 
 
 def reachable(geo: PalletizerGeometry, r: float, z: float) -> bool:
@@ -131,104 +128,17 @@ def reachable(geo: PalletizerGeometry, r: float, z: float) -> bool:
     The planar two-link solution (:mod:`scara_pin.kinematics.planar2r`) of the arm plane, both elbows,
     with the IK's tolerances.
     """
-    arm = geo.arm
-    code, _, g, heading, lean = arm.solve(z - geo.h0, r - geo.r0)  # the arm plane as (x, y) = (v, h)
-    if code != Reach.OK:
-        return False
-    lo, hi, cont = geo.lower, geo.upper, geo.continuous
-    for q3, q2 in ((g, heading - lean), (-g, heading + lean)):
-        if _fits(q2, lo[1], hi[1], cont[1]) and _fits(q2 + q3, lo[2], hi[2], cont[2]):
-            return True
-    return False
-
-
-def _candidates(geo: PalletizerGeometry) -> list[tuple[tuple[float, float], float, float, float, str]]:
-    """(center, radius, phi0, phi1, limit) of every candidate arc."""
-    r0, z0 = _origin(geo)
-    a2, a3 = geo.a2, geo.a3
-    (lo2, hi2), (lo3, hi3) = ((-math.pi, math.pi) if geo.continuous[j] else (geo.lower[j], geo.upper[j])
-                              for j in (1, 2))  # fmt: skip
-    hi2, hi3 = min(hi2, lo2 + _TWO_PI), min(hi3, lo3 + _TWO_PI)
-    out = []
-    for q2, name in ((lo2, "joint2_lower"), (hi2, "joint2_upper")):
-        out.append(((r0 + a2 * math.sin(q2), z0 + a2 * math.cos(q2)), a3, lo3, hi3, name))
-    for t3, name in ((lo3, "joint3_lower"), (hi3, "joint3_upper")):
-        out.append(((r0 + a3 * math.sin(t3), z0 + a3 * math.cos(t3)), a2, lo2, hi2, name))
-    for k in range(-2, 3):  # theta3 = q2 + 2 pi k (stretched) and q2 + pi + 2 pi k (folded)
-        a, b = max(lo2, lo3 - k * _TWO_PI), min(hi2, hi3 - k * _TWO_PI)
-        if a < b:
-            out.append(((r0, z0), a2 + a3, a, b, "stretched"))
-        a, b = max(lo2, lo3 - math.pi - k * _TWO_PI), min(hi2, hi3 - math.pi - k * _TWO_PI)
-        if a < b and a2 != a3:  # folded: the point is shoulder + (a2 - a3) e(q2)
-            if a2 > a3:
-                out.append(((r0, z0), a2 - a3, a, b, "folded"))
-            else:
-                off = math.pi + k * _TWO_PI  # as a function of theta3 = q2 + pi + 2 pi k
-                out.append(((r0, z0), a3 - a2, a + off, b + off, "folded"))
-    return out
-
-
-def _circle_hits(c1: tuple[float, float], r1: float, c2: tuple[float, float], r2: float) -> list[np.ndarray]:
-    d = math.hypot(c2[0] - c1[0], c2[1] - c1[1])
-    tol = _TANGENT * (r1 + r2)  # circles this close to tangent touch (rounding must not hide a tangency)
-    if d == 0.0 or d > r1 + r2 + tol or d < abs(r1 - r2) - tol:
-        return []
-    a = (r1 * r1 - r2 * r2 + d * d) / (2 * d)
-    h = math.sqrt(max(r1 * r1 - a * a, 0.0))
-    ex, ey = (c2[0] - c1[0]) / d, (c2[1] - c1[1]) / d
-    px, py = c1[0] + a * ex, c1[1] + a * ey
-    return [np.array([px - h * ey, py + h * ex]), np.array([px + h * ey, py - h * ex])]
-
-
-def _phi_on(center: tuple[float, float], p: np.ndarray, phi0: float) -> float:
-    """The phi of point p on a circle, as the 2 pi-equivalent at or above phi0."""
-    phi = math.atan2(p[0] - center[0], p[1] - center[1])
-    return phi + math.ceil((phi0 - phi) / _TWO_PI - 1e-12) * _TWO_PI
+    return bool(_box(geo).contains(np.array([z - geo.h0]), np.array([r - geo.r0]))[0])
 
 
 def arm_plane_envelope(geo: PalletizerGeometry) -> ArmPlaneEnvelope:
     """The exact reach envelope of the tool point in the arm plane under the q2 and theta3 limits."""
-    cands = _candidates(geo)
-    arcs: list[EnvelopeArc] = []
-    for i, (c, R, phi0, phi1, name) in enumerate(cands):
-        cuts = [phi0, phi1]
-        for j, (c2, R2, *_rest) in enumerate(cands):
-            if j != i:
-                for p in _circle_hits(c, R, c2, R2):
-                    phi = _phi_on(c, p, phi0)
-                    if phi0 < phi < phi1:
-                        cuts.append(phi)
-        cuts.sort()
-        for a, b in zip(cuts[:-1], cuts[1:]):
-            if b - a <= 1e-12:
-                continue
-            m = 0.5 * (a + b)
-            n = np.array([math.sin(m), math.cos(m)])
-            p = np.array([c[0], c[1]]) + R * n
-            outer = reachable(geo, *(p + _PROBE * n))
-            inner = reachable(geo, *(p - _PROBE * n))
-            if outer != inner:
-                arcs.append(EnvelopeArc((float(c[0]), float(c[1])), R, a, b - a, name, inner))
-    arcs = _merge(arcs)
-    area = sum(a.green() for a in arcs)
+    region = box_region(_box(geo), _LABELS)
+    arcs = [EnvelopeArc((a.center[1] + geo.r0, a.center[0] + geo.h0), a.radius, a.param_start, a.sweep, a.label,
+                        a.region_inside) for a in region.arcs]  # fmt: skip
     pts = np.array([p for a in arcs for p in a.extreme_points()]) if arcs else np.zeros((1, 2))
-    return ArmPlaneEnvelope(tuple(arcs), float(area), (float(pts[:, 0].min()), float(pts[:, 0].max())),
+    return ArmPlaneEnvelope(tuple(arcs), float(region.area), (float(pts[:, 0].min()), float(pts[:, 0].max())),
                             (float(pts[:, 1].min()), float(pts[:, 1].max())), geo)  # fmt: skip
-
-
-def _merge(arcs: list[EnvelopeArc]) -> list[EnvelopeArc]:
-    """Join consecutive pieces of the same candidate arc (cut where another arc crossed the interior)."""
-    out: list[EnvelopeArc] = []
-    for a in arcs:
-        last = out[-1] if out else None
-        if (last is not None and last.limit == a.limit and last.center == a.center and last.radius == a.radius
-                and last.inside_toward_center == a.inside_toward_center
-                and abs(last.start + last.sweep - a.start) <= 1e-12):  # fmt: skip
-            out[-1] = EnvelopeArc(last.center, last.radius, last.start, last.sweep + a.sweep, a.limit,
-                                  a.inside_toward_center)  # fmt: skip
-        else:
-            out.append(a)
-    return out
 
 
 def plot_envelope(env: ArmPlaneEnvelope, path: str, q: np.ndarray | None = None) -> None:

@@ -18,21 +18,17 @@ outer loop and possibly holes; it never comes in two pieces. Its boundary lies i
   gamma = pi (folded, r = |l1 - l2|), when the elbow range contains them (mod 2 pi).
 
 A J1 range of 2 pi or more (or infinite limits) leaves only circles about A1 (an annulus, no side arcs);
-an elbow range of 2 pi or more makes the J1 edges whole circles. The candidate arcs are split at all their
-mutual intersections, taken from the joint parameters where they are known (an elbow circle meets the
-shoulder circle of elbow angle g at (theta, +/-g); g = 0 and pi are tangencies, where the general
-circle-circle formula would lose half the digits); a piece is kept when exactly one side of its midpoint
-(offset radially by ``SIDE_OFFSET`` times l1 + l2, or a quarter of the distance to the nearest other
-candidate circle if that is less) is in the exact set (:meth:`Workspace.contains` with tol = 0), and
-labelled with the joint limit that produces it. The kept pieces are merged and chained into loops
-oriented with the region on the left (outer loop counterclockwise, holes clockwise); the area is exact by
-Green's theorem over the arcs: for an arc of centre c, radius R from angle a to b (signed), the integral
-of x dy - y dx is R^2 (b - a) + R [c_x (sin b - sin a) - c_y (cos b - cos a)].
+an elbow range of 2 pi or more makes the J1 edges whole circles. This is the arm of
+:mod:`scara_pin.kinematics.planar2r` over a box with a RELATIVE second joint (gamma): the candidate arcs,
+their splitting at mutual intersections (exact from the joint parameters where known), the side test with
+the exact membership, the merging, the loops (outer loop counterclockwise, holes clockwise) and the exact
+area by Green's theorem are those of the package's one arc engine, :mod:`scara_pin.workspace.arcs`; here
+they get their labels (:class:`Limit`, named by the joint and its q limit) and, with ``yaw``, an offset.
 
-:meth:`Workspace.contains` is the closed-form IK's test (independent of the arcs): r = |W - A1| gives
-|gamma| by the half-angle law of cosines; each elbow sign gives gamma and theta, and the point is inside
-when gamma and theta each have a 2 pi-equivalent within the limits (tolerance ``LIMIT_TOL`` = 1e-10 rad
-on the joints and ``REACH_TOL`` = 1e-10 m on the reach, the IK's own).
+:meth:`Workspace.contains` is the closed-form IK's test, independent of the arcs (the engine's
+``ArmBox.contains``): r = |W - A1| gives |gamma| by the half-angle law of cosines; each elbow sign gives
+gamma and theta, and the point is inside when gamma and theta each have a 2 pi-equivalent within the limits
+(tolerance ``LIMIT_TOL`` = 1e-10 rad on the joints and ``REACH_TOL`` = 1e-10 m on the reach, the IK's own).
 
 Which point. The region is that of the wrist axis point. The shipped robots have no plan-view tool offset,
 so it is also the tool point's. With a tool offset t from the wrist axis, the tool point is
@@ -69,8 +65,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidInputError, ParameterError
-from ..kinematics.planar2r import LIMIT_TOL, Planar2R, fits_array
+from ..kinematics.planar2r import LIMIT_TOL
 from ..kinematics.scara import ScaraGeometry
+from .arcs import SIDE_OFFSET, ArmBox, JointRange, Role, box_region
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -91,12 +88,6 @@ __all__ = [
 
 EDGE_TOL = 1e-9
 """[m] a ray start this close to the edge is on it; arc ranges are widened by this much for ray hits."""
-SIDE_OFFSET = 1e-7
-"""[-] radial offset (times l1 + l2) of the two side points that decide whether an arc piece is boundary."""
-_MERGE_TOL = 1e-12
-"""[-] (times l1 + l2) two candidate circles closer than this are the same circle."""
-_CHAIN_TOL = 1e-7
-"""[-] (times l1 + l2) arc ends closer than this are joined into a loop."""
 
 _TWO_PI = 2.0 * math.pi
 
@@ -233,87 +224,12 @@ class RayBatch:
     limit: np.ndarray
 
 
-@dataclass(frozen=True)
-class _Params:
-    """The plain numbers of the region (angles in the plane, not joint values)."""
-
-    a1: tuple[float, float]
-    l1: float
-    l2: float
-    t_lo: float
-    t_hi: float
-    t_full: bool
-    g_lo: float
-    g_hi: float
-    g_full: bool
-    arm: Planar2R
-
-
-def _turn_ok(v: np.ndarray, lo: float, hi: float, full: bool, tol: float) -> np.ndarray:
-    """Whether v + 2 pi k lies in [lo - tol, hi + tol] for some integer k (elementwise)."""
-    return np.ones(np.shape(v), dtype=bool) if full else fits_array(v, lo, hi, tol)
-
-
-def _contains_xy(p: _Params, x: np.ndarray, y: np.ndarray, tol: float = LIMIT_TOL) -> np.ndarray:
-    """The closed-form IK's reachability test of wrist points (the planar arm's, module docstring).
-
-    tol [rad] and [m]: how far outside a joint limit or a reach circle still counts as inside.
-    """
-    arm = p.arm
-    dx, dy = np.asarray(x, dtype=float) - p.a1[0], np.asarray(y, dtype=float) - p.a1[1]
-    r, g0, heading, lean, _ = arm.solve_array(dx, dy)
-    free = r < 1e-15  # l1 = l2 and the wrist on the shoulder axis: the shoulder angle is free
-    inside = np.zeros(np.shape(r), dtype=bool)
-    for sign in (1.0, -1.0):
-        ok_g = _turn_ok(sign * g0, p.g_lo, p.g_hi, p.g_full, tol)
-        ok_t = _turn_ok(heading - sign * lean, p.t_lo, p.t_hi, p.t_full, tol) | free
-        inside |= ok_g & ok_t
-    return inside & (r <= arm.l12 + tol) & (r >= arm.d12 - tol)
-
-
-def _circle_intersections(c1: tuple[float, float], r1: float, c2: tuple[float, float], r2: float) -> list[float]:
-    """Angles on circle 1 of its intersections with circle 2 (a tangency gives the same angle twice)."""
-    dx, dy = c2[0] - c1[0], c2[1] - c1[1]
-    d = math.hypot(dx, dy)
-    eps = 1e-13 * max(r1, r2)
-    if d < 1e-15 or d > r1 + r2 + eps or d < abs(r1 - r2) - eps:
-        return []
-    base = math.atan2(dy, dx)
-    c = (d * d + r1 * r1 - r2 * r2) / (2.0 * d * r1)
-    h = math.acos(min(1.0, max(-1.0, c)))
-    return [base - h, base + h]
-
-
-def _intersections(p: _Params, a: _Candidate, b: _Candidate) -> list[float]:
-    """Angles on a's circle of its intersections with b's, from the joint parameters where they are known.
-
-    An elbow circle (heading theta) meets the shoulder circle of elbow angle g at the configurations
-    (theta, +g) and (theta, -g): angles theta +/- g on the elbow circle, theta +/- psi(g) on the shoulder
-    circle; g = 0 and g = pi are the tangencies with the outer and folded circles, exact here where the
-    general formula would lose half the digits. Two shoulder circles are concentric; two elbow circles
-    (the two J1 limits) meet where the general formula says.
-    """
-    (ka, va), (kb, vb) = a.circle, b.circle
-    if ka == "shoulder" and kb == "shoulder":
-        return []
-    if ka == "elbow" and kb == "elbow":
-        return _circle_intersections(a.center, a.radius, b.center, b.radius)
-    if ka == "elbow":
-        return [va + vb, va - vb]
-    psi = math.atan2(p.l2 * math.sin(va), p.l1 + p.l2 * math.cos(va))
-    return [vb + psi, vb - psi]
-
-
-@dataclass
-class _Candidate:
-    center: tuple[float, float]
-    radius: float
-    start: float
-    sweep: float  # 2 pi: whole circle
-    limit: Limit
-    description: str
-    # ("elbow", theta): radius l2 about the elbow at heading theta; ("shoulder", |gamma|): r(gamma) about A1
-    circle: tuple[str, float]
+def _box(geo: ScaraGeometry) -> ArmBox:
+    """The arm and its box of joint angles in the plane: theta = s1 q1 + beta1, gamma = elbow_angle(q2)."""
+    ra, rb = geo.revolute[0], geo.revolute[1]
+    t = JointRange.of(geo.signs[ra] * geo.lower[ra] + geo.beta1, geo.signs[ra] * geo.upper[ra] + geo.beta1)
+    g = JointRange.of(geo.elbow_angle(geo.lower[rb]), geo.elbow_angle(geo.upper[rb]))
+    return ArmBox(geo.a1, geo.arm, t, g, relative=True)
 
 
 @dataclass(frozen=True)
@@ -341,14 +257,14 @@ class Workspace:
     z_range: tuple[float, float]
     offset: tuple[float, float] = (0.0, 0.0)
     yaw: float | None = None
-    _p: _Params = field(init=False, repr=False, compare=False)
+    _box: ArmBox = field(init=False, repr=False, compare=False)
     _z_limits: tuple[Limit, Limit] = field(init=False, repr=False, compare=False)
     _arc_arrays: tuple[np.ndarray, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # derived once (the workspace is frozen): the plain numbers of the test and the arcs as arrays
         geo = self.geometry
-        object.__setattr__(self, "_p", _params(geo))
+        object.__setattr__(self, "_box", _box(geo))
         up = geo.signs[geo.prismatic] > 0  # the top of the stroke is J3's upper limit
         z_limits = (Limit.J3_LOWER, Limit.J3_UPPER) if up else (Limit.J3_UPPER, Limit.J3_LOWER)
         object.__setattr__(self, "_z_limits", z_limits)
@@ -374,7 +290,7 @@ class Workspace:
         P = np.atleast_2d(P)
         if P.shape[1] < 2:
             raise ParameterError("points", f"array of shape {np.shape(points)}", "must be (2,) or (N, 2)")
-        out = _contains_xy(self._p, P[:, 0] - self.offset[0], P[:, 1] - self.offset[1], tol)
+        out = self._box.contains(P[:, 0] - self.offset[0], P[:, 1] - self.offset[1], tol)
         return bool(out[0]) if one else out
 
     def contains_by_arcs(self, points: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -535,10 +451,10 @@ class Workspace:
         return f"{name} at the {side} end of its stroke ({'top' if at_top else 'bottom'}: z = {z:.6g} m)"
 
     def _why_outside(self, xy: np.ndarray) -> str:
-        p = self._p
-        r = math.hypot(xy[0] - self.offset[0] - p.a1[0], xy[1] - self.offset[1] - p.a1[1])
-        if r > p.l1 + p.l2:
-            return f"r = {r:.9g} m from the shoulder axis is beyond the reach l1 + l2 = {p.l1 + p.l2:.9g} m"
+        a1, l12 = self._box.origin, self._box.arm.l12
+        r = math.hypot(xy[0] - self.offset[0] - a1[0], xy[1] - self.offset[1] - a1[1])
+        if r > l12:
+            return f"r = {r:.9g} m from the shoulder axis is beyond the reach l1 + l2 = {l12:.9g} m"
         if r < self.r_min:
             return f"r = {r:.9g} m from the shoulder axis is inside the inner limit r_min = {self.r_min:.9g} m"
         g = self.geometry
@@ -616,191 +532,42 @@ def workspace(
         al = float(yaw) - geo.yaw0
         tx, ty = geo.tool
         offset = (math.cos(al) * tx - math.sin(al) * ty, math.sin(al) * tx + math.cos(al) * ty)
-    p = _params(geo)
-    arcs = _boundary(geo, p)
-    if offset != (0.0, 0.0):
+    box = _box(geo)
+    region = box_region(box, _labels(geo))
+    arcs = [Arc(a.center, a.radius, a.start, a.sweep, a.label[0], a.label[1], a.region_inside) for a in region.arcs]
+    if offset != (0.0, 0.0):  # a translation: the loops and the area stay
         arcs = [replace(a, center=(a.center[0] + offset[0], a.center[1] + offset[1])) for a in arcs]
-    loops = _chain(arcs, p.l1 + p.l2)
-    area = 0.0
-    for a in arcs:
-        s = 1.0 if a.region_inside else -1.0
-        cx, cy, R = a.center[0], a.center[1], a.radius
-        b, e = a.start, a.end
-        green = R * R * a.sweep + R * (cx * (math.sin(e) - math.sin(b)) - cy * (math.cos(e) - math.cos(b)))
-        area += 0.5 * s * green
     # (radius_range() needs finite elbow limits; a full elbow turn reaches every radius of the annulus)
-    r_min, r_max = (abs(p.l1 - p.l2), p.l1 + p.l2) if p.g_full else geo.radius_range()
+    r_min, r_max = (box.arm.d12, box.arm.l12) if box.second.full else geo.radius_range()
     ip = geo.prismatic
     zs = sorted((geo.z0 + geo.signs[ip] * geo.lower[ip], geo.z0 + geo.signs[ip] * geo.upper[ip]))
-    return Workspace(geo, tuple(arcs), loops, area, r_min, r_max, (zs[0], zs[1]), offset, yaw)
-
-
-def _params(geo: ScaraGeometry) -> _Params:
-    ra, rb = geo.revolute[0], geo.revolute[1]
-    t = sorted((geo.signs[ra] * geo.lower[ra] + geo.beta1, geo.signs[ra] * geo.upper[ra] + geo.beta1))
-    g = sorted((geo.elbow_angle(geo.lower[rb]), geo.elbow_angle(geo.upper[rb])))
-    t_full = not (math.isfinite(t[0]) and math.isfinite(t[1]) and t[1] - t[0] < _TWO_PI)
-    g_full = not (math.isfinite(g[0]) and math.isfinite(g[1]) and g[1] - g[0] < _TWO_PI)
-    return _Params(geo.a1, geo.l1, geo.l2, t[0], t[1], t_full, g[0], g[1], g_full, geo.arm)
+    return Workspace(geo, tuple(arcs), region.loops, region.area, r_min, r_max, (zs[0], zs[1]), offset, yaw)
 
 
 def _deg(v: float) -> str:
     return f"{math.degrees(v):.6g} deg"
 
 
-def _candidates(geo: ScaraGeometry, p: _Params) -> list[_Candidate]:
-    """Every arc that may carry boundary: rectangle edges and singular circles (module docstring)."""
+def _labels(geo: ScaraGeometry) -> dict[Role, tuple[tuple[Limit, str], int]]:
+    """Each candidate role's (Limit, description) and rank: the joint limit it is, named in q (not angle) terms.
+
+    An axis pointing down (sign -1) turns the lower end of the angle range into the joint's upper limit.
+    """
     ra, rb = geo.revolute[0], geo.revolute[1]
     n1, n2 = geo.names[ra], geo.names[rb]
-    l1, l2, a1 = p.l1, p.l2, p.a1
-    out: list[_Candidate] = []
-    t_sweep = _TWO_PI if p.t_full else p.t_hi - p.t_lo
-    t_start = 0.0 if p.t_full else p.t_lo
-
-    def reaches(angle: float) -> bool:
-        return p.g_full or angle + math.ceil((p.g_lo - angle) / _TWO_PI) * _TWO_PI <= p.g_hi
-
-    # J1 edges: J1 at a limit, J2 sweeping: radius l2 about the elbow
-    if not p.t_full:
-        for t, lower_q in ((p.t_lo, geo.signs[ra] > 0), (p.t_hi, geo.signs[ra] < 0)):
-            q = geo.lower[ra] if lower_q else geo.upper[ra]
-            lim = Limit.J1_LOWER if lower_q else Limit.J1_UPPER
-            c = (a1[0] + l1 * math.cos(t), a1[1] + l1 * math.sin(t))
-            sw = _TWO_PI if p.g_full else p.g_hi - p.g_lo
-            st = 0.0 if p.g_full else t + p.g_lo
-            if sw > 0.0:
-                text = f"{n1} at its {'lower' if lower_q else 'upper'} limit {_deg(q)}, {n2} sweeping"
-                out.append(_Candidate(c, l2, st, sw, lim, text, ("elbow", t)))
-    # J2 edges: J2 at a limit, J1 sweeping: radius r(g) about the shoulder
-    if not p.g_full:
-        for g, lower_q in ((p.g_lo, geo.signs[rb] > 0), (p.g_hi, geo.signs[rb] < 0)):
-            R = p.arm.radius(g)
-            if R <= 1e-12 * (l1 + l2):
-                continue
-            q = geo.lower[rb] if lower_q else geo.upper[rb]
-            lim = Limit.J2_LOWER if lower_q else Limit.J2_UPPER
-            psi = math.atan2(l2 * math.sin(g), l1 + l2 * math.cos(g))
-            if t_sweep > 0.0:
-                text = f"{n2} at its {'lower' if lower_q else 'upper'} limit {_deg(q)}, {n1} sweeping"
-                out.append(_Candidate(a1, R, t_start + (0.0 if p.t_full else psi), t_sweep, lim, text,
-                                      ("shoulder", abs(math.remainder(g, _TWO_PI)))))  # fmt: skip
-    # singular circles
-    if reaches(0.0) and t_sweep > 0.0:
-        text = f"outer: arm stretched ({n2} at elbow angle 0), {n1} sweeping"
-        out.append(_Candidate(a1, l1 + l2, t_start, t_sweep, Limit.OUTER, text, ("shoulder", 0.0)))
-    if reaches(math.pi) and abs(l1 - l2) > 1e-12 * (l1 + l2) and t_sweep > 0.0:
-        psi = 0.0 if l1 > l2 else math.pi
-        text = f"inner: arm folded ({n2} at elbow angle 180 deg), {n1} sweeping"
-        start = t_start + (0.0 if p.t_full else psi)
-        out.append(_Candidate(a1, abs(l1 - l2), start, t_sweep, Limit.FOLDED, text, ("shoulder", math.pi)))
-    return out
-
-
-def _boundary(geo: ScaraGeometry, p: _Params) -> list[Arc]:
-    """Split the candidates at their intersections, keep the boundary pieces, merge them (module docstring)."""
-    scale = p.l1 + p.l2
-    cands = _candidates(geo, p)
-    # group candidates lying on the same circle
-    groups: list[list[_Candidate]] = []
-    for c in cands:
-        for grp in groups:
-            g0 = grp[0]
-            if (math.hypot(c.center[0] - g0.center[0], c.center[1] - g0.center[1]) < _MERGE_TOL * scale
-                    and abs(c.radius - g0.radius) < _MERGE_TOL * scale):  # fmt: skip
-                grp.append(c)
-                break
-        else:
-            groups.append([c])
-    arcs: list[Arc] = []
-    delta = SIDE_OFFSET * scale
-    for gi, grp in enumerate(groups):
-        center, R = grp[0].center, grp[0].radius
-        bps: list[float] = []
-        for c in grp:
-            if c.sweep < _TWO_PI:
-                bps += [c.start % _TWO_PI, (c.start + c.sweep) % _TWO_PI]
-        for gj, other in enumerate(groups):
-            if gj != gi:
-                bps += [a % _TWO_PI for a in _intersections(p, grp[0], other[0])]
-        bps.sort()
-        uniq: list[float] = []
-        for b in bps:
-            if not uniq or b - uniq[-1] > 1e-13:
-                uniq.append(b)
-        if len(uniq) > 1 and uniq[0] + _TWO_PI - uniq[-1] <= 1e-13:
-            uniq.pop()
-        if not uniq:
-            pieces = [(0.0, _TWO_PI)]
-        else:
-            pieces = [(uniq[i], uniq[i + 1]) for i in range(len(uniq) - 1)] + [(uniq[-1], uniq[0] + _TWO_PI)]
-        kept: list[tuple[float, float, _Candidate, bool]] = []
-        for s, e in pieces:
-            m = 0.5 * (s + e)
-            covering = [c for c in grp if c.sweep >= _TWO_PI or (m - c.start) % _TWO_PI < c.sweep]
-            if not covering:
-                continue
-            cm, sm = math.cos(m), math.sin(m)
-            # side points closer to this circle than to any other candidate circle (nearly coincident
-            # circles: a J2 limit just off 0 or pi), tested on the exact set (tol = 0)
-            px, py = center[0] + R * cm, center[1] + R * sm
-            gap = min((abs(math.hypot(px - o[0].center[0], py - o[0].center[1]) - o[0].radius)
-                       for gj, o in enumerate(groups) if gj != gi), default=math.inf)  # fmt: skip
-            d = min(delta, 0.25 * gap) if gap > 0.0 else delta
-            xs = np.array([center[0] + (R - d) * cm, center[0] + (R + d) * cm])
-            ys = np.array([center[1] + (R - d) * sm, center[1] + (R + d) * sm])
-            in_in, in_out = _contains_xy(p, xs, ys, 0.0)
-            if bool(in_in) == bool(in_out):
-                continue
-            # keep the previous piece's label while its candidate still covers (fewer, longer arcs)
-            prev = kept[-1][2] if kept and abs(kept[-1][1] - s) < 1e-13 and kept[-1][3] == bool(in_in) else None
-            best = prev if prev in covering else min(covering, key=lambda c: _PRIORITY[c.limit])
-            kept.append((s, e, best, bool(in_in)))
-        # merge neighbours with the same label and side (cyclically)
-        merged: list[list[Any]] = []
-        for s, e, c, side in kept:
-            if merged and abs(merged[-1][1] - s) < 1e-13 and merged[-1][2] is c and merged[-1][3] == side:
-                merged[-1][1] = e
-            else:
-                merged.append([s, e, c, side])
-        if len(merged) > 1:
-            first, last = merged[0], merged[-1]
-            if abs(last[1] - (first[0] + _TWO_PI)) < 1e-13 and last[2] is first[2] and last[3] == first[3]:
-                first[0] = last[0]
-                first[1] = first[1] + _TWO_PI if first[1] < last[0] else first[1]
-                merged.pop()
-        for s, e, c, side in merged:
-            sweep = min(e - s, _TWO_PI)
-            start = 0.0 if sweep >= _TWO_PI else s % _TWO_PI
-            arcs.append(Arc(center, R, start, sweep, c.limit, c.description, side))
-    return arcs
-
-
-def _chain(arcs: list[Arc], scale: float) -> tuple[tuple[int, ...], ...]:
-    """Order the arcs into closed loops, each arc traversed with the region on its left."""
-
-    def ends(i: int) -> tuple[tuple[float, float], tuple[float, float]]:
-        a = arcs[i]
-        p0, p1 = a.point(a.start), a.point(a.end)
-        return (p0, p1) if a.region_inside else (p1, p0)
-
-    unused = set(range(len(arcs)))
-    loops: list[tuple[int, ...]] = []
-    while unused:
-        first = min(unused)
-        unused.discard(first)
-        loop = [first]
-        if arcs[first].sweep < _TWO_PI:
-            head = ends(first)[0]
-            tail = ends(first)[1]
-            while math.dist(tail, head) > _CHAIN_TOL * scale:
-                nxt = min(unused, key=lambda j: math.dist(ends(j)[0], tail), default=None)
-                if nxt is None or math.dist(ends(nxt)[0], tail) > _CHAIN_TOL * scale:
-                    break  # an open chain: reported as it is (should not happen)
-                unused.discard(nxt)
-                loop.append(nxt)
-                tail = ends(nxt)[1]
-        loops.append(tuple(loop))
-    return tuple(loops)
+    out: dict[Role, tuple[tuple[Limit, str], int]] = {}
+    for j, roles, limits, other in ((ra, (Role.FIRST_LO, Role.FIRST_HI), (Limit.J1_LOWER, Limit.J1_UPPER), n2),
+                                    (rb, (Role.SECOND_LO, Role.SECOND_HI), (Limit.J2_LOWER, Limit.J2_UPPER), n1)):
+        for role, lower_q in zip(roles, (geo.signs[j] > 0, geo.signs[j] < 0), strict=True):
+            limit = limits[0] if lower_q else limits[1]
+            q = geo.lower[j] if lower_q else geo.upper[j]
+            text = f"{geo.names[j]} at its {'lower' if lower_q else 'upper'} limit {_deg(q)}, {other} sweeping"
+            out[role] = ((limit, text), _PRIORITY[limit])
+    out[Role.STRETCHED] = ((Limit.OUTER, f"outer: arm stretched ({n2} at elbow angle 0), {n1} sweeping"),
+                           _PRIORITY[Limit.OUTER])
+    out[Role.FOLDED] = ((Limit.FOLDED, f"inner: arm folded ({n2} at elbow angle 180 deg), {n1} sweeping"),
+                        _PRIORITY[Limit.FOLDED])
+    return out  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ picture
