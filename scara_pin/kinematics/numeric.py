@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg.lapack import dgesv as _gesv
 
 from ..errors import ParameterError
 
@@ -193,7 +194,7 @@ class _Task:
     Works on the robot's private model re-rooted at the base frame (its ``oMf`` are placements in
     ``base``, its LOCAL_WORLD_ALIGNED Jacobians are in base axes), with the tool frame id: no input
     re-validation per iteration (q stays a float64 4-vector inside the limits); the 4 x 4 systems are
-    LAPACK's (``np.linalg.solve``), and the Jacobian and J^T J, J^T e are reused while a rejected step
+    LAPACK's (gesv, through scipy), and the Jacobian and J^T J, J^T e are reused while a rejected step
     leaves q unchanged.
     """
 
@@ -334,8 +335,10 @@ def _damped_solve(G: np.ndarray, l2: float, g: np.ndarray) -> list[float]:
 
 
 def _solve(A: np.ndarray, b: np.ndarray) -> list[float] | None:
-    """Solve the 4 x 4 system A x = b (LAPACK's gesv); ``None`` when A is exactly singular."""
-    try:
-        return np.linalg.solve(A, b).tolist()
-    except np.linalg.LinAlgError:
-        return None
+    """Solve the 4 x 4 system A x = b (LAPACK's gesv); ``None`` when A is exactly singular.
+
+    LAPACK through scipy's thin wrapper: the same routine as ``np.linalg.solve``, without its ~3 us of
+    Python around a 4 x 4 system (0.6 us here).
+    """
+    _, _, x, info = _gesv(A, b)
+    return None if info != 0 else x.tolist()

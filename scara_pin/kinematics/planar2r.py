@@ -269,27 +269,28 @@ def turn_edge(value: float, lo: float, hi: float, slack: float) -> float | None:
     return None
 
 
-def turner(lo: float, hi: float, continuous: bool = False) -> Callable[[float, float], tuple[float, int, int] | None]:
-    """:func:`nearest_turn` with a joint's limits bound once: ``turn(value, ref)`` (the per-call paths)."""
-    if continuous:
+def turner(lo: float, hi: float, continuous: bool = False) -> Callable[..., tuple[float, int, int] | None]:
+    """:func:`nearest_turn` with a joint's limits bound once: ``turn(value, ref, ranges=True)``.
 
-        def turn_continuous(value: float, ref: float) -> tuple[float, int, int] | None:
-            return value + TWO_PI * _floor((ref + _PI - value) * _INV_TWO_PI), 0, 0
-
-        return turn_continuous
+    With ``ranges=False`` (the per-call nearest path) the range of the other turns is not computed when the
+    nearest turn fits the limits: (q, 0, 0) then.
+    """
     lo_t, hi_t = lo - LIMIT_TOL, hi + LIMIT_TOL
 
-    def turn(value: float, ref: float) -> tuple[float, int, int] | None:
+    def turn(value: float, ref: float, ranges: bool = True) -> tuple[float, int, int] | None:
+        k = _floor((ref + _PI - value) * _INV_TWO_PI)
+        q = value + TWO_PI * k
+        if continuous:
+            return q, 0, 0
+        if not ranges and lo_t <= q <= hi_t:
+            return (lo if q < lo else (hi if q > hi else q)), 0, 0
         k_min = _ceil((lo_t - value) * _INV_TWO_PI)
         k_max = _floor((hi_t - value) * _INV_TWO_PI)
         if k_min > k_max:
             return None
-        k = _floor((ref + _PI - value) * _INV_TWO_PI)
-        if k < k_min:
-            k = k_min
-        elif k > k_max:
-            k = k_max
-        q = value + TWO_PI * k
+        if k < k_min or k > k_max:
+            k = k_min if k < k_min else k_max
+            q = value + TWO_PI * k
         return (lo if q < lo else (hi if q > hi else q)), k_min - k, k_max - k
 
     return turn

@@ -61,7 +61,6 @@ from .planar2r import (
     TWO_PI,
     Planar2R,
     Reach,
-    nearest_turn,
     nearest_turn_array,
     turn_edge,
     turner,
@@ -362,6 +361,8 @@ def wrist_point(geo: ScaraGeometry, x: float, y: float, alpha: float) -> tuple[f
 _Branch = tuple[str, bool, list[float], list[tuple[int, int] | None]]
 """(label, singular, q in q order, turns per joint) of one solution."""
 _Failure = tuple[IKStatus, str]
+_LimitFailure = tuple[IKStatus, tuple[str, int, float]]
+"""A branch's joint-limit failure: (status, (branch label, joint index, joint value)), worded when needed."""
 
 
 def _branches(
@@ -403,7 +404,7 @@ def _branches(
     else:
         elbows = ((gamma, heading - lean, "right"), (-gamma, heading + lean, "left"))
     found: list[_Branch] = []
-    failures: list[_Failure] = []
+    failures: list[_LimitFailure] = []
     cont = geo.continuous
     turn = geo._turn
     turn_a, turn_b, turn_c = turn[ra], turn[rb], turn[rc]
@@ -412,9 +413,10 @@ def _branches(
         if branch == "all" or label == branch or singular:
             # the common case inline: every joint has a turn inside its limits (else _joints says why,
             # or puts a joint that rounding alone moved out onto its limit)
-            qb = turn_b(s_b * (g - db), ref_b)
-            qa = turn_a(s_a * (theta1 - b1), ref_a) if qb is not None else None
-            qc = turn_c(s_c * (alpha - s_a * qa[0] - s_b * qb[0]), ref_c) if qa is not None and qb is not None else None
+            qb = turn_b(s_b * (g - db), ref_b, turns)
+            qa = turn_a(s_a * (theta1 - b1), ref_a, turns) if qb is not None else None
+            qc = (turn_c(s_c * (alpha - s_a * qa[0] - s_b * qb[0]), ref_c, turns)
+                  if qa is not None and qb is not None else None)  # fmt: skip
             if qa is None or qb is None or qc is None:
                 out = _joints(geo, wx, wy, alpha, g, theta1, ref, label)
                 if len(out) == 2:
@@ -435,7 +437,11 @@ def _branches(
     if not failures:  # the requested branch was not among the elbows (cannot happen for "all")
         return [], (IKStatus.J2_LIMIT, f"no {branch} solution")
     worst = max(failures, key=lambda f: _STAGE[f[0]])
-    return [], (worst[0], "no solution inside the joint limits: " + "; ".join(f[1] for f in failures))
+    # the sentences are written only now, when no branch solves (the nearest path often drops a failure)
+    names = geo.names
+    why = [f"{label}: {names[j]} = {wrap(v):.9g} rad (+2 pi k) outside [{lo[j]:.9g}, {hi[j]:.9g}]"
+           for _, (label, j, v) in failures]  # fmt: skip
+    return [], (worst[0], "no solution inside the joint limits: " + "; ".join(why))
 
 
 def _joints(
@@ -443,57 +449,54 @@ def _joints(
 ) -> tuple[Any, ...]:
     """Shoulder, elbow and wrist of one branch at their turns nearest ``ref`` ((q, k_lo, k_hi) each).
 
-    Or (status, message) when a joint has no turn inside its limits.
+    Or (status, (branch label, joint index, joint value)) when a joint has no turn inside its limits.
 
     A joint that rounding alone puts outside a limit (by less than ``wob``, the arm's ill-conditioning)
     is put on it and the arm re-solved with that angle fixed.
     """
     ra, rb, rc, _, s_a, s_b, s_c, _, _, _, _, _, _, _, _, _, b1, db = geo._k
-    lo, hi, cont = geo.lower, geo.upper, geo.continuous
+    lo, hi, turn = geo.lower, geo.upper, geo._turn
     # elbow
     vb = s_b * (gamma - db)
-    tb = nearest_turn(vb, lo[rb], hi[rb], ref[rb], cont[rb])
+    tb = turn[rb](vb, ref[rb])
     if tb is None:
-        s, names, arm, b2 = geo.signs, geo.names, geo.arm, geo.beta2
+        s, arm, b2 = geo.signs, geo.arm, geo.beta2
         wob = arm.wobble(gamma)
         edge = turn_edge(vb, lo[rb], hi[rb], wob)
         if edge is not None:
             theta1, miss = arm.with_elbow(wx, wy, geo.elbow_angle(edge))
-            tb = nearest_turn(edge, lo[rb], hi[rb], ref[rb]) if miss <= REACH_TOL else None
+            tb = turn[rb](edge, ref[rb]) if miss <= REACH_TOL else None
         if tb is None:
-            return IKStatus.J2_LIMIT, f"{label}: {names[rb]} = {wrap(vb):.9g} rad (+2 pi k) outside [{lo[rb]:.9g}, " \
-                                      f"{hi[rb]:.9g}]"  # fmt: skip
+            return IKStatus.J2_LIMIT, (label, rb, vb)
     # shoulder
     va = s_a * (theta1 - b1)
-    ta = nearest_turn(va, lo[ra], hi[ra], ref[ra], cont[ra])
+    ta = turn[ra](va, ref[ra])
     if ta is None:
-        s, names, arm, b2 = geo.signs, geo.names, geo.arm, geo.beta2
+        s, arm, b2 = geo.signs, geo.arm, geo.beta2
         wob = arm.wobble(gamma)
         edge = turn_edge(va, lo[ra], hi[ra], wob)
         if edge is not None:
             g, miss = arm.with_link1(wx, wy, s[ra] * edge + b1)
-            tb = nearest_turn(s[rb] * (g + b1 - b2), lo[rb], hi[rb], ref[rb], cont[rb])
-            ta = nearest_turn(edge, lo[ra], hi[ra], ref[ra]) if miss <= REACH_TOL and tb is not None else None
+            tb = turn[rb](s[rb] * (g + b1 - b2), ref[rb])
+            ta = turn[ra](edge, ref[ra]) if miss <= REACH_TOL and tb is not None else None
         if ta is None or tb is None:
-            return IKStatus.J1_LIMIT, f"{label}: {names[ra]} = {wrap(va):.9g} rad (+2 pi k) outside [{lo[ra]:.9g}, " \
-                                      f"{hi[ra]:.9g}]"  # fmt: skip
+            return IKStatus.J1_LIMIT, (label, ra, va)
     # wrist: s_c (alpha - s_a q_a - s_b q_b), whatever turns the shoulder and elbow took
     vc = s_c * (alpha - s_a * ta[0] - s_b * tb[0])
-    tc = nearest_turn(vc, lo[rc], hi[rc], ref[rc], cont[rc])
+    tc = turn[rc](vc, ref[rc])
     if tc is None:
-        s, names, arm, b2 = geo.signs, geo.names, geo.arm, geo.beta2
+        s, arm, b2 = geo.signs, geo.arm, geo.beta2
         wob = arm.wobble(gamma)
         edge = turn_edge(vc, lo[rc], hi[rc], 2.0 * wob)
         if edge is not None:  # the wrist on its limit fixes link 2's heading
             sigma = alpha - s[rc] * edge + b2
             theta1, miss = arm.with_link2(wx, wy, sigma)
-            ta = nearest_turn(s[ra] * (theta1 - b1), lo[ra], hi[ra], ref[ra], cont[ra])
-            tb = nearest_turn(s[rb] * (sigma - theta1 + b1 - b2), lo[rb], hi[rb], ref[rb], cont[rb])
+            ta = turn[ra](s[ra] * (theta1 - b1), ref[ra])
+            tb = turn[rb](s[rb] * (sigma - theta1 + b1 - b2), ref[rb])
             if miss <= REACH_TOL and ta is not None and tb is not None:
-                tc = nearest_turn(s[rc] * (alpha - s[ra] * ta[0] - s[rb] * tb[0]), lo[rc], hi[rc], ref[rc])
+                tc = turn[rc](s[rc] * (alpha - s[ra] * ta[0] - s[rb] * tb[0]), ref[rc])
         if tc is None or ta is None or tb is None:
-            return IKStatus.J4_LIMIT, f"{label}: {names[rc]} = {wrap(vc):.9g} rad (+2 pi k) outside [{lo[rc]:.9g}, " \
-                                      f"{hi[rc]:.9g}]"  # fmt: skip
+            return IKStatus.J4_LIMIT, (label, rc, vc)
     return ta, tb, tc
 
 
