@@ -33,11 +33,11 @@ from .kinematics import palletizer, scara
 from .kinematics.polish import polish_batch, seed_geometry, solve_refined
 from .kinematics.results import BatchIKResult, IKResult
 from .model import Kinematics, Robot
-from .workspace.palletizer import ArmPlaneEnvelope, arm_plane_envelope
-from .workspace.scara import Workspace, workspace
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
+    from .workspace.palletizer import ArmPlaneEnvelope
+    from .workspace.scara import Workspace
 
 __all__ = [
     "PalletizerKinematics",
@@ -115,6 +115,8 @@ class ScaraKinematics:
 
     def workspace(self, **kwargs: Any) -> Workspace:
         """:func:`scara_pin.workspace.scara.workspace` (keyword arguments as there)."""
+        from .workspace.scara import workspace  # on first use: `scara-pin fk` does not need it
+
         return workspace(self.geometry, **kwargs)
 
 
@@ -159,6 +161,8 @@ class PalletizerKinematics:
 
     def workspace(self) -> ArmPlaneEnvelope:
         """:func:`scara_pin.workspace.palletizer.arm_plane_envelope`."""
+        from .workspace.palletizer import arm_plane_envelope  # on first use
+
         return arm_plane_envelope(self.geometry)
 
 
@@ -306,6 +310,8 @@ class Scara3Kinematics(ScaraKinematics):
         for key, pad in (("lower", -math.inf), ("upper", math.inf)):
             if kwargs.get(key) is not None:
                 kwargs[key] = [*kwargs[key], pad] if len(kwargs[key]) == 3 else kwargs[key]
+        from .workspace.scara import workspace  # on first use: `scara-pin fk` does not need it
+
         return workspace(self.geometry, **kwargs)
 
 
