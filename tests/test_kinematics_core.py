@@ -443,3 +443,27 @@ def test_nearest_refuses_with_the_reason() -> None:
     with pytest.raises(InvalidInputError):
         robot.ik_nearest([0.3, 0.1, -0.1, 0.5], np.zeros(4), branch="up")
     assert pin.__version__  # Pinocchio is the C++ layer; the package has none of its own
+
+
+@pytest.mark.parametrize("branch", ["nearest", "up", "down"])
+def test_palletizer_batch_is_the_scalar_route_row_by_row(branch: str) -> None:
+    """The vectorised palletizer batch gives, row for row, the scalar solutions' nearest (or their status)."""
+    robot = sp.load_robot("palletizer")
+    kin = robot.kinematics
+    rng = np.random.default_rng(21)
+    lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
+    Q = rng.uniform(lo - 0.3, hi + 0.3, (600, 4))  # some outside the limits: targets without a solution too
+    T = np.array([robot.tool_pose(q) for q in Q])
+    T[::50, :3] *= 3.0  # out of reach
+    for ref in (None, rng.uniform(lo, hi)):
+        res = kin.batch(T, ref, branch=branch)
+        r = np.zeros(4) if ref is None else ref
+        for i, t in enumerate(T):
+            one = kin.solve(t, branch="all" if branch == "nearest" else branch, reference=r)
+            best = one.nearest(r) if one.success else None
+            assert int(res.status[i]) == int(one.status), (i, one.message)
+            if best is None:
+                assert np.isnan(res.q[i]).all() and res.branch[i] == 0
+            else:
+                assert np.abs(res.q[i] - best.q).max() <= 1e-12, (i, res.q[i], best.q)
+                assert res.branch[i] == (1 if best.branch == "up" else -1)

@@ -44,11 +44,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from .._checks import _vector
+from .._checks import MAGNITUDE_MAX, _vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
-from .planar2r import FREE_R, REACH_TOL, Planar2R, Reach, nearest_turn, turn_edge, wrap
+from .planar2r import FREE_R, LIMIT_TOL, REACH_TOL, Planar2R, Reach, nearest_turn, nearest_turn_array, turn_edge, wrap
 from .results import BatchIKResult, IKResult, result_of
-from .targets import parse_target, reference_floats, weight_floats
+from .targets import check_magnitude, parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -375,7 +375,14 @@ def solve_nearest(
 def solve_batch(
     geo: PalletizerGeometry, targets: ArrayLike, *, branch: str = "nearest", reference: ArrayLike | None = None
 ) -> BatchIKResult:
-    """One solution per target (as the SCARA's :func:`~scara_pin.kinematics.scara.solve_batch`), row by row.
+    """One solution per target, vectorised (as the SCARA's :func:`~scara_pin.kinematics.scara.solve_batch`).
+
+    The same formulas as :func:`solve` on arrays (:meth:`Planar2R.solve_array`, the turns by
+    :func:`~scara_pin.kinematics.planar2r.nearest_turn_array`): for each target the four candidates (reaching
+    forwards or backwards over the waist, elbow up or down) in :func:`solve`'s order, the one nearest the
+    reference (default q = 0) kept, or with ``branch="up"``/``"down"`` the nearest of that branch. The rare
+    rows :func:`solve` decides alone (a target on the waist axis, a limit within the arm's rounding, rows
+    without a solution: their status) take its route.
 
     Returns:
         BatchIKResult: q (NaN rows without a solution), PalletizerIKStatus codes, branch +1 up / -1 down.
@@ -385,18 +392,46 @@ def solve_batch(
         raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
     if branch not in ("nearest", *BRANCHES):
         raise InvalidInputError(f"branch {branch!r} must be 'nearest', 'up' or 'down'")
+    if T.size and not (T.max() <= MAGNITUDE_MAX and T.min() >= -MAGNITUDE_MAX):  # NaN fails the comparisons
+        check_magnitude(T[int(np.argmax(~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)))].tolist())
     ref = np.zeros(4) if reference is None else np.asarray(reference, dtype=float)
+    if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
+        raise ParameterError("reference", f"array of shape {ref.shape}", "must be 4 finite values or (N, 4)")
+    refs = [ref[j] if ref.ndim == 1 else ref[:, j] for j in range(4)]
     n = len(T)
-    q = np.full((n, 4), np.nan)
-    status = np.zeros(n, dtype=np.int64)
+    lo, hi, cont, arm = geo.lower, geo.upper, geo.continuous, geo.arm
+    x, y, z, yaw = T[:, 0], T[:, 1], T[:, 2], T[:, 3]
+    rho = np.sqrt(x * x + y * y)
+    phi = np.arctan2(y, x)
+    v = z - geo.h0
+    best_q = np.full((n, 4), np.nan)
+    best_d = np.full(n, np.inf)
     sign = np.zeros(n, dtype=np.int64)
-    for i in range(n):
+    rare = rho <= FREE_R
+    for label, sg in (("up", 1.0), ("down", -1.0)):  # solve()'s order: up before down, forwards first
+        if branch not in ("nearest", label):
+            continue
+        for turn_back in (0.0, math.pi):
+            r = rho if turn_back == 0.0 else -rho
+            D, g, heading, lean, _ = arm.solve_array(v, r - geo.r0)
+            reach = (D <= arm.l12 + REACH_TOL) & (D >= arm.d12 - REACH_TOL)
+            q2, ok2 = nearest_turn_array(heading - sg * lean, lo[1], hi[1], refs[1], cont[1])
+            t3, ok3 = nearest_turn_array(heading - sg * lean + sg * g, lo[2], hi[2], refs[2], cont[2])
+            q1, ok1 = nearest_turn_array(phi + turn_back, lo[0], hi[0], refs[0], cont[0])
+            q4, ok4 = nearest_turn_array(yaw - geo.tool_yaw - q1, lo[3], hi[3], refs[3], cont[3])
+            ok = reach & ok1 & ok2 & ok3 & ok4
+            # a joint-limit failure near the stretched/folded circles may be rounding: solve() decides those
+            rare |= reach & ~ok & (arm.wobble_array(g) > LIMIT_TOL)
+            Q = np.column_stack((q1, q2, t3, q4))
+            d = np.where(ok, ((Q - ref) ** 2).sum(axis=1), np.inf)
+            take = d < best_d
+            best_q[take], best_d[take], sign[take] = Q[take], d[take], int(sg)
+    status = np.where(np.isfinite(best_d), 0, -1).astype(np.int64)
+    for i in np.flatnonzero(rare | (status != 0)).tolist():  # their status and reason: solve()'s
         row_ref = ref if ref.ndim == 1 else ref[i]
         res = solve(geo, T[i], branch="all" if branch == "nearest" else branch, reference=row_ref)
         best = res.nearest(row_ref) if res.success else None
         status[i] = int(res.status)
-        if best is not None:
-            q[i] = best.q
-            sign[i] = 1 if best.branch == "up" else -1
-    return BatchIKResult(q, status, sign)
-
+        best_q[i] = np.nan if best is None else best.q
+        sign[i] = 0 if best is None else (1 if best.branch == "up" else -1)
+    return BatchIKResult(best_q, status, sign)
