@@ -103,7 +103,9 @@ class ScaraKinematics:
     def batch(self, targets: ArrayLike, reference: ArrayLike | None = None, *, branch: str = "nearest"
               ) -> BatchIKResult:  # fmt: skip
         """:func:`scara_pin.kinematics.scara.solve_batch` (refined row by row when near-parallel)."""
-        res = scara.solve_batch(self.geometry, targets, branch=branch, reference=reference)
+        # near-parallel: seeds from the ideal arm with the widened limits (as solve's); the polish enforces
+        # the model's own limits
+        res = scara.solve_batch(self._seeds, targets, branch=branch, reference=reference)
         if self.robot is None:
             return res
         T = np.asarray(targets, dtype=float)

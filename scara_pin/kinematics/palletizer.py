@@ -46,7 +46,18 @@ import pinocchio as pin
 
 from .._checks import MAGNITUDE_MAX, _vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
-from .planar2r import FREE_R, LIMIT_TOL, REACH_TOL, Planar2R, Reach, nearest_turn, nearest_turn_array, turn_edge, wrap
+from .planar2r import (
+    FREE_R,
+    LIMIT_TOL,
+    REACH_TOL,
+    Planar2R,
+    Reach,
+    free_angle,
+    nearest_turn,
+    nearest_turn_array,
+    turn_edge,
+    wrap,
+)
 from .results import BatchIKResult, IKResult, result_of
 from .targets import check_magnitude, parse_target, reference_floats, weight_floats
 
@@ -227,7 +238,7 @@ def _branches(
     """The solutions of the requested branches (reaching forwards, then backwards), or the most telling failure."""
     lo, hi, cont = geo.lower, geo.upper, geo.continuous
     arm = geo.arm
-    rho = math.hypot(x, y)
+    rho = math.sqrt(x * x + y * y)  # as the batch computes it (np.sqrt of the same sum): the same bits
     if rho <= FREE_R:  # on the waist axis: q1 is free; the reference's, inside the limits
         q1 = ref[0] if cont[0] else min(max(ref[0], lo[0]), hi[0])
         candidates = [(q1, 0.0)]
@@ -253,10 +264,13 @@ def _branches(
             failed(PalletizerIKStatus.INSIDE_INNER_LIMIT,
                    f"the wrist would be {D:.9g} m from the shoulder axis, inside |a2 - a3| = {arm.d12:.9g} m")
             continue
-        singular = arm.singular(g)
+        singular = arm.singular(g) and abs(math.sin(lean)) < 1e-9  # equal arms folded: two configurations
         wob = arm.wobble(g)
-        if singular:
-            elbows: list[tuple[float, float, str]] = [(g, heading - lean, "up" if g < 1.0 else "down")]
+        if D <= FREE_R:  # a2 = a3 and the wrist on the shoulder axis, folded: the big arm is free
+            free = free_angle(lo[1], hi[1], lo[2], hi[2], 1.0, math.pi, ref[1], cont[2])  # theta3 = q2 + pi
+            elbows: list[tuple[float, float, str]] = [(math.pi, ref[1] if free is None else free, "down")]
+        elif singular:
+            elbows = [(g, heading - lean, "up" if g < 1.0 else "down")]
         else:
             elbows = [(g, heading - lean, "up"), (-g, heading + lean, "down")]
         for q3, q2, label in elbows:
@@ -415,6 +429,7 @@ def solve_batch(
             r = rho if turn_back == 0.0 else -rho
             D, g, heading, lean, _ = arm.solve_array(v, r - geo.r0)
             reach = (D <= arm.l12 + REACH_TOL) & (D >= arm.d12 - REACH_TOL)
+            rare |= reach & (D <= FREE_R)  # a2 = a3, the wrist on the shoulder: the big arm is free (solve's)
             q2, ok2 = nearest_turn_array(heading - sg * lean, lo[1], hi[1], refs[1], cont[1])
             t3, ok3 = nearest_turn_array(heading - sg * lean + sg * g, lo[2], hi[2], refs[2], cont[2])
             q1, ok1 = nearest_turn_array(phi + turn_back, lo[0], hi[0], refs[0], cont[0])

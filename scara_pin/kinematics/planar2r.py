@@ -25,7 +25,7 @@ Tolerances (one set for every caller):
 - ``SINGULAR``: an elbow angle this close to 0 or pi makes the two branches one solution.
 
 Near the boundary circles the elbow angle is ill-conditioned: a radius known to a few ulps fixes gamma only
-to about ``sqrt(4 SNAP_TOL) (l1 + l2) / sqrt(l1 l2)`` (1.7e-7 rad for l1 = l2). :meth:`Planar2R.wobble`
+to about ``sqrt(64 SNAP_TOL) (l1 + l2) / sqrt(l1 l2)`` (7e-7 rad for l1 = l2). :meth:`Planar2R.wobble`
 gives that bound for a given gamma; callers use it to land a joint exactly on its limit when rounding
 alone puts it outside (:meth:`Planar2R.with_link1`, :meth:`with_elbow`, :meth:`with_link2` re-solve the
 arm with one angle fixed).
@@ -56,6 +56,7 @@ __all__ = [
     "Planar2R",
     "Reach",
     "fits_array",
+    "free_angle",
     "nearest_turn",
     "nearest_turn_array",
     "turn_edge",
@@ -121,8 +122,9 @@ class Planar2R:
         object.__setattr__(self, "_snap", SNAP_TOL * l12)
         object.__setattr__(self, "_2l2", 2.0 * self.l2)
         object.__setattr__(self, "_dl", self.l1 - self.l2)
-        # the spread of gamma^2 that a radius within the snap tolerance leaves (see wobble)
-        object.__setattr__(self, "_c", 4.0 * SNAP_TOL * l12 * l12 / (self.l1 * self.l2))
+        # the spread of gamma^2 that a rounded radius leaves (see wobble): targets computed from coordinates
+        # of a few metres carry several ulps of them, hence the generous factor (a rescue is checked anyway)
+        object.__setattr__(self, "_c", 64.0 * SNAP_TOL * l12 * l12 / (self.l1 * self.l2))
 
     # ------------------------------------------------------------------------------------------ scalar
     def reach(self, r: float) -> int:
@@ -174,7 +176,7 @@ class Planar2R:
     def wobble(self, gamma: float) -> float:
         """[rad] how far rounding of the wrist radius may move gamma (and the joint angles) near the boundary.
 
-        gamma^2 is known to about c = 4 SNAP_TOL (l1 + l2)^2 / (l1 l2) near gamma = 0 (and (pi - gamma)^2
+        gamma^2 is known to about c = 64 SNAP_TOL (l1 + l2)^2 / (l1 l2) near gamma = 0 (and (pi - gamma)^2
         near pi), so gamma to sqrt(g^2 + c) - g with g the distance to the boundary; far from it this is
         below 1e-12 rad.
         """
@@ -310,6 +312,31 @@ def nearest_turn(
         None when no turn fits.
     """
     return turner(lo, hi, continuous)(value, ref)
+
+
+def free_angle(
+    lo_a: float, hi_a: float, lo_b: float, hi_b: float, sign: float, offset: float, ref: float,
+    continuous_b: bool = False,
+) -> float | None:  # fmt: skip
+    """A joint angle the geometry leaves free (the wrist on the shoulder axis, l1 = l2), nearest ``ref``.
+
+    The a in [lo_a, hi_a] nearest ``ref`` such that b = sign a + offset (sign +/-1) has a turn inside
+    [lo_b, hi_b]; None if none. b + 2 pi k in [lo_b, hi_b] puts a in the interval sign ([lo_b, hi_b] -
+    offset) shifted by 2 pi k; the two shifts nearest the reference are the candidates.
+    """
+    want = min(max(ref, lo_a), hi_a)
+    if continuous_b or hi_b - lo_b >= TWO_PI:  # every a has a turn of b inside its limits
+        return want
+    lo_i, hi_i = sorted((sign * (lo_b - offset), sign * (hi_b - offset)))
+    k = _floor((want - hi_i) * _INV_TWO_PI)
+    best = None
+    for kk in (k, k + 1):
+        a, b = max(lo_i + kk * TWO_PI, lo_a), min(hi_i + kk * TWO_PI, hi_a)
+        if a <= b:
+            v = min(max(want, a), b)
+            if best is None or abs(v - want) < abs(best - want):
+                best = v
+    return best
 
 
 def fits_array(value: np.ndarray, lo: float, hi: float, tol: float = LIMIT_TOL) -> np.ndarray:

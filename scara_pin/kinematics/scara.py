@@ -61,6 +61,7 @@ from .planar2r import (
     TWO_PI,
     Planar2R,
     Reach,
+    free_angle,
     nearest_turn_array,
     turn_edge,
     turner,
@@ -395,7 +396,9 @@ def _branches(
                                            f"the reach l1 + l2 = {arm.l12:.9g} m")  # fmt: skip
     if code == Reach.IN or r < r_min_tol:
         return [], (IKStatus.INSIDE_INNER_LIMIT, _inside_message(geo, r, geo._radius[0]))
-    singular = gamma < SINGULAR or _PI - gamma < SINGULAR
+    # stretched or folded: the two branches are one configuration, unless equal arms fold (their lean is
+    # then +/-pi/2, and the two "twins" differ by pi at the shoulder: both are kept)
+    singular = (gamma < SINGULAR or _PI - gamma < SINGULAR) and abs(_sin(lean)) < 1e-9
     if r <= FREE_R:  # l1 = l2 and the wrist on the shoulder axis: the shoulder is free
         heading = _free_shoulder(geo, alpha, gamma + geo.beta1 - geo.beta2, ref[ra]) + geo.beta1
         lean = 0.0  # (the wrist on the shoulder axis: r = 0, no lean)
@@ -509,22 +512,10 @@ def _free_shoulder(geo: ScaraGeometry, alpha: float, phi2: float, ref_a: float) 
     ra, _, rc = geo.revolute
     s_a, s_c = geo.signs[ra], geo.signs[rc]
     lo_a, hi_a = geo.lower[ra], geo.upper[ra]
-    lo_c, hi_c = geo.lower[rc], geo.upper[rc]
-    want = min(max(ref_a, lo_a), hi_a)
-    if geo.continuous[rc] or hi_c - lo_c >= TWO_PI:  # any q1 has a wrist turn inside its limits
-        return s_a * want
-    # q4 = s_c (alpha - phi2 - s_a q1) + 2 pi k in [lo_c, hi_c]  <=>  q1 in an interval shifted by 2 pi k
-    c = alpha - phi2
-    ends = sorted((s_a * (c - s_c * lo_c), s_a * (c - s_c * hi_c)))
-    k = math.floor((want - ends[1]) / TWO_PI)  # the shifted intervals nearest the reference: k and k + 1
-    best = None
-    for kk in (k, k + 1):
-        a, b = max(ends[0] + kk * TWO_PI, lo_a), min(ends[1] + kk * TWO_PI, hi_a)
-        if a <= b:
-            v = min(max(want, a), b)
-            if best is None or abs(v - want) < abs(best - want):
-                best = v
-    return s_a * (want if best is None else best)  # no turn fits the wrist: J4_LIMIT follows
+    # q4 = s_c (alpha - phi2 - s_a q1): sign -s_c s_a, offset s_c (alpha - phi2)
+    q1 = free_angle(lo_a, hi_a, geo.lower[rc], geo.upper[rc], -s_c * s_a, s_c * (alpha - phi2), ref_a,
+                    geo.continuous[rc])  # fmt: skip
+    return s_a * (min(max(ref_a, lo_a), hi_a) if q1 is None else q1)  # no turn fits the wrist: J4_LIMIT follows
 
 
 def _inside_message(geo: ScaraGeometry, r: float, r_min: float) -> str:
@@ -703,6 +694,9 @@ class _BatchWork:
         self._q = np.empty((len(self.signs), 4, rows))
         self._mask = np.empty(rows, dtype=np.int64)
         self._keep = np.empty(rows, dtype=np.int64)
+        # elbow angles this close to 0 or pi can make a limit a matter of rounding (wobble > LIMIT_TOL: the
+        # wobble is ~c / (2 g) there; twice that margin, the exact test then on those rows only)
+        self.near_g = geo.arm._c / LIMIT_TOL
         lo, hi, cont = geo.lower, geo.upper, geo.continuous
         self.modes: dict[int, str] = {}
         for j in geo.revolute:
@@ -857,13 +851,22 @@ class _BatchWork:
             sg_out[:] = self.signs[0]
         np.copyto(q_out, Q0.T)
         st_out[:] = 0
-        if solved.all() and not (r <= FREE_R).any():
+        # a branch that failed a limit near the stretched/folded circles may be rounding (solve() puts that
+        # joint on its limit): such rows take solve()'s route even when the other branch solved
+        failed_one = np.logical_not(np.logical_and(oks[0], oks[-1], out=b[1]), out=b[1])
+        near = np.logical_or(np.less(gamma, self.near_g, out=b[6]), np.greater(gamma, math.pi - self.near_g, out=b[5]),
+                             out=b[6])  # fmt: skip
+        np.logical_and(failed_one, near, out=failed_one)
+        np.logical_and(failed_one, np.logical_not(bad, out=b[5]), out=failed_one)
+        some = np.flatnonzero(failed_one)  # few rows: the exact test of the arm's rounding on them only
+        near_failed = some[self.geo.arm.wobble_array(gamma[some]) > LIMIT_TOL] if len(some) else some
+        if solved.all() and not len(near_failed) and not (r <= FREE_R).any():
             return
-        self._failures(T, ref, m, bad, oks, solved, qp, r, gamma, q_out, st_out, sg_out)
+        self._failures(T, ref, m, bad, solved, r, gamma, q_out, st_out, sg_out, near_failed)
 
-    def _failures(self, T: np.ndarray, ref: np.ndarray, m: int, bad: np.ndarray, oks: list[np.ndarray],
-                  solved: np.ndarray, qp: np.ndarray, r: np.ndarray, gamma: np.ndarray, q_out: np.ndarray,
-                  st_out: np.ndarray, sg_out: np.ndarray) -> None:  # fmt: skip
+    def _failures(self, T: np.ndarray, ref: np.ndarray, m: int, bad: np.ndarray, solved: np.ndarray, r: np.ndarray,
+                  gamma: np.ndarray, q_out: np.ndarray, st_out: np.ndarray, sg_out: np.ndarray,
+                  near_failed: np.ndarray) -> None:  # fmt: skip
         """Statuses of the rows without a solution, and the rare rows :func:`solve` decides."""
         geo = self.geo
         ip = geo.prismatic
@@ -886,6 +889,7 @@ class _BatchWork:
         # rows whose joint-limit failure may be rounding (near stretched/folded), and free shoulders
         rare = set(lim[geo.arm.wobble_array(gamma[lim]) > LIMIT_TOL].tolist()) if len(lim) else set()
         rare |= set(np.flatnonzero((r <= FREE_R) & ~bad).tolist())
+        rare |= set(near_failed.tolist())  # one branch failed within the arm's rounding, the other solved
         for i in sorted(rare):
             row_ref = ref if ref.ndim == 1 else ref[i]
             res = solve(geo, T[i], branch="all" if self.branch == "nearest" else self.branch, reference=row_ref)
