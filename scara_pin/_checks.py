@@ -31,14 +31,26 @@ def number_text(text: str) -> float:
     return float(stripped) if NUMBER_TEXT.fullmatch(stripped) else math.nan
 
 
+def _floats(name: str, value: object, rule: str) -> np.ndarray:
+    """``value`` as a float array (any shape), or a ParameterError saying ``rule``.
+
+    Strings, objects and integers too large for a float give the ParameterError, never a bare TypeError,
+    ValueError or OverflowError.
+    """
+    if isinstance(value, (str, bytes)):
+        raise ParameterError(name, ParameterError.NOTHING, rule)
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(name, ParameterError.NOTHING, rule) from None
+    return arr
+
+
 def _vector(name: str, value: object, n: int | None = 4) -> np.ndarray:
     """``value`` as ``n`` finite floats (None: one per joint, 4 or 3: JOINT_COUNTS), or a ParameterError."""
     counts = JOINT_COUNTS if n is None else (n,)
     what = " or ".join(map(str, counts))
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(name, value, f"must be {what} numbers") from None
+    arr = _floats(name, value, f"must be {what} numbers")
     if arr.ndim != 1 or len(arr) not in counts:
         raise ParameterError(name, value, f"must be {what} numbers (got shape {arr.shape})")
     if not np.isfinite(arr).all():

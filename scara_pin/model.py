@@ -26,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._checks import MAGNITUDE_MAX
-from .description import JOINT_COUNTS, JOINT_NAMES, JointLimits, RobotParameters, generate_urdf, load_parameters
+from .description import JOINT_COUNTS, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
 from .urdf_rules import choose_frames, read_tree
 
@@ -398,7 +398,7 @@ class Robot:
         if arr.shape != (n,):
             raise ParameterError("q", q, f"must be {n} numbers (got shape {arr.shape})")
         if not all(-MAGNITUDE_MAX <= v <= MAGNITUDE_MAX for v in arr.tolist()):  # NaN fails every comparison
-            for joint, value in zip(JOINT_NAMES, arr.tolist()):
+            for joint, value in zip(self.joint_names, arr.tolist()):
                 if not math.isfinite(value):
                     raise ParameterError(joint, value, "must be finite")
                 if abs(value) > MAGNITUDE_MAX:
@@ -423,7 +423,7 @@ class Robot:
     def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:
         """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
         out = []
-        for i, joint in enumerate(JOINT_NAMES[: self.dof]):
+        for i, joint in enumerate(self.joint_names):
             if self.continuous[i]:  # no position limit
                 continue
             lo, hi = self.limits.lower[i], self.limits.upper[i]

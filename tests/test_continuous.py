@@ -132,7 +132,7 @@ def test_bad_pinocchio_q_is_refused(robot: Robot, bad: object) -> None:
 def test_continuous_joints_have_no_position_limit(robot: Robot) -> None:
     assert robot.outside_limits(np.array([0.1, 10.0, 0.0, -20.0])) == []
     (item,) = robot.outside_limits(np.array([0.2, 10.0, 0.0, -20.0]))
-    assert item.startswith("joint1 = 0.2 outside")  # the lift (first joint of q) still has its limits
+    assert item.startswith("lift = 0.2 outside")  # the URDF name of q1  # the lift (first joint of q) still has its limits
 
 
 def test_other_joint_kinds_are_still_refused() -> None:
@@ -253,7 +253,7 @@ def test_cli_fk(capsys: pytest.CaptureFixture[str]) -> None:
     assert data["q"] == q
     assert pose_diff(np.array([*data["position"], data["yaw"]]), irb920_fk(np.array(q))) <= FK_TOL
     rc, _, err = run(capsys, ["fk", "--urdf", str(PATH), "0.2", "0", "0", "0", "--strict"])
-    assert rc == 3 and "joint1" in err  # the lift is still limited
+    assert rc == 3 and "lift" in err  # the lift is still limited
 
 
 def test_cli_ik(capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,6 +1,6 @@
 """Numeric inverse kinematics with Pinocchio: damped least squares on the 4-D task (x, y, z, yaw).
 
-It is the independent check of the closed form (:mod:`scara_pin.ik`) and the fallback for robots the
+It is the independent check of the closed form (:mod:`scara_pin.kinematics.scara`) and the fallback for robots the
 closed form refuses. Each iteration solves
 
     (J^T J + lambda^2 I) dq = J^T e,    e = (p* - p(q), wrap(yaw* - yaw(q))),
@@ -29,7 +29,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.linalg.lapack import dgesv as _gesv
 
-from ..errors import ParameterError
+from ..errors import InvalidInputError, ParameterError
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -139,6 +139,8 @@ def solve_numeric(
         NumericIKResult with the best q found; ``success`` tells whether it reaches the target.
     """
     opts = options or _DEFAULTS
+    if robot.dof != 4:
+        raise InvalidInputError(f"the numeric IK solves 4 joints (x, y, z, yaw); robot {robot.name!r} has {robot.dof}")
     tgt = np.asarray(target, dtype=float)
     if tgt.shape != (4,) or not np.isfinite(tgt).all():
         raise ParameterError("target", tgt.tolist(), "must be 4 finite numbers (x, y, z, yaw)")

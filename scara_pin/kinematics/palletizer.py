@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from .._checks import MAGNITUDE_MAX, _vector
+from .._checks import MAGNITUDE_MAX, _floats, _vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 from .planar2r import (
     FREE_R,
@@ -401,14 +401,14 @@ def solve_batch(
     Returns:
         BatchIKResult: q (NaN rows without a solution), PalletizerIKStatus codes, branch +1 up / -1 down.
     """
-    T = np.asarray(targets, dtype=float)
+    T = _floats("targets", targets, "must be an (N, 4) array of x, y, z, yaw")
     if T.ndim != 2 or T.shape[1] != 4:
         raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
     if branch not in ("nearest", *BRANCHES):
         raise InvalidInputError(f"branch {branch!r} must be 'nearest', 'up' or 'down'")
     if T.size and not (T.max() <= MAGNITUDE_MAX and T.min() >= -MAGNITUDE_MAX):  # NaN fails the comparisons
         check_magnitude(T[int(np.argmax(~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)))].tolist())
-    ref = np.zeros(4) if reference is None else np.asarray(reference, dtype=float)
+    ref = np.zeros(4) if reference is None else _floats("reference", reference, "must be 4 values or (N, 4)")
     if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
         raise ParameterError("reference", f"array of shape {ref.shape}", "must be 4 finite values or (N, 4)")
     refs = [ref[j] if ref.ndim == 1 else ref[:, j] for j in range(4)]

@@ -60,7 +60,6 @@ __all__ = [
     "nearest_turn",
     "nearest_turn_array",
     "turn_edge",
-    "turn_range",
     "turner",
     "wrap",
 ]
@@ -127,14 +126,6 @@ class Planar2R:
         object.__setattr__(self, "_c", 64.0 * SNAP_TOL * l12 * l12 / (self.l1 * self.l2))
 
     # ------------------------------------------------------------------------------------------ scalar
-    def reach(self, r: float) -> int:
-        """:class:`Reach` code of a wrist radius ``r`` [m] (within ``REACH_TOL`` counts as inside)."""
-        if r > self.l12 + REACH_TOL:
-            return Reach.OUT
-        if r < self.d12 - REACH_TOL:
-            return Reach.IN
-        return Reach.OK
-
     def lean(self, gamma: float) -> float:
         """atan2(l2 sin gamma, l1 + l2 cos gamma): the angle from link 1 to the wrist point [rad]."""
         return _atan2(self.l2 * _sin(gamma), self.l1 + self.l2 * _cos(gamma))
@@ -162,11 +153,6 @@ class Planar2R:
         """The wrist radius at elbow angle ``gamma``: sqrt(l1^2 + l2^2 + 2 l1 l2 cos gamma) [m]."""
         l1, l2 = self.l1, self.l2
         return _sqrt(max(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * _cos(gamma), 0.0))
-
-    def forward(self, theta1: float, gamma: float) -> tuple[float, float]:
-        """The wrist point (x, y) [m] at heading ``theta1`` and elbow ``gamma`` [rad]."""
-        s = theta1 + gamma
-        return self.l1 * _cos(theta1) + self.l2 * _cos(s), self.l1 * _sin(theta1) + self.l2 * _sin(s)
 
     def singular(self, gamma: float) -> bool:
         """Whether |gamma| is stretched or folded (the two branches coincide)."""
@@ -248,14 +234,6 @@ class Planar2R:
 
 
 # ---------------------------------------------------------------------------------------------- turns
-def turn_range(value: float, lo: float, hi: float) -> tuple[int, int]:
-    """(k_min, k_max): the turns k with value + 2 pi k inside [lo, hi] widened by LIMIT_TOL (empty: k_min > k_max).
-
-    Infinite limits are for continuous joints: call :func:`nearest_turn` with ``continuous=True`` instead.
-    """
-    return (_ceil((lo - LIMIT_TOL - value) * _INV_TWO_PI), _floor((hi + LIMIT_TOL - value) * _INV_TWO_PI))
-
-
 def turn_edge(value: float, lo: float, hi: float, slack: float) -> float | None:
     """The limit (``lo`` or ``hi``) that a turn of ``value`` misses by at most ``slack``, or None.
 

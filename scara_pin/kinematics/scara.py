@@ -51,7 +51,7 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import pinocchio as pin
 
-from .._checks import MAGNITUDE_MAX
+from .._checks import MAGNITUDE_MAX, _floats
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 from .planar2r import (
     FREE_R,
@@ -91,10 +91,8 @@ __all__ = [
 
 YAW_POSE_TOL = 1e-9
 """[rad] the largest tilt of a target rotation still taken as a pure yaw."""
-PARALLEL_TOL = 1e-6
-"""[rad] axes this close to the base z axis are vertical for the closed form's purposes (``check``'s rule)."""
 NEAR_PARALLEL_TOL = 1e-2
-"""[rad] the largest angle between a joint axis and the base z axis for a SCARA: beyond PARALLEL_TOL the
+"""[rad] the largest angle between a joint axis and the base z axis for a SCARA: beyond EXACT_TILT the
 axes are near-parallel (pi written as 3.14 in an rpy) and the closed form's solutions are refined on the
 model (:mod:`scara_pin.kinematics.polish`)."""
 EXACT_TILT = 1e-12
@@ -437,8 +435,6 @@ def _branches(
             found.append((label, singular, q, k))
     if found:
         return found, None
-    if not failures:  # the requested branch was not among the elbows (cannot happen for "all")
-        return [], (IKStatus.J2_LIMIT, f"no {branch} solution")
     worst = max(failures, key=lambda f: _STAGE[f[0]])
     # the sentences are written only now, when no branch solves (the nearest path often drops a failure)
     names = geo.names
@@ -619,8 +615,8 @@ def solve_nearest(
 
 # ------------------------------------------------------------------------------------------ batch
 _BATCH_ROWS = 16384
-_INV_TWO_PI = 1.0 / TWO_PI
 """Rows per block of :func:`solve_batch` (its arrays stay in the cache)."""
+_INV_TWO_PI = 1.0 / TWO_PI
 
 
 def solve_batch(
@@ -646,7 +642,7 @@ def solve_batch(
     Returns:
         BatchIKResult with (N, 4) q (NaN rows without a solution), (N,) IKStatus codes, (N,) branch signs.
     """
-    T = np.asarray(targets, dtype=float)
+    T = _floats("targets", targets, "must be an (N, 4) array of x, y, z, yaw")
     if T.ndim != 2 or T.shape[1] != 4:
         raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
     if branch not in ("nearest", *BRANCHES):
@@ -654,7 +650,7 @@ def solve_batch(
     if T.size and not (T.max() <= MAGNITUDE_MAX and T.min() >= -MAGNITUDE_MAX):  # NaN fails the comparisons
         i = int(np.argmax(~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)))
         check_magnitude(T[i].tolist())
-    ref = np.zeros(4) if reference is None else np.asarray(reference, dtype=float)
+    ref = np.zeros(4) if reference is None else _floats("reference", reference, "must be 4 values or (N, 4)")
     if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
         raise ParameterError("reference", f"array of shape {ref.shape}", "must be 4 finite values or (N, 4)")
     n = T.shape[0]

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .._checks import MAGNITUDE_MAX, _vector
+from .._checks import MAGNITUDE_MAX, _floats, _vector
 from ..errors import ParameterError
 
 if TYPE_CHECKING:
@@ -48,11 +48,12 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
                 x, y, z, yaw = a, b, c, d
             else:
                 x, y, z, yaw = float(a), float(b), float(c), float(d)
-        except (TypeError, ValueError):
-            raise ParameterError("target", target, "must be 4 numbers (x, y, z, yaw)") from None
-        if -m <= x <= m and -m <= y <= m and -m <= z <= m and -m <= yaw <= m:  # NaN fails every comparison
-            return x, y, z, yaw - yaw0, 0.0
-    M = target.homogeneous if isinstance(target, pin.SE3) else np.asarray(target, dtype=float)  # type: ignore[arg-type]
+            if -m <= x <= m and -m <= y <= m and -m <= z <= m and -m <= yaw <= m:  # NaN fails every comparison
+                return x, y, z, yaw - yaw0, 0.0
+        except (TypeError, ValueError, OverflowError):
+            pass  # not 4 plain numbers (a 4 x 4 pose as nested lists, say): the general route below says why
+    rule = "must be (x, y, z, yaw) or a 4 x 4 pose"
+    M = target.homogeneous if isinstance(target, pin.SE3) else _floats("target", target, rule)
     if M.shape == (4,):
         x, y, z, yaw = (float(v) for v in _vector("target", M))
         check_magnitude((x, y, z, yaw))

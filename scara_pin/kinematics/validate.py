@@ -1,7 +1,7 @@
 """Cross-validation of the closed-form IK against Pinocchio (FK and numeric IK).
 
-The closed form is the robot kind's: the SCARA's (:func:`scara_pin.ik.solve`) or the palletizer's
-geometric IK (:func:`scara_pin.palletizer.solve`, on the coupled model with its mimic joints).
+The closed form is the robot kind's (``robot.kinematics``): the SCARA's or the palletizer's
+geometric IK (on the coupled model with its mimic joints).
 
 For N configurations sampled inside the joint limits (seeded), with target = FK(q) from Pinocchio:
 

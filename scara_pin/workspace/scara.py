@@ -1,7 +1,7 @@
 """Exact plan-view workspace of a SCARA under any J1/J2 limits, and the nearest edge along a ray.
 
 The region. With theta = phi1 + beta1 (heading of arm 1) and gamma the elbow angle (angle from arm 1 to
-arm 2, see :mod:`scara_pin.ik`), the wrist axis point (the J4 axis) is
+arm 2, see :mod:`scara_pin.kinematics.scara`), the wrist axis point (the J4 axis) is
 
     W(theta, gamma) = A1 + l1 e(theta) + l2 e(theta + gamma),     e(a) = (cos a, sin a),
 
@@ -32,7 +32,7 @@ gamma and theta, and the point is inside when gamma and theta each have a 2 pi-e
 
 Which point. The region is that of the wrist axis point. The shipped robots have no plan-view tool offset,
 so it is also the tool point's. With a tool offset t from the wrist axis, the tool point is
-W + R(alpha) t with alpha = yaw - yaw0 (:mod:`scara_pin.ik`); at a FIXED yaw, with J4 free to take any
+W + R(alpha) t with alpha = yaw - yaw0 (:mod:`scara_pin.kinematics.scara`); at a FIXED yaw, with J4 free to take any
 turn (a J4 range of at least 2 pi, so that J4 never cuts the region), the tool point region is the wrist
 region translated by R(yaw - yaw0) t: pass ``yaw`` to :func:`workspace` to get it. Without a yaw (or with
 J4 limited to less than a turn) only the wrist axis region is defined here.
@@ -487,7 +487,7 @@ def workspace(
     """Build the exact workspace of a robot.
 
     Args:
-        robot: a :class:`~scara_pin.model.Robot` or its :class:`~scara_pin.ik.ScaraGeometry`.
+        robot: a :class:`~scara_pin.model.Robot` or its :class:`~scara_pin.kinematics.scara.ScaraGeometry`.
         lower: lower joint limits in q order replacing the model's (e.g. a software range) [rad, m].
         upper: upper joint limits in q order replacing the model's [rad, m].
         yaw: a fixed tool yaw [rad]: the region is then the tool point's at that yaw (needs J4 to span at
