@@ -132,7 +132,7 @@ def test_bad_pinocchio_q_is_refused(robot: Robot, bad: object) -> None:
 def test_continuous_joints_have_no_position_limit(robot: Robot) -> None:
     assert robot.outside_limits(np.array([0.1, 10.0, 0.0, -20.0])) == []
     (item,) = robot.outside_limits(np.array([0.2, 10.0, 0.0, -20.0]))
-    assert item.startswith("lift = 0.2 outside")  # the URDF name of q1  # the lift (first joint of q) still has its limits
+    assert item.startswith("lift = 0.2 outside")  # the URDF name of q1: the lift still has its limits
 
 
 def test_other_joint_kinds_are_still_refused() -> None:
