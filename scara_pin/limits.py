@@ -153,6 +153,8 @@ def text_lines(handle: IO[bytes], origin: str, max_rows: int = MAX_ROWS) -> Iter
             raise InvalidInputError(f"{origin} line {number} is longer than {MAX_LINE_CHARS:,} characters; refused")
         if b"\0" in body:
             raise InvalidInputError(f"{origin} line {number}: a NUL byte (a binary file, not CSV text)")
+        if number == 1 and body.startswith(b"\xef\xbb\xbf"):  # a UTF-8 byte order mark (a CSV saved by Excel)
+            body = body[3:]
         try:
             text = body.decode("utf-8")
         except UnicodeDecodeError as exc:

@@ -40,6 +40,8 @@ def open_csv(path: str | os.PathLike[str]) -> Iterator[IO[bytes]]:
     path = Path(path)
     if path.is_dir():
         raise InvalidInputError(f"{path}: cannot be read (it is a folder)")
+    if path.exists() and not path.is_file():  # a FIFO would block the open until a writer comes; a device
+        raise InvalidInputError(f"{path}: cannot be read (not a regular file: a FIFO, a socket or a device)")
     try:
         handle = path.open("rb")
     except OSError as exc:

@@ -140,6 +140,9 @@ _MAX_NAME = 4096
 def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
     from ..robots import load_robot
 
+    if args.robot is not None and getattr(args, "urdf", None) is not None:
+        raise InvalidInputError("give either --robot NAME or --urdf FILE, not both")
+    args.robot = "default" if args.robot is None else args.robot
     if len(args.robot) > _MAX_NAME or "\0" in args.robot:
         raise InvalidInputError(f"--robot {args.robot[:40]!r}...: not a robot name nor a folder "
                                 f"(longer than {_MAX_NAME} characters or with a NUL)")  # fmt: skip
@@ -268,7 +271,7 @@ def _add_units(
 
 def _add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True) -> None:
     g = p.add_argument_group("robot")
-    g.add_argument("--robot", default="default", metavar="NAME|CONFIG_DIR",
+    g.add_argument("--robot", default=None, metavar="NAME|CONFIG_DIR",
                    help="shipped robot name (see `scara-pin robots`) or a folder of yaml files "
                    "(default: default)")  # fmt: skip
     g.add_argument("--set", action="append", metavar="KEY=VALUE",

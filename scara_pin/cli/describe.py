@@ -36,13 +36,13 @@ def cmd_urdf(args: argparse.Namespace) -> int:
     if args.dh:
         from ..description.dh import dh_to_urdf
 
-        if args.set or args.prefix or args.robot != "default":
+        if args.set or args.prefix or args.robot is not None:
             raise InvalidInputError("--dh takes the whole robot from the table: no --robot, --set or --prefix")
         text = dh_to_urdf(Path(args.dh))
     else:
         from ..description import generate_urdf
 
-        text = generate_urdf(args.robot, _parse_sets(args.set), prefix=args.prefix)
+        text = generate_urdf(args.robot or "default", _parse_sets(args.set), prefix=args.prefix)
     if args.output in (None, "-"):
         sys.stdout.write(text)
     else:

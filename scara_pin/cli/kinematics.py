@@ -159,6 +159,9 @@ def cmd_ik(args: argparse.Namespace) -> int:
         except NotScaraError as exc:
             log.warning("closed-form IK refused this robot (%s); using the numeric IK", exc)
             numeric = True
+    if numeric and args.branch != "all":  # the numeric IK lands where its seed leads: no branch to choose
+        raise InvalidInputError("--branch chooses among the closed form's solutions; the numeric IK follows its "
+                                "seed: give --near Q (a configuration on the wanted branch) instead")
     turns: list[Any] = []
     if numeric:
         status, message, qs, branches = _ik_numeric(robot, target, near)

@@ -33,7 +33,7 @@ def cmd_view(args: argparse.Namespace) -> int:
             log.warning("%s (shown anyway)", item)
     times = qs = None
     if args.traj:
-        times, qs = viz.read_trajectory_csv(args.traj)
+        times, qs = viz.read_trajectory_csv(args.traj, robot.dof)
     polylines = None
     if args.workspace:
         from ..workspace.scara import workspace

@@ -153,18 +153,17 @@ def _points(name: str, value: object, dim: int) -> np.ndarray:
 
 
 def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.ndarray]:
-    """Check a sampled motion: (N,) strictly increasing finite times [s] and (N, 4) joint values."""
+    """Check a sampled motion: (N,) strictly increasing finite times [s] and (N, dof) joint values."""
+    n = robot.dof
     try:
         t = np.array(times, dtype=float)
         q = np.array(qs, dtype=float)
     except (TypeError, ValueError):
-        raise InvalidInputError("times and qs must be numbers: (N,) times [s] and (N, 4) joint values") from None
+        raise InvalidInputError(f"times and qs must be numbers: (N,) times [s] and (N, {n}) joint values") from None
     if t.ndim != 1 or t.shape[0] < 1:
         raise InvalidInputError(f"times must be a 1-D array of at least one time [s] (got shape {t.shape})")
-    if q.shape != (t.shape[0], 4):
-        raise InvalidInputError(
-            f"qs must have shape ({t.shape[0]}, 4), one row per time (got {q.shape})"
-        )
+    if q.shape != (t.shape[0], n):
+        raise InvalidInputError(f"qs must have shape ({t.shape[0]}, {n}), one row per time (got {q.shape})")
     if not np.isfinite(t).all():
         raise InvalidInputError("times must be finite")
     steps = np.diff(t)
@@ -176,8 +175,8 @@ def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.nda
     return t, q
 
 
-def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
-    """Read the times and joint values of a trajectory CSV (columns ``t,q1,q2,q3,q4``; others ignored).
+def read_trajectory_csv(path: str | os.PathLike[str], dof: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Read the times and joint values of a trajectory CSV (columns ``t,q1..q{dof}``; others ignored).
 
     Reads the files of :meth:`scara_pin.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``)
     with the package's one CSV reader (:func:`scara_pin.tables.read_csv`: bounded, blank lines and lines
@@ -192,15 +191,15 @@ def read_trajectory_csv(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.nd
     from ..limits import MAX_SAMPLES
     from ..tables import read_csv
 
-    table = read_csv(path, ("t", "q1", "q2", "q3", "q4"), max_rows=MAX_SAMPLES)
+    table = read_csv(path, ("t", *(f"q{i + 1}" for i in range(dof))), max_rows=MAX_SAMPLES)
     return table[:, 0], table[:, 1:]
 
 
 def tool_path(robot: Robot, qs: object) -> np.ndarray:
     """(N, 3) positions of the tool frame in the base frame [m] along the joint values ``qs`` (N, 4)."""
     q = np.array(qs, dtype=float)
-    if q.ndim != 2 or q.shape[1] != 4:
-        raise InvalidInputError(f"qs must have shape (N, 4) (got {q.shape})")
+    if q.ndim != 2 or q.shape[1] != robot.dof:
+        raise InvalidInputError(f"qs must have shape (N, {robot.dof}) (got {q.shape})")
     return np.array([robot.tool_placement(robot.check_q(row)).translation for row in q])
 
 
