@@ -194,3 +194,13 @@ def test_blended_cycle_keeps_its_limits_between_the_verified_samples(robot, plai
     _, qd, qdd = traj.sample(t)
     assert (np.abs(qd) / np.array(robot.limits.velocity)).max() <= 1 + 1e-6
     assert (np.abs(qdd) / np.array(robot.limits.acceleration)).max() <= 1 + 1e-6
+
+
+def test_jerk_cycle_keeps_its_limits_between_the_verified_samples(robot, jerk_cycle):
+    """At 8 kHz (8 times the promise; the jerk law verifies its breakpoints, 16 points between them, the rate
+    grid and both sides of the path's knots) no velocity or acceleration limit is exceeded by 1e-6."""
+    traj = jerk_cycle.move.trajectory
+    t = np.linspace(0.0, traj.duration, int(traj.duration * 8000) + 1)
+    _, qd, qdd = traj.sample(t)
+    assert (np.abs(qd) / np.array(robot.limits.velocity)).max() <= 1 + 1e-6
+    assert (np.abs(qdd) / np.array(robot.limits.acceleration)).max() <= 1 + 1e-6

@@ -46,8 +46,9 @@ if TYPE_CHECKING:
 __all__ = ["FilteredLaw", "JerkRatios", "jerk_limited", "joint_jerk", "path_third_derivative"]
 
 _ACCEPT = 1.0 + 1e-10
-_SUB = 4
-"""Checked points inside each interval between the law's breakpoints (besides both ends and the rate grid)."""
+_SUB = 16
+"""Checked points inside each interval between the law's breakpoints (besides both ends and the rate grid):
+16 keep the acceleration between checked points within 1e-6 of its limit (4 left 1.2e-4 at 8 kHz)."""
 _FD_STEP = 1e-4
 """Finite-difference step of q''' relative to the width of the smooth piece of the path."""
 
@@ -182,6 +183,17 @@ class JerkRatios:
         return max(v for v in (self.velocity, self.acceleration, self.jerk, self.torque) if v is not None)
 
 
+def _knot_times(law: FilteredLaw, knots: np.ndarray) -> np.ndarray:
+    """The times the monotonic law reaches the path's knots (bisection, all at once), and just before each."""
+    s_target = np.asarray(knots, dtype=float)
+    lo, hi = np.zeros(len(s_target)), np.full(len(s_target), float(law.duration))
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        below = law.evaluate(mid)[0] < s_target
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return np.clip(np.concatenate([hi, hi * (1.0 - 1e-9), hi * (1.0 + 1e-9)]), 0.0, float(law.duration))
+
+
 def _times(law: FilteredLaw, sub: int, rate: float | None, t_start: float) -> np.ndarray:
     """The breakpoints, each interval's end (the jerk's left limit), ``sub`` points per interval, the rate grid."""
     bp = law.breakpoints()
@@ -312,7 +324,9 @@ def jerk_limited(
         k, _ = _scale(robot, Motion(path, law), _times(law, _SUB, None, 0.0), v, a, jv, e)
         law = law.scaled(k)
         for _ in range(8):
-            t = _times(law, _SUB, opts.check_rate, t_start)
+            # the law's breakpoints, the rate grid, and both sides of the path's knots (where q''' jumps: the
+            # joints' jerk has its one-sided extremes there, which the rate grid alone steps over)
+            t = np.concatenate([_times(law, _SUB, opts.check_rate, t_start), _knot_times(law, path.knots())])
             k, r = _scale(robot, Motion(path, law), t, v, a, jv, e)
             if k <= _ACCEPT:
                 break
