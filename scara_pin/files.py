@@ -30,7 +30,15 @@ from typing import IO, Any
 
 from .errors import InvalidInputError
 
-__all__ = ["STDOUT", "atomic_output", "check_output_path", "write_atomic_with", "write_text_atomic"]
+__all__ = [
+    "FIGURE_FORMATS",
+    "STDOUT",
+    "atomic_output",
+    "check_output_path",
+    "save_figure",
+    "write_atomic_with",
+    "write_text_atomic",
+]
 
 STDOUT = "-"
 """The output name that means standard output."""
@@ -158,4 +166,24 @@ def write_atomic_with(path: str | os.PathLike[str], produce: Callable[[IO[str]],
     path = Path(path)
     with atomic_output(path) as tmp, tmp.open("w", encoding="utf-8", newline="") as handle:
         produce(handle)
+    return path
+
+
+FIGURE_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+"""What a plot's file name may end with, and the format written."""
+
+
+def save_figure(figure: Any, path: str | os.PathLike[str], **kwargs: Any) -> Path:
+    """Write a matplotlib figure atomically, in the format its name says (.png, .svg, .pdf; PNG without one).
+
+    Raises:
+        InvalidInputError: another ending (the file would not be what its name says), or an unwritable path.
+    """
+    path = Path(path)
+    fmt = FIGURE_FORMATS.get(path.suffix.lower()) if path.suffix else "png"  # "-" (stdout) too
+    if fmt is None:
+        raise InvalidInputError(f"cannot write {path}: a plot is written as {', '.join(FIGURE_FORMATS)}; "
+                                "name the file with one of these endings")  # fmt: skip
+    with atomic_output(path) as tmp:
+        figure.savefig(tmp, format=fmt, **kwargs)
     return path

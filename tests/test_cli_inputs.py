@@ -58,3 +58,14 @@ def test_a_three_joint_trajectory_is_shown(tmp_path: Path, capsys: pytest.Captur
                  "2", "--out", str(csv_path)]) == 0  # fmt: skip
     assert main(["view", "--urdf", urdf, "--traj", str(csv_path), "--html", str(html)]) == 0
     assert html.stat().st_size > 100_000  # the page with meshcat's script and the motion
+
+
+def test_a_plot_is_written_in_the_format_its_name_says(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["workspace", "--plot", str(tmp_path / "ws.svg")]) == 0
+    assert (tmp_path / "ws.svg").read_bytes().lstrip().startswith((b"<?xml", b"<svg"))
+    assert main(["workspace", "--plot", str(tmp_path / "ws.png")]) == 0
+    assert (tmp_path / "ws.png").read_bytes().startswith(b"\x89PNG")
+    capsys.readouterr()
+    assert main(["workspace", "--plot", str(tmp_path / "ws.jpg")]) == 2
+    assert ".png, .svg, .pdf" in one_error(capsys)
+    assert not (tmp_path / "ws.jpg").exists()

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..description import JOINT_NAMES
-from ..files import atomic_output
+from ..files import save_figure
 
 if TYPE_CHECKING:
     from ..description import JointLimits
@@ -86,6 +86,4 @@ def plot_cycle(
     ax.set_xlabel("t [s]")
     if title:
         fig.suptitle(title)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi)
-    return Path(path)
+    return save_figure(fig, path, dpi=dpi)

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import ParameterError
-from ..files import atomic_output
+from ..files import save_figure
 from ..motion.trajectory import Trajectory
 
 if TYPE_CHECKING:
@@ -111,9 +111,7 @@ def plot_trajectory(
     if robot is not None:
         _tool_panel(fig.add_subplot(grid[:, 1]), robot, q)
     fig.suptitle(title or f"trajectory: {trajectory.duration:.4g} s", fontsize=12)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi)
-    return Path(path)
+    return save_figure(fig, path, dpi=dpi)
 
 
 def _tool_panel(ax: Axes, robot: Robot, q: np.ndarray) -> None:

@@ -172,7 +172,6 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str, q: np.ndarray | None = None)
     ax.set_title(f"palletizer: tool0 in the arm plane, area {env.area:.5g} m$^2$")
     ax.legend(loc="best", fontsize=8)
     ax.grid(True, alpha=0.3)
-    from ..files import atomic_output  # written atomically: never through a symlink, never a device
+    from ..files import save_figure  # written atomically: never through a symlink, never a device
 
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120, bbox_inches="tight")
+    save_figure(fig, path, dpi=120, bbox_inches="tight")

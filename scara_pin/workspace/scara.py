@@ -642,7 +642,6 @@ def plot_workspace(
     ax.set_ylabel("y [m]")
     ax.set_title(f"workspace: area {ws.area:.5g} m$^2$, r in [{ws.r_min:.4g}, {ws.r_max:.4g}] m")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=7, framealpha=0.8)
-    from ..files import atomic_output  # written atomically: never through a symlink, never a device
+    from ..files import save_figure  # written atomically: never through a symlink, never a device
 
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120, bbox_inches="tight")
+    save_figure(fig, path, dpi=120, bbox_inches="tight")
