@@ -69,3 +69,11 @@ def test_a_plot_is_written_in_the_format_its_name_says(tmp_path: Path, capsys: p
     assert main(["workspace", "--plot", str(tmp_path / "ws.jpg")]) == 2
     assert ".png, .svg, .pdf" in one_error(capsys)
     assert not (tmp_path / "ws.jpg").exists()
+
+
+def test_a_payload_the_quill_cannot_hold_is_named(capsys: pytest.CaptureFixture[str]) -> None:
+    # 15.3 kg on the quill: its static load exceeds the joint3 effort limit (150 N)
+    assert main(["traj", "--from", "0", "0.1", "0", "0", "--to", "0.5", "0.6", "0.02", "0.3", "--torque",
+                 "--payload", "15.3"]) == 3  # fmt: skip
+    message = one_error(capsys)
+    assert "static load on joint3" in message and "cannot even hold still" in message

@@ -376,7 +376,9 @@ def _time_segment(
                                        solver_wrapper="seidel")  # fmt: skip
         inst.compute_parameterization(0.0, 0.0)
         data = inst.problem_data
-    except Exception as exc:  # toppra raises assorted exceptions: report them typed
+    except Exception as exc:  # toppra raises assorted exceptions: the likely cause when there is one, else typed
+        if g_static is not None and lim.effort is not None and (np.abs(g_static) >= lim.effort).any():
+            raise _diagnose("Exception", robot, grid, B, q, g_static, lim, m, segment, None) from exc  # a static load
         raise TimingError("Exception", f"toppra raised {type(exc).__name__}: {exc}", segment=segment) from exc
     code = data.return_code.name
     if code != "Ok" or data.sd_vec is None or not np.isfinite(data.sd_vec).all():
