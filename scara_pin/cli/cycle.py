@@ -6,7 +6,6 @@ import argparse
 import json
 import logging
 import math
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError, ParameterError
@@ -76,9 +75,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     move = result.move
     outputs: dict[str, str] = {}
     if args.out:
-        out = Path(args.out)
-        (move.trajectory.to_json if out.suffix.lower() == ".json" else move.trajectory.to_csv)(out, rate=args.rate)
-        outputs["trajectory"] = str(out)
+        move.trajectory.save(args.out, rate=args.rate)
+        outputs["trajectory"] = str(args.out)
     if args.plot:
         from ..viz.cycle import plot_cycle
 

@@ -109,9 +109,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
         log.warning(message)
     outputs: dict[str, str] = {}
     if args.out:
-        out = Path(args.out)
-        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
-        outputs["trajectory"] = str(out)
+        traj.save(args.out, rate=args.rate)
+        outputs["trajectory"] = str(args.out)
     if args.setpoints:
         motor = None
         if args.gear or args.steps_per_rev or args.screw_lead is not None:
@@ -168,9 +167,8 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any) -> int:
     traj = move.trajectory
     outputs: dict[str, str] = {}
     if args.out:
-        out = Path(args.out)
-        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
-        outputs["trajectory"] = str(out)
+        traj.save(args.out, rate=args.rate)
+        outputs["trajectory"] = str(args.out)
     if args.plot:
         from ..viz.cycle import plot_cycle
 
@@ -214,8 +212,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     jog = jog_to_edge(robot, q0, direction, margin=margin)
     traj = jog.trajectory
     if args.out:
-        out = Path(args.out)
-        (traj.to_json if out.suffix.lower() == ".json" else traj.to_csv)(out, rate=args.rate)
+        traj.save(args.out, rate=args.rate)
     if args.plot:
         from ..viz.plots import plot_trajectory
 

@@ -536,6 +536,10 @@ class Trajectory:
         text = self.resample(rate).csv_text()
         return write_text_atomic(Path(path), text)
 
+    def save(self, path: str | os.PathLike[str], rate: float = 1000.0) -> Path:
+        """Write the samples at ``rate`` [Hz]: JSON for a name ending in ``.json``, else CSV; atomically."""
+        return (self.to_json if Path(path).suffix.lower() == ".json" else self.to_csv)(path, rate=rate)
+
     def to_json(self, path: str | os.PathLike[str], rate: float = 1000.0) -> Path:
         """Write the samples at ``rate`` [Hz] as JSON (see :meth:`Samples.to_dict`), atomically."""
         data = self.resample(rate).to_dict()
