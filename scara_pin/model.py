@@ -288,11 +288,24 @@ class Robot:
         self.has_continuous = any(continuous)
         # the per-call paths take q as it is when the cheap check passes: 4 plain joints only
         self._slow_q = self.has_continuous or self.dof != 4
+        self.tool_placement, self.task_jacobian = _per_call_paths(self)
         self._kinematics_factory = kinematics
         if self.has_continuous:
             # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
             iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
             self._q_map = tuple(zip(range(self.dof), iq, continuous))
+
+    tool_placement: Callable[[np.ndarray], pin.SE3]
+    """``tool_placement(q)``: ``baseMtool``, the placement of the tool frame in the base frame at ``q``.
+
+    Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
+    """
+    task_jacobian: Callable[[np.ndarray], np.ndarray]
+    """``task_jacobian(q)``: the 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame.
+
+    Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the base z
+    axis, which equals d(yaw)/dt while the tool stays level).
+    """
 
     # ----------------------------------------------------------------- construction helpers
     @classmethod
@@ -486,17 +499,6 @@ class Robot:
             out[i] = math.atan2(arr[iq + 1], arr[iq]) if cont else arr[iq]
         return out
 
-    def tool_placement(self, q: np.ndarray) -> pin.SE3:
-        """``baseMtool``: the placement of the tool frame in the base frame, at ``q``.
-
-        Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
-        """
-        if self._slow_q or not _q_ok(q):
-            q = self._pin_q(q)
-        model, data = self._base_model, self._base_data
-        _forward(model, data, q)
-        return _frame_placement(model, data, self.tool_id)
-
     def tool_pose(self, q: np.ndarray) -> np.ndarray:
         """(x, y, z, yaw) of the tool frame in the base frame [m, m, m, rad]."""
         return pose_from_placement(self.tool_placement(q))
@@ -530,16 +532,6 @@ class Robot:
             reference = _REFERENCES[reference.lower()]
         return pin.computeFrameJacobian(self.model, self.data, q, fid, reference)
 
-    def task_jacobian(self, q: np.ndarray) -> np.ndarray:
-        """The 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame.
-
-        Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
-        base z axis, which equals d(yaw)/dt while the tool stays level).
-        """
-        if self._slow_q or not _q_ok(q):
-            q = self._pin_q(q)
-        return _frame_jacobian(self._base_model, self._base_data, q, self.tool_id, _LWA).take(_TASK_ROWS, 0)
-
     def manipulability(self, q: np.ndarray) -> float:
         """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4).
 
@@ -552,6 +544,41 @@ class Robot:
             names = ", ".join(f.name for f in self.model.frames)
             raise InvalidInputError(f"no frame named {frame!r}; frames: {names}")
         return int(self.model.getFrameId(frame))
+
+
+def _per_call_paths(robot: Robot) -> tuple[Callable[[np.ndarray], pin.SE3], Callable[[np.ndarray], np.ndarray]]:
+    """The robot's ``tool_placement`` and ``task_jacobian``, as closures over its model.
+
+    These are the per-call hot paths (a controller calls them at kHz): closures read their model, data and
+    frame from cells, where a method pays an attribute lookup on the robot for each, and more once the
+    robot's ``__dict__`` has grown (any cached property does that). Each takes q as it is when
+    :func:`_q_ok`'s test passes (written inline: a call of it would cost a fifth of FK), else converts it
+    with ``robot._pin_q`` (which checks it and raises ParameterError).
+    """
+    model, data, tool, fast, full = robot._base_model, robot._base_data, robot.tool_id, not robot._slow_q, robot._pin_q
+    forward, placement, jacobian, lwa, rows, f64, bound = _forward, _frame_placement, _frame_jacobian, _LWA, \
+        _TASK_ROWS, _F64, _Q_MAX2  # fmt: skip
+
+    def tool_placement(q: np.ndarray) -> pin.SE3:
+        """``baseMtool``: the placement of the tool frame in the base frame at ``q`` (``robot.data`` untouched)."""
+        try:
+            a, b, c, d = q.tolist()
+            ok = fast and a * a + b * b + c * c + d * d <= bound and q.dtype is f64  # NaN and inf fail
+        except (AttributeError, TypeError, ValueError):  # not an array, a wrong length, nested values
+            ok = False
+        forward(model, data, q if ok else full(q))
+        return placement(model, data, tool)
+
+    def task_jacobian(q: np.ndarray) -> np.ndarray:
+        """The 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame (rows x, y, z, yaw rate)."""
+        try:
+            a, b, c, d = q.tolist()
+            ok = fast and a * a + b * b + c * c + d * d <= bound and q.dtype is f64  # as tool_placement's
+        except (AttributeError, TypeError, ValueError):
+            ok = False
+        return jacobian(model, data, q if ok else full(q), tool, lwa).take(rows, 0)
+
+    return tool_placement, task_jacobian
 
 
 def _q_ok(q: Any) -> bool:

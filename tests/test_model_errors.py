@@ -264,6 +264,71 @@ def test_kinematics_check_q(robot: Robot, method: str) -> None:
         getattr(robot, method)([0.0, 0.0, 0.0])
 
 
+_ARRAY_REFUSED = {
+    "NaN": np.array([0.1, math.nan, 0.0, 0.0]),
+    "inf": np.array([0.1, 0.2, -math.inf, 0.0]),
+    "beyond 1e6": np.array([0.0, 0.0, 0.0, 1.5e6]),
+    "3 values": np.zeros(3),
+    "5 values": np.zeros(5),
+    "4 x 1": np.zeros((4, 1)),
+    "1 x 4": np.zeros((1, 4)),
+    "0-d": np.array(0.5),
+    "booleans": np.array([True, False, True, False]),
+    "complex": np.zeros(4, dtype=complex),
+    "strings": np.array(["0.1", "0.2", "0.0", "0.0"]),
+    "objects": np.array([0.1, 0.2, 0.0, None], dtype=object),
+}
+
+
+@pytest.mark.parametrize("method", ["tool_placement", "task_jacobian"])
+@pytest.mark.parametrize("label", list(_ARRAY_REFUSED))
+def test_per_call_paths_refuse_bad_arrays(robot: Robot, method: str, label: str) -> None:
+    """The per-call paths take a float64 array as it is only when the inline test passes; anything else is
+    checked in full: a bad q is a ParameterError, never a silent NaN or a Pinocchio exception."""
+    with pytest.raises(ParameterError):
+        getattr(robot, method)(_ARRAY_REFUSED[label])
+
+
+@pytest.mark.parametrize(
+    "q",
+    [
+        np.array([0.4, -1.2, 0.07, 2.0]),
+        np.array([0.4, -1.2, 0.07, 2.0], dtype=np.float32).astype(np.float64)[::-1][::-1],  # a view
+        np.array([[0.4, 9.0], [-1.2, 9.0], [0.07, 9.0], [2.0, 9.0]])[:, 0],  # not contiguous
+        np.array([0.4, -1.2, 0.07, 2.0], dtype=np.float32),
+        np.array([1, -1, 0, 2]),
+        np.array([0.4, -1.2, 0.07, 2.0]).astype(">f8"),  # big-endian
+        [0.4, -1.2, 0.07, 2.0],
+        (1, -1, 0, 2),
+    ],
+    ids=["float64", "view", "strided", "float32", "int", "big-endian", "list", "tuple"],
+)
+def test_per_call_paths_equal_raw_pinocchio(robot: Robot, q: object) -> None:
+    """Whatever the form of a valid q, FK and the task Jacobian are raw Pinocchio's on the same numbers (1e-12):
+    baseMtool from framesForwardKinematics on the robot's own model, and the rows x, y, z, wz of its
+    LOCAL_WORLD_ALIGNED frame Jacobian rotated into base axes."""
+    values = np.array([float(v) for v in np.asarray(q).tolist()])
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, values)
+    oMb, oMt = data.oMf[robot.base_id], data.oMf[robot.tool_id]
+    J = pin.computeFrameJacobian(robot.model, data, values, robot.tool_id, pin.LOCAL_WORLD_ALIGNED)
+    Rbo = oMb.rotation.T
+    expected_J = np.vstack([Rbo @ J[:3], (Rbo @ J[3:])[2]])
+    assert np.abs(robot.tool_placement(q).homogeneous - oMb.actInv(oMt).homogeneous).max() <= 1e-12
+    got_J = robot.task_jacobian(q)
+    assert got_J.shape == (4, 4)
+    assert np.abs(got_J - expected_J).max() <= 1e-12
+
+
+def test_per_call_results_are_not_shared(robot: Robot) -> None:
+    """Each call returns its own objects: a result kept by the caller does not change with the next call."""
+    q1, q2 = np.array([0.4, -1.2, 0.07, 2.0]), np.array([-0.3, 0.5, 0.01, -1.0])
+    M1, J1 = robot.tool_placement(q1), robot.task_jacobian(q1)
+    M1_copy, J1_copy = M1.homogeneous.copy(), J1.copy()
+    robot.tool_placement(q2), robot.task_jacobian(q2)
+    assert np.array_equal(M1.homogeneous, M1_copy) and np.array_equal(J1, J1_copy)
+
+
 def test_check_q_accepts_four_numbers(robot: Robot) -> None:
     q = robot.check_q((1, 2, 0, -3))
     assert q.dtype == float and q.shape == (4,)
