@@ -378,14 +378,17 @@ class Robot:
         """Closed-form IK of the robot's kind: each branch's solution, turns nearest ``reference`` (default 0)."""
         return self.kinematics.solve(target, branch=branch, reference=reference, all_turns=all_turns)
 
-    def ik_nearest(self, target: Any, reference: ArrayLike | None = None, *, weights: ArrayLike | None = None,
-                   branch: str = "all") -> np.ndarray:  # fmt: skip
-        """The closed-form solution nearest ``reference`` (weighted joint space), as a new array.
+    @cached_property
+    def ik_nearest(self) -> Callable[..., np.ndarray]:
+        """``ik_nearest(target, reference=None, *, weights=None, branch="all")``: the nearest solution, a new array.
+
+        The closed-form solution nearest ``reference`` (weighted joint space). This attribute is the kind's
+        ``nearest`` itself, looked up once (a per-call path).
 
         Raises:
             NoSolutionError: no solution inside the limits (``status``, ``reason``; exit code 3).
         """
-        return self.kinematics.nearest(target, reference, weights=weights, branch=branch)
+        return self.kinematics.nearest
 
     def ik_batch(self, targets: ArrayLike, reference: ArrayLike | None = None, *, branch: str = "nearest"
                  ) -> BatchIKResult:  # fmt: skip

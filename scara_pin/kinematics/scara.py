@@ -46,6 +46,7 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass, field
+from operator import itemgetter
 from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
@@ -598,15 +599,14 @@ def solve_nearest(
     if failure is not None:
         raise NoSolutionError(*failure)
     q = found[0][2]
-    if len(found) > 1:
-        w0, w1, w2, w3 = (1.0, 1.0, 1.0, 1.0) if weights is None else weight_floats(weights)
-        a0, a1, a2, a3 = q
-        b0, b1, b2, b3 = found[1][2]
-        r0, r1, r2, r3 = ref
-        d_first = w0 * (a0 - r0) ** 2 + w1 * (a1 - r1) ** 2 + w2 * (a2 - r2) ** 2 + w3 * (a3 - r3) ** 2
-        d_second = w0 * (b0 - r0) ** 2 + w1 * (b1 - r1) ** 2 + w2 * (b2 - r2) ** 2 + w3 * (b3 - r3) ** 2
-        if d_second < d_first:
-            q = found[1][2]
+    if len(found) > 1:  # the branches share the vertical joint: its term is the same on both sides, left out
+        ra, rb, rc = geo.revolute
+        wa, wb, wc = (1.0, 1.0, 1.0) if weights is None else itemgetter(ra, rb, rc)(weight_floats(weights))
+        p = found[1][2]
+        a, b, c = q[ra] - ref[ra], q[rb] - ref[rb], q[rc] - ref[rc]
+        d, e, f = p[ra] - ref[ra], p[rb] - ref[rb], p[rc] - ref[rc]
+        if wa * d * d + wb * e * e + wc * f * f < wa * a * a + wb * b * b + wc * c * c:
+            q = p
     elif weights is not None:
         weight_floats(weights)
     return np.array(q)
