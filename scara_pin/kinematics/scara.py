@@ -688,8 +688,8 @@ class _BatchWork:
         self.branch = branch
         self.signs = (1, -1) if branch == "nearest" else ((1,) if branch == "right" else (-1,))
         nb = len(self.signs)
-        self._f = np.empty((6, rows))
-        self._s = np.empty((6, nb, rows))  # the shoulder, elbow and wrist of each branch; three scratch rows
+        self._f = np.empty((7, rows))  # alpha, wx, wy, r, gamma, heading, the vertical joint
+        self._s = np.empty((5, nb, rows))  # the shoulder, elbow and wrist of each branch; lean; scratch
         self._b = np.empty((6, rows), dtype=bool)
         self._ok = np.empty((3, nb, rows), dtype=bool)
         self._mask = np.empty(rows, dtype=np.int64)
@@ -713,7 +713,7 @@ class _BatchWork:
                     mode = "unique"  # no other turn than the nearest can be inside the limits
             self.modes[j] = mode
 
-    def _turn(self, v: np.ndarray, j: int, ref: Any, ok: np.ndarray, S: np.ndarray, t_b: np.ndarray) -> bool:
+    def _turn(self, v: np.ndarray, j: int, ref: Any, ok: np.ndarray, S: list[np.ndarray], t_b: np.ndarray) -> bool:
         """Move v (one row per branch) in place to its turn nearest ``ref`` inside joint j's limits.
 
         ``ok``: where it fits; ``S``: the scratch rows. Returns False when every row fits (``ok`` not written).
@@ -777,7 +777,10 @@ class _BatchWork:
         nb = len(self.signs)
         f = [a[:m] for a in self._f]
         b = [a[:m] for a in self._b]
-        S = self._s[:, :, :m]  # S[0], S[1], S[2]: shoulder, elbow, wrist, one row per branch
+        # S[0], S[1], S[2]: shoulder, elbow and wrist, one row per branch; S[3] (wx, wy once the arm is
+        # solved), S[4] (each branch's signed lean), S[5]: scratch
+        Sq = self._s[:, :, :m]
+        S = [Sq[0], Sq[1], Sq[2], self._f[1 : 1 + nb, :m], Sq[3], Sq[4]]
         oks = self._ok[:, :, :m]
         ra, rb, rc = geo.revolute
         ip = geo.prismatic
@@ -786,7 +789,7 @@ class _BatchWork:
         refs: list[Any] = self.const_ref if self.const_ref is not None else [ref[:, j] for j in range(4)]
         x, y, z, yaw = T[:, 0], T[:, 1], T[:, 2], T[:, 3]
         # vertical joint (the same value on every branch) and the shared failures: stroke, reach
-        qp = q_out[:, ip]
+        qp = f[6]  # written to q_out with the other joints (its rows then stay in the cache)
         if sgn[ip] < 0:
             np.subtract(geo.z0, z, out=qp)  # -(z - z0)
         else:
@@ -804,9 +807,9 @@ class _BatchWork:
         tx, ty = geo.tool
         if tx or ty:
             ca, sa = np.cos(alpha, out=f[3]), np.sin(alpha, out=f[4])
-            np.subtract(x, np.subtract(np.multiply(ca, tx, out=f[5]), np.multiply(sa, ty, out=S[3, 0]), out=f[5]),
+            np.subtract(x, np.subtract(np.multiply(ca, tx, out=f[5]), np.multiply(sa, ty, out=S[5][0]), out=f[5]),
                         out=wx)  # fmt: skip
-            np.subtract(y, np.add(np.multiply(sa, tx, out=f[5]), np.multiply(ca, ty, out=S[3, 0]), out=f[5]), out=wy)
+            np.subtract(y, np.add(np.multiply(sa, tx, out=f[5]), np.multiply(ca, ty, out=S[5][0]), out=f[5]), out=wy)
             if geo.a1[0] != 0.0:
                 np.subtract(wx, geo.a1[0], out=wx)
             if geo.a1[1] != 0.0:
@@ -815,7 +818,7 @@ class _BatchWork:
             np.subtract(x, geo.a1[0], out=wx)
             np.subtract(y, geo.a1[1], out=wy)
         lean = S[4]  # each branch's signed lean: theta1 = heading - sign lean
-        r, gamma, heading, _, _ = arm.solve_array(wx, wy, out=(f[3], f[4], f[5], lean[0], S[5, 0]))
+        r, gamma, heading, _, _ = arm.solve_array(wx, wy, out=(f[3], f[4], f[5], lean[0], S[5][0]))
         if nb == 2:
             np.negative(lean[0], out=lean[1])
         elif self.signs[0] < 0:
@@ -878,16 +881,18 @@ class _BatchWork:
             # select bit for bit (an exact blend without branches): q0 ^ ((q1 ^ q0) & mask), mask = -1 where use
             mask = self._mask[:m]
             np.negative(use.view(np.uint8), out=mask, dtype=np.int64, casting="unsafe")
-            Si = S[:3].view(np.int64)
+            Si = Sq[:3].view(np.int64)
             np.bitwise_xor(Si[:, 1], Si[:, 0], out=Si[:, 1])
             np.bitwise_and(Si[:, 1], mask, out=Si[:, 1])
             for n, j in enumerate((ra, rb, rc)):
                 np.bitwise_xor(Si[n, 0], Si[n, 1], out=qo[:, j])
+            np.copyto(q_out[:, ip], qp)
             np.bitwise_or(mask, 1, out=sg_out)  # -1 where the second (left) branch, else 1
             solved = None if ok is None else np.logical_or(ok[0], ok[1], out=b[3])
         else:
             for n, j in enumerate((ra, rb, rc)):
-                np.copyto(q_out[:, j], S[n, 0])
+                np.copyto(q_out[:, j], S[n][0])
+            np.copyto(q_out[:, ip], qp)
             sg_out.fill(self.signs[0])
             solved = None if ok is None else ok[0]
         st_out.fill(0)
