@@ -218,15 +218,19 @@ class Planar2R:
         else:  # r - 0 and r + 0 are r
             np.less(r, snap, out=mask)
             np.multiply(r, r, out=i)
-        if mask.any():
+        snapped = mask.any()
+        if snapped:
             np.copyto(i, 0.0, where=mask)
         np.multiply(i, l12, out=t)  # t: the lean's cosine side (l1 + l2) i + (l1 - l2) o
         if self._dl != 0.0:
             np.add(t, np.multiply(o, self._dl, out=g), out=t)
         np.sqrt(o, out=o)
-        np.sqrt(i, out=i)
-        np.arctan2(o, i, out=g)
-        np.multiply(o, i, out=o)
+        # sqrt(i) with i = r r (l1 = l2, no row snapped) is r: sqrt(x x) = |x| exactly in binary floating point
+        # (S. Boldo, "Stupid is as stupid does: taking the square root of the square of a floating-point
+        # number", 2015)
+        si = r if d12 == 0.0 and not snapped else np.sqrt(i, out=i)
+        np.arctan2(o, si, out=g)
+        np.multiply(o, si, out=o)
         np.multiply(o, self._2l2, out=o)
         np.arctan2(o, t, out=lean)
         np.add(g, g, out=g)

@@ -778,7 +778,7 @@ class _BatchWork:
         f = [a[:m] for a in self._f]
         b = [a[:m] for a in self._b]
         # S[0], S[1], S[2]: shoulder, elbow and wrist, one row per branch; S[3] (wx, wy once the arm is
-        # solved), S[4] (each branch's signed lean), S[5]: scratch
+        # solved), S[4], S[5]: scratch
         Sq = self._s[:, :, :m]
         S = [Sq[0], Sq[1], Sq[2], self._f[1 : 1 + nb, :m], Sq[3], Sq[4]]
         oks = self._ok[:, :, :m]
@@ -817,12 +817,7 @@ class _BatchWork:
         else:
             np.subtract(x, geo.a1[0], out=wx)
             np.subtract(y, geo.a1[1], out=wy)
-        lean = S[4]  # each branch's signed lean: theta1 = heading - sign lean
-        r, gamma, heading, _, _ = arm.solve_array(wx, wy, out=(f[3], f[4], f[5], lean[0], S[5][0]))
-        if nb == 2:
-            np.negative(lean[0], out=lean[1])
-        elif self.signs[0] < 0:
-            np.negative(lean[0], out=lean[0])
+        r, gamma, heading, lean, _ = arm.solve_array(wx, wy, out=(f[3], f[4], f[5], S[4][0], S[5][0]))
         r_lo, r_hi = r.min(), r.max()
         if not (r_hi <= arm.l12 + REACH_TOL and r_lo >= geo._radius[0] - REACH_TOL):
             if bad is None:
@@ -833,7 +828,8 @@ class _BatchWork:
             np.logical_or(bad, np.less(r, geo._radius[0] - REACH_TOL, out=b[1]), out=bad)
         # both branches at once: shoulder, elbow and wrist at their turns nearest the reference
         Qa, Qb, Qc = S[0], S[1], S[2]
-        np.subtract(heading, lean, out=Qa)
+        for n, sg in enumerate(self.signs):  # theta1 = heading -+ lean
+            (np.subtract if sg > 0 else np.add)(heading, lean, out=Qa[n])
         if geo.beta1 != 0.0:
             np.subtract(Qa, geo.beta1, out=Qa)
         if sgn[ra] < 0:
