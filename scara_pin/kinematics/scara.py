@@ -713,17 +713,20 @@ class _BatchWork:
                     mode = "unique"  # no other turn than the nearest can be inside the limits
             self.modes[j] = mode
 
-    def _turn(self, v: np.ndarray, j: int, ref: Any, ok: np.ndarray, S: list[np.ndarray], t_b: np.ndarray) -> bool:
+    def _turn(self, v: np.ndarray, j: int, ref: Any, ok: np.ndarray, S: list[np.ndarray], t_b: np.ndarray,
+              span: tuple[float, float] | None = None) -> bool:  # fmt: skip
         """Move v (one row per branch) in place to its turn nearest ``ref`` inside joint j's limits.
 
-        ``ok``: where it fits; ``S``: the scratch rows. Returns False when every row fits (``ok`` not written).
+        ``ok``: where it fits; ``S``: the scratch rows; ``span``: (min, max) of v when known (a reference
+        for every row and mode "inside" or "unique" then). Returns False when every row fits (``ok`` not
+        written).
         """
         geo, mode = self.geo, self.modes[j]
         lo, hi = geo.lower[j], geo.upper[j]
         lo_t, hi_t = lo - LIMIT_TOL, hi + LIMIT_TOL
-        if j == geo.revolute[1] and mode != "clip" and self.const_ref is not None:
-            # the elbow of a branch spans half a turn: often one k for the whole block (k is monotonic in v)
-            v_lo, v_hi = float(v.min()), float(v.max())
+        if span is not None:
+            # often one k for the whole block (k = floor((ref + pi - v) / 2 pi) is monotonic in v)
+            v_lo, v_hi = span
             if _isfinite(v_lo) and _isfinite(v_hi):
                 k = math.floor((ref + _PI - v_hi) * _INV_TWO_PI)
                 if k == math.floor((ref + _PI - v_lo) * _INV_TWO_PI):
@@ -835,8 +838,15 @@ class _BatchWork:
         if sgn[ra] < 0:
             np.negative(Qa, out=Qa)
         np.multiply(gamma, self._gs, out=Qb)  # s_b (+/-gamma + beta1 - beta2)
-        if geo.beta1 != geo.beta2:
-            np.add(Qb, sgn[rb] * (geo.beta1 - geo.beta2), out=Qb)
+        c_b = sgn[rb] * (geo.beta1 - geo.beta2)
+        if c_b != 0.0:
+            np.add(Qb, c_b, out=Qb)
+        g_lo, g_hi = float(gamma.min()), float(gamma.max())
+        span = None
+        if self.const_ref is not None and self.modes[rb] != "clip":
+            # the elbow of a branch spans half a turn: its extremes are those of gamma (v is monotonic in gamma)
+            ends = [e + c_b if c_b != 0.0 else e for sg in self._gs[:, 0].tolist() for e in (g_lo * sg, g_hi * sg)]
+            span = (min(ends), max(ends))
         ok: np.ndarray | None = None  # where each branch fits (None: everywhere)
         t_ok, t_b = oks[1], oks[2]
         for Q, j in ((Qb, rb), (Qa, ra), (Qc, rc)):
@@ -845,7 +855,7 @@ class _BatchWork:
                 (np.subtract if sgn[rb] > 0 else np.add)(Qc, Qb, out=Qc)
                 if sgn[rc] < 0:
                     np.negative(Qc, out=Qc)
-            if self._turn(Q, j, refs[j], oks[0] if ok is None else t_ok, S, t_b):
+            if self._turn(Q, j, refs[j], oks[0] if ok is None else t_ok, S, t_b, span if j == rb else None):
                 if ok is None:
                     ok = oks[0]
                 else:
@@ -859,15 +869,15 @@ class _BatchWork:
         if nb == 2:
             # the squared distance of the revolute joints (the vertical one is shared); q - 0 is q
             d, t = S[3], S[4]
-            for n, (Q, j) in enumerate(((Qa, ra), (Qb, rb), (Qc, rc))):
-                dj = d if n == 0 else t
-                if self.const_ref is not None and refs[j] == 0.0:
-                    np.multiply(Q, Q, out=dj)
-                else:
+            if self.const_ref is not None and refs[ra] == refs[rb] == refs[rc] == 0.0:
+                np.einsum("ijk,ijk->jk", Sq[:3], Sq[:3], out=d)  # ((qa qa + qb qb) + qc qc), in one pass
+            else:
+                for n, (Q, j) in enumerate(((Qa, ra), (Qb, rb), (Qc, rc))):
+                    dj = d if n == 0 else t
                     np.subtract(Q, refs[j], out=dj)
                     np.multiply(dj, dj, out=dj)
-                if n:
-                    np.add(d, dj, out=d)
+                    if n:
+                        np.add(d, dj, out=d)
             # the second branch where it solves and the first does not or is farther (strictly: first on a tie)
             use = b[2]
             np.less(d[1], d[0], out=use)
@@ -896,9 +906,12 @@ class _BatchWork:
         if ok is not None:
             # a branch that failed a limit near the stretched/folded circles may be rounding (solve() puts that
             # joint on its limit): such rows take solve()'s route even when the other branch solved
-            near = np.less(gamma, self.near_g, out=b[4])
-            np.logical_or(near, np.greater(gamma, math.pi - self.near_g, out=b[5]), out=near)
-            some = np.flatnonzero(near)  # few rows: the exact test of the arm's rounding on them only
+            near = np.less(gamma, self.near_g, out=b[4]) if g_lo < self.near_g else None
+            if g_hi > math.pi - self.near_g:
+                far = np.greater(gamma, math.pi - self.near_g, out=b[5])
+                near = far if near is None else np.logical_or(near, far, out=near)
+            # few rows: the exact test of the arm's rounding on them only
+            some = np.flatnonzero(near) if near is not None else np.zeros(0, dtype=np.int64)
             if len(some):
                 failed_one = ~(ok[0][some] & ok[-1][some])
                 if bad is not None:
