@@ -1038,6 +1038,29 @@ def test_batch_clamps_an_elbow_rounded_just_past_its_limit() -> None:
     assert clamped >= 3
 
 
+def test_batch_takes_solves_route_for_a_branch_failing_by_rounding_near_stretched() -> None:
+    """Near the stretched circle the left elbow misses its limit by less than the arm's rounding while the right
+    one solves: solve() puts the left elbow on its limit, and the batch (one reference for all rows) follows."""
+    g = 1e-4  # wobble(g) ~ 2e-9 rad
+    robot = load_robot("default", {"joint2_lower": -g + 1e-9})
+    q = np.array([0.3, g, 0.0, 0.1])
+    ref = np.array([0.3 + g, -g, 0.0, 0.1])  # the left branch, nearer
+    T = np.array([robot.tool_pose(q), robot.tool_pose([0.2, 1.0, 0.0, 0.0])])
+    batch = robot.ik_batch(T, ref)
+    for i in range(len(T)):
+        want = robot.ik_nearest(T[i], ref)
+        assert int(batch.status[i]) == 0 and np.abs(batch.q[i] - want).max() <= 1e-12, (i, batch.q[i], want)
+    assert batch.branch[0] == -1 and batch.q[0, 1] == -g + 1e-9
+    # and near the folded circle (the right elbow just past its upper limit, the left one inside)
+    robot = load_robot("default", {"joint2_lower": -math.pi - g / 2, "joint2_upper": math.pi - g - 1e-9})
+    q = np.array([-1.0, math.pi - g, 0.0, 0.1])
+    T = np.array([robot.tool_pose(q), robot.tool_pose([0.2, 1.0, 0.0, 0.0])])
+    batch = robot.ik_batch(T, q)
+    for i in range(len(T)):
+        want = robot.ik_nearest(T[i], q)
+        assert int(batch.status[i]) == 0 and np.abs(batch.q[i] - want).max() <= 1e-12, (i, batch.q[i], want)
+
+
 def _hard_case_params() -> list[Any]:
     out = []
     for case in _hard_cases():
