@@ -1000,6 +1000,67 @@ def test_batch_agrees_with_scalar(name: str, n: int, hand_robots: dict[str, Robo
     assert expected_codes <= statuses, sorted(statuses)
 
 
+@pytest.mark.parametrize(("name", "n"), [("limited", 3_000), ("kr5_negz", 3_000), ("wide", 2_000)])
+def test_batch_default_call_is_ik_nearest(name: str, n: int, hand_robots: dict[str, Robot]) -> None:
+    """The default call (reference None, i.e. q = 0, branch nearest; the squared distances in one pass): each
+    row is ``ik_nearest(t, 0)`` and has its status, also where the elbow of a whole block has one turn."""
+    robot = _batch_robot(name, hand_robots)
+    geo = robot.kinematics.geometry
+    T = _batch_targets(robot, n, seed=31)
+    batch = robot.ik_batch(T)
+    zero = np.zeros(4)
+    for i in range(n):
+        res = solve(geo, T[i], reference=zero)
+        assert int(batch.status[i]) == int(res.status), (i, T[i].tolist(), res.message)
+        if res.success:
+            assert np.abs(batch.q[i] - robot.ik_nearest(T[i], zero)).max() <= 1e-12, (i, T[i].tolist())
+        else:
+            assert np.isnan(batch.q[i]).all() and batch.branch[i] == 0
+
+
+def test_batch_clamps_an_elbow_rounded_just_past_its_limit() -> None:
+    """Every elbow of the block within LIMIT_TOL outside its limits, some beyond them: clamped onto the limit."""
+    robot = load_robot("default")
+    hi = robot.kinematics.geometry.upper[1]
+    T = np.array([robot.tool_pose([0.1, hi + 5e-11, 0.0, 0.2]), robot.tool_pose([-0.3, -hi - 5e-11, 0.05, 0.0])])
+    clamped = 0
+    for branch in ("nearest", "right", "left"):
+        batch = robot.ik_batch(T, branch=branch)
+        for i in range(len(T)):
+            scalar = "all" if branch == "nearest" else branch
+            res = solve(robot.kinematics.geometry, T[i], branch=scalar, reference=np.zeros(4))
+            assert int(batch.status[i]) == int(res.status), (branch, i)
+            if res.success:
+                want = robot.ik_nearest(T[i], branch=scalar)
+                assert np.abs(batch.q[i] - want).max() <= 1e-12, (branch, i, batch.q[i].tolist(), want.tolist())
+                assert -hi <= batch.q[i, 1] <= hi
+                clamped += abs(batch.q[i, 1]) == hi
+    assert clamped >= 3
+
+
+def test_batch_takes_solves_route_for_a_branch_failing_by_rounding_near_stretched() -> None:
+    """Near the stretched circle the left elbow misses its limit by less than the arm's rounding while the right
+    one solves: solve() puts the left elbow on its limit, and the batch (one reference for all rows) follows."""
+    g = 1e-4  # wobble(g) ~ 2e-9 rad
+    robot = load_robot("default", {"joint2_lower": -g + 1e-9})
+    q = np.array([0.3, g, 0.0, 0.1])
+    ref = np.array([0.3 + g, -g, 0.0, 0.1])  # the left branch, nearer
+    T = np.array([robot.tool_pose(q), robot.tool_pose([0.2, 1.0, 0.0, 0.0])])
+    batch = robot.ik_batch(T, ref)
+    for i in range(len(T)):
+        want = robot.ik_nearest(T[i], ref)
+        assert int(batch.status[i]) == 0 and np.abs(batch.q[i] - want).max() <= 1e-12, (i, batch.q[i], want)
+    assert batch.branch[0] == -1 and batch.q[0, 1] == -g + 1e-9
+    # and near the folded circle (the right elbow just past its upper limit, the left one inside)
+    robot = load_robot("default", {"joint2_lower": -math.pi - g / 2, "joint2_upper": math.pi - g - 1e-9})
+    q = np.array([-1.0, math.pi - g, 0.0, 0.1])
+    T = np.array([robot.tool_pose(q), robot.tool_pose([0.2, 1.0, 0.0, 0.0])])
+    batch = robot.ik_batch(T, q)
+    for i in range(len(T)):
+        want = robot.ik_nearest(T[i], q)
+        assert int(batch.status[i]) == 0 and np.abs(batch.q[i] - want).max() <= 1e-12, (i, batch.q[i], want)
+
+
 def _hard_case_params() -> list[Any]:
     out = []
     for case in _hard_cases():

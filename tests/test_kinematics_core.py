@@ -74,6 +74,20 @@ def test_planar2r_against_the_textbook_law_of_cosines(l1: float, l2: float, t1: 
         assert abs(a - b) <= 4 * EPS * max(1.0, abs(b)), (a, b)
 
 
+def test_planar2r_array_equal_links_near_the_shoulder() -> None:
+    """l1 = l2: the array form takes sqrt(r r) as r, except on rows that snap to the folded circle (i = 0)."""
+    arm = Planar2R(0.2, 0.2)
+    wx = np.array([0.0, 1e-17, 3e-16, 1e-9, 0.1, 0.3, 0.4 * (1 - EPS)])
+    wy = np.array([0.0, 0.0, 2e-16, -1e-9, 0.05, -0.2, 0.0])
+    for rows in (slice(None), slice(3, None)):  # with and without snapped rows in the block
+        out = arm.solve_array(wx[rows], wy[rows])
+        for k, (x, y) in enumerate(zip(wx[rows].tolist(), wy[rows].tolist())):
+            _, r, gamma, heading, lean = arm.solve(x, y)
+            assert out[0][k] == r
+            for a, b in zip((out[1][k], out[2][k], out[3][k]), (gamma, heading, lean)):
+                assert abs(a - b) <= 4 * EPS * max(1.0, abs(b)), (x, y, a, b)
+
+
 def test_planar2r_snaps_the_stretched_and_folded_circles() -> None:
     arm = Planar2R(0.3, 0.2)
     for r in (0.5, 0.5 * (1 - 2 * EPS), 0.1, 0.1 * (1 + 2 * EPS)):

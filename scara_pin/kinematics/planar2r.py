@@ -208,19 +208,29 @@ class Planar2R:
         mask = np.less(o, snap)
         np.add(r, l12, out=t)
         np.multiply(o, t, out=o)
-        np.copyto(o, 0.0, where=mask)
-        np.subtract(r, d12, out=i)
-        np.less(i, snap, out=mask)
-        np.add(r, d12, out=t)
-        np.multiply(i, t, out=i)
-        np.copyto(i, 0.0, where=mask)
+        if mask.any():
+            np.copyto(o, 0.0, where=mask)
+        if d12 != 0.0:
+            np.subtract(r, d12, out=i)
+            np.less(i, snap, out=mask)
+            np.add(r, d12, out=t)
+            np.multiply(i, t, out=i)
+        else:  # r - 0 and r + 0 are r
+            np.less(r, snap, out=mask)
+            np.multiply(r, r, out=i)
+        snapped = mask.any()
+        if snapped:
+            np.copyto(i, 0.0, where=mask)
         np.multiply(i, l12, out=t)  # t: the lean's cosine side (l1 + l2) i + (l1 - l2) o
         if self._dl != 0.0:
             np.add(t, np.multiply(o, self._dl, out=g), out=t)
         np.sqrt(o, out=o)
-        np.sqrt(i, out=i)
-        np.arctan2(o, i, out=g)
-        np.multiply(o, i, out=o)
+        # sqrt(i) with i = r r (l1 = l2, no row snapped) is r: sqrt(x x) = |x| exactly in binary floating point
+        # (S. Boldo, "Stupid is as stupid does: taking the square root of the square of a floating-point
+        # number", 2015)
+        si = r if d12 == 0.0 and not snapped else np.sqrt(i, out=i)
+        np.arctan2(o, si, out=g)
+        np.multiply(o, si, out=o)
         np.multiply(o, self._2l2, out=o)
         np.arctan2(o, t, out=lean)
         np.add(g, g, out=g)
