@@ -188,6 +188,34 @@ def test_cli_unknown_frame_exits_2_with_one_line(xacro: Path, capsys: pytest.Cap
     assert code == 2 and "[frame-missing]" in out and "'tool_0'" in out
 
 
+@pytest.mark.parametrize("how", ["exc attribute", "context"])
+def test_a_missing_package_wrapped_by_any_xacro_exception_is_named(xacro: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                   how: str) -> None:  # fmt: skip
+    """xacro wraps the finder's PackageNotFoundError (as ``.exc``, or as the exception being handled), and
+    xacrodoc 2.0.0 raises its own copy of XacroException, not xacro's: the error names the package anyway."""
+    from xacrodoc import XacroDoc, packages
+
+    class OtherXacroException(Exception):  # not xacro.XacroException
+        pass
+
+    def raising(*args: Any, **kwargs: Any) -> None:
+        missing = packages.PackageNotFoundError("some_missing_description")
+        if how == "exc attribute":
+            wrapped = OtherXacroException("Package not found")
+            wrapped.exc = missing  # type: ignore[attr-defined]
+            raise wrapped
+        try:
+            raise missing
+        except packages.PackageNotFoundError:
+            raise OtherXacroException("Package not found") from None
+
+    monkeypatch.setattr(XacroDoc, "from_string", raising)
+    with pytest.raises(UrdfError) as info:
+        PackagePath().expand_xacro(xacro)
+    assert "package 'some_missing_description' not found" in str(info.value)
+    assert len(str(info.value).splitlines()) == 1
+
+
 def test_missing_package_is_one_line_naming_it(xacro: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
     monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)

@@ -121,12 +121,13 @@ class PackagePath:
             doc = XacroDoc.from_string(text, resolve_packages=False, rootdir=path.parent)
         except packages.PackageNotFoundError as exc:
             raise self._not_found(exc.args[0] if exc.args else "?") from None
-        except XacroException as exc:
-            missing = getattr(exc, "exc", None)
-            if isinstance(missing, packages.PackageNotFoundError):
-                raise self._not_found(missing.args[0]) from None
-            raise UrdfError(f"{path}: xacro: {' '.join(str(exc).split())}") from None
         except Exception as exc:  # xacro raises plain Python errors for bad expressions, XML errors...
+            # a missing package wrapped by xacro (xacrodoc 2.0.0 raises its own copy of XacroException)
+            missing = getattr(exc, "exc", None) or exc.__context__
+            if isinstance(missing, packages.PackageNotFoundError):
+                raise self._not_found(missing.args[0] if missing.args else "?") from None
+            if isinstance(exc, XacroException):
+                raise UrdfError(f"{path}: xacro: {' '.join(str(exc).split())}") from None
             raise UrdfError(f"{path}: xacro: {type(exc).__name__}: {' '.join(str(exc).split())}") from None
         return str(doc.dom.toprettyxml(indent="  "))
 
