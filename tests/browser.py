@@ -118,9 +118,8 @@ def orange_pixels(png: bytes | Path) -> int:
 
 @pytest.fixture(scope="session")
 def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    """A headless Chromium context with a fresh profile, launched once per session (each test gets its own page;
-    conftest.py registers this fixture and keeps the tests that use it on one pytest-xdist worker): see
-    browser_for_tests."""
+    """A headless Chromium context with a fresh profile, launched once per session (per pytest-xdist worker;
+    each test gets its own page; conftest.py registers this fixture): see browser_for_tests."""
     yield from browser_for_tests(tmp_path_factory)
 
 

@@ -36,11 +36,3 @@ def rng() -> np.random.Generator:
     """A freshly seeded generator (the same numbers in every test that asks for it)."""
     return np.random.default_rng(20240611)
 
-
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Under pytest-xdist (``--dist loadgroup``) the tests that use the browser run on one worker: one Chromium."""
-    if not config.pluginmanager.hasplugin("xdist"):
-        return
-    for item in items:
-        if "browser" in getattr(item, "fixturenames", ()):
-            item.add_marker(pytest.mark.xdist_group("browser"))
