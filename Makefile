@@ -1,6 +1,7 @@
 # Two commands do all the set-up on a fresh machine with Python 3.11 and make:
 #   make demo   creates .venv, installs scara-pin, runs the demo
-#   make test   creates .venv, installs scara-pin with its test extras, runs the whole suite
+#   make test   creates .venv, installs scara-pin with its test extras, runs the whole suite (on every core:
+#               pytest-xdist's -n auto is in pyproject.toml's addopts; pass -n 0 for one process)
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin

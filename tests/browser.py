@@ -75,7 +75,7 @@ def chromium(profile: Path) -> Iterator[Any]:
 
 
 def browser_for_tests(tmp_path_factory: Any) -> Iterator[Any]:
-    """The body of a module-scoped ``browser`` fixture: skipped only outside CI when Chromium or Playwright is
+    """The body of the ``browser`` fixture: skipped only outside CI when Chromium or Playwright is
     absent; in CI, or when Chromium is there but cannot start, the tests fail."""
     import pytest
 
@@ -116,9 +116,10 @@ def orange_pixels(png: bytes | Path) -> int:
     return int(mask.sum())
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    """A headless Chromium context with a fresh profile (one per test module): see browser_for_tests."""
+    """A headless Chromium context with a fresh profile, launched once per session (per pytest-xdist worker;
+    each test gets its own page; conftest.py registers this fixture): see browser_for_tests."""
     yield from browser_for_tests(tmp_path_factory)
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from browser import browser, page  # noqa: F401 - the headless Chromium fixtures (tests/browser.py), shared
 
 from scara_pin import Robot, load_robot
 
@@ -34,3 +35,4 @@ def robots(robot_default: Robot, robot_s1: Robot) -> dict[str, Robot]:
 def rng() -> np.random.Generator:
     """A freshly seeded generator (the same numbers in every test that asks for it)."""
     return np.random.default_rng(20240611)
+

@@ -8,8 +8,11 @@ jerk).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import io
 import json
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -17,7 +20,7 @@ import pytest
 
 from scara_pin import load_robot
 from scara_pin.cli import main
-from scara_pin.motion.cycle import standard_cycle, trajectory_jerk
+from scara_pin.motion.cycle import STANDARD_RISE, STANDARD_SPAN, standard_cycle, trajectory_jerk
 from scara_pin.motion.jerk import FilteredLaw
 from scara_pin.motion.payload import Payload
 from scara_pin.motion.timing import TimingOptions
@@ -50,9 +53,46 @@ def jerk_cycle(robot):
     return standard_cycle(robot, payload=Payload(MASS, COM), jerk=JERK)
 
 
+@dataclasses.dataclass
+class CliRun:
+    code: int
+    out: str
+    folder: Path
+    planned: list  # (keyword arguments, CycleResult) of each standard_cycle call the command made
+
+
 @pytest.fixture(scope="module")
-def plain(robot):
-    return standard_cycle(robot), standard_cycle(robot, blend=0.0)
+def cli_corners(tmp_path_factory):
+    """``cycle --no-blend --plot --out --json`` run once, in-process. standard_cycle is wrapped (not replaced)
+    to record what the command planned, so the library tests below share that planning instead of repeating it."""
+    import scara_pin.motion.cycle as cycle_module
+
+    folder = tmp_path_factory.mktemp("cycle-cli")
+    real = cycle_module.standard_cycle
+    planned = []
+
+    def recording(*args, **kwargs):
+        planned.append((kwargs, real(*args, **kwargs)))
+        return planned[-1][1]
+
+    out = io.StringIO()
+    with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out):
+        mp.setattr(cycle_module, "standard_cycle", recording)
+        code = main(["cycle", "--no-blend", "--plot", str(folder / "c.png"), "--out", str(folder / "c.csv"), "--json"])
+    return CliRun(code, out.getvalue(), folder, planned)
+
+
+@pytest.fixture(scope="module")
+def plain(robot, cli_corners):
+    """(blended, corners): ``standard_cycle(robot)``, and ``standard_cycle(robot, blend=0.0)`` as the CLI's
+    --no-blend planned it (asserted here: that call is this one, every other argument at its default)."""
+    assert len(cli_corners.planned) == 1
+    kwargs, corners = cli_corners.planned[0]
+    assert kwargs["blend"] == 0.0 and kwargs["span"] == STANDARD_SPAN and kwargs["rise"] == STANDARD_RISE
+    assert kwargs["start"] is None and kwargs["direction"] is None and kwargs["jerk"] is None
+    assert kwargs["payload"] == Payload() and kwargs["limits"] == robot.limits
+    assert kwargs.keys() == {"start", "direction", "span", "rise", "blend", "payload", "jerk", "limits"}
+    return standard_cycle(robot), corners
 
 
 def _check_times(traj):
@@ -137,10 +177,12 @@ def test_csv_by_finite_differences(robot, jerk_cycle, tmp_path):
     assert np.max(np.abs(tau) / lim.effort) <= 1 + PROMISE
 
 
-def test_cli_plot_json_and_text(tmp_path, capsys):
+def test_cli_plot_json_and_text(cli_corners, plain):
+    tmp_path = cli_corners.folder
     png, csv = tmp_path / "c.png", tmp_path / "c.csv"
-    assert main(["cycle", "--no-blend", "--plot", str(png), "--out", str(csv), "--json"]) == 0
-    summary = json.loads(capsys.readouterr().out)
+    assert cli_corners.code == 0
+    summary = json.loads(cli_corners.out)
+    assert summary["cycle_time"] == plain[1].cycle_time  # what the command planned is what it reports
     assert {"cycle_time", "legs", "limits"} <= summary.keys()
     assert [leg["name"] for leg in summary["legs"]] == ["lift", "traverse", "descend"] * 2
     assert abs(sum(leg["duration"] for leg in summary["legs"]) - summary["cycle_time"]) < 1e-9

@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 import shutil
 import xml.etree.ElementTree as ET
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import trimesh
-from browser import browser_for_tests, next_frames, orange_pixels
+from browser import next_frames, orange_pixels
 
 from scara_pin import Robot, load_robot
 from scara_pin.cli import main
@@ -392,11 +391,6 @@ def test_missing_and_broken_meshes_are_warnings_with_a_placeholder(
 
 
 # ------------------------------------------------------------------------------------------ in a real browser
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    yield from browser_for_tests(tmp_path_factory)
-
-
 def render(browser: Any, html: Path) -> tuple[int, list[str], int]:
     """(orange pixels, the geometry types of the visuals, page errors) of an offline page."""
     page = browser.new_page()

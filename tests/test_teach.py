@@ -19,7 +19,6 @@ import urllib.request
 from pathlib import Path
 from typing import Any
 
-import browser as _browser
 import numpy as np
 import pinocchio as pin
 import psutil
@@ -31,9 +30,6 @@ from scara_pin.kinematics.scara import NotScaraError
 from scara_pin.viz.meshcat import export_html
 from scara_pin.viz.teach import JogAxis, Solver, TeachSession
 from scara_pin.viz.tree import FIELD_OF_VIEW, framing, joint_nodes
-
-browser = _browser.browser  # the shared fixtures (tests/browser.py)
-page = _browser.page
 
 NAMES = ("s1", "default", "palletizer")
 Q_S1 = np.array([0.3, 0.9, 0.02, -0.5])  # inside s1's workspace, 10 mm of x to spare either way

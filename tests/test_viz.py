@@ -24,7 +24,6 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import browser as _browser
 import numpy as np
 import psutil
 import pytest
@@ -42,8 +41,6 @@ from scara_pin.viz.meshcat import (
 )
 from scara_pin.viz.tree import node_paths
 
-browser = _browser.browser  # the shared fixtures (tests/browser.py)
-page = _browser.page
 ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
 SERVER_MARK = "scara-pin-meshcat-server"
 FPS = 30

@@ -247,6 +247,15 @@ def _check_joint_limits(robot: Robot, path: GeometricPath, n: int = 2001) -> Non
     raise PathError("the spline leaves the joint limits: " + "; ".join(robot.outside_limits(qb)), s=b, q=qb)
 
 
+def _singular(J: np.ndarray) -> bool:
+    """True when np.linalg.solve refuses J (exactly singular in LAPACK's LU)."""
+    try:
+        np.linalg.solve(J, np.zeros(J.shape[0]))
+    except np.linalg.LinAlgError:
+        return True
+    return False
+
+
 class _Kinematics:
     """Task Jacobian J = d(x, y, z, yaw)/dq and its derivative along a direction, on private Pinocchio data."""
 
@@ -335,19 +344,25 @@ class CartesianSegment(GeometricPath):
         if order == 0:
             return (q,)
         n = len(s)
-        dq = np.empty((n, 4))
-        ddq = np.empty((n, 4))
         d1, d2 = self.pose_derivatives(s)
+        J = np.empty((n, 4, 4))
         for k in range(n):
-            J = self._kin.jacobian(q[k])
-            try:
-                dq[k] = np.linalg.solve(J, d1[k])
-                if order >= 2:
-                    ddq[k] = np.linalg.solve(J, d2[k] - self._kin.jacobian_rate(q[k], dq[k]) @ dq[k])
-            except np.linalg.LinAlgError:
-                raise PathError("the task Jacobian is singular (stretched or folded arm)", s=s[k],
-                                pose=self.poses(s[k])[0], q=q[k]) from None  # fmt: skip
-        return (q, dq, ddq)[: order + 1]
+            J[k] = self._kin.jacobian(q[k])
+        # one stacked solve per order: LAPACK's gesv on each matrix, as n separate calls would do, without
+        # numpy's per-call overhead (that overhead was most of the time of a timed Cartesian path)
+        try:
+            dq = np.linalg.solve(J, d1[:, :, None])[:, :, 0]
+            if order < 2:
+                return (q, dq)
+            rhs = np.empty((n, 4))
+            for k in range(n):
+                rhs[k] = d2[k] - self._kin.jacobian_rate(q[k], dq[k]) @ dq[k]
+            ddq = np.linalg.solve(J, rhs[:, :, None])[:, :, 0]
+        except np.linalg.LinAlgError:
+            k = next(k for k in range(n) if _singular(J[k]))
+            raise PathError("the task Jacobian is singular (stretched or folded arm)", s=s[k],
+                            pose=self.poses(s[k])[0], q=q[k]) from None  # fmt: skip
+        return (q, dq, ddq)
 
 
 @dataclass(frozen=True, eq=False)
