@@ -558,30 +558,46 @@ def _per_call_paths(robot: Robot) -> tuple[Callable[[np.ndarray], pin.SE3], Call
     :func:`_q_ok`'s test passes (written inline: a call of it would cost a fifth of FK), else converts it
     with ``robot._pin_q`` (which checks it and raises ParameterError).
     """
-    model, data, tool, fast, full = robot._base_model, robot._base_data, robot.tool_id, not robot._slow_q, robot._pin_q
+    model, data, tool, full = robot._base_model, robot._base_data, robot.tool_id, robot._pin_q
     forward, placement, jacobian, lwa, rows, f64, bound = _forward, _frame_placement, _frame_jacobian, _LWA, \
         _TASK_ROWS, _F64, _Q_MAX2  # fmt: skip
 
-    def tool_placement(q: np.ndarray) -> pin.SE3:
+    if robot._slow_q:  # continuous joints (Pinocchio's q differs) or three joints: every q is converted
+
+        def tool_placement(q: np.ndarray) -> pin.SE3:
+            """``baseMtool``: the placement of the tool frame in the base frame at ``q`` (``robot.data`` untouched)."""
+            forward(model, data, full(q))
+            return placement(model, data, tool)
+
+        def task_jacobian(q: np.ndarray) -> np.ndarray:
+            """The 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame (rows x, y, z, yaw rate)."""
+            return jacobian(model, data, full(q), tool, lwa).take(rows, 0)
+
+        return tool_placement, task_jacobian
+
+    def fast_tool_placement(q: np.ndarray) -> pin.SE3:
         """``baseMtool``: the placement of the tool frame in the base frame at ``q`` (``robot.data`` untouched)."""
         try:
             a, b, c, d = q.tolist()
-            ok = fast and a * a + b * b + c * c + d * d <= bound and q.dtype is f64  # NaN and inf fail
+            if a * a + b * b + c * c + d * d <= bound and q.dtype is f64:  # NaN and inf fail
+                forward(model, data, q)
+                return placement(model, data, tool)
         except (AttributeError, TypeError, ValueError):  # not an array, a wrong length, nested values
-            ok = False
-        forward(model, data, q if ok else full(q))
+            pass
+        forward(model, data, full(q))  # checked and converted (ParameterError)
         return placement(model, data, tool)
 
-    def task_jacobian(q: np.ndarray) -> np.ndarray:
+    def fast_task_jacobian(q: np.ndarray) -> np.ndarray:
         """The 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame (rows x, y, z, yaw rate)."""
         try:
             a, b, c, d = q.tolist()
-            ok = fast and a * a + b * b + c * c + d * d <= bound and q.dtype is f64  # as tool_placement's
+            if a * a + b * b + c * c + d * d <= bound and q.dtype is f64:  # as fast_tool_placement's
+                return jacobian(model, data, q, tool, lwa).take(rows, 0)
         except (AttributeError, TypeError, ValueError):
-            ok = False
-        return jacobian(model, data, q if ok else full(q), tool, lwa).take(rows, 0)
+            pass
+        return jacobian(model, data, full(q), tool, lwa).take(rows, 0)
 
-    return tool_placement, task_jacobian
+    return fast_tool_placement, fast_task_jacobian
 
 
 def _q_ok(q: Any) -> bool:
