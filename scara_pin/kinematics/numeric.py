@@ -234,7 +234,7 @@ class _Task:
         """Return the 4 x 4 task Jacobian (rows x, y, z, yaw) at q, in base axes."""
         if self.model is None:
             return np.asarray(self.robot.task_jacobian(q), dtype=float)
-        return _jac(self.model, self.data, q, self.tool, _LWA)[_TASK_ROWS]
+        return _jac(self.model, self.data, q, self.tool, _LWA).take(_TASK_ROWS, 0)
 
     def project(self, q: np.ndarray) -> np.ndarray:
         """Into the limits: revolute joints by a 2 pi turn when that lands inside, then clipping."""
