@@ -18,11 +18,8 @@ Rules:
 from __future__ import annotations
 
 import os
-import secrets
-import shutil
 import stat
 import sys
-import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -86,7 +83,7 @@ def _new_temp(folder: Path, name: str, created: list[Path]) -> Path:
     """
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
     for _ in range(100):
-        tmp = folder / f".{name[:64]}.{secrets.token_hex(6)}.tmp"
+        tmp = folder / f".{name[:64]}.{os.urandom(6).hex()}.tmp"  # as secrets.token_hex(6)
         created.append(tmp)
         try:
             fd = os.open(tmp, flags, 0o666)
@@ -122,7 +119,12 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     """
     path = check_output_path(path)
     to_stdout = str(path) == STDOUT
-    folder = Path(tempfile.gettempdir()) if to_stdout else (path.parent if str(path.parent) else Path("."))
+    if to_stdout:
+        import tempfile  # here: `scara-pin fk` writes no file and does not pay for the import
+
+        folder = Path(tempfile.gettempdir())
+    else:
+        folder = path.parent if str(path.parent) else Path(".")
     created: list[Path] = []
     try:
         tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created)
@@ -134,6 +136,8 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
                 if out is None:  # a text stream (tests): text outputs only
                     sys.stdout.write(src.read().decode("utf-8"))
                 else:
+                    import shutil
+
                     shutil.copyfileobj(src, out)
             sys.stdout.flush()
             return
