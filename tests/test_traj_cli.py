@@ -125,3 +125,33 @@ def test_setpoints_in_motor_steps(capsys: pytest.CaptureFixture[str], tmp_path: 
     steps = data[:, 5:9]
     assert (steps == np.round(steps)).all()
     assert np.abs(steps - data[:, 1:5] * counts).max() <= 0.5 + 1e-9  # absolute rounding: no drift
+
+
+def test_json_out_says_the_motions_duration_and_view_plays_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]
+                                                              ) -> None:  # fmt: skip
+    """`traj --out x.json` records the motion's duration (the one the summary prints), not the end of the
+    sample grid; `view --traj x.json` reads it; a file naming a duration outside its last interval is one
+    error line (exit 2)."""
+    out = tmp_path / "t.json"
+    rc, summary, err = run(capsys, ["traj", "--from", "0", "0", "0", "0", "--to", "1", "1", "0.05", "1", "--duration",
+                                    "1.2345", "--rate", "10", "--out", str(out), "--json"])  # fmt: skip
+    assert rc == 0, err
+    data = json.loads(out.read_text())
+    assert data["duration"] == json.loads(summary)["duration"] == 1.2345
+    assert data["t"][-1] == pytest.approx(1.3, abs=1e-15)
+    html = tmp_path / "t.html"
+    rc, printed, err = run(capsys, ["view", "--traj", str(out), "--html", str(html)])
+    assert rc == 0 and html.is_file(), err
+    data["duration"] = 1.05  # before the last interval [1.2, 1.3]
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    rc, printed, err = run(capsys, ["view", "--traj", str(bad), "--html", str(tmp_path / "bad.html")])
+    assert rc == 2 and printed == "" and len(err.splitlines()) == 1 and "last interval" in err
+    assert not (tmp_path / "bad.html").exists()
+    data["duration"] = 1.2345
+    data["q"] = [row[:3] for row in data["q"]]
+    data["qd"] = [row[:3] for row in data["qd"]]
+    data["qdd"] = [row[:3] for row in data["qdd"]]
+    bad.write_text(json.dumps(data))
+    rc, printed, err = run(capsys, ["view", "--traj", str(bad), "--html", str(tmp_path / "bad.html")])
+    assert rc == 2 and "3 joints" in err and len(err.splitlines()) == 1

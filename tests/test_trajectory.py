@@ -30,6 +30,7 @@ from scara_pin.motion.trajectory import (
     joint_path,
     joint_pose,
     line_optimal_duration,
+    load_samples,
     load_trajectory,
     quintic,
     quintic_min_duration,
@@ -422,6 +423,32 @@ def test_export_round_trip(tmp_path: Path, fmt: str) -> None:
     mask = os.umask(0)
     os.umask(mask)
     assert out.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
+def test_json_duration_is_the_motions_not_the_grids(tmp_path: Path) -> None:
+    """A grid whose last sample falls after the end of the motion (T = 1.2345 s at 10 Hz: samples to 1.3 s)
+    records the motion's own duration, T itself; read back, the samples keep it."""
+    T = 1.2345
+    tr = quintic(S1_Q0, S1_Q1, T)
+    out = tr.to_json(tmp_path / "t.json", rate=10.0)
+    data = json.loads(out.read_text())
+    assert data["t"][-1] == pytest.approx(1.3, abs=1e-15) and data["t"][-2] == pytest.approx(1.2, abs=1e-15)
+    assert data["duration"] == T
+    assert tr.resample(10.0).to_dict()["duration"] == T
+    assert load_samples(out).duration == T
+    assert np.array_equal(load_samples(out).q[-1], tr.sample(T)[0])  # the last sample holds the end at rest
+    # on the grid (1.25 s at 20 Hz): the motion's end is the last sample
+    on_grid = quintic(S1_Q0, S1_Q1, 1.25)
+    assert json.loads(on_grid.to_json(tmp_path / "v.json", rate=20.0).read_text())["duration"] == 1.25
+
+
+@pytest.mark.parametrize("duration", [1.2, 1.3000001, -1.0, math.nan, math.inf])
+def test_samples_duration_must_lie_in_the_last_interval(duration: float) -> None:
+    t = np.array([0.0, 0.6, 1.2, 1.3])
+    with pytest.raises(ParameterError, match="last interval"):
+        Samples(t, np.zeros((4, 4)), np.zeros((4, 4)), np.zeros((4, 4)), duration)
+    assert Samples(t, np.zeros((4, 4)), np.zeros((4, 4)), np.zeros((4, 4)), 1.25).duration == 1.25
+    assert Samples(t, np.zeros((4, 4)), np.zeros((4, 4)), np.zeros((4, 4))).duration == 1.3
 
 
 def test_load_refuses_malformed_files(tmp_path: Path) -> None:

@@ -32,7 +32,15 @@ def cmd_view(args: argparse.Namespace) -> int:
         for item in robot.outside_limits(q):
             log.warning("%s (shown anyway)", item)
     times = qs = None
-    if args.traj:
+    if args.traj and args.traj.lower().endswith(".json"):  # as `traj --out` writes it
+        from ..motion.trajectory import load_samples
+
+        samples = load_samples(args.traj)
+        if samples.q.shape[1] != robot.dof:
+            raise InvalidInputError(f"{args.traj}: a trajectory of {samples.q.shape[1]} joints; robot {robot.name!r} "
+                                    f"has {robot.dof}")  # fmt: skip
+        times, qs = samples.t, samples.q
+    elif args.traj:
         times, qs = viz.read_trajectory_csv(args.traj, robot.dof)
     polylines = None
     if args.workspace:
@@ -67,7 +75,8 @@ def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
     p = sub.add_parser("view", help="show the robot in the browser (meshcat); --html writes a standalone page")
     p.add_argument("--q", nargs="+", metavar="Q", help="configuration to show, one value per joint (default: zero)")
-    p.add_argument("--traj", metavar="CSV", help="animate a trajectory (a `traj --out` CSV) and draw the tool path")
+    p.add_argument("--traj", metavar="FILE",
+                   help="animate a trajectory (a `traj --out` CSV, or its JSON: *.json) and draw the tool path")
     p.add_argument("--workspace", action="store_true", help="draw the workspace boundary on the floor")
     p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")
     p.add_argument("--open", action="store_true", help="open the page in the web browser")

@@ -77,6 +77,7 @@ __all__ = [
     "joint_path",
     "joint_pose",
     "line_optimal_duration",
+    "load_samples",
     "load_trajectory",
     "quintic",
     "quintic_min_duration",
@@ -335,12 +336,15 @@ class Samples:
     Attributes:
         t: (n,) increasing times from 0 [s].
         q, qd, qdd: (n, 4) positions, velocities, accelerations.
+        duration: the motion's own length [s]: ``t[-1]`` (the default), or a time in (t[-2], t[-1]] when the
+            samples are a fixed-rate grid whose last sample falls after the end of the motion (at rest).
     """
 
     t: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
+    duration: float | None = None
 
     def __post_init__(self) -> None:
         t = np.array(self.t, dtype=float)
@@ -349,6 +353,14 @@ class Samples:
         if not np.isfinite(t).all() or t[0] != 0.0 or not (np.diff(t) > 0).all():
             raise ParameterError("t", f"[{t[0]}, ..., {t[-1]}]", "must be finite, start at 0 and increase strictly")
         object.__setattr__(self, "t", t)
+        if self.duration is None:
+            object.__setattr__(self, "duration", float(t[-1]))
+        else:
+            T = float(self.duration)
+            if not (math.isfinite(T) and t[-2] < T <= t[-1]):
+                last = f"({float(t[-2])!r}, {float(t[-1])!r}]"
+                raise ParameterError("duration", self.duration, f"must be in {last} (the last interval)", "s")
+            object.__setattr__(self, "duration", T)
         dof = np.shape(self.q)[-1] if np.ndim(self.q) == 2 and np.shape(self.q)[-1] in JOINT_COUNTS else 4
         for name in ("q", "qd", "qdd"):
             arr = np.array(getattr(self, name), dtype=float)
@@ -375,7 +387,7 @@ class Samples:
             "version": 1,
             "units": "SI: s; rad or m; per s; per s^2",
             "joints": list(JOINT_NAMES[: self.q.shape[1]]),
-            "duration": float(self.t[-1]),
+            "duration": self.duration,  # the motion's length (the last sample may be up to one period later)
             "t": self.t.tolist(),
             "q": self.q.tolist(),
             "qd": self.qd.tolist(),
@@ -514,7 +526,7 @@ class Trajectory:
     def resample(self, rate: float) -> Samples:
         """Samples on the fixed-rate grid :meth:`times`."""
         t = self.times(rate)
-        return Samples(t, *self.sample(t))
+        return Samples(t, *self.sample(t), duration=min(self.duration, float(t[-1])))
 
     def scaled(self, k: float) -> Trajectory:
         """The same trajectory ``k`` times slower (velocities / k, accelerations / k^2)."""
@@ -599,11 +611,21 @@ def load_trajectory(path: str | os.PathLike[str]) -> Trajectory:
             return Trajectory.from_samples(Samples.from_table(table))
         except ParameterError as exc:
             raise InvalidInputError(f"{path}: {exc}") from None
+    return Trajectory.from_samples(load_samples(path))
+
+
+def load_samples(path: str | os.PathLike[str]) -> Samples:
+    """The samples of a JSON trajectory file (:meth:`Trajectory.to_json`), with the motion's duration.
+
+    Raises:
+        InvalidInputError: unreadable file, not a trajectory file, or bad values.
+    """
+    path = Path(path)
     try:
         text = read_text(path, "trajectory")  # bounded: /dev/zero or a huge file is refused, not read whole
     except InvalidInputError as exc:
         raise InvalidInputError(f"{path}: cannot be read ({exc})") from None
-    return Trajectory.from_samples(_samples_from_json(text, str(path)))
+    return _samples_from_json(text, str(path))
 
 
 def _samples_from_json(text: str, origin: str) -> Samples:
@@ -614,8 +636,12 @@ def _samples_from_json(text: str, origin: str) -> Samples:
     if not isinstance(data, dict) or data.get("format") != _FORMAT:
         raise InvalidInputError(f"{origin}: not a {_FORMAT} file")
     try:
+        duration = data.get("duration")  # the motion's length; files of version 1 may hold t[-1] there
         return Samples(np.array(data["t"], dtype=float), np.array(data["q"], dtype=float),
-                       np.array(data["qd"], dtype=float), np.array(data["qdd"], dtype=float))  # fmt: skip
+                       np.array(data["qd"], dtype=float), np.array(data["qdd"], dtype=float),
+                       None if duration is None else float(duration))  # fmt: skip
+    except ParameterError as exc:
+        raise InvalidInputError(f"{origin}: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
         raise InvalidInputError(f"{origin}: bad trajectory data ({exc})") from None
 
