@@ -429,3 +429,24 @@ def test_ik_does_not_import_heavy_packages(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     result = [line for line in proc.stdout.splitlines() if line.startswith("RESULT")]
     assert result == ["RESULT [0, 0, 0] [] []"], proc.stdout + proc.stderr
+
+
+def test_near_outside_the_limits_is_used_with_a_warning(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """A --near joint outside its limits (50 typed for a 0.05 m quill, say) is still a reference: the nearest
+    solution is returned, and one warning names the joint (single target and batch)."""
+    target = s4_pose(Q)
+    rc, out, err = run(capsys, ["ik", *argv_pose(target), "--json", "--near", "0", "0", "50", "0"])
+    assert rc == 0
+    warnings = [line for line in err.splitlines() if line.startswith("warning:")]
+    assert len(warnings) == 1 and "--near" in warnings[0] and "joint3 = 50" in warnings[0]
+    got = np.array(json.loads(out)["solutions"][0]["q"])
+    ref = np.array([0.0, 0.0, 50.0, 0.0])
+    best = min(s4_solutions(target), key=lambda q: float(((q - ref) ** 2).sum()))
+    assert np.abs(got - best).max() <= 1e-9
+    rc, out, err = run(capsys, ["ik", *argv_pose(target), "--near", "0", "0", "0.02", "0"])
+    assert rc == 0 and "warning" not in err  # inside the limits: no warning
+    targets = tmp_path / "t.csv"
+    targets.write_text("x,y,z,yaw\n" + ",".join(map(repr, target.tolist())) + "\n")
+    rc, out, err = run(capsys, ["ik", "--input", str(targets), "--output", str(tmp_path / "q.csv"), "--near", "0", "0",
+                                "50", "0"])  # fmt: skip
+    assert rc == 0 and sum("--near" in line and line.startswith("warning:") for line in err.splitlines()) == 1

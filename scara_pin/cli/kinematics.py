@@ -136,11 +136,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
     if args.input is None and args.output:
         raise InvalidInputError("--output goes with --input (batch mode)")
     target = _read_pose(args.target, units, dof=robot.dof)
-    near = None
-    if args.near:
-        if len(args.near) != robot.dof:
-            raise ParameterError("--near", " ".join(args.near), f"must be {robot.dof} joint values")
-        near = robot.check_q(_q_values(args.near, units))
+    near = _near(robot, args.near, units) if args.near else None
     numeric = args.numeric
     if numeric:
         _needs_wrist(robot, "ik --numeric")
@@ -221,6 +217,20 @@ def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) 
     return "OK", f"converged in {res.iterations} iterations (residual {res.residual:.3g})", [res.q], [branch]
 
 
+def _near(robot: Robot, texts: Sequence[str], units: Units) -> np.ndarray:
+    """``--near``: the reference configuration, checked.
+
+    A joint outside its limits is used as given, with a warning (a reference may lie anywhere, but there
+    it is often a unit slip: 50 typed for 0.05 m).
+    """
+    if len(texts) != robot.dof:
+        raise ParameterError("--near", " ".join(texts), f"must be {robot.dof} joint values")
+    near = robot.check_q(_q_values(texts, units))
+    for item in robot.outside_limits(near):
+        log.warning("--near: %s (used as given: the solutions nearest to it are returned)", item)
+    return near
+
+
 def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     """``ik --input CSV --output CSV``: :func:`scara_pin.kinematics.batch_io.solve_csv`, then one line."""
     from ..kinematics.batch_io import solve_csv
@@ -232,7 +242,7 @@ def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
         raise InvalidInputError("--input needs --output FILE")
     summary = solve_csv(robot, args.input, args.output, pose_scale=units.scale(_POSE_KINDS),
                         q_scale=units.scale(units.q), branch=None if args.branch == "all" else args.branch,
-                        reference=_q_values(args.near, units) if args.near else None, progress=True)  # fmt: skip
+                        reference=_near(robot, args.near, units) if args.near else None, progress=True)  # fmt: skip
     print(f"wrote {summary.output}: {summary.total} targets, {summary.solved} solved, {summary.failed} without "
           "solution", file=sys.stderr)  # fmt: skip
     return 3 if summary.failed else 0
