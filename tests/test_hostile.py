@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from sigint import default_sigint
 
 from scara_pin import load_robot
 from scara_pin.cli import main
@@ -45,6 +46,7 @@ MOVE = ["--from", "0", "0.1", "0", "0", "--to", "0.5", "0.6", "0.02", "0.3"]  # 
 
 
 def _limited() -> None:  # in the child, before exec
+    default_sigint()
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY, MEMORY))
     resource.setrlimit(resource.RLIMIT_CPU, (CPU_SECONDS, CPU_SECONDS))
 

@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 import psutil
 import pytest
+from sigint import default_sigint
 
 from scara_pin import InvalidInputError, Robot, load_robot
 from scara_pin.cli import main
@@ -222,7 +223,8 @@ def test_live_teach_page_jogs_with_ik(page: Any, robot_s1: Robot) -> None:
     cmd = [str(script)] if script.exists() else [sys.executable, "-m", "scara_pin.cli"]
     q0 = [repr(float(v)) for v in Q_S1]
     proc = subprocess.Popen([*cmd, "teach", "--robot", "s1", "--port", "0", "--q", *q0],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_sigint)  # fmt: skip
     port = None
     try:
         line = proc.stdout.readline()  # type: ignore[union-attr]

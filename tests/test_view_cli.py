@@ -13,6 +13,7 @@ from pathlib import Path
 
 import psutil
 import pytest
+from sigint import default_sigint
 
 from scara_pin.cli import main
 
@@ -57,7 +58,7 @@ def test_live_viewer_serves_on_loopback_until_ctrl_c() -> None:
     script = Path(sys.executable).parent / "scara-pin"
     cmd = [str(script)] if script.exists() else [sys.executable, "-m", "scara_pin.cli"]
     proc = subprocess.Popen([*cmd, "view", "--q", "0.3", "0.4", "0.02", "-0.5"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)  # fmt: skip
     try:
         line = proc.stdout.readline()  # type: ignore[union-attr]
         match = re.search(r"(http://127\.0\.0\.1:\d+/static/)", line)
