@@ -288,24 +288,34 @@ class Robot:
         self.has_continuous = any(continuous)
         # the per-call paths take q as it is when the cheap check passes: 4 plain joints only
         self._slow_q = self.has_continuous or self.dof != 4
-        self.tool_placement, self.task_jacobian = _per_call_paths(self)
+        self._per_call = _per_call_paths(self)
+        # the closures themselves as the instance's attributes (one call less), unless a subclass overrides them
+        if type(self).tool_placement is _ROBOT_TOOL_PLACEMENT:
+            self.tool_placement = self._per_call[0]  # type: ignore[method-assign,assignment]
+        if type(self).task_jacobian is _ROBOT_TASK_JACOBIAN:
+            self.task_jacobian = self._per_call[1]  # type: ignore[method-assign,assignment]
         self._kinematics_factory = kinematics
         if self.has_continuous:
             # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
             iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
             self._q_map = tuple(zip(range(self.dof), iq, continuous))
 
-    tool_placement: Callable[[np.ndarray], pin.SE3]
-    """``tool_placement(q)``: ``baseMtool``, the placement of the tool frame in the base frame at ``q``.
+    def tool_placement(self, q: np.ndarray) -> pin.SE3:
+        """``baseMtool``: the placement of the tool frame in the base frame, at ``q``.
 
-    Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
-    """
-    task_jacobian: Callable[[np.ndarray], np.ndarray]
-    """``task_jacobian(q)``: the 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame.
+        Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
+        An instance calls the closure of :func:`_per_call_paths` directly (this method is what a subclass
+        overrides, and what ``super()`` reaches).
+        """
+        return self._per_call[0](q)
 
-    Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the base z
-    axis, which equals d(yaw)/dt while the tool stays level).
-    """
+    def task_jacobian(self, q: np.ndarray) -> np.ndarray:
+        """The 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame.
+
+        Rows: the tool origin's velocity in base axes, then the yaw rate (the angular velocity about the
+        base z axis, which equals d(yaw)/dt while the tool stays level). Called as :meth:`tool_placement`.
+        """
+        return self._per_call[1](q)
 
     # ----------------------------------------------------------------- construction helpers
     @classmethod
@@ -358,20 +368,36 @@ class Robot:
         return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
 
     # ----------------------------------------------------------------- inverse kinematics (delegated)
-    @cached_property
+    @property
     def kinematics(self) -> Kinematics:
         """The kinematics object of the robot's kind (built on first use by the factory given at load).
+
+        It may be replaced (``robot.kinematics = other``) or reset (``del robot.kinematics``): ``ik_nearest``
+        follows.
 
         Raises:
             UrdfError: no kinematics factory was given, or the kind's closed form refuses the model (e.g.
                 ``NotScaraError``, naming the joint).
         """
-        if self._kinematics_factory is None:
-            raise UrdfError(
-                f"robot {self.name!r} was loaded without its kinematics: load it with scara_pin.load_robot(...) "
-                "(or pass kinematics=scara_pin.robots.kinematics_for)"
-            )
-        return self._kinematics_factory(self)
+        kin = self.__dict__.get("_kinematics")
+        if kin is None:
+            if self._kinematics_factory is None:
+                raise UrdfError(
+                    f"robot {self.name!r} was loaded without its kinematics: load it with "
+                    "scara_pin.load_robot(...) (or pass kinematics=scara_pin.robots.kinematics_for)"
+                )
+            kin = self.__dict__["_kinematics"] = self._kinematics_factory(self)
+        return kin  # type: ignore[no-any-return]
+
+    @kinematics.setter
+    def kinematics(self, value: Kinematics) -> None:
+        self.__dict__["_kinematics"] = value
+        self.__dict__.pop("ik_nearest", None)  # the cached nearest of the previous kinematics
+
+    @kinematics.deleter
+    def kinematics(self) -> None:
+        self.__dict__.pop("_kinematics", None)
+        self.__dict__.pop("ik_nearest", None)
 
     def ik(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None,
            all_turns: bool = False) -> IKResult:  # fmt: skip
@@ -549,6 +575,10 @@ class Robot:
         return int(self.model.getFrameId(frame))
 
 
+_ROBOT_TOOL_PLACEMENT = Robot.tool_placement
+_ROBOT_TASK_JACOBIAN = Robot.task_jacobian
+
+
 def _per_call_paths(robot: Robot) -> tuple[Callable[[np.ndarray], pin.SE3], Callable[[np.ndarray], np.ndarray]]:
     """The robot's ``tool_placement`` and ``task_jacobian``, as closures over its model.
 
@@ -578,10 +608,11 @@ def _per_call_paths(robot: Robot) -> tuple[Callable[[np.ndarray], pin.SE3], Call
     def fast_tool_placement(q: np.ndarray) -> pin.SE3:
         """``baseMtool``: the placement of the tool frame in the base frame at ``q`` (``robot.data`` untouched)."""
         try:
-            a, b, c, d = q.tolist()
-            if a * a + b * b + c * c + d * d <= bound and q.dtype is f64:  # NaN and inf fail
-                forward(model, data, q)
-                return placement(model, data, tool)
+            if q.size == 4:  # (an array of many q by mistake is not converted to a list)
+                a, b, c, d = q.tolist()
+                if a * a + b * b + c * c + d * d <= bound and q.dtype is f64:  # NaN and inf fail
+                    forward(model, data, q)
+                    return placement(model, data, tool)
         except (AttributeError, TypeError, ValueError):  # not an array, a wrong length, nested values
             pass
         forward(model, data, full(q))  # checked and converted (ParameterError)
@@ -590,9 +621,10 @@ def _per_call_paths(robot: Robot) -> tuple[Callable[[np.ndarray], pin.SE3], Call
     def fast_task_jacobian(q: np.ndarray) -> np.ndarray:
         """The 4 x 4 Jacobian d(x, y, z, yaw)/dq of the tool pose in the base frame (rows x, y, z, yaw rate)."""
         try:
-            a, b, c, d = q.tolist()
-            if a * a + b * b + c * c + d * d <= bound and q.dtype is f64:  # as fast_tool_placement's
-                return jacobian(model, data, q, tool, lwa).take(rows, 0)
+            if q.size == 4:
+                a, b, c, d = q.tolist()
+                if a * a + b * b + c * c + d * d <= bound and q.dtype is f64:  # as fast_tool_placement's
+                    return jacobian(model, data, q, tool, lwa).take(rows, 0)
         except (AttributeError, TypeError, ValueError):
             pass
         return jacobian(model, data, full(q), tool, lwa).take(rows, 0)

@@ -1114,3 +1114,17 @@ def test_geometry_is_read_from_the_model(default: Robot) -> None:
     assert geo.revolute == (0, 1, 3) and geo.prismatic == 2
     assert geo.signs == (1.0, 1.0, -1.0, 1.0)
     assert geo.radius_range() == pytest.approx((2 * 0.2 * math.cos(D(75)), 0.4), abs=1e-15)
+
+
+def test_batch_never_writes_negative_zero_where_the_scalar_writes_zero() -> None:
+    """A stretched elbow on the left branch is -gamma = -0.0 before its turn is added; the scalar path adds
+    2 pi k (k = 0) and returns 0.0: the batch, alone or with other rows in its block, does the same."""
+    robot = load_robot("default")
+    lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
+    mid = (lo + hi) / 2
+    T = np.array([robot.tool_pose(np.array([0.3, 0.0, 0.05, 0.1]))])  # elbow stretched (q2 = 0)
+    scalar = robot.ik_nearest(T[0], mid, branch="left")
+    for rows in (T, np.vstack([T, [[0.1, 0.1, -0.1, 0.0]]])):
+        got = robot.ik_batch(rows, mid, branch="left").q[0]
+        assert np.array_equal(got, scalar)
+        assert np.array_equal(np.signbit(got), np.signbit(scalar))  # 0.0, not -0.0 (a CSV would print it)

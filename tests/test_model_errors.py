@@ -363,3 +363,54 @@ def test_unknown_frame(robot: Robot) -> None:
         robot.frame_placement(q, "tool0", relative_to="no_such_frame")
     # the good names work
     assert robot.frame_placement(q, "link2").translation[0] == pytest.approx(0.2, abs=1e-12)
+
+
+def test_a_subclass_override_of_the_per_call_paths_is_used(robot: Robot) -> None:
+    """The closures stand in for the methods only on the class itself: a subclass's override is what its
+    instances call (tool_pose and manipulability included), and super() reaches the base computation."""
+
+    class Flange(Robot):
+        def tool_placement(self, q: np.ndarray) -> pin.SE3:
+            return super().tool_placement(q) * pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.1]))
+
+    flanged = Flange(robot.urdf)
+    q = np.array([0.4, -1.2, 0.07, 2.0])
+    plain = robot.tool_placement(q)
+    expected = plain * pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.1]))  # tool0's z points down: 0.1 m lower
+    assert np.abs(flanged.tool_placement(q).homogeneous - expected.homogeneous).max() <= 1e-15
+    assert flanged.tool_pose(q)[2] == pytest.approx(plain.translation[2] - 0.1, abs=1e-15)
+    assert hasattr(Robot, "tool_placement") and hasattr(Robot, "task_jacobian")
+    assert np.array_equal(Robot.task_jacobian(robot, q), robot.task_jacobian(q))
+
+
+def test_many_q_by_mistake_are_refused_without_converting_them(robot: Robot) -> None:
+    """An (N, 4) array passed as q is a ParameterError, decided from its size: it is never turned into a
+    Python list first (2 million rows would take seconds and hundreds of MB)."""
+    import tracemalloc
+
+    many = np.zeros((2_000_000, 4))
+    tracemalloc.start()
+    try:
+        for method in (robot.tool_placement, robot.task_jacobian):
+            with pytest.raises(ParameterError, match="shape"):
+                method(many)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1_000_000, peak
+
+
+def test_ik_nearest_follows_a_replaced_kinematics() -> None:
+    """ik_nearest is the kind's nearest, looked up once; replacing or resetting robot.kinematics resets it."""
+    robot = load_robot("default")
+    target = robot.tool_pose(np.array([0.4, -1.2, 0.07, 2.0]))
+    first = robot.ik_nearest(target)
+
+    class Fake:
+        def nearest(self, *args: object, **kwargs: object) -> str:
+            return "fake"
+
+    robot.kinematics = Fake()  # type: ignore[assignment]
+    assert robot.ik_nearest(target) == "fake"
+    del robot.kinematics
+    assert np.array_equal(robot.ik_nearest(target), first)

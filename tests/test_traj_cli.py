@@ -155,3 +155,26 @@ def test_json_out_says_the_motions_duration_and_view_plays_it(tmp_path: Path, ca
     bad.write_text(json.dumps(data))
     rc, printed, err = run(capsys, ["view", "--traj", str(bad), "--html", str(tmp_path / "bad.html")])
     assert rc == 2 and "3 joints" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("field", ["duration", "t"])
+@pytest.mark.parametrize("number", ["1" + "0" * 400, "1" + "0" * 5000], ids=["beyond float", "beyond int digits"])
+def test_json_trajectory_with_a_huge_integer_is_one_error_line(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                               field: str, number: str) -> None:  # fmt: skip
+    """An integer beyond float's range (OverflowError) or of more digits than Python converts (ValueError) in a
+    trajectory file is bad input (exit 2, one line), never an internal error."""
+    out = tmp_path / "t.json"
+    rc, _, err = run(capsys, ["traj", "--from", "0", "0", "0", "0", "--to", "1", "1", "0.05", "1", "--duration", "1",
+                              "--rate", "10", "--out", str(out)])  # fmt: skip
+    assert rc == 0, err
+    text = out.read_text()
+    if field == "duration":
+        text = text.replace('"duration": 1.0', f'"duration": {number}', 1)
+    else:
+        text = text.replace('"t": [0.0,', f'"t": [{number},', 1)
+    assert number in text
+    bad = tmp_path / "bad.json"
+    bad.write_text(text)
+    rc, printed, err = run(capsys, ["view", "--traj", str(bad), "--html", str(tmp_path / "bad.html")])
+    assert rc == 2 and printed == "" and len(err.splitlines()) == 1 and err.startswith("error:"), err
+    assert "internal error" not in err

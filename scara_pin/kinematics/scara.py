@@ -730,9 +730,8 @@ class _BatchWork:
             if _isfinite(v_lo) and _isfinite(v_hi):
                 k = math.floor((ref + _PI - v_hi) * _INV_TWO_PI)
                 if k == math.floor((ref + _PI - v_lo) * _INV_TWO_PI):
-                    if k:
-                        np.add(v, TWO_PI * k, out=v)
-                        v_lo, v_hi = v_lo + TWO_PI * k, v_hi + TWO_PI * k
+                    np.add(v, TWO_PI * k, out=v)  # also for k = 0, as the scalar path: -0.0 + 0.0 is 0.0
+                    v_lo, v_hi = v_lo + TWO_PI * k, v_hi + TWO_PI * k
                     if mode == "inside" or (lo <= v_lo and v_hi <= hi):
                         return False
                     if lo_t <= v_lo and v_hi <= hi_t:

@@ -599,6 +599,10 @@ class Trajectory:
 def load_trajectory(path: str | os.PathLike[str]) -> Trajectory:
     """Read a trajectory written by :meth:`Trajectory.to_csv` or :meth:`Trajectory.to_json` (by suffix).
 
+    The trajectory passes through every sample: its ``duration`` is the last sample's time, which on a
+    fixed-rate grid may be up to one period after the end of the motion (at rest); the motion's own
+    duration of a JSON file is :func:`load_samples`'s.
+
     Raises:
         InvalidInputError: unreadable file, wrong header or format, or bad values (with the line).
     """
@@ -631,7 +635,7 @@ def load_samples(path: str | os.PathLike[str]) -> Samples:
 def _samples_from_json(text: str, origin: str) -> Samples:
     try:
         data = json.loads(text)
-    except json.JSONDecodeError as exc:
+    except ValueError as exc:  # JSONDecodeError, or an integer of more digits than Python converts
         raise InvalidInputError(f"{origin}: not JSON: {exc}") from None
     if not isinstance(data, dict) or data.get("format") != _FORMAT:
         raise InvalidInputError(f"{origin}: not a {_FORMAT} file")
@@ -642,7 +646,7 @@ def _samples_from_json(text: str, origin: str) -> Samples:
                        None if duration is None else float(duration))  # fmt: skip
     except ParameterError as exc:
         raise InvalidInputError(f"{origin}: {exc}") from None
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:  # OverflowError: an integer beyond float
         raise InvalidInputError(f"{origin}: bad trajectory data ({exc})") from None
 
 
