@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from .description import RobotParameters
 from .errors import InvalidInputError, NoSolutionError, ParameterError
@@ -87,10 +88,19 @@ class ScaraKinematics:
 
         geo = self.geometry
         x, y, z, alpha, tilt = parse_target(target, geo.yaw0, geo.R0)
-        if tilt > scara.YAW_POSE_TOL:  # the closed form says why
-            return scara.solve(geo, target, branch=branch, reference=reference)
+        rotation = None
+        yaw = alpha + geo.yaw0
+        if tilt > scara.YAW_POSE_TOL:
+            # a placement: this model's own poses tilt (roll/pitch) by a few times its axes' tilt
+            if tilt > POSE_TILT_FACTOR * geo.tilt + scara.YAW_POSE_TOL:  # the closed form says why
+                return scara.solve(geo, target, branch=branch, reference=reference)
+            M = target.homogeneous if isinstance(target, pin.SE3) else np.asarray(target, dtype=float)
+            rotation = M[:3, :3]
+            yaw = math.atan2(M[1, 0], M[0, 0])  # the yaw as tool_pose (and the polish) read it from the model
         res = solve_refined(self.robot, geo, lambda t: scara.solve(self._seeds, t, branch=branch, reference=reference),
-                            np.array((x, y, z, alpha + geo.yaw0)))  # fmt: skip
+                            np.array((x, y, z, yaw)))  # fmt: skip
+        if rotation is not None and res.success:
+            res = _with_rotation(self.robot, res, rotation)
         return res.expand(geo.lower, geo.upper) if all_turns and res.success else res
 
     def nearest(self, target: Any, reference: ArrayLike | None = None, *, weights: ArrayLike | None = None,
@@ -120,6 +130,26 @@ class ScaraKinematics:
         from .workspace.scara import workspace  # on first use: `scara-pin fk` does not need it
 
         return workspace(self.geometry, **kwargs)
+
+
+POSE_TILT_FACTOR = 8.0
+"""A placement target of a near-parallel robot tilting up to this many times its axes' tilt is solved (its
+roll/pitch then checked); beyond, it is NOT_A_YAW_POSE at once."""
+
+
+def _with_rotation(robot: Robot, res: IKResult, rotation: np.ndarray) -> IKResult:
+    """The solutions of ``res`` whose tool rotation is the target's (to YAW_POSE_TOL rad), or NOT_A_YAW_POSE.
+
+    A near-parallel robot reaches a position and yaw with a roll/pitch set by its configuration: of the
+    solutions found from (x, y, z, yaw), those with another roll/pitch are not the target's.
+    """
+    errors = [float(np.linalg.norm(pin.log3(robot.tool_placement(s.q).rotation.T @ rotation))) for s in res.solutions]
+    kept = tuple(s for s, e in zip(res.solutions, errors) if e <= scara.YAW_POSE_TOL)
+    if kept:
+        return replace(res, solutions=kept)
+    return replace(res, solutions=(), status=scara.IKStatus.NOT_A_YAW_POSE,
+                   message=f"the target's roll/pitch is not one this robot reaches at that position and yaw: the "
+                           f"nearest solution's tool rotation is {min(errors):.3g} rad away")  # fmt: skip
 
 
 class PalletizerKinematics:

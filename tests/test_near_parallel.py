@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from scara_pin import NoSolutionError
 from scara_pin.cli import main
 from scara_pin.kinematics.polish import polish_result
 from scara_pin.kinematics.results import IKResult, IKSolution
@@ -201,3 +202,48 @@ def test_cli_check_reports_the_tilt_and_the_unrefined_error(capsys: pytest.Captu
     tilt = math.pi - 3.14
     assert 0.1 * tilt * 0.2 * 1000 <= mm <= tilt * 0.7 * 1000
     assert re.search(rf"joint2's axis is {math.degrees(tilt):.6g} deg", out)
+
+
+def test_placements_of_the_model_are_solved_and_their_roll_pitch_checked(case: tuple) -> None:
+    """A near-parallel robot's own poses are not pure yaws (they tilt by about its axes' tilt): given as a
+    placement (pin.SE3 or 4 x 4), they are solved from (x, y, z, yaw) and the solutions whose tool rotation is
+    not the target's are dropped. Expected values: raw Pinocchio on the file (FileFK)."""
+    name, robot, fk = case
+    found = 0
+    for i, q in enumerate(samples(60, seed=13)):
+        qp = np.array([q[0], q[1], q[2], math.cos(q[3]), math.sin(q[3])])
+        pin.framesForwardKinematics(fk.model, fk.data, qp)
+        M = fk.data.oMf[fk.tool].copy()
+        target = M if i % 2 else M.homogeneous.tolist()  # an SE3, or a 4 x 4 as nested lists
+        res = robot.ik(target)
+        by_pose = robot.ik(fk.pose(q))  # the same (x, y, z, yaw) as 4 numbers: every roll/pitch
+        assert res.success, (name, q.tolist(), res.message)
+        for s in res.solutions:
+            qs = np.array([s.q[0], s.q[1], s.q[2], math.cos(s.q[3]), math.sin(s.q[3])])
+            pin.framesForwardKinematics(fk.model, fk.data, qs)
+            got = fk.data.oMf[fk.tool]
+            assert np.abs(got.translation - M.translation).max() <= TOL
+            assert np.linalg.norm(pin.log3(got.rotation.T @ M.rotation)) <= 1e-9
+            assert min(p.distance(s.q) for p in by_pose.solutions) <= TOL  # one of the (x, y, z, yaw) solutions
+        if min(s.distance(q) for s in by_pose.solutions) <= TOL:  # the sampled q, when that route finds it
+            assert min(s.distance(q) for s in res.solutions) <= TOL
+            found += 1
+        near = robot.ik_nearest(target, q)
+        assert np.abs(near - q).max() <= TOL or min(s.distance(q) for s in by_pose.solutions) > TOL
+    assert found >= 55
+
+
+def test_a_placement_whose_roll_pitch_the_robot_cannot_take_is_refused(case: tuple) -> None:
+    name, robot, fk = case
+    tilt = FILES[name]
+    q = np.array([0.3, 1.0, 0.05, 0.2])
+    M = robot.tool_placement(q)
+    rolled = M * pin.SE3(pin.exp3(np.array([0.5 * tilt, 0.0, 0.0])), np.zeros(3))  # a little more roll
+    res = robot.ik(rolled)
+    assert res.status is IKStatus.NOT_A_YAW_POSE and "roll/pitch" in res.message and not res.solutions
+    far = M * pin.SE3(pin.exp3(np.array([0.1, 0.0, 0.0])), np.zeros(3))  # far beyond the robot's own tilts
+    res = robot.ik(far)
+    assert res.status is IKStatus.NOT_A_YAW_POSE and "deg" in res.message
+    with pytest.raises(NoSolutionError) as info:
+        robot.ik_nearest(rolled)
+    assert info.value.status is IKStatus.NOT_A_YAW_POSE
