@@ -247,3 +247,18 @@ def test_a_placement_whose_roll_pitch_the_robot_cannot_take_is_refused(case: tup
     with pytest.raises(NoSolutionError) as info:
         robot.ik_nearest(rolled)
     assert info.value.status is IKStatus.NOT_A_YAW_POSE
+
+
+def test_beyond_the_ideal_reach_at_a_shoulder_limit_both_branches_come_back() -> None:
+    """The ideal arm cannot reach this target (0.45009 m > l1 + l2) and joint1 is 0.08 rad from its limit: the
+    seeds moved well inside the reach bend the elbow so far that this branch's shoulder seed leaves the
+    limits; moved just inside first, both branches are found (the sampled q among them, to 1e-9)."""
+    path = DATA / "scara_rpy_3_14.urdf"
+    robot, fk = load_robot(urdf=path), FileFK(path)
+    q = np.array([-2.4163858918231145, -0.03342788829433996, 0.0971598413446888, -1.3479617223735876])
+    target = fk.pose(q)
+    res = robot.ik(target)
+    assert res.success and min(s.distance(q) for s in res.solutions) <= TOL, res
+    assert {s.branch for s in res.solutions} == {"right", "left"}
+    for s in res.solutions:
+        assert task_error(fk.pose(s.q), target) <= TOL

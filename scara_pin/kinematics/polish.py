@@ -64,9 +64,10 @@ _FINE = 1e-13
 """[m, rad] the residual where the steps stop early (a few ulps of a metre-sized pose)."""
 SEED_MARGIN = 20.0
 """The seeds come from the ideal geometry with every limit widened by SEED_MARGIN * tilt [rad or m], and a
-target the ideal arm cannot reach is moved radially by SEED_MARGIN * tilt * (l1 + l2) inside its reach: the
-model departs from the ideal geometry by about the tilt times a lever, so its solutions near a limit or the
-reach circles have seeds; the limits and the reach are then the model's own (checked after the steps)."""
+target the ideal arm cannot reach is moved radially inside its reach, by tilt * (l1 + l2) then SEED_MARGIN
+times that: the model departs from the ideal geometry by about the tilt times a lever, so its solutions near
+a limit or the reach circles have seeds; the limits and the reach are then the model's own (checked after
+the steps)."""
 MAX_STEPS = 30
 """The most Newton steps per seed."""
 HALVINGS = 8
@@ -207,12 +208,12 @@ def seed_geometry(geo: ScaraGeometry) -> ScaraGeometry:
     return replace(geo, lower=tuple(v - m for v in geo.lower), upper=tuple(v + m for v in geo.upper))
 
 
-def _reach_seed(geo: ScaraGeometry, task: np.ndarray, status: IKStatus) -> np.ndarray:
-    """``task`` moved radially (about the shoulder axis) so that its wrist point lies inside the ideal reach."""
+def _reach_seed(geo: ScaraGeometry, task: np.ndarray, status: IKStatus, margin: float = SEED_MARGIN) -> np.ndarray:
+    """``task`` moved radially about the shoulder axis: its wrist ``margin`` x tilt x (l1 + l2) inside the reach."""
     alpha = float(task[3]) - geo.yaw0 if len(task) == 4 else 0.0
     wx, wy = wrist_point(geo, float(task[0]), float(task[1]), alpha)
     r = math.hypot(wx, wy)
-    m = SEED_MARGIN * geo.tilt * geo.arm.l12
+    m = margin * geo.tilt * geo.arm.l12
     r_min, r_max = geo.radius_range()
     want = r_max - m if status is IKStatus.OUT_OF_REACH else min(r_min + m, r_max)
     out = np.array(task, dtype=float)
@@ -240,9 +241,26 @@ def solve_refined(robot: Robot, geo: ScaraGeometry, seeds: Callable[[np.ndarray]
     """
     res = seeds(task)
     if res.status in (IKStatus.OUT_OF_REACH, IKStatus.INSIDE_INNER_LIMIT):
-        moved = seeds(_reach_seed(geo, task, IKStatus(res.status)))
-        alt = polish_result(robot, geo, replace(moved, target=res.target), task)
-        return alt if alt.success else res
+        # just inside the reach first (the seeds stay near the target's joints: a joint near its limit keeps
+        # its seed), then well inside (where the model's reach departs more); each branch from the first
+        # move that gives it
+        found: dict[str, IKSolution] = {}
+        alt = res
+        for margin in (1.0, SEED_MARGIN):
+            moved = seeds(_reach_seed(geo, task, IKStatus(res.status), margin))
+            out = polish_result(robot, geo, replace(moved, target=res.target), task)
+            for sol in out.solutions:
+                found.setdefault(sol.branch, sol)
+            if out.success and not alt.success:
+                alt = out
+        if not found:
+            return alt if alt.success else res
+        order = {"right": 0, "left": 1}
+        sols = tuple(sorted(found.values(), key=lambda s: order.get(s.branch, 2)))
+        if len(sols) == len(alt.solutions):
+            return replace(alt, solutions=sols)
+        return replace(alt, solutions=sols, message=f"{len(sols)} solution(s), refined on the model (axes up to "
+                       f"{geo.tilt:.3g} rad from vertical) from seeds moved inside the ideal arm's reach")  # fmt: skip
     return polish_result(robot, geo, res, task)
 
 
