@@ -474,7 +474,6 @@ def test_cli_traj_time_optimal(capsys: pytest.CaptureFixture[str], tmp_path: Pat
         ["jog", "--robot", "palletizer", "--from", "0", "0.2", "1.4", "0", "--direction", "1", "0"],
         ["traj", "--robot", "palletizer", "--from", "0", "0.2", "1.4", "0", "--to", "0.5", "0.2", "1.4", "0",
          "--linear"],
-        ["view", "--robot", "palletizer", "--workspace", "--html", "unused.html"],
     ],
 )
 def test_cli_scara_only_commands_say_so(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
@@ -576,3 +575,31 @@ def test_numeric_ik_sees_the_four_actuated_joints_of_the_coupled_model() -> None
     res = solve_numeric(robot, target)
     assert res.success and res.residual < 1e-9
     assert robot.outside_limits(res.q) == []
+
+
+def test_the_3d_workspace_wireframe_is_the_reach_boundary(tmp_path: Path) -> None:
+    """`view --workspace` draws the palletizer's envelope in 3-D: the arm-plane boundary at the waist limits and
+    the circles of its extreme points. Every drawn point is a tool point the IK reaches (Pinocchio FK of the
+    solution gives it back to 1e-9 m), the planes are at the waist limits, and 1 mm beyond the outermost
+    circle nothing is reachable."""
+    robot = load_robot("palletizer")
+    env = robot.kinematics.workspace()
+    lines = env.wireframe(n=24)
+    lo, hi = robot.limits.lower[0], robot.limits.upper[0]
+    assert hi - lo < 2 * math.pi and len(lines) == 2 * len(env.arcs) + 3
+    for k, pts in enumerate(lines):
+        assert pts.shape[1] == 3
+        if k < 2 * len(env.arcs):  # a boundary arc in the plane of one waist limit
+            angle = lo if k < len(env.arcs) else hi
+            r = np.hypot(pts[:, 0], pts[:, 1])
+            assert np.allclose(np.arctan2(pts[:, 1], pts[:, 0])[r > 1e-9], angle, atol=1e-12)
+        for x, y, z in pts[::3]:
+            res = robot.ik(np.array([x, y, z, 0.0]))
+            assert res.success, (k, x, y, z, res.message)
+            assert np.abs(robot.tool_pose(res.solutions[0].q)[:3] - [x, y, z]).max() <= 1e-9
+    r_max, z_at = max(((math.hypot(*p[0, :2]), p[0, 2]) for p in lines[-3:]), key=lambda t: t[0])
+    for a in np.linspace(lo, hi, 7):
+        r = r_max + 1e-3
+        assert not robot.ik(np.array([r * math.cos(a), r * math.sin(a), z_at, 0.0])).success
+    html = tmp_path / "p.html"
+    assert main(["view", "--robot", "palletizer", "--workspace", "--html", str(html)]) == 0 and html.is_file()

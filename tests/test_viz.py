@@ -351,7 +351,9 @@ def test_bad_motions_and_drawings_are_refused(viewer: Viewer) -> None:
     with pytest.raises(InvalidInputError, match="finite"):
         viewer.draw_path([[0, 0, 0], [np.nan, 0, 0]])
     with pytest.raises(InvalidInputError, match="2 numbers"):
-        viewer.draw_polylines([np.zeros((5, 3))])
+        viewer.draw_polylines([np.zeros((5, 4))])  # (x, y) or (x, y, z) points only
+    with pytest.raises(InvalidInputError, match="at least 2 points of 3 numbers"):
+        viewer.draw_polylines([np.zeros((1, 3))])
     with pytest.raises(InvalidInputError, match="x, y, z, yaw"):
         viewer.draw_targets([[0.1, 0.2, 0.0]])
 
@@ -385,7 +387,7 @@ def test_export_html_is_atomic_and_self_contained(robot: Robot, tmp_path: Path) 
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s1.html"]  # no temporary file left
     # a failed write leaves the old file as it was
     with pytest.raises(InvalidInputError, match="2 numbers"):
-        export_html(robot, path, polylines=[[[0, 0, 0]]])
+        export_html(robot, path, polylines=[[[0, 0, 0, 0]]])
     assert path.read_text(encoding="utf-8") == text
     with pytest.raises(InvalidInputError, match="does not exist"):
         export_html(robot, tmp_path / "missing" / "x.html")

@@ -46,10 +46,11 @@ def cmd_view(args: argparse.Namespace) -> int:
     if args.workspace:
         from ..workspace.scara import workspace
 
-        if robot.kind != "scara":
-            raise InvalidInputError(f"view --workspace is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
-        ws = workspace(robot)
-        polylines = [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
+        if robot.kind == "palletizer":  # the arm-plane envelope at the waist limits, and its sweep
+            polylines = robot.kinematics.workspace().wireframe()
+        else:
+            ws = workspace(robot)
+            polylines = [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
     if args.html:
         viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines,
                         title=f"scara-pin: {robot.name}")  # fmt: skip
@@ -77,7 +78,8 @@ def register(sub: Any) -> None:
     p.add_argument("--q", nargs="+", metavar="Q", help="configuration to show, one value per joint (default: zero)")
     p.add_argument("--traj", metavar="FILE",
                    help="animate a trajectory (a `traj --out` CSV, or its JSON: *.json) and draw the tool path")
-    p.add_argument("--workspace", action="store_true", help="draw the workspace boundary on the floor")
+    p.add_argument("--workspace", action="store_true",
+                   help="draw the workspace boundary (SCARA: on the floor; palletizer: its envelope in 3-D)")
     p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
     _add_units(p, json_help=None)

@@ -138,6 +138,17 @@ def _resample(times: np.ndarray, qs: np.ndarray, fps: int) -> tuple[np.ndarray, 
 
 
 # ------------------------------------------------------------------------------------------ input checks
+def _width(value: object) -> int | None:
+    """The number of columns of a 2-D array-like (None for anything else)."""
+    shape = getattr(value, "shape", None)
+    if shape is None:
+        try:
+            shape = np.shape(value)  # type: ignore[call-overload]
+        except ValueError:  # ragged
+            return None
+    return int(shape[1]) if len(shape) == 2 else None
+
+
 def _points(name: str, value: object, dim: int) -> np.ndarray:
     """``value`` as an (N, dim) float array of finite numbers, N >= 2, or raise InvalidInputError."""
     try:
@@ -677,13 +688,14 @@ class _Scene:
     def draw_polylines(self, polylines: Iterable[object], name: str, z: float | None, color: int) -> None:
         if isinstance(polylines, np.ndarray) and polylines.ndim == 2:
             polylines = [polylines]
-        checked = [_points(f"polyline {i}", p, 2) for i, p in enumerate(polylines)]
+        # (x, y) points, drawn at one height, or (x, y, z) points, drawn as given (base frame)
+        checked = [_points(f"polyline {i}", p, 3 if _width(p) == 3 else 2) for i, p in enumerate(polylines)]
         # default height: the floor, z = 0 of the root link, expressed in the base frame
         zb = -float(self.oMb.translation[2]) if z is None else float(z)
         node = self.vis[f"{_OVERLAYS}/{name}"]
         node.delete()
         for i, xy in enumerate(checked):
-            pts = np.column_stack([xy, np.full(len(xy), zb)])
+            pts = xy if xy.shape[1] == 3 else np.column_stack([xy, np.full(len(xy), zb)])
             self.line(f"{_OVERLAYS}/{name}/{i}", self._world(pts), color)
 
 
@@ -785,7 +797,8 @@ def export_html(
         qs: (N, 4) joint values at those times; the page plays the motion in real time (looping unless
             ``loop=False``) with the panel's play / pause button and time slider, which drive the joint
             sliders (a given ``q`` is shown first, paused).
-        polylines: workspace boundary: (M, 2) arrays of (x, y) in the base frame [m], drawn on the floor.
+        polylines: workspace boundary: (M, 2) arrays of (x, y) in the base frame [m], drawn on the floor,
+            or (M, 3) arrays of (x, y, z) in the base frame [m].
         path_points: (K, 3) points of a tool path in the base frame [m]; by default the path of the tool
             along ``qs`` is drawn (``draw_tool_path=False`` turns that off).
         targets: (P, 4) target poses (x, y, z, yaw) in the base frame [m, rad], drawn as small frames.

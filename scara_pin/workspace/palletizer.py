@@ -103,6 +103,30 @@ class ArmPlaneEnvelope:
         """Whether the tool point can be at (r, z) in the arm plane inside the joint limits."""
         return reachable(self.geometry, r, z)
 
+    def wireframe(self, n: int = 64) -> list[np.ndarray]:
+        """The envelope in 3-D, as (M, 3) polylines of tool points (x, y, z) in the base frame [m].
+
+        The boundary arcs in the arm plane at the waist's lower and upper limits (at four waist angles, a
+        quarter turn apart, when the waist turns a full turn or more), and the circles the extreme points
+        of the envelope (largest r, lowest and highest z) sweep over the waist's range: x = r cos q1,
+        y = r sin q1, as the forward kinematics.
+        """
+        geo = self.geometry
+        lo, hi = geo.lower[0], geo.upper[0]
+        full = geo.continuous[0] or hi - lo >= 2.0 * math.pi
+        planes = [0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi] if full else [lo, hi]
+        out = []
+        for q1 in planes:
+            c, s_ = math.cos(q1), math.sin(q1)
+            for arc in self.arcs:
+                rz = arc.points(n)
+                out.append(np.column_stack([rz[:, 0] * c, rz[:, 0] * s_, rz[:, 1]]))
+        sweep = np.linspace(0.0, 2.0 * math.pi, 4 * n + 1) if full else np.linspace(lo, hi, max(2, n))
+        pts = [p for a in self.arcs for p in a.extreme_points()]
+        for r, z in (max(pts, key=lambda p: p[0]), min(pts, key=lambda p: p[1]), max(pts, key=lambda p: p[1])):
+            out.append(np.column_stack([r * np.cos(sweep), r * np.sin(sweep), np.full(len(sweep), z)]))
+        return out
+
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready summary (SI units)."""
         return {
