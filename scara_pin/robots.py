@@ -33,7 +33,7 @@ from .errors import InvalidInputError, NoSolutionError, ParameterError
 from .kinematics import palletizer, scara
 from .kinematics.polish import polish_batch, seed_geometry, solve_refined
 from .kinematics.results import BatchIKResult, IKResult
-from .model import Kinematics, Robot
+from .model import Kinematics, Robot, pose_from_placement
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -84,21 +84,21 @@ class ScaraKinematics:
         """:func:`scara_pin.kinematics.scara.solve` (refined on the model when its axes are near-parallel)."""
         if self.robot is None:
             return scara.solve(self.geometry, target, branch=branch, reference=reference, all_turns=all_turns)
-        from .kinematics.targets import parse_target
+        from .kinematics.targets import parse_target, placement_matrix
 
         geo = self.geometry
         x, y, z, alpha, tilt = parse_target(target, geo.yaw0, geo.R0)
         rotation = None
-        yaw = alpha + geo.yaw0
+        task = np.array((x, y, z, alpha + geo.yaw0))
         if tilt > scara.YAW_POSE_TOL:
             # a placement: this model's own poses tilt (roll/pitch) by a few times its axes' tilt
             if tilt > POSE_TILT_FACTOR * geo.tilt + scara.YAW_POSE_TOL:  # the closed form says why
                 return scara.solve(geo, target, branch=branch, reference=reference)
-            M = target.homogeneous if isinstance(target, pin.SE3) else np.asarray(target, dtype=float)
-            rotation = M[:3, :3]
-            yaw = math.atan2(M[1, 0], M[0, 0])  # the yaw as tool_pose (and the polish) read it from the model
+            placement = pin.SE3(placement_matrix(target))  # (parse_target checked it: a rotation, 4 x 4)
+            rotation = placement.rotation
+            task = pose_from_placement(placement)  # the yaw as tool_pose (and the polish) read it from the model
         res = solve_refined(self.robot, geo, lambda t: scara.solve(self._seeds, t, branch=branch, reference=reference),
-                            np.array((x, y, z, yaw)))  # fmt: skip
+                            task)  # fmt: skip
         if rotation is not None and res.success:
             res = _with_rotation(self.robot, res, rotation)
         return res.expand(geo.lower, geo.upper) if all_turns and res.success else res

@@ -14,10 +14,11 @@ from ..errors import ParameterError
 if TYPE_CHECKING:
     from .._typing import ArrayLike
 
-__all__ = ["check_magnitude", "parse_target", "reference_floats", "weight_floats"]
+__all__ = ["check_magnitude", "parse_target", "placement_matrix", "reference_floats", "weight_floats"]
 
 _F64 = np.dtype(np.float64)
 _isfinite = math.isfinite
+_TARGET_RULE = "must be (x, y, z, yaw) or a 4 x 4 pose"
 
 
 def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, float, float, float, float]:
@@ -52,14 +53,13 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
                 return x, y, z, yaw - yaw0, 0.0
         except (TypeError, ValueError, OverflowError):
             pass  # not 4 plain numbers (a 4 x 4 pose as nested lists, say): the general route below says why
-    rule = "must be (x, y, z, yaw) or a 4 x 4 pose"
-    M = target.homogeneous if isinstance(target, pin.SE3) else _floats("target", target, rule)
+    M = placement_matrix(target)
     if M.shape == (4,):
         x, y, z, yaw = (float(v) for v in _vector("target", M))
         check_magnitude((x, y, z, yaw))
         return x, y, z, yaw - yaw0, 0.0
     if M.shape != (4, 4) or not np.isfinite(M).all():
-        raise ParameterError("target", "array of shape " + str(M.shape), "must be (x, y, z, yaw) or a 4 x 4 pose")
+        raise ParameterError("target", "array of shape " + str(M.shape), _TARGET_RULE)
     check_magnitude(M[:3, 3].tolist())
     R = M[:3, :3]
     if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
@@ -67,6 +67,11 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
     E = R @ R0.T  # a pure yaw of the tool's zero-pose rotation: E = Rz(alpha)
     tilt = math.atan2(math.hypot(E[0, 2], E[1, 2]), E[2, 2])
     return float(M[0, 3]), float(M[1, 3]), float(M[2, 3]), math.atan2(E[1, 0], E[0, 0]), tilt
+
+
+def placement_matrix(target: object) -> np.ndarray:
+    """A target as a float array: a pin.SE3's 4 x 4 matrix, else the values as given (shape not checked here)."""
+    return target.homogeneous if isinstance(target, pin.SE3) else _floats("target", target, _TARGET_RULE)
 
 
 def check_magnitude(values: ArrayLike) -> None:
