@@ -35,7 +35,7 @@ import numpy as np
 
 from .planar2r import LIMIT_TOL, TWO_PI, nearest_turn
 from .results import IKResult, IKSolution
-from .scara import IKStatus, ScaraGeometry, branch_of, wrist_point
+from .scara import BRANCHES, IKStatus, ScaraGeometry, branch_of, wrist_point
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -192,7 +192,7 @@ def polish_result(robot: Robot, geo: ScaraGeometry, result: IKResult, task: np.n
             kept.append(out)
         else:
             failures.append(out)
-    refined = f"refined on the model (axes up to {geo.tilt:.3g} rad from vertical)"
+    refined = _refined(geo)
     if kept:
         note = "; ".join(f[1] for f in failures)
         message = f"{len(kept)} solution(s), {refined}" + (f"; dropped: {note}" if note else "")
@@ -225,6 +225,10 @@ def _reach_seed(geo: ScaraGeometry, task: np.ndarray, status: IKStatus, margin: 
     return out
 
 
+def _refined(geo: ScaraGeometry) -> str:
+    return f"refined on the model (axes up to {geo.tilt:.3g} rad from vertical)"
+
+
 def solve_refined(robot: Robot, geo: ScaraGeometry, seeds: Callable[[np.ndarray], IKResult], task: np.ndarray
                   ) -> IKResult:  # fmt: skip
     """The closed form's seeds, polished on the model (see the module docstring).
@@ -253,14 +257,15 @@ def solve_refined(robot: Robot, geo: ScaraGeometry, seeds: Callable[[np.ndarray]
                 found.setdefault(sol.branch, sol)
             if out.success and not alt.success:
                 alt = out
+            if len(found) == len(BRANCHES):  # every branch already: no second move
+                break
         if not found:
             return alt if alt.success else res
-        order = {"right": 0, "left": 1}
-        sols = tuple(sorted(found.values(), key=lambda s: order.get(s.branch, 2)))
+        sols = tuple(found[b] for b in BRANCHES if b in found)
         if len(sols) == len(alt.solutions):
             return replace(alt, solutions=sols)
-        return replace(alt, solutions=sols, message=f"{len(sols)} solution(s), refined on the model (axes up to "
-                       f"{geo.tilt:.3g} rad from vertical) from seeds moved inside the ideal arm's reach")  # fmt: skip
+        return replace(alt, solutions=sols, message=f"{len(sols)} solution(s), {_refined(geo)} from seeds moved "
+                       "inside the ideal arm's reach")  # fmt: skip
     return polish_result(robot, geo, res, task)
 
 
