@@ -1,8 +1,9 @@
 """Output files written atomically: a temporary file in the same folder, flushed to disk, then a rename.
 
 An error, Ctrl-C or SIGTERM (the command line turns it into the same clean-up) leaves the old file or
-none, never a half-written one. Used by every command that writes a file (URDF, trajectories, setpoints,
-plots, HTML pages, batch IK results).
+none, never a half-written one; so does a Ctrl-C or SIGTERM that a library swallowed while the output was
+being made (:func:`scara_pin.signals.raise_pending` is called before the rename). Used by every command
+that writes a file (URDF, trajectories, setpoints, plots, HTML pages, batch IK results).
 
 Rules:
 
@@ -25,6 +26,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
 
+from . import signals
 from .errors import InvalidInputError
 
 __all__ = [
@@ -129,6 +131,7 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     try:
         tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created)
         yield tmp
+        signals.raise_pending()  # a Ctrl-C or SIGTERM that a library swallowed meanwhile: nothing is written
         if to_stdout:
             sys.stdout.flush()
             with tmp.open("rb") as src:

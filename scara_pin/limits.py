@@ -5,8 +5,10 @@ One place for the caps and the checks, used by the command line and the library 
 - :func:`check_count` refuses a number of samples, setpoints, animation frames, grid points or rows above
   its cap (or not finite) with an :class:`~scara_pin.errors.InvalidInputError` (exit code 2), before any
   array of that size exists;
-- :func:`read_text` reads a whole document (URDF, yaml, JSON) with a byte cap: ``/dev/zero`` is refused
-  after :data:`MAX_DOCUMENT_BYTES` bytes, never read to the end;
+- :func:`open_regular` opens a file for reading only if it is a regular file: it opens with ``O_NONBLOCK``
+  FIRST and checks the open file (``fstat``), so a FIFO swapped in after a check cannot block the open;
+- :func:`read_bytes` and :func:`read_text` read a whole file (URDF, yaml, JSON, a mesh, a package's
+  ``package.xml``, a xacro include) through :func:`open_regular`, with a byte cap: nothing larger is read;
 - :func:`text_lines` streams a text file line by line, each line at most :data:`MAX_LINE_CHARS`
   characters, bad UTF-8 and NUL bytes refused with the line number.
 
@@ -26,17 +28,28 @@ from typing import IO
 from .errors import InvalidInputError
 
 __all__ = [
-    "MAX_DOCUMENT_BYTES",
     "MAX_CHECK_ELEMENTS",
+    "MAX_DOCUMENT_BYTES",
     "MAX_FRAMES",
     "MAX_LINE_CHARS",
+    "MAX_MESH_BYTES",
     "MAX_NUMBER",
+    "MAX_PACKAGE_XML_BYTES",
+    "MAX_PAGE_MESH_BYTES",
+    "MAX_PAGE_MESH_READ",
     "MAX_PATH_POINTS",
     "MAX_ROWS",
     "MAX_SAMPLES",
     "MAX_URDF_ELEMENTS",
+    "MAX_VISUALS",
+    "MAX_WALK_DEPTH",
+    "MAX_WALK_ENTRIES",
+    "MAX_XACRO_FILES",
+    "UnreadableFileError",
     "check_count",
     "check_input_file",
+    "open_regular",
+    "read_bytes",
     "read_text",
     "text_lines",
 ]
@@ -61,6 +74,28 @@ a chain about 5,000 links deep overflows the C stack (a crash, not an error), 3,
 MAX_CHECK_ELEMENTS = 50_000
 """Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
 
+# ----------------------------------------------------------------------- files named by packages and meshes
+MAX_MESH_BYTES = 200 * 1024 * 1024
+"""Bytes of one mesh file, counted AFTER decompression (a ``.dae`` that is a zip or gzip archive): a mesh
+holding more is not read (a placeholder box is drawn)."""
+MAX_PAGE_MESH_READ = 1024 * 1024 * 1024
+"""Bytes of mesh files read (after decompression) to draw one robot; each file is read once, however many
+visuals name it. The meshes beyond are drawn as placeholder boxes."""
+MAX_PAGE_MESH_BYTES = 128 * 1024 * 1024
+"""Bytes of triangles (float32 vertices, uint32 indices) embedded in one page, each mesh once however many
+visuals name it (about 5 million triangles). The meshes beyond are drawn as placeholder boxes."""
+MAX_VISUALS = 2_000
+"""Visuals (``<visual>`` elements) of one robot drawn in a page (a SCARA has about 10)."""
+MAX_PACKAGE_XML_BYTES = 1024 * 1024
+"""Bytes of one ``package.xml`` read while looking for a package (a real one is a few KB)."""
+MAX_WALK_DEPTH = 16
+"""Folders below a package folder searched (``--package-path``, ``ROS_PACKAGE_PATH``) for packages."""
+MAX_WALK_ENTRIES = 200_000
+"""Folder entries listed by the search of one package folder (links to folders already seen are skipped)."""
+MAX_XACRO_FILES = 1_000
+"""Files (includes, yaml) read by the expansion of one xacro file; their bytes together are at most
+:data:`MAX_DOCUMENT_BYTES`."""
+
 
 def check_count(what: str, n: float, cap: int, hint: str = "") -> int:
     """``n`` as an int if ``0 <= n <= cap``, else an :class:`InvalidInputError` naming ``what`` and the cap.
@@ -79,14 +114,57 @@ def check_count(what: str, n: float, cap: int, hint: str = "") -> int:
     return int(n)
 
 
-def _open(path: str | os.PathLike[str], what: str) -> IO[bytes]:
+_NOT_REGULAR = "not a regular file (a device, FIFO, socket or folder)"
+
+
+class UnreadableFileError(InvalidInputError):
+    """A file that cannot be opened for reading, or is not a regular file (exit code 2).
+
+    Attributes:
+        path: the file.
+        reason: why, e.g. ``"No such file or directory"``.
+        errno: the system's error number (``errno.ENOENT``...), or None for a file that is not regular.
+    """
+
+    def __init__(self, what: str, path: Path, reason: str, errno: int | None = None) -> None:
+        super().__init__(f"cannot read {what} {path}: {reason}")
+        self.path = path
+        self.reason = reason
+        self.errno = errno
+
+
+def open_regular(path: str | os.PathLike[str], what: str = "file") -> IO[bytes]:
+    """Open ``path`` for reading (binary) if it is a regular file; never blocks on a FIFO.
+
+    The file is checked (``stat``: a device is not even opened), opened with ``O_NONBLOCK`` and checked
+    again (``fstat`` of the open file): a FIFO swapped in between returns at once from the open instead of
+    blocking it, and is refused. The flag is cleared before the handle is returned (reads of a regular
+    file never block anyway).
+
+    Raises:
+        UnreadableFileError: missing, unreadable, or not a regular file (a device such as ``/dev/zero``,
+            a FIFO, a socket, a folder).
+    """
     path = Path(path)
-    try:
-        if path.is_dir():
-            raise InvalidInputError(f"cannot read {what} {path}: it is a folder")
-        return path.open("rb")
+    try:  # a device is not even opened (opening some has effects: a tape rewinds)
+        regular = stat.S_ISREG(os.stat(path).st_mode)
     except OSError as exc:
-        raise InvalidInputError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+        raise UnreadableFileError(what, path, exc.strerror or str(exc), exc.errno) from None
+    if not regular:
+        raise UnreadableFileError(what, path, _NOT_REGULAR)
+    flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOCTTY", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        raise UnreadableFileError(what, path, exc.strerror or str(exc), exc.errno) from None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise UnreadableFileError(what, path, _NOT_REGULAR)
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
 
 
 def check_input_file(path: str | os.PathLike[str], what: str = "file", limit: int = MAX_DOCUMENT_BYTES) -> Path:
@@ -97,30 +175,41 @@ def check_input_file(path: str | os.PathLike[str], what: str = "file", limit: in
             or larger than ``limit``.
     """
     path = Path(path)
-    try:
-        st = os.stat(path)
-    except OSError as exc:
-        raise InvalidInputError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise InvalidInputError(f"cannot read {what} {path}: not a regular file (a device, FIFO or folder)")
-    if st.st_size > limit:
-        raise InvalidInputError(f"{what} {path} is {st.st_size:,} bytes, above the cap of {limit:,}; refused")
+    with open_regular(path, what) as handle:
+        size = os.fstat(handle.fileno()).st_size
+    if size > limit:
+        raise InvalidInputError(f"{what} {path} is {size:,} bytes, above the cap of {limit:,}; refused")
     return path
 
 
-def read_text(path: str | os.PathLike[str], what: str = "file", limit: int = MAX_DOCUMENT_BYTES) -> str:
-    """The UTF-8 text of a file of at most ``limit`` bytes; larger (or endless) files are refused.
+def read_bytes(path: str | os.PathLike[str], what: str = "file", limit: int = MAX_DOCUMENT_BYTES) -> bytes:
+    """The bytes of a regular file (:func:`open_regular`) of at most ``limit`` bytes; larger files are refused.
+
+    At most ``limit + 1`` bytes are read, whatever the file's size says (it may grow meanwhile).
 
     Raises:
-        InvalidInputError: missing, unreadable, a folder, over ``limit`` bytes, or not UTF-8.
+        InvalidInputError: missing, unreadable, not a regular file, or over ``limit`` bytes.
     """
-    with _open(path, what) as handle:
+    with open_regular(path, what) as handle:
         try:
+            size = os.fstat(handle.fileno()).st_size
+            if size > limit:
+                raise InvalidInputError(f"{what} {path} is {size:,} bytes, above the cap of {limit:,}; refused")
             data = handle.read(limit + 1)
         except OSError as exc:
             raise InvalidInputError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
     if len(data) > limit:
         raise InvalidInputError(f"{what} {path} is larger than {limit:,} bytes; refused")
+    return data
+
+
+def read_text(path: str | os.PathLike[str], what: str = "file", limit: int = MAX_DOCUMENT_BYTES) -> str:
+    """The UTF-8 text of a regular file of at most ``limit`` bytes (:func:`read_bytes`).
+
+    Raises:
+        InvalidInputError: missing, unreadable, not a regular file, over ``limit`` bytes, or not UTF-8.
+    """
+    data = read_bytes(path, what, limit)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -29,7 +29,7 @@ import numpy as np
 
 from ._checks import NUMBER_TEXT
 from .errors import InvalidInputError
-from .limits import MAX_NUMBER, MAX_ROWS, text_lines
+from .limits import MAX_NUMBER, MAX_ROWS, UnreadableFileError, open_regular, text_lines
 
 __all__ = ["csv_rows", "open_csv", "read_csv"]
 
@@ -42,10 +42,10 @@ def open_csv(path: str | os.PathLike[str]) -> Iterator[IO[bytes]]:
         raise InvalidInputError(f"{path}: cannot be read (it is a folder)")
     if path.exists() and not path.is_file():  # a FIFO would block the open until a writer comes; a device
         raise InvalidInputError(f"{path}: cannot be read (not a regular file: a FIFO, a socket or a device)")
-    try:
-        handle = path.open("rb")
-    except OSError as exc:
-        raise InvalidInputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    try:  # O_NONBLOCK, then fstat: a FIFO swapped in after the checks above is refused, never waited for
+        handle = open_regular(path, "CSV file")
+    except UnreadableFileError as exc:
+        raise InvalidInputError(f"{path}: cannot be read ({exc.reason})") from None
     with handle:
         yield handle
 

@@ -22,13 +22,10 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-import signal
 import sys
-import threading
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
-from types import FrameType
+from collections.abc import Callable, Sequence
 
+from .. import signals
 from ..errors import ScaraError
 from . import cycle, describe, kinematics, motion, teach, view, workspace
 from ._common import _Parser, _UsageError, log
@@ -55,27 +52,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-class _Terminated(KeyboardInterrupt):
-    """SIGTERM, raised like Ctrl-C so that the same clean-up runs (temporary files removed)."""
-
-
-def _on_sigterm(signum: int, frame: FrameType | None) -> None:
-    raise _Terminated()
-
-
-@contextmanager
-def _sigterm_as_interrupt() -> Iterator[None]:
-    """While a command runs: SIGTERM raises :class:`_Terminated` (main thread only; restored after)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
 class _Formatter(logging.Formatter):
     def format(self, record: logging.LogRecord) -> str:
         return f"{record.levelname.lower()}: {record.getMessage()}"
@@ -100,12 +76,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         if func is None:
             print("error: no command given (see scara-pin --help)", file=sys.stderr)
             return 2
-        with _sigterm_as_interrupt():
-            return func(args)
+        with signals.kept():  # SIGINT / SIGTERM raise, and one swallowed by a library is raised again
+            try:
+                code = func(args)
+            except Exception:
+                signals.raise_pending()  # a signal swallowed meanwhile wins over what followed it
+                raise
+            signals.raise_pending()
+            return code
     except ScaraError as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
-    except _Terminated:
+    except signals.Terminated:
         print("error: terminated (SIGTERM)", file=sys.stderr)
         return 143
     except KeyboardInterrupt:

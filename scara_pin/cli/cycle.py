@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError, ParameterError
@@ -18,6 +17,7 @@ from ._common import (
     _load,
     _needs_wrist,
     _number,
+    number_type,
 )
 
 if TYPE_CHECKING:
@@ -56,8 +56,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     L = units.length
     robot = _load(args, units)
     _needs_wrist(robot, "cycle")
-    if not (math.isfinite(args.rate) and args.rate > 0):
-        raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
+    if not args.rate > 0:  # parsed by the one number grammar (number_type): finite, ASCII digits
+        raise ParameterError("--rate", args.rate, "must be > 0", "Hz")
     span = _number("--span", args.span) / L
     rise = _number("--rise", args.rise) / L
     blend = 0.0 if args.no_blend else (None if args.arch is None else _number("--arch", args.arch) / L)
@@ -132,7 +132,8 @@ def register(sub: Any) -> None:
     g.add_argument("--jerk-limit", nargs="+", metavar="J", help="joint jerk limit, one or 4 (rad/s^3, m/s^3)")
     _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
-    g.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="sampling rate of --out (default 1000)")
+    g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
+                   help="sampling rate of --out (default 1000)")  # fmt: skip
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
     g.add_argument("--plot", metavar="PNG", help="side and plan view of the tool path; joint rates against limits")
     _add_units(p, inputs=True, json_help='print one JSON object {"cycle_time", "legs", "limits", ...}')

@@ -6,7 +6,8 @@ import argparse
 import sys
 from typing import Any
 
-from ._common import Units, _add_robot_options, _add_units, _load, _q_values
+from .. import signals
+from ._common import Units, _add_robot_options, _add_units, _load, _q_values, integer_type
 
 
 def cmd_teach(args: argparse.Namespace) -> int:
@@ -24,7 +25,10 @@ def cmd_teach(args: argparse.Namespace) -> int:
         webbrowser.open(server.url, new=2)
     try:
         server.serve_forever()
-    except KeyboardInterrupt:
+    except signals.Terminated:  # SIGTERM: exit 143, as README says
+        raise
+    except KeyboardInterrupt:  # Ctrl-C is how a server is stopped: exit 0
+        signals.handled()
         print("stopped", file=sys.stderr)
     return 0
 
@@ -32,7 +36,8 @@ def cmd_teach(args: argparse.Namespace) -> int:
 def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
     p = sub.add_parser("teach", help="teach pendant in the browser: joint sliders, Cartesian jog with IK (127.0.0.1)")
-    p.add_argument("--port", type=int, default=0, help="port on 127.0.0.1 (default 0: a free one)")
+    p.add_argument("--port", type=integer_type("--port", 0, 65535), default=0,
+                   help="port on 127.0.0.1 (default 0: a free one)")
     p.add_argument("--q", nargs=4, metavar="Q", help="start configuration (default: zero)")
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
     _add_units(p, json_help=None)

@@ -417,12 +417,15 @@ def generate_urdf(
     """
     import xacro
 
+    from .packages import xacro_lock
+
     params = load_parameters(robot, overrides)
     mappings = params.xacro_mappings(prefix)
     entry = urdf_dir() / _schema(params.kind).entry
     try:
-        # xacro keeps (and mutates) the mappings dict it is given: hand it a copy.
-        doc = xacro.process_file(str(entry), mappings=dict(mappings))
+        # xacro keeps (and mutates) the mappings dict it is given: hand it a copy; its state is global
+        with xacro_lock:
+            doc = xacro.process_file(str(entry), mappings=dict(mappings))
     except Exception as exc:  # xacro raises plain Exceptions too; all mean a broken template here
         raise DescriptionError(f"xacro failed on {entry}: {exc}") from exc
     doc.documentElement.setAttribute("name", params.name)

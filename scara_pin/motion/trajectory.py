@@ -514,8 +514,17 @@ class Trajectory:
         return self.sample(self.duration)[0]
 
     def times(self, rate: float) -> np.ndarray:
-        """The fixed-rate grid k / rate, k = 0, 1, ..., through T (the last sample is at or just after T)."""
+        """The fixed-rate grid k / rate, k = 0, 1, ..., through T (the last sample is at or just after T).
+
+        Sized first: the number of samples (at most :data:`~scara_pin.limits.MAX_SAMPLES`), and the grid's
+        end, which lies up to one sample period 1 / rate past T: a period longer than both the motion and
+        1 s is refused (``rate = 1e-50`` would put the last sample at t = 1e50 s).
+        """
         rate = _positive("rate", rate, "Hz")
+        if self.duration > 0 and 1.0 / rate > max(self.duration, 1.0):  # then the grid is [0, 1 / rate]
+            raise InvalidInputError(f"a rate of {rate:.6g} Hz samples every {1.0 / rate:.6g} s, longer than the "
+                                    f"{self.duration:.6g} s motion and 1 s: its last sample would be at "
+                                    f"t = {1.0 / rate:.6g} s; raise the rate")  # fmt: skip
         check_count(f"samples ({self.duration:.6g} s at {rate:.6g} Hz)", self.duration * rate + 1.0, MAX_SAMPLES,
                     "lower the rate or shorten the motion")  # fmt: skip
         n = math.floor(self.duration * rate + 1e-9)
