@@ -10,11 +10,16 @@ from __future__ import annotations
 
 import json
 import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
-from test_hostile import Done, assert_one_error, cli, default_urdf
+from sigint import default_sigint
+from test_hostile import RUN, Done, _env, _limited, assert_one_error, cli, default_urdf
 
 from scara_pin import load_robot
 from scara_pin.cli import main
@@ -162,6 +167,97 @@ def test_a_relative_include_resolves_against_the_including_file(tmp_path: Path) 
     (elsewhere / "part.xacro").write_text("<robot><link name='decoy'/></robot>")  # never the one read
     done = cli(["fk", "--urdf", "../robot/top.xacro", "--json", *Q], cwd=elsewhere)
     np.testing.assert_allclose(fk_json(done), expected_fk(), rtol=0, atol=1e-12)
+
+
+# --------------------------------------------------------------------------------------------- 4. signals
+SWALLOWING_READER = """
+import sys, trimesh.exchange.load as _load
+_real = _load.mesh_loaders["stl"]
+def _blocked(*args, **kwargs):  # as trimesh's texture loads: blocked on a file, BaseException caught
+    try:
+        sys.stderr.write("blocked\\n"); sys.stderr.flush()
+        open({fifo!r}).read()
+    except BaseException:
+        pass
+    return _real(*args, **kwargs)
+_load.mesh_loaders["stl"] = _blocked
+"""
+
+
+def mesh_robot(folder: Path, stl: bytes) -> Path:
+    (folder / "part.stl").write_bytes(stl)
+    mesh = '<visual><geometry><mesh filename="part.stl"/></geometry></visual>'
+    (folder / "r.urdf").write_text(default_urdf().replace('<link name="tool0"/>', f'<link name="tool0">{mesh}</link>'))
+    (folder / "v.html").write_text("old page")
+    return folder / "r.urdf"
+
+
+def box_stl(facets: int, seed: int = 0) -> bytes:
+    corners = np.random.default_rng(seed).uniform(-0.05, 0.05, (facets, 3, 3)).tolist()
+    body = "".join("facet normal 0 0 1\nouter loop\n" + "".join(f"vertex {a!r} {b!r} {c!r}\n" for a, b, c in t)
+                   + "endloop\nendfacet\n" for t in corners)  # fmt: skip
+    return f"solid part\n{body}endsolid part\n".encode()
+
+
+def signalled(folder: Path, args: list[str], sig: int, ready: str,
+              prelude: str = "") -> subprocess.CompletedProcess[str]:  # fmt: skip
+    """Run the command, wait for ``ready`` on its stderr, send ``sig``; the finished process."""
+    code = prelude + RUN
+    proc = subprocess.Popen([sys.executable, "-c", code, *args], cwd=folder, stdin=subprocess.DEVNULL,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, preexec_fn=_limited,
+                            env=_env())  # fmt: skip
+    assert proc.stderr is not None
+    lines = []
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        line = proc.stderr.readline()
+        lines.append(line)
+        if not line or ready in line:
+            break
+    assert ready in lines[-1], lines
+    proc.send_signal(sig)
+    try:
+        _, rest = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        raise AssertionError("the command went on after the signal") from None
+    return subprocess.CompletedProcess(args, proc.returncode, "", "".join(lines) + rest)
+
+
+@pytest.mark.parametrize(("sig", "code", "message"), [(signal.SIGINT, 130, "error: interrupted"),
+                                                      (signal.SIGTERM, 143, "error: terminated (SIGTERM)")])
+def test_a_signal_swallowed_by_a_blocked_mesh_reader_still_ends_the_command(tmp_path: Path, sig: int, code: int,
+                                                                             message: str) -> None:  # fmt: skip
+    """Item 4: the reader catches BaseException around a blocked open (as trimesh does): the command still
+    ends with 130 / 143, and the old page stays."""
+    os.mkfifo(tmp_path / "fifo")
+    urdf = mesh_robot(tmp_path, box_stl(12))
+    prelude = SWALLOWING_READER.format(fifo=str(tmp_path / "fifo"))
+    done = signalled(tmp_path, ["view", "--urdf", str(urdf), "--html", "v.html"], sig, "blocked", prelude)
+    assert done.returncode == code, done.stderr
+    assert done.stderr.splitlines()[1:] == [message], done.stderr
+    assert (tmp_path / "v.html").read_text() == "old page"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo", "part.stl", "r.urdf", "v.html"]
+
+
+def test_ctrl_c_while_trimesh_parses_a_mesh(tmp_path: Path) -> None:
+    """Item 4, with the real reader: Ctrl-C lands while trimesh parses a 6 MB ASCII STL (in code that may catch
+    it or not): 130, the old page."""
+    urdf = mesh_robot(tmp_path, box_stl(40_000, seed=1))
+    done = signalled(tmp_path, ["-v", "view", "--urdf", str(urdf), "--html", "v.html"], signal.SIGINT,
+                     "reading mesh")  # fmt: skip
+    assert done.returncode == 130, done.stderr
+    assert done.stderr.splitlines()[-1] == "error: interrupted"
+    assert (tmp_path / "v.html").read_text() == "old page"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["part.stl", "r.urdf", "v.html"]
+
+
+def test_children_get_sigint_default() -> None:
+    """The helper the signal tests use: a child that ignored SIGINT would never see the Ctrl-C."""
+    p = subprocess.run([sys.executable, "-c", "import signal; print(signal.getsignal(signal.SIGINT))"],
+                       capture_output=True, text=True, preexec_fn=default_sigint, timeout=30)  # fmt: skip
+    assert "default_int_handler" in p.stdout
 
 
 # --------------------------------------------------------------------------------------------- 9. --rate

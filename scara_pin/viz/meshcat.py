@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import atexit
 import collections
+import functools
 import logging
 import math
 import os
@@ -52,6 +53,8 @@ import pinocchio as pin
 
 from ..errors import InvalidInputError, ScaraError
 from ..limits import MAX_FRAMES, check_count
+from .meshes import PLACEHOLDER_SIZE
+from .page import SHARE_GEOMETRY
 
 if TYPE_CHECKING:
     from ..model import Robot
@@ -222,14 +225,18 @@ class _Recorder:
         self.objects: dict[str, bytes] = {}
         self.properties: dict[str, list[bytes]] = collections.defaultdict(list)
         self.transforms: dict[str, bytes] = {}
+        self.shares: dict[str, tuple[str, bytes]] = {}  # path -> (source path, command): see _ShareGeometry
         self.animation: bytes | None = None
 
-    def add(self, kind: str, path: str, packed: bytes) -> None:
+    def add(self, kind: str, path: str, packed: bytes, source: str = "") -> None:
         path = path.rstrip("/")
-        if kind == "set_object":
+        if kind == SHARE_GEOMETRY:
+            self.shares[path] = (source.rstrip("/"), packed)
+        elif kind == "set_object":
             self.objects.pop(path, None)  # re-inserted last: drawn after what it may depend on
             self.objects[path] = packed
             self.properties.pop(path, None)
+            self.shares.pop(path, None)
         elif kind == "set_property":
             self.properties[path].append(packed)
         elif kind == "set_transform":
@@ -237,20 +244,26 @@ class _Recorder:
         elif kind == "set_animation":
             self.animation = packed
         elif kind == "delete":
+            def under(key: str) -> bool:
+                return key == path or key.startswith(path + "/")
+
             for table in (self.objects, self.properties, self.transforms):
-                for key in [k for k in table if k == path or k.startswith(path + "/")]:
+                for key in [k for k in table if under(k)]:
                     del table[key]
+            for key in [k for k, (src, _) in self.shares.items() if under(k) or under(src)]:
+                del self.shares[key]
 
     def commands(self) -> list[bytes]:
         """List the commands to replay, in an order that works.
 
-        Objects and their properties, then the properties of nodes without objects, then transforms, then
-        the animation.
+        Objects and their properties, then the shared geometries (once both their objects exist), then the
+        properties of nodes without objects, then transforms, then the animation.
         """
         out: list[bytes] = []
         for path, packed in self.objects.items():
             out.append(packed)
             out.extend(self.properties.get(path, ()))
+        out.extend(packed for _, packed in self.shares.values())
         out.extend(p for path, props in self.properties.items() if path not in self.objects for p in props)
         out.extend(self.transforms.values())
         if self.animation is not None:
@@ -449,7 +462,11 @@ class _Window:
 
         data = command.lower()
         packed = umsgpack.packb(data)
-        self.recorder.add(data["type"], data.get("path", ""), packed)
+        self.recorder.add(data["type"], data.get("path", ""), packed, data.get("source", ""))
+        if data["type"] == SHARE_GEOMETRY:
+            if self.zmq_url is not None:  # meshcat's server has no such command: never sent to it
+                raise ViewerError("a shared mesh geometry is for offline pages only (the live viewer sends copies)")
+            return
         if self.zmq_url is not None:
             answer = self._request([data["type"].encode("utf-8"), data.get("path", "").encode("utf-8"), packed])
             if answer != b"ok":
@@ -477,16 +494,56 @@ class _Window:
 
 
 # ------------------------------------------------------------------------------------------ meshes (issue 13)
-def _draw_meshes(vis: Any, robot: Robot, viz: Any) -> None:
+class _ShareGeometry:
+    """The :data:`SHARE_GEOMETRY` command (meshcat's command interface: ``lower()``)."""
+
+    def __init__(self, path: str, source: str) -> None:
+        self.path, self.source = path, source
+
+    def lower(self) -> dict[str, str]:
+        return {"type": SHARE_GEOMETRY, "path": self.path, "source": self.source}
+
+
+@functools.cache
+def _scaled_mesh_class() -> Any:
+    """Meshcat's triangle mesh geometry, with a visual's ``scale`` as the object's matrix.
+
+    The vertices are sent as read (the file's unit applied), so one copy serves visuals of any scale.
+    """
+    mg = _meshcat().geometry
+
+    class ScaledMesh(mg.TriangularMeshGeometry):  # type: ignore[misc, name-defined]
+        def __init__(self, vertices: np.ndarray, faces: np.ndarray, scale: tuple[float, float, float]) -> None:
+            super().__init__(vertices, faces)
+            self.scale = scale
+
+        def intrinsic_transform(self) -> np.ndarray:
+            return np.diag([*self.scale, 1.0])
+
+    return ScaledMesh
+
+
+_STAND_IN = (np.eye(3, dtype=np.float32) * PLACEHOLDER_SIZE, np.array([[0, 1, 2]], dtype=np.uint32))
+"""The one triangle a sharing visual's object holds until the page gives it the shared geometry."""
+
+
+def _draw_meshes(vis: Any, robot: Robot, viz: Any, share: bool) -> None:
     """Set each readable mesh of the robot's visuals (:func:`scara_pin.viz.meshes.visual_meshes`) on its node.
 
     The scene drew a placeholder box for each mesh at the geometry's node (``viz.getViewerNodeName``, under
-    its joint's node); the mesh replaces the box there (vertices already scaled), in the URDF's colour.
+    its joint's node); the mesh replaces the box there, in the URDF's colour, its ``scale`` as the object's
+    matrix. With ``share`` (a recorded page), a mesh named by several visuals is embedded once
+    (:data:`SHARE_GEOMETRY`); else (meshcat's live server) each visual gets a copy, and the copies count
+    against :data:`~scara_pin.limits.MAX_PAGE_MESH_BYTES` together.
     """
+    from ..limits import MAX_PAGE_MESH_BYTES
     from .meshes import visual_meshes
 
     mg = _meshcat().geometry
+    scaled = _scaled_mesh_class()
     visuals = robot.visual_model
+    drawn: dict[int, str] = {}  # id of a MeshGeometry -> the node path (lowered) holding its triangles
+    sent = 0
     for mesh in visual_meshes(robot):
         if not visuals.existGeometryName(mesh.name):
             continue
@@ -494,8 +551,21 @@ def _draw_meshes(vis: Any, robot: Robot, viz: Any) -> None:
         rgba = geometry_object.meshColor
         color = int(rgba[0] * 255) * 65536 + int(rgba[1] * 255) * 256 + int(rgba[2] * 255)
         material = mg.MeshPhongMaterial(color=color, opacity=float(rgba[3]), transparent=float(rgba[3]) < 1.0)
-        geometry = mg.TriangularMeshGeometry(mesh.vertices.astype(np.float32), mesh.faces.astype(np.uint32))
-        vis[viz.getViewerNodeName(geometry_object, pin.GeometryType.VISUAL)].set_object(geometry, material)
+        node = vis[viz.getViewerNodeName(geometry_object, pin.GeometryType.VISUAL)]
+        source = drawn.get(id(mesh.geometry)) if share else None
+        if source is not None:
+            node.set_object(scaled(*_STAND_IN, mesh.scale), material)
+            node.window.send(_ShareGeometry(node.path.lower(), source))
+            continue
+        size = mesh.geometry.embedded_bytes
+        if not share and sent + size > MAX_PAGE_MESH_BYTES:
+            log.warning("mesh %r: its copy for link %s would take the meshes sent over %.0f MiB, the cap; "
+                        "drawn as a %g m box", mesh.filename, mesh.link, MAX_PAGE_MESH_BYTES / 2**20,
+                        PLACEHOLDER_SIZE)  # fmt: skip
+            continue
+        sent += size
+        node.set_object(scaled(mesh.geometry.vertices, mesh.geometry.faces, mesh.scale), material)
+        drawn[id(mesh.geometry)] = node.path.lower()
 
 
 # ------------------------------------------------------------------------------------------ the scene
@@ -510,8 +580,10 @@ class _Scene:
     """
 
     def __init__(self, robot: Robot, window: _Window) -> None:
+        from .meshes import check_visual_count
         from .tree import framing, joint_nodes, node_paths
 
+        check_visual_count(robot)  # sized first: each visual is a node and a geometry of the page
         meshcat = _meshcat()
         self.robot = robot
         self.vis = meshcat.Visualizer(window=window)
@@ -531,7 +603,8 @@ class _Scene:
                 self._load_geometry(geometry)
         except (ValueError, RuntimeError, OSError) as exc:
             raise InvalidInputError(f"cannot show the robot's geometry: {' '.join(str(exc).split())}") from None
-        _draw_meshes(self.vis, robot, self.viz)  # the real meshes in place of their placeholder boxes
+        # the real meshes in place of their placeholder boxes; a recorded page embeds each mesh once
+        _draw_meshes(self.vis, robot, self.viz, share=window.zmq_url is None)
         self.frame_paths: dict[str, str] = {}
         for frame_id in (robot.base_id, robot.tool_id):
             self._triad(frame_id, 0.25 * self.size)

@@ -3,16 +3,34 @@
 A URDF ``<mesh filename=... scale=...>`` names its file as ``package://pkg/path`` (looked up as
 :mod:`scara_pin.description.packages` says: ``--package-path``, the folders above the robot's file,
 ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``), ``file:///abs/path``, an absolute path or a path relative to
-the robot's file. Rules:
+the robot's file. A mesh file is input like any other (it may come from a stranger). Rules:
 
 - no network: any other scheme (``http://``, ``https://``, ...) is refused;
 - no escape: the resolved file (symbolic links followed) must lie inside the package it names, or for
   other names inside one of the package folders searched or the robot file's folder; ``..`` that climbs
   out, and absolute paths elsewhere, are refused;
-- STL, DAE (COLLADA) and OBJ are read with trimesh; ``scale`` is applied to the vertices.
+- regular files only, opened non-blocking and then checked (:func:`scara_pin.limits.open_regular`): a FIFO
+  is never waited for;
+- bounded bytes, counted AFTER decompression: a ``.dae`` may be a zip (``.zae``) or gzip archive; it is
+  opened here, and at most :data:`~scara_pin.limits.MAX_MESH_BYTES` of it are decompressed (trimesh and
+  pycollada never see the archive); an archive inside an archive is refused;
+- only the mesh file is read: the materials (``.mtl``) and textures a mesh names are not (the viewer draws
+  the URDF's colour), so none of them can block, or fill the memory;
+- each file is read once, however many visuals name it, and the files of one robot are bounded together:
+  at most :data:`~scara_pin.limits.MAX_PAGE_MESH_READ` bytes read and
+  :data:`~scara_pin.limits.MAX_PAGE_MESH_BYTES` bytes of triangles kept (the meshes beyond are not drawn);
+- STL, DAE (COLLADA) and OBJ are read with trimesh. A COLLADA file's ``<asset><unit meter="...">`` is
+  honoured (its vertices are scaled to metres, as assimp and RViz do); STL and OBJ have no unit (metres);
+- ``scale`` (the one number grammar of URDF numbers, 1 or 3 finite nonzero values) is checked with the
+  geometry it produces: coordinates beyond :data:`MAX_MESH_COORDINATE`, or a mesh that float32 (the
+  page's vertex type) collapses to a point, are refused; a mesh more than :data:`LARGE_RATIO` times the
+  robot's size, or less than 1 / :data:`SMALL_RATIO` of it, is drawn with a warning (its units are
+  probably wrong: a file in millimetres without ``scale="0.001 0.001 0.001"``).
 
-A mesh that is refused, missing or unreadable is reported as one ``warning:`` naming the file; the viewer
-keeps the placeholder box it draws for every mesh (:func:`placeholder_urdf`), never failing on it.
+A mesh that is refused, missing or unreadable is reported as one ``warning:`` naming the file (and the
+links that name it); the viewer keeps the placeholder box it draws for every mesh
+(:func:`placeholder_urdf`), never failing on it. trimesh catches ``BaseException`` in places: a Ctrl-C or
+SIGTERM it swallows is raised again right after it returns (:func:`scara_pin.signals.raise_pending`).
 
 Pinocchio's geometry models of the robot (``robot.visual_model``) are built from
 :func:`placeholder_urdf` (each mesh a :data:`PLACEHOLDER_SIZE` box at the mesh's origin), so Pinocchio
@@ -21,32 +39,101 @@ never reads a mesh file; :func:`visual_meshes` gives the real shapes, under Pino
 
 from __future__ import annotations
 
+import functools
+import gzip
+import io
 import logging
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+import zipfile
+import zlib
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .. import signals
+from .._checks import number_text
+from ..errors import InvalidInputError
+from ..limits import (
+    MAX_MESH_BYTES,
+    MAX_PAGE_MESH_BYTES,
+    MAX_PAGE_MESH_READ,
+    MAX_VISUALS,
+    UnreadableFileError,
+    check_count,
+    read_bytes,
+)
+
 if TYPE_CHECKING:
     from ..description.packages import PackagePath
     from ..model import Robot
 
-__all__ = ["MAX_MESH_BYTES", "PLACEHOLDER_SIZE", "VisualMesh", "placeholder_urdf", "resolve_mesh", "visual_meshes"]
+__all__ = [
+    "LARGE_RATIO",
+    "MAX_MESH_BYTES",
+    "MAX_MESH_COORDINATE",
+    "PLACEHOLDER_SIZE",
+    "SMALL_RATIO",
+    "MeshGeometry",
+    "VisualMesh",
+    "check_visual_count",
+    "placeholder_urdf",
+    "resolve_mesh",
+    "robot_size",
+    "visual_meshes",
+]
 
 log = logging.getLogger(__name__)
 
 PLACEHOLDER_SIZE = 0.02
 """[m] edge of the box drawn where a mesh is (and stays, when the mesh cannot be read)."""
-MAX_MESH_BYTES = 200 * 1024 * 1024
-"""[bytes] a mesh file larger than this is not read (a placeholder is drawn)."""
-_FORMATS = {".stl": "stl", ".dae": "dae", ".obj": "obj"}
+MAX_MESH_COORDINATE = 1e6
+"""[m] largest coordinate of a drawn mesh, scale applied: beyond, no robot part; float32 keeps 0.1 m there."""
+LARGE_RATIO = 20.0
+"""A mesh more than this many times the robot's size across is drawn with a warning (units?)."""
+SMALL_RATIO = 1000.0
+"""A mesh less than 1 / this of the robot's size across is drawn with a warning (units?)."""
+_FORMATS = {".stl": "stl", ".dae": "dae", ".zae": "dae", ".obj": "obj"}
+"""The file endings read, and their kind (``.zae``: a zipped COLLADA file, read like a ``.dae`` that is one)."""
+_ZIP, _GZIP = b"PK\x03\x04", b"\x1f\x8b"
+_SHOWN_LINKS = 3
+"""Links named in one warning (a mesh named by many visuals is one warning)."""
 
 
 class MeshProblem(Exception):
     """Why a mesh is not drawn (the message names the file); reported as a warning, never raised to users."""
+
+
+@dataclass(frozen=True)
+class MeshGeometry:
+    """The triangles of one mesh file, read once whatever the number of visuals naming it.
+
+    Attributes:
+        path: the file read.
+        vertices: (N, 3) vertices [m], the file's unit applied (COLLADA ``<unit>``), not a visual's scale.
+        faces: (M, 3) vertex indices of the triangles.
+        unit: [m] the length of one unit of the file (1 unless a COLLADA file says otherwise).
+        bytes_read: bytes of the file read (after decompression).
+    """
+
+    path: Path
+    vertices: np.ndarray
+    faces: np.ndarray
+    unit: float = 1.0
+    bytes_read: int = 0
+    low: np.ndarray = field(init=False, repr=False, compare=False)
+    high: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "low", self.vertices.min(axis=0))
+        object.__setattr__(self, "high", self.vertices.max(axis=0))
+
+    @property
+    def embedded_bytes(self) -> int:
+        """Bytes of the triangles in a page: float32 vertices and uint32 indices."""
+        return 12 * len(self.vertices) + 12 * len(self.faces)
 
 
 @dataclass(frozen=True)
@@ -58,16 +145,26 @@ class VisualMesh:
         link: the link it belongs to.
         filename: the file name as written in the URDF.
         path: the file read.
-        vertices: (N, 3) vertices in the visual's frame, ``scale`` applied [m].
-        faces: (M, 3) vertex indices of the triangles.
+        geometry: the file's triangles, shared by every visual that names the file.
+        scale: the visual's ``scale`` (x, y, z).
     """
 
     name: str
     link: str
     filename: str
     path: Path
-    vertices: np.ndarray
-    faces: np.ndarray
+    geometry: MeshGeometry
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(N, 3) vertices in the visual's frame, unit and ``scale`` applied [m] (a new array)."""
+        return self.geometry.vertices * np.asarray(self.scale)
+
+    @property
+    def faces(self) -> np.ndarray:
+        """(M, 3) vertex indices of the triangles."""
+        return self.geometry.faces
 
 
 def _inside(path: Path, folder: Path) -> bool:
@@ -111,46 +208,203 @@ def resolve_mesh(filename: str, packages: PackagePath) -> Path:
     return path
 
 
-def _scale(text: str | None, filename: str) -> np.ndarray:
+def _scale(text: str | None, filename: str) -> tuple[float, float, float]:
     if text is None:
-        return np.ones(3)
-    try:
-        values = [float(v) for v in text.split()]
-    except ValueError:
-        values = []
+        return (1.0, 1.0, 1.0)
+    values = [number_text(v) for v in text.split()]  # the URDF number grammar: no "1_0", no "nan"
     if len(values) == 1:
         values *= 3
     if len(values) != 3 or not all(math.isfinite(v) and v != 0 for v in values):
-        raise MeshProblem(f"mesh {filename!r}: scale {text!r} must be 3 finite nonzero numbers")
-    return np.array(values)
+        raise MeshProblem(f"mesh {filename!r}: scale {text!r} must be 1 or 3 finite nonzero numbers")
+    return (values[0], values[1], values[2])
 
 
-def _load(path: Path, filename: str) -> tuple[np.ndarray, np.ndarray]:
-    """(vertices, faces) of a mesh file, or :class:`MeshProblem`."""
+def _decompressed(data: bytes, path: Path, filename: str) -> bytes:
+    """A COLLADA file's XML: a zip (``.zae``) or gzip archive is opened here, bounded AFTER decompression."""
+    if not data.startswith((_ZIP, _GZIP)):
+        return data
+    try:
+        if data.startswith(_ZIP):
+            with zipfile.ZipFile(io.BytesIO(data)) as archive:
+                names = [n for n in archive.namelist() if n.upper().endswith(".DAE")]
+                names.sort(key=lambda n: "MACOSX" in n)  # pycollada's choice: a .dae not under __MACOSX
+                if not names:
+                    raise MeshProblem(f"mesh {filename!r}: {path} is a zip archive holding no .dae file")
+                with archive.open(names[0]) as member:
+                    out = member.read(MAX_MESH_BYTES + 1)  # decompressed step by step: never more
+        else:
+            with gzip.GzipFile(fileobj=io.BytesIO(data)) as member:
+                out = member.read(MAX_MESH_BYTES + 1)
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, RuntimeError, NotImplementedError) as exc:
+        raise MeshProblem(f"mesh {filename!r}: {path} is a broken archive ({type(exc).__name__}: "
+                          f"{' '.join(str(exc).split())[:200]})") from None  # fmt: skip
+    if len(out) > MAX_MESH_BYTES:
+        raise MeshProblem(f"mesh {filename!r}: {path} holds more than {MAX_MESH_BYTES / 2**20:.0f} MiB once "
+                          "decompressed, the cap: not read")  # fmt: skip
+    if out.startswith((_ZIP, _GZIP)):
+        raise MeshProblem(f"mesh {filename!r}: {path} is an archive inside an archive: not read")
+    return out
+
+
+def _collada_unit(data: bytes, filename: str) -> float:
+    """[m] the COLLADA document's unit: ``<COLLADA><asset><unit meter="..."/>`` (1 when absent).
+
+    Only the start of the document is parsed (the ``<asset>``, its first element, per the schema).
+    """
+    depth = 0
+    in_asset = False
+    try:
+        for event, element in ET.iterparse(io.BytesIO(data), events=("start", "end")):
+            tag = element.tag.rsplit("}", 1)[-1] if isinstance(element.tag, str) else ""
+            if event == "end":
+                depth -= 1
+                if depth == 1 and in_asset:
+                    return 1.0
+                continue
+            depth += 1
+            if depth == 2:
+                if tag != "asset":
+                    return 1.0
+                in_asset = True
+            elif depth == 3 and in_asset and tag == "unit":
+                text = element.get("meter", "1")
+                unit = number_text(text)
+                if not (math.isfinite(unit) and unit > 0):
+                    raise MeshProblem(f"mesh {filename!r}: COLLADA <unit meter={text!r}> must be a number > 0")
+                return unit
+    except ET.ParseError:
+        pass  # trimesh's reader says what is wrong with the document
+    return 1.0
+
+
+@functools.cache
+def _no_files() -> Any:
+    """A trimesh resolver that reads nothing: the materials and textures a mesh names are not read."""
+    import trimesh
+
+    class NoFiles(trimesh.resolvers.Resolver):  # type: ignore[misc]
+        def __init__(self) -> None:
+            pass
+
+        def get(self, key: str) -> bytes:
+            raise OSError(f"{key}: scara-pin reads no material or texture file (the URDF's colour is drawn)")
+
+        def write(self, name: str, data: Any) -> None:
+            raise OSError("scara-pin writes no file through a mesh reader")
+
+        def namespaced(self, namespace: str) -> Any:
+            return self
+
+        def keys(self) -> list[str]:
+            return []
+
+    return NoFiles()
+
+
+def _load(path: Path, filename: str) -> MeshGeometry:
+    """The triangles of a mesh file (rules in the module docstring), or :class:`MeshProblem`."""
     kind = _FORMATS.get(path.suffix.lower())
     if kind is None:
-        raise MeshProblem(f"mesh {filename!r}: {path.suffix or 'no'} extension: only STL, DAE and OBJ are read")
+        raise MeshProblem(f"mesh {filename!r}: {path.suffix or 'no'} extension: only STL, DAE (ZAE) and OBJ are read")
     try:
-        size = path.stat().st_size
-    except OSError as exc:
-        raise MeshProblem(f"mesh {filename!r}: {path} cannot be read ({exc.strerror})") from None
-    if size > MAX_MESH_BYTES:
-        raise MeshProblem(f"mesh {filename!r}: {path} is {size / 2**20:.0f} MiB, over the "
-                          f"{MAX_MESH_BYTES / 2**20:.0f} MiB read")  # fmt: skip
+        data = read_bytes(path, "mesh", MAX_MESH_BYTES)
+    except UnreadableFileError as exc:
+        if exc.reason == "No such file or directory":
+            raise MeshProblem(f"mesh {filename!r}: {path} does not exist") from None
+        raise MeshProblem(f"mesh {filename!r}: {path} cannot be read ({exc.reason})") from None
+    except InvalidInputError:
+        raise MeshProblem(f"mesh {filename!r}: {path} is over the {MAX_MESH_BYTES / 2**20:.0f} MiB read") from None
+    unit = 1.0
+    if kind == "dae":
+        data = _decompressed(data, path, filename)
+        unit = _collada_unit(data, filename)
     import trimesh
 
     try:
-        with path.open("rb") as handle:
-            mesh: Any = trimesh.load(handle, file_type=kind, force="mesh")
+        log.debug("reading mesh %s (%d bytes)", path, len(data))
+        mesh: Any = trimesh.load(io.BytesIO(data), file_type=kind, force="mesh", resolver=_no_files(),
+                                 skip_materials=True)  # fmt: skip
         vertices = np.asarray(mesh.vertices, dtype=float)
         faces = np.asarray(mesh.faces, dtype=np.int64)
     except Exception as exc:  # trimesh and its readers raise many kinds of errors on a bad file
+        signals.raise_pending()
         raise MeshProblem(f"mesh {filename!r}: {path} cannot be read as {kind.upper()} "
                           f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None  # fmt: skip
+    signals.raise_pending()  # a Ctrl-C or SIGTERM that trimesh swallowed (it catches BaseException)
     if vertices.ndim != 2 or vertices.shape[1:] != (3,) or faces.ndim != 2 or faces.shape[1:] != (3,) \
-            or len(faces) == 0 or not np.isfinite(vertices).all():  # fmt: skip
-        raise MeshProblem(f"mesh {filename!r}: {path} holds no triangles (or non-finite vertices)")
-    return vertices, faces
+            or len(faces) == 0 or len(vertices) == 0:  # fmt: skip
+        raise MeshProblem(f"mesh {filename!r}: {path} holds no triangles")
+    vertices = vertices * unit
+    if not np.isfinite(vertices.astype(np.float32)).all():
+        raise MeshProblem(f"mesh {filename!r}: {path} holds non-finite vertices (or beyond float32, 3.4e38)")
+    return MeshGeometry(path, vertices, faces, unit, len(data))
+
+
+def robot_size(robot: Robot) -> float:
+    """[m] the robot's size: the diagonal of the box of its frames' origins at q = 0 (at least 5 cm).
+
+    The yardstick of the meshes' plausibility: the links laid out end to end.
+    """
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
+    points = np.array([f.translation for f in data.oMf])
+    return max(0.05, float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))))
+
+
+def _checked_size(geometry: MeshGeometry, scale: tuple[float, float, float], filename: str, size: float) -> str:
+    """A warning when the scaled mesh's size is implausible against the robot's (else ""), or MeshProblem."""
+    s = np.asarray(scale)
+    corners = np.stack([geometry.low * s, geometry.high * s])
+    reach = float(np.abs(corners).max())
+    if not reach <= MAX_MESH_COORDINATE:
+        raise MeshProblem(f"mesh {filename!r}: with scale {' '.join(f'{v:g}' for v in scale)} it reaches "
+                          f"{reach:.3g} m from its origin, beyond {MAX_MESH_COORDINATE:g} m: not drawn")  # fmt: skip
+    flat = corners.astype(np.float32)
+    if np.all(flat[0] == flat[1]):
+        raise MeshProblem(f"mesh {filename!r}: with scale {' '.join(f'{v:g}' for v in scale)} it collapses to a "
+                          "point in float32 (the page's vertex type): not drawn")  # fmt: skip
+    across = float(np.linalg.norm(corners[1] - corners[0]))
+    advice = "check its units (a COLLADA <unit>, or scale=\"0.001 0.001 0.001\" for a file in mm)"
+    if across > LARGE_RATIO * size:
+        return (f"mesh {filename!r} is {across:.4g} m across, {across / size:.3g} times the robot's size "
+                f"({size:.3g} m at q = 0): {advice}")  # fmt: skip
+    if across * SMALL_RATIO < size:
+        return (f"mesh {filename!r} is {across:.3g} m across, 1/{size / across:.3g} of the robot's size "
+                f"({size:.3g} m at q = 0): {advice}")  # fmt: skip
+    return ""
+
+
+class _Budget:
+    """What the meshes of one robot may cost together (read bytes, kept triangles)."""
+
+    def __init__(self) -> None:
+        self.read = 0
+        self.kept = 0
+
+    def load(self, path: Path, filename: str) -> MeshGeometry:
+        if self.read >= MAX_PAGE_MESH_READ:
+            raise MeshProblem(f"mesh {filename!r}: not read: the meshes read for this robot reached "
+                              f"{MAX_PAGE_MESH_READ / 2**20:.0f} MiB, the cap")  # fmt: skip
+        if self.kept >= MAX_PAGE_MESH_BYTES:
+            raise MeshProblem(f"mesh {filename!r}: not read: the meshes kept for this robot reached "
+                              f"{MAX_PAGE_MESH_BYTES / 2**20:.0f} MiB of triangles, the cap")  # fmt: skip
+        geometry = _load(path, filename)
+        self.read += geometry.bytes_read
+        if self.kept + geometry.embedded_bytes > MAX_PAGE_MESH_BYTES:
+            raise MeshProblem(f"mesh {filename!r}: {geometry.embedded_bytes / 2**20:.1f} MiB of triangles would "
+                              f"take this robot's meshes over {MAX_PAGE_MESH_BYTES / 2**20:.0f} MiB, the cap: "
+                              "not drawn")  # fmt: skip
+        self.kept += geometry.embedded_bytes
+        return geometry
+
+
+def _links(links: list[str]) -> str:
+    shown = ", ".join(links[:_SHOWN_LINKS])
+    if len(links) > _SHOWN_LINKS:
+        return f"links {shown} and {len(links) - _SHOWN_LINKS} more are"
+    return f"link {shown} is" if len(links) == 1 else f"links {shown} are"
 
 
 def _mesh_elements(root: ET.Element) -> list[tuple[str, int, ET.Element, ET.Element]]:
@@ -177,11 +431,28 @@ def placeholder_urdf(urdf: str) -> str:
     return ET.tostring(root, encoding="unicode") if changed else urdf
 
 
-def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
-    """The meshes of the robot's visuals that can be read; one ``warning`` per one that cannot.
+def check_visual_count(robot: Robot) -> int:
+    """The number of visuals of the robot, refused above :data:`~scara_pin.limits.MAX_VISUALS` (before any is built).
 
-    Names are Pinocchio's geometry names (``robot.visual_model``), where the placeholder boxes are.
+    Raises:
+        InvalidInputError: more visuals than the cap.
     """
+    count = sum(len(link.findall("visual")) for link in ET.fromstring(robot.urdf).findall("link"))
+    return check_count("visuals of the robot (its <visual> elements, each drawn)", count, MAX_VISUALS,
+                       "a page draws at most that many")  # fmt: skip
+
+
+def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
+    """The meshes of the robot's visuals that can be read; one ``warning`` per mesh that cannot.
+
+    Names are Pinocchio's geometry names (``robot.visual_model``), where the placeholder boxes are. Each
+    file is read once (its :class:`MeshGeometry` is shared by the visuals that name it); the files of the
+    robot together are bounded (module docstring). A mesh of implausible size is drawn, with a warning.
+    """
+    size = robot_size(robot)
+    budget = _Budget()
+    read: dict[Path, MeshGeometry | MeshProblem] = {}
+    problems: dict[str, tuple[list[str], bool]] = {}  # warning -> (links, drawn as a box)
     out = []
     for link, index, _geometry, mesh in _mesh_elements(ET.fromstring(robot.urdf)):
         filename = mesh.get("filename", "")
@@ -190,11 +461,24 @@ def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
                 raise MeshProblem(f"a <mesh> of link {link} has no filename")
             scale = _scale(mesh.get("scale"), filename)
             path = resolve_mesh(filename, robot.package_path)
-            if not path.is_file():
-                raise MeshProblem(f"mesh {filename!r}: {path} does not exist")
-            vertices, faces = _load(path, filename)
+            if path not in read:
+                try:
+                    read[path] = budget.load(path, filename)
+                except MeshProblem as exc:
+                    read[path] = exc
+            geometry = read[path]
+            if isinstance(geometry, MeshProblem):
+                raise geometry
+            warning = _checked_size(geometry, scale, filename, size)
         except MeshProblem as exc:
-            log.warning("%s; link %s is drawn as a %g m box", exc, link, PLACEHOLDER_SIZE)
+            problems.setdefault(str(exc), ([], True))[0].append(link)
             continue
-        out.append(VisualMesh(f"{link}_{index}", link, filename, path, vertices * scale, faces))
+        if warning:
+            problems.setdefault(warning, ([], False))[0].append(link)
+        out.append(VisualMesh(f"{link}_{index}", link, filename, path, geometry, scale))
+    for message, (links, boxed) in problems.items():
+        if boxed:
+            log.warning("%s; %s drawn as a %g m box", message, _links(links), PLACEHOLDER_SIZE)
+        else:
+            log.warning("%s (%s drawn as it is)", message, _links(links))
     return tuple(out)

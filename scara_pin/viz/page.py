@@ -16,7 +16,14 @@ import json
 from pathlib import Path
 from typing import Any
 
-__all__ = ["render"]
+__all__ = ["SHARE_GEOMETRY", "render"]
+
+SHARE_GEOMETRY = "scara_share_geometry"
+"""A page command (not meshcat's): the object at ``path`` takes the geometry of the object at ``source``.
+
+A mesh named by several visuals is embedded once in a page: the first visual's object holds its triangles,
+each other visual's object a one-triangle stand-in, replaced at load by a reference to the first one's
+geometry (the page's script handles the command before meshcat sees it). Never sent to meshcat's server."""
 
 _STYLE = """
 html, body { margin: 0; height: 100%; font: 13px/1.35 system-ui, sans-serif; color: #1d232b; }
@@ -87,10 +94,12 @@ def render(title: str, viewer_js: str, commands: list[bytes], data: dict[str, An
     Args:
         title: the page title.
         viewer_js: meshcat's viewer script (``</script`` already escaped).
-        commands: the scene's msgpack commands, applied in order at load (no fetch).
+        commands: the scene's msgpack commands, applied in order at load (no fetch); meshcat's, and
+            :data:`SHARE_GEOMETRY` (a mesh embedded once, shown by several visuals).
         data: the panel's data (:meth:`scara_pin.viz.meshcat._Scene.page_data`, plus ``q``, and ``motion``
             or ``teach``); None for a page without a panel.
     """
+    share = SHARE_GEOMETRY
     encoded = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in commands)
     panel = script = ""
     if data is not None:
@@ -131,6 +140,23 @@ def render(title: str, viewer_js: str, commands: list[bytes], data: dict[str, An
 </script>
 <script>
 var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));
+(function () {{
+  // A mesh named by several visuals is embedded once: each other visual's object takes its geometry.
+  var handle = viewer.handle_command.bind(viewer);
+  function object(path) {{
+    var names = path.split("/").filter(function (name) {{ return name.length > 0; }});
+    return viewer.scene_tree.find(names.concat(["<object>"])).object;
+  }}
+  viewer.handle_command = function (command) {{
+    if (command.type !== "{share}") return handle(command);
+    var target = object(command.path), source = object(command.source);
+    if (target.isMesh && source.isMesh) {{
+      target.geometry.dispose();
+      target.geometry = source.geometry;
+      viewer.set_dirty();
+    }}
+  }};
+}})();
 (function () {{
   // The scene, as msgpack commands (base64): decoded and applied synchronously, in order; no fetch.
   var commands = [
