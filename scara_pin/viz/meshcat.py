@@ -51,9 +51,9 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 import pinocchio as pin
 
+from ..description.placeholders import PLACEHOLDER_SIZE
 from ..errors import InvalidInputError, ScaraError
 from ..limits import MAX_FRAMES, check_count
-from .meshes import PLACEHOLDER_SIZE
 from .page import SHARE_GEOMETRY
 
 if TYPE_CHECKING:

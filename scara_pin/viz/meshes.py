@@ -29,12 +29,13 @@ the robot's file. A mesh file is input like any other (it may come from a strang
 
 A mesh that is refused, missing or unreadable is reported as one ``warning:`` naming the file (and the
 links that name it); the viewer keeps the placeholder box it draws for every mesh
-(:func:`placeholder_urdf`), never failing on it. trimesh catches ``BaseException`` in places: a Ctrl-C or
-SIGTERM it swallows is raised again right after it returns (:func:`scara_pin.signals.raise_pending`).
+(:func:`scara_pin.description.placeholders.placeholder_urdf`), never failing on it. trimesh catches
+``BaseException`` in places: a Ctrl-C or SIGTERM it swallows is raised again right after it returns
+(:func:`scara_pin.signals.raise_pending`).
 
 Pinocchio's geometry models of the robot (``robot.visual_model``) are built from
-:func:`placeholder_urdf` (each mesh a :data:`PLACEHOLDER_SIZE` box at the mesh's origin), so Pinocchio
-never reads a mesh file; :func:`visual_meshes` gives the real shapes, under Pinocchio's geometry names.
+:func:`~scara_pin.description.placeholders.placeholder_urdf` (each mesh a small box at the mesh's origin),
+so Pinocchio never reads a mesh file; :func:`visual_meshes` gives the real shapes, under Pinocchio's geometry names.
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ import numpy as np
 
 from .. import signals
 from .._checks import number_text
+from ..description.placeholders import PLACEHOLDER_SIZE
 from ..errors import InvalidInputError
 from ..limits import (
     MAX_MESH_BYTES,
@@ -74,12 +76,10 @@ __all__ = [
     "LARGE_RATIO",
     "MAX_MESH_BYTES",
     "MAX_MESH_COORDINATE",
-    "PLACEHOLDER_SIZE",
     "SMALL_RATIO",
     "MeshGeometry",
     "VisualMesh",
     "check_visual_count",
-    "placeholder_urdf",
     "resolve_mesh",
     "robot_size",
     "visual_meshes",
@@ -87,8 +87,6 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-PLACEHOLDER_SIZE = 0.02
-"""[m] edge of the box drawn where a mesh is (and stays, when the mesh cannot be read)."""
 MAX_MESH_COORDINATE = 1e6
 """[m] largest coordinate of a drawn mesh, scale applied: beyond, no robot part; float32 keeps 0.1 m there."""
 LARGE_RATIO = 20.0
@@ -417,18 +415,6 @@ def _mesh_elements(root: ET.Element) -> list[tuple[str, int, ET.Element, ET.Elem
             if geometry is not None and mesh is not None:
                 out.append((link.get("name", ""), i, geometry, mesh))
     return out
-
-
-def placeholder_urdf(urdf: str) -> str:
-    """The URDF text with every ``<mesh>`` (visual and collision) replaced by a :data:`PLACEHOLDER_SIZE` box."""
-    root = ET.fromstring(urdf)
-    changed = False
-    for geometry in root.iter("geometry"):
-        for mesh in geometry.findall("mesh"):
-            geometry.remove(mesh)
-            ET.SubElement(geometry, "box", size=" ".join([repr(PLACEHOLDER_SIZE)] * 3))
-            changed = True
-    return ET.tostring(root, encoding="unicode") if changed else urdf
 
 
 def check_visual_count(robot: Robot) -> int:
