@@ -26,8 +26,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
 
-from . import signals
 from .errors import InvalidInputError
+from .signals import raise_pending
 
 __all__ = [
     "FIGURE_FORMATS",
@@ -131,7 +131,7 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
     try:
         tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created)
         yield tmp
-        signals.raise_pending()  # a Ctrl-C or SIGTERM that a library swallowed meanwhile: nothing is written
+        raise_pending()  # a Ctrl-C or SIGTERM that a library swallowed meanwhile: nothing is written
         if to_stdout:
             sys.stdout.flush()
             with tmp.open("rb") as src:

@@ -26,8 +26,8 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from .. import signals
 from ..errors import ScaraError
+from ..signals import Terminated, kept, raise_pending
 from . import cycle, describe, kinematics, motion, teach, view, workspace
 from ._common import _Parser, _UsageError, log
 
@@ -122,18 +122,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         if func is None:
             print("error: no command given (see scara-pin --help)", file=sys.stderr)
             return 2
-        with signals.kept():  # SIGINT / SIGTERM raise, and one swallowed by a library is raised again
+        with kept():  # SIGINT / SIGTERM raise, and one swallowed by a library is raised again
             try:
                 code = func(args)
             except Exception:
-                signals.raise_pending()  # a signal swallowed meanwhile wins over what followed it
+                raise_pending()  # a signal swallowed meanwhile wins over what followed it
                 raise
-            signals.raise_pending()
+            raise_pending()
             return code
     except ScaraError as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
-    except signals.Terminated:
+    except Terminated:
         print("error: terminated (SIGTERM)", file=sys.stderr)
         return 143
     except KeyboardInterrupt:

@@ -6,7 +6,7 @@ import argparse
 import sys
 from typing import Any
 
-from .. import signals
+from ..signals import Terminated, handled
 from ._common import Units, _add_robot_options, _add_units, _load, _q_values, integer_type
 
 
@@ -25,10 +25,10 @@ def cmd_teach(args: argparse.Namespace) -> int:
         webbrowser.open(server.url, new=2)
     try:
         server.serve_forever()
-    except signals.Terminated:  # SIGTERM: exit 143, as README says
+    except Terminated:  # SIGTERM: exit 143, as README says
         raise
     except KeyboardInterrupt:  # Ctrl-C is how a server is stopped: exit 0
-        signals.handled()
+        handled()
         print("stopped", file=sys.stderr)
     return 0
 

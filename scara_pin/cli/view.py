@@ -7,9 +7,9 @@ import math
 import sys
 from typing import TYPE_CHECKING, Any
 
-from .. import signals
 from ..errors import InvalidInputError
 from ..files import check_output_path
+from ..signals import Terminated, handled
 from ._common import Units, _add_robot_options, _add_units, _load, _q_values, log
 
 if TYPE_CHECKING:
@@ -68,10 +68,10 @@ def cmd_view(args: argparse.Namespace) -> int:
         print(f"meshcat viewer: {viewer.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
         try:
             viewer.serve()
-        except signals.Terminated:  # SIGTERM: exit 143, as README says
+        except Terminated:  # SIGTERM: exit 143, as README says
             raise
         except KeyboardInterrupt:  # Ctrl-C is how a server is stopped: exit 0
-            signals.handled()
+            handled()
             print("stopped", file=sys.stderr)
     return 0
 

@@ -54,7 +54,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .. import signals
 from .._checks import number_text
 from ..description.placeholders import PLACEHOLDER_SIZE
 from ..errors import InvalidInputError
@@ -67,6 +66,7 @@ from ..limits import (
     check_count,
     read_bytes,
 )
+from ..signals import raise_pending
 
 if TYPE_CHECKING:
     from ..description.packages import PackagePath
@@ -325,10 +325,10 @@ def _load(path: Path, filename: str) -> MeshGeometry:
         vertices = np.asarray(mesh.vertices, dtype=float)
         faces = np.asarray(mesh.faces, dtype=np.int64)
     except Exception as exc:  # trimesh and its readers raise many kinds of errors on a bad file
-        signals.raise_pending()
+        raise_pending()
         raise MeshProblem(f"mesh {filename!r}: {path} cannot be read as {kind.upper()} "
                           f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None  # fmt: skip
-    signals.raise_pending()  # a Ctrl-C or SIGTERM that trimesh swallowed (it catches BaseException)
+    raise_pending()  # a Ctrl-C or SIGTERM that trimesh swallowed (it catches BaseException)
     if vertices.ndim != 2 or vertices.shape[1:] != (3,) or faces.ndim != 2 or faces.shape[1:] != (3,) \
             or len(faces) == 0 or len(vertices) == 0:  # fmt: skip
         raise MeshProblem(f"mesh {filename!r}: {path} holds no triangles")
