@@ -40,6 +40,7 @@ so Pinocchio never reads a mesh file; :func:`visual_meshes` gives the real shape
 
 from __future__ import annotations
 
+import errno
 import functools
 import gzip
 import io
@@ -114,6 +115,8 @@ class MeshGeometry:
         faces: (M, 3) vertex indices of the triangles.
         unit: [m] the length of one unit of the file (1 unless a COLLADA file says otherwise).
         bytes_read: bytes of the file read (after decompression).
+        low: (3,) smallest coordinates of the vertices [m] (set from them).
+        high: (3,) largest coordinates of the vertices [m] (set from them).
     """
 
     path: Path
@@ -307,7 +310,7 @@ def _load(path: Path, filename: str) -> MeshGeometry:
     try:
         data = read_bytes(path, "mesh", MAX_MESH_BYTES)
     except UnreadableFileError as exc:
-        if exc.reason == "No such file or directory":
+        if exc.errno == errno.ENOENT:
             raise MeshProblem(f"mesh {filename!r}: {path} does not exist") from None
         raise MeshProblem(f"mesh {filename!r}: {path} cannot be read ({exc.reason})") from None
     except InvalidInputError:
@@ -453,8 +456,8 @@ def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
                 except MeshProblem as exc:
                     read[path] = exc
             geometry = read[path]
-            if isinstance(geometry, MeshProblem):
-                raise geometry
+            if isinstance(geometry, MeshProblem):  # the file's problem, said once for every visual naming it
+                raise MeshProblem(*geometry.args)
             warning = _checked_size(geometry, scale, filename, size)
         except MeshProblem as exc:
             problems.setdefault(str(exc), ([], True))[0].append(link)
