@@ -18,12 +18,12 @@ def cmd_teach(args: argparse.Namespace) -> int:
     robot = _load(args, units)
     q = _q_values(args.q, units) if args.q else None
     server = TeachServer(robot, port=args.port, q=q)
-    print(f"teach pendant: {server.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
-    if args.open:
-        import webbrowser
+    try:  # from the line that says so on, Ctrl-C stops the server
+        print(f"teach pendant: {server.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
+        if args.open:
+            import webbrowser
 
-        webbrowser.open(server.url, new=2)
-    try:
+            webbrowser.open(server.url, new=2)
         server.serve_forever()
     except Terminated:  # SIGTERM: exit 143, as README says
         raise

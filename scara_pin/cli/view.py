@@ -65,8 +65,8 @@ def cmd_view(args: argparse.Namespace) -> int:
             viewer.animate(times, qs, loop=True)
         else:
             viewer.display(q if q is not None else np.zeros(robot.dof))
-        print(f"meshcat viewer: {viewer.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
-        try:
+        try:  # from the line that says so on, Ctrl-C stops the server
+            print(f"meshcat viewer: {viewer.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
             viewer.serve()
         except Terminated:  # SIGTERM: exit 143, as README says
             raise
