@@ -449,3 +449,23 @@ def test_the_triangles_kept_for_one_robot_are_capped(tmp_path: Path, monkeypatch
     assert [v.name for v in found] == ["tool0_0", "tool0_2"] and found[0].geometry is found[1].geometry
     (record,) = caplog.records
     assert "b.stl" in record.getMessage() and "the cap" in record.getMessage()
+
+
+def test_the_live_viewer_sends_copies_counted_against_the_cap(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                             caplog: pytest.LogCaptureFixture) -> None:  # fmt: skip
+    """meshcat's server has no shared geometry: each visual gets a copy, and the copies count together."""
+    import scara_pin.limits
+    from scara_pin.viz.meshcat import _draw_meshes, _Scene, _Window
+
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "a.stl").write_bytes(ascii_stl((0.01, 0.02, 0.03), b"a"))
+    robot = Robot.from_file(write_package(tmp_path, {"tool0": visual("a.stl") * 5}))
+    scene = _Scene(robot, _Window())  # a recorded page: one copy, four shares
+    assert len(scene.vis.window.recorder.shares) == 4
+    monkeypatch.setattr(scara_pin.limits, "MAX_PAGE_MESH_BYTES", 3 * (8 * 12 + 12 * 12))  # three copies of the box
+    window = _Window()  # the meshes drawn again, as for the live server (the scene's node names)
+    _draw_meshes(type(scene.vis)(window=window), robot, scene.viz, share=False)
+    copies = [p for p in window.recorder.objects if "/visuals/tool0_" in p]
+    assert len(copies) == 3 and not window.recorder.shares
+    (record,) = [r for r in caplog.records if "the cap" in r.getMessage()]
+    assert "2 of its copies (links tool0)" in record.getMessage()

@@ -544,6 +544,7 @@ def _draw_meshes(vis: Any, robot: Robot, viz: Any, share: bool) -> None:
     visuals = robot.visual_model
     drawn: dict[int, str] = {}  # id of a MeshGeometry -> the node path (lowered) holding its triangles
     sent = 0
+    over: dict[str, list[str]] = {}  # the meshes whose copies went over the cap -> the links left as boxes
     for mesh in visual_meshes(robot):
         if not visuals.existGeometryName(mesh.name):
             continue
@@ -559,13 +560,15 @@ def _draw_meshes(vis: Any, robot: Robot, viz: Any, share: bool) -> None:
             continue
         size = mesh.geometry.embedded_bytes
         if not share and sent + size > MAX_PAGE_MESH_BYTES:
-            log.warning("mesh %r: its copy for link %s would take the meshes sent over %.0f MiB, the cap; "
-                        "drawn as a %g m box", mesh.filename, mesh.link, MAX_PAGE_MESH_BYTES / 2**20,
-                        PLACEHOLDER_SIZE)  # fmt: skip
+            over.setdefault(mesh.filename, []).append(mesh.link)
             continue
         sent += size
         node.set_object(scaled(mesh.geometry.vertices, mesh.geometry.faces, mesh.scale), material)
         drawn[id(mesh.geometry)] = node.path.lower()
+    for filename, links in over.items():
+        log.warning("mesh %r: %d of its copies (links %s) would take the meshes sent over %.0f MiB, the cap; drawn "
+                    "as %g m boxes", filename, len(links), ", ".join(sorted(set(links))),
+                    MAX_PAGE_MESH_BYTES / 2**20, PLACEHOLDER_SIZE)  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ the scene
