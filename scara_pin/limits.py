@@ -26,12 +26,14 @@ from typing import IO
 from .errors import InvalidInputError
 
 __all__ = [
+    "MAX_CALIBRATION_ROWS",
     "MAX_DOCUMENT_BYTES",
     "MAX_CHECK_ELEMENTS",
     "MAX_FRAMES",
     "MAX_LINE_CHARS",
     "MAX_NUMBER",
     "MAX_PATH_POINTS",
+    "MAX_PLAN_POSES",
     "MAX_ROWS",
     "MAX_SAMPLES",
     "MAX_URDF_ELEMENTS",
@@ -51,6 +53,10 @@ MAX_FRAMES = 200_000
 """Animation frames of one ``view`` page or live animation."""
 MAX_ROWS = 20_000_000
 """Data rows of one batch file (``ik --input``)."""
+MAX_CALIBRATION_ROWS = 100_000
+"""Lines of one calibration measurement file (the identification Jacobian holds 4 x 40 numbers per row)."""
+MAX_PLAN_POSES = 10_000
+"""Poses of one calibration experiment plan (``calibrate --plan N``)."""
 MAX_LINE_CHARS = 65_536
 """Characters of one line of a CSV input."""
 MAX_DOCUMENT_BYTES = 64 * 1024 * 1024

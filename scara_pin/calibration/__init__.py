@@ -1,0 +1,1 @@
+"""Kinematic calibration: identify a robot's description from measured tool positions."""
