@@ -55,6 +55,7 @@ __all__ = [
     "Origin",
     "ParameterKind",
     "kabsch",
+    "read_triple",
 ]
 
 
@@ -174,7 +175,7 @@ def _basis(axis: np.ndarray) -> tuple[np.ndarray, tuple[str, str, str]]:
     return np.column_stack([u, np.cross(axis, u), axis]), ("ru", "rv", "ra")
 
 
-def _triple(el: ET.Element | None, attr: str) -> np.ndarray:
+def read_triple(el: ET.Element | None, attr: str) -> np.ndarray:
     """A URDF ``xyz`` / ``rpy`` attribute (absent: zeros); the loader has parsed the file already."""
     text = el.get(attr) if el is not None else None
     if text is None:
@@ -276,10 +277,10 @@ class ChainModel:
         origins: list[Origin] = []
         for j in chain:
             el = urdf_joints[model.names[j]]
-            xyz, rpy = _triple(el.find("origin"), "xyz"), _triple(el.find("origin"), "rpy")
+            xyz, rpy = read_triple(el.find("origin"), "xyz"), read_triple(el.find("origin"), "rpy")
             R0 = pin.rpy.rpyToMatrix(*rpy)
             axis_el = el.find("axis")
-            axis = _triple(axis_el, "xyz") if axis_el is not None else np.array([1.0, 0.0, 0.0])
+            axis = read_triple(axis_el, "xyz") if axis_el is not None else np.array([1.0, 0.0, 0.0])
             axis = axis / np.linalg.norm(axis)
             prismatic = el.get("type") == "prismatic"
             basis = np.eye(3) if prismatic else _basis(axis)[0]
@@ -289,7 +290,7 @@ class ChainModel:
         tool_el = next((el for el in urdf_joints.values()
                         if (c := el.find("child")) is not None and c.get("link") == robot.tool_frame), None)  # fmt: skip
         if tool_el is not None and tool_el.get("type") == "fixed":
-            xyz, rpy = _triple(tool_el.find("origin"), "xyz"), _triple(tool_el.find("origin"), "rpy")
+            xyz, rpy = read_triple(tool_el.find("origin"), "xyz"), read_triple(tool_el.find("origin"), "rpy")
             R0 = pin.rpy.rpyToMatrix(*rpy)
             pre = model.frames[robot.tool_id].placement * pin.SE3(R0, xyz).inverse()
             origins.append(Origin(tool_el.get("name", ""), robot.tool_frame, tool_joint, int(robot.tool_id), pre, xyz,

@@ -289,7 +289,11 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
         dist = np.linalg.norm(r_after[:, :3], axis=1)
         outliers = tuple(Outlier(int(i), measurements.where(int(i)), float(dist[i])) for i in np.flatnonzero(~used))
     names = chain.names()
+    # why each fixed error is fixed: said at the nominal model, where the dependencies are exact (at the
+    # solution every column leans a little on many others)
     reasons = {order[i]: why for i, why in idf.reasons([names[k] for k in order]).items()}
+    idf0, order0 = _identify_at(final, zero, opt.tol)
+    reasons.update({order0[i]: why for i, why in idf0.reasons([names[k] for k in order0]).items()})
     stds = np.sqrt(np.clip(np.diag(covariance), 0.0, None)) if len(kept) else np.zeros(0)
     std_of = dict(zip(kept, stds))
     estimates = tuple(

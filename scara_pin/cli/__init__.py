@@ -30,7 +30,7 @@ from contextlib import contextmanager
 from types import FrameType
 
 from ..errors import ScaraError
-from . import cycle, describe, kinematics, motion, teach, view, workspace
+from . import calibrate, cycle, describe, kinematics, motion, teach, view, workspace
 from ._common import _Parser, _UsageError, log
 
 __all__ = ["build_parser", "main"]
@@ -50,7 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
-    for module in (describe, kinematics, motion, cycle, workspace, view, teach):
+    for module in (describe, kinematics, motion, cycle, workspace, view, teach, calibrate):
         module.register(sub)
     return parser
 
