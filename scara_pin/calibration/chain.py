@@ -8,14 +8,15 @@ target). Its candidate errors, in the order the identification keeps them when t
   device's frame, 3 translations [m] and 3 rotations [rad] (``device.x`` .. ``device.rz``);
 - ``offsets``: each revolute joint's zero offset [rad] (``jointN.offset``: the true angle is the reading
   plus the offset);
-- ``scale``: each prismatic joint's relative scale error [1] (``jointN.scale``: the true stroke is
-  ``(1 + scale)`` times the reading);
 - ``origins``: each moving joint's origin placement (the URDF ``<origin>``): 3 translations [m] added to
   its ``xyz`` (``jointN.x``, ``.y``, ``.z``, in the parent link's frame, as ``xyz`` is written) and the
   rotations [rad] about the axes of the joint frame other than the joint's own axis (the tilts,
   ``jointN.rx``, ``.ry``, ...; a prismatic joint also turns about its own axis, ``jointN.rz``);
 - ``tool``: the tool frame's fixed joint (the measured target on the flange): 3 translations (its ``xyz``)
-  and 3 rotations.
+  and 3 rotations;
+- ``scale``: each prismatic joint's relative scale error [1] (``jointN.scale``: the true stroke is
+  ``(1 + scale)`` times the reading), last: fitted only when the poses separate it from every other error
+  (a quill that never moves leaves it fixed, a height error being the likelier).
 
 Each moving joint's origin thus gets a full placement error (6 numbers, the joint zero offset being the
 rotation about its own axis): a complete, POE-style parameterisation of a serial chain, made minimal by the
@@ -504,10 +505,6 @@ def _parameters(origins: list[Origin], groups: frozenset[Group]) -> tuple[tuple[
         for o in moving:
             if not o.prismatic:
                 add(f"{o.name}.r", 3, 2, ErrorParameter(f"{o.label}.offset", Group.OFFSETS, o.name, Rt, 2))
-    if Group.SCALE in groups:
-        for o in moving:
-            if o.prismatic:
-                add(f"{o.name}.s", 1, 0, ErrorParameter(f"{o.label}.scale", Group.SCALE, o.name, S, 0))
     if Group.ORIGINS in groups:
         for o in moving:
             suffixes = ("rx", "ry", "rz") if o.prismatic else _basis(o.axis)[1]
@@ -521,4 +518,8 @@ def _parameters(origins: list[Origin], groups: frozenset[Group]) -> tuple[tuple[
                 add(f"{o.name}.t", 3, c, ErrorParameter(f"{o.label}.{'xyz'[c]}", Group.TOOL, o.name, T, c))
             for c in range(3):
                 add(f"{o.name}.r", 3, c, ErrorParameter(f"{o.label}.r{'xyz'[c]}", Group.TOOL, o.name, Rt, c))
+    if Group.SCALE in groups:
+        for o in moving:
+            if o.prismatic:
+                add(f"{o.name}.s", 1, 0, ErrorParameter(f"{o.label}.scale", Group.SCALE, o.name, S, 0))
     return tuple(params), {k: tuple(v) for k, v in slots.items()}

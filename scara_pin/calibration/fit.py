@@ -10,10 +10,10 @@ The steps of :func:`calibrate`:
    alignment (:func:`~scara_pin.calibration.chain.kabsch`) of the nominal predictions with the measurements;
 2. the structural count: how many errors a rich set of poses separates (:func:`identify` on random poses
    inside the limits); fewer measured poses than that is refused;
-3. the identifiable errors of these poses (:func:`identify` at the nominal model), fitted by scipy's
-   ``least_squares`` (trust-region reflective, analytic Jacobian), the others fixed at zero; the
-   identification is repeated at the solution (an error without effect at the nominal model, a tilt about
-   a tool point on its axis, may act at the solution), and the fit with it, until the set stops growing;
+3. the identifiable errors of these poses (:func:`identify` at the nominal model: first-order
+   identifiability), fitted by scipy's ``least_squares`` (trust-region reflective, analytic Jacobian), the
+   others fixed at zero. An error without first-order effect (J4's tilt when the target is on J4's axis)
+   is fixed even if the errors of the real robot give it a second-order one: it is never fitted to noise;
 4. with a robust loss: the rows whose position error exceeds ``outlier_sigmas`` robust standard deviations
    (1.4826 times the median absolute coordinate residual) are outliers, listed and left out of a final
    linear fit;
@@ -46,8 +46,6 @@ FIT_TOL = 1e-15
 """``least_squares``' ftol, xtol and gtol: the fit runs to working precision (noise-free data are met to 1e-12 m)."""
 MAX_NFEV = 200
 """The most model evaluations of one fit."""
-MAX_ROUNDS = 4
-"""The most identification rounds (the set of identified errors grows at most this many times)."""
 OUTLIER_FLOOR = 1e-9
 """[m] a position error below this is never an outlier (noise-free data)."""
 URDF_CHECK_TOL = 1e-9
@@ -166,28 +164,19 @@ def _fit(problem: _Problem, kept: tuple[int, ...], theta0: np.ndarray, loss: Los
     return full(sol.x), int(sol.nfev)
 
 
-def _identify_at(problem: _Problem, theta: np.ndarray, tol: float, first: tuple[int, ...] = ()) -> tuple[Identifiability, list[int]]:
-    """The identifiability at ``theta``, preferring the errors ``first`` (then the model's order)."""
+def _identify_at(problem: _Problem, theta: np.ndarray, tol: float) -> tuple[Identifiability, list[int]]:
+    """The identifiability at ``theta`` (errors in the model's order of preference), and that order."""
     _, J = problem.residuals(theta)
-    order = list(first) + [k for k in range(problem.chain.size) if k not in first]
-    idf = identify(J[:, order], tol)  # type: ignore[index]
-    return idf, order
+    order = list(range(problem.chain.size))
+    return identify(J, tol), order  # type: ignore[arg-type]
 
 
-def _fit_rounds(problem: _Problem, theta0: np.ndarray, loss: Loss, f_scale: float,
-                tol: float) -> tuple[np.ndarray, tuple[int, ...], int]:  # fmt: skip
-    """Identify, fit, and identify again at the solution while the identified set grows."""
-    idf, order = _identify_at(problem, theta0, tol)
+def _fit_identified(problem: _Problem, theta0: np.ndarray, loss: Loss, f_scale: float,
+                    tol: float) -> tuple[np.ndarray, tuple[int, ...], int]:  # fmt: skip
+    """The errors these poses separate at the nominal model, fitted from ``theta0``."""
+    idf, order = _identify_at(problem, np.zeros(problem.chain.size), tol)
     kept = tuple(sorted(order[i] for i in idf.kept))
     theta, nfev = _fit(problem, kept, theta0, loss, f_scale)
-    for _ in range(MAX_ROUNDS - 1):
-        idf, order = _identify_at(problem, theta, tol, kept)
-        grown = tuple(sorted(order[i] for i in idf.kept))
-        if len(grown) <= len(kept) or not set(kept) <= set(grown):
-            break
-        kept = grown
-        theta, more = _fit(problem, kept, theta, loss, f_scale)
-        nfev += more
     return theta, kept, nfev
 
 
@@ -263,7 +252,7 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
         p_base, _ = nominal.predict(np.zeros(0), nominal.pinocchio_q(measurements.q), device0, jacobian=False)
         device0 = kabsch(p_base, measurements.position)
     problem = _Problem(chain, measurements, device0, opt.yaw_weight)
-    theta, kept, nfev = _fit_rounds(problem, zero, opt.loss, opt.f_scale, opt.tol)
+    theta, kept, nfev = _fit_identified(problem, zero, opt.loss, opt.f_scale, opt.tol)
     used = np.ones(n, dtype=bool)
     outliers: tuple[Outlier, ...] = ()
     if opt.loss is not Loss.LINEAR:
@@ -275,10 +264,8 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
             raise InvalidInputError(f"{measurements.source}: {int((~used).sum())} of {n} poses are outliers: "
                                     f"{int(used.sum())} remain for {count} identifiable parameters")  # fmt: skip
         if not used.all():
-            theta, kept, nfev = _fit_rounds(problem.subset(used), theta, Loss.LINEAR, opt.f_scale, opt.tol)
+            theta, kept, nfev = _fit_identified(problem.subset(used), theta, Loss.LINEAR, opt.f_scale, opt.tol)
     final = problem.subset(used)
-    idf, order = _identify_at(final, theta, opt.tol, kept)
-    kept = tuple(sorted(order[i] for i in idf.kept))
     covariance, sigma = _covariance(final, theta, kept)
     if len(kept) < count:
         notes.append(f"these poses identify {len(kept)} of the {count} errors a richer set of poses would: add "
@@ -289,11 +276,9 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
         dist = np.linalg.norm(r_after[:, :3], axis=1)
         outliers = tuple(Outlier(int(i), measurements.where(int(i)), float(dist[i])) for i in np.flatnonzero(~used))
     names = chain.names()
-    # why each fixed error is fixed: said at the nominal model, where the dependencies are exact (at the
-    # solution every column leans a little on many others)
+    # why each fixed error is fixed: said at the nominal model, where it was decided
+    idf, order = _identify_at(final, zero, opt.tol)
     reasons = {order[i]: why for i, why in idf.reasons([names[k] for k in order]).items()}
-    idf0, order0 = _identify_at(final, zero, opt.tol)
-    reasons.update({order0[i]: why for i, why in idf0.reasons([names[k] for k in order0]).items()})
     stds = np.sqrt(np.clip(np.diag(covariance), 0.0, None)) if len(kept) else np.zeros(0)
     std_of = dict(zip(kept, stds))
     estimates = tuple(
@@ -329,7 +314,7 @@ def _cross_validation(problem: _Problem, opt: CalibrationOptions, count: int,
     for f in range(folds):
         test = np.zeros(n, dtype=bool)
         test[perm[f::folds]] = True
-        theta, _, _ = _fit_rounds(problem.subset(~test), np.zeros(problem.chain.size), Loss.LINEAR, opt.f_scale,
+        theta, _, _ = _fit_identified(problem.subset(~test), np.zeros(problem.chain.size), Loss.LINEAR, opt.f_scale,
                                   opt.tol)  # fmt: skip
         r, _ = problem.subset(test).residuals(theta, jacobian=False)
         held.append(r)
