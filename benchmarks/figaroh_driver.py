@@ -1,8 +1,9 @@
 """Run FIGAROH's geometric calibration on a data set written by bench_calibration.py (its own venv).
 
-Usage: .venv-figaroh/bin/python benchmarks/figaroh_driver.py DIR [REPEAT]  (DIR holds robot.urdf, figaroh.csv,
-figaroh.yaml); prints one JSON object: FIGAROH's residuals, parameters, median wall time of REPEAT runs. FIGAROH needs a subclass
-per robot (its cost function) and a config file: this is the one for a 4-joint SCARA measured by position.
+Usage: .venv-figaroh/bin/python benchmarks/figaroh_driver.py DIR [REPEAT]
+(DIR holds robot.urdf, figaroh.csv, figaroh.yaml); prints one JSON object: FIGAROH's residuals, parameters,
+median wall time of REPEAT runs. FIGAROH needs a subclass per robot (its cost function) and a config file:
+this is the one for a 4-joint SCARA measured by position.
 """
 
 import contextlib

@@ -229,7 +229,8 @@ def test_outliers_are_found_with_the_robust_loss(nominal, truth) -> None:
     p[bad] += [0.004, -0.003, 0.002]  # millimetres off: a slipped target
     plain = calibrate(nominal, Measurements(readings, p), CalibrationOptions(folds=0))
     robust = calibrate(nominal, Measurements(readings, p), CalibrationOptions(loss=Loss.SOFT_L1, folds=0))
-    assert [o.row for o in robust.outliers] == bad and [o.where for o in robust.outliers] == ["row 5", "row 18", "row 34"]
+    assert [o.row for o in robust.outliers] == bad
+    assert [o.where for o in robust.outliers] == ["row 5", "row 18", "row 34"]
     assert all(o.distance > 1e-3 for o in robust.outliers)
     assert abs(robust.after.rms / NOISE - 1.0) <= 0.25 < plain.after.rms / NOISE - 1.0
 
@@ -421,7 +422,8 @@ def test_cli_bad_measurements_exit_2(tmp_path, capsys, noisy, rows, cell, messag
         lines[5] = ",".join(values)
         csv.write_text("\n".join(lines) + "\n")
     out = tmp_path / "c.urdf"
-    rc = main(["calibrate", "--robot", "default", "--set", "tool_x=0.05", "--measurements", str(csv), "--out", str(out)])
+    rc = main(["calibrate", "--robot", "default", "--set", "tool_x=0.05", "--measurements", str(csv),
+               "--out", str(out)])  # fmt: skip
     err = capsys.readouterr().err
     assert rc == 2 and err.startswith("error: ") and err.count("\n") == 1 and message in err, err
     assert not out.exists()

@@ -191,7 +191,8 @@ def kabsch(a: np.ndarray, b: np.ndarray) -> pin.SE3:
     """The rigid placement ``M`` minimising ``sum |M a_i - b_i|^2`` (Kabsch / Umeyama without scale).
 
     Args:
-        a, b: (n, 3) points [m], n >= 3 not all on one line for a unique answer.
+        a: (n, 3) points [m], n >= 3 not all on one line for a unique answer.
+        b: (n, 3) their images [m].
     """
     ca, cb = a.mean(axis=0), b.mean(axis=0)
     H = (a - ca).T @ (b - cb)
@@ -288,8 +289,8 @@ class ChainModel:
             pre = model.jointPlacements[j] * pin.SE3(R0, xyz).inverse()
             origins.append(Origin(model.names[j], model.names[j], j, -1, pre, xyz, R0, rpy, basis, axis, prismatic))
         notes: list[str] = []
-        tool_el = next((el for el in urdf_joints.values()
-                        if (c := el.find("child")) is not None and c.get("link") == robot.tool_frame), None)  # fmt: skip
+        children = {(c.get("link") if (c := el.find("child")) is not None else None): el for el in urdf_joints.values()}
+        tool_el = children.get(robot.tool_frame)
         if tool_el is not None and tool_el.get("type") == "fixed":
             xyz, rpy = read_triple(tool_el.find("origin"), "xyz"), read_triple(tool_el.find("origin"), "rpy")
             R0 = pin.rpy.rpyToMatrix(*rpy)
@@ -485,9 +486,13 @@ class ChainModel:
         return out, J.reshape(n * rows, self.size)
 
 
-def _parameters(origins: list[Origin], groups: frozenset[Group]) -> tuple[tuple[ErrorParameter, ...], dict[str, tuple[int, ...]]]:
-    """The candidate errors in preference order, and per slot (``name.t``, ``name.r``, ``name.s``, ``device``)
-    the index of each component's parameter (-1: not a parameter)."""
+def _parameters(
+    origins: list[Origin], groups: frozenset[Group]
+) -> tuple[tuple[ErrorParameter, ...], dict[str, tuple[int, ...]]]:
+    """The candidate errors in preference order, and the index of each component's parameter per slot.
+
+    Slots: ``name.t``, ``name.r``, ``name.s`` per origin, ``device``; -1: the component is not a parameter.
+    """
     params: list[ErrorParameter] = []
     slots: dict[str, list[int]] = {}
 

@@ -85,7 +85,8 @@ class ExperimentPlan:
     def to_csv(self) -> str:
         """A measurement file template: the configurations and the nominal positions, to replace by measured ones."""
         head = [f"# scara-pin calibrate --plan {len(self.q)}: robot {self.robot!r}, criterion {self.criterion.value} "
-                f"(log det {self.log_det:.6g}, smallest singular value {self.min_sv:.6g}, condition {self.condition:.6g})",
+                f"(log det {self.log_det:.6g}, smallest singular value {self.min_sv:.6g}, "
+                f"condition {self.condition:.6g})",
                 "# x, y, z (and yaw) are the NOMINAL model's, base frame: replace them by the measured values",
                 ",".join(self.columns)]  # fmt: skip
         rows = [",".join(repr(float(v)) for v in (*q, *p)) for q, p in zip(self.q, self.predicted)]

@@ -37,7 +37,15 @@ from ..model import Robot
 from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame, kabsch
 from .identify import IDENTIFY_TOL, Identifiability, identify
 from .measurements import Measurements
-from .results import CalibrationResult, CrossValidation, Loss, Outlier, ParameterEstimate, ParameterStatus, ResidualStats
+from .results import (
+    CalibrationResult,
+    CrossValidation,
+    Loss,
+    Outlier,
+    ParameterEstimate,
+    ParameterStatus,
+    ResidualStats,
+)
 from .urdf_edit import edit_origins
 
 __all__ = ["CalibrationOptions", "calibrate", "structural_count"]

@@ -57,7 +57,8 @@ class Measurements:
             raise ParameterError("lines", f"{len(lines)} values", f"must be one per pose ({len(q)})")
         for k, row in enumerate(np.column_stack([q, p] + ([yaw] if yaw is not None else []))):
             if not np.isfinite(row).all():
-                raise InvalidInputError(f"{self.source}, {_where(self.source, lines[k])}: a value is not a finite number")
+                where = _where(self.source, lines[k])
+                raise InvalidInputError(f"{self.source}, {where}: a value is not a finite number")
         for a in (q, p) + ((yaw,) if yaw is not None else ()):
             a.setflags(write=False)
         object.__setattr__(self, "q", q)

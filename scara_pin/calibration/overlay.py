@@ -60,7 +60,8 @@ class YamlOverlay:
             f"(the calibrated URDF: rms {self.calibrated.rms:.4g} m, max {self.calibrated.max:.4g} m)",
         ]
         if self.unexpressed:
-            lines.append("# not expressible in the yaml (use the calibrated URDF for them): " + ", ".join(self.unexpressed))
+            lines.append("# not expressible in the yaml (the calibrated URDF carries them): "
+                         + ", ".join(self.unexpressed))  # fmt: skip
         lines.extend(f"{k}: {v!r}" for k, v in self.values.items())
         return "\n".join(lines) + "\n"
 

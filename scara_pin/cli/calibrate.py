@@ -38,7 +38,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         if path not in (None, "-"):  # refused before any work
             check_output_path(path)
     if args.overlay is not None and args.urdf is not None:
-        raise InvalidInputError("--overlay writes the yaml parameters of a configured robot (--robot), not of a URDF file")
+        raise InvalidInputError("--overlay writes the yaml parameters of a configured robot (--robot), "
+                                "not of a URDF file")  # fmt: skip
     units = Units(args.deg, args.mm)
     groups = _groups(args.model)
     frame = MeasurementFrame(args.frame)
