@@ -176,6 +176,15 @@ def test_noise_free_truth_is_recovered(nominal, truth, exact) -> None:
     assert np.abs(res.predict(fresh_readings) - fresh_p).max() <= 1e-9
 
 
+def test_measured_yaw_identifies_one_more_error(nominal, truth, exact) -> None:
+    """With the yaw measured, the tool's rotation about its axis joins: 19 errors, still exact."""
+    _, (readings, p, yaw, _) = exact
+    res = calibrate(nominal, Measurements(readings, p, yaw), CalibrationOptions(folds=0))
+    assert len(res.identified) == 19 and res.after.max <= 1e-9 and res.after.yaw_max <= 1e-9
+    for name, value in truth_values(IDENTIFIABLE).items():
+        assert abs(res.parameter(name).value - value) <= 1e-8, name
+
+
 def test_unseparable_errors_are_reported_and_fixed(exact) -> None:
     res, _ = exact
     fixed = {p.name: p.reason for p in res.fixed}
