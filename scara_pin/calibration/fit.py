@@ -33,6 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInputError, ParameterError
+from ..kinematics.planar2r import wrap
 from ..model import Robot
 from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame, kabsch
 from .identify import IDENTIFY_TOL, Identifiability, identify
@@ -124,7 +125,7 @@ class _Problem:
         out, J = self.chain.predict(theta, self.qpin, self.device0, jacobian=jacobian)
         r = out - self.target
         if self.chain.yaw:
-            r[:, 3] = np.remainder(r[:, 3] + math.pi, 2 * math.pi) - math.pi
+            r[:, 3] = wrap(r[:, 3])  # type: ignore[arg-type]
             if J is not None:
                 J = J.copy()
                 J[3::4] *= self.yaw_weight
@@ -189,11 +190,8 @@ def _fit_identified(problem: _Problem, theta0: np.ndarray, loss: Loss, f_scale: 
 
 
 def _random_poses(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
-    """``n`` joint readings drawn uniformly inside the limits (a continuous joint: one turn)."""
-    lo, hi = np.array(robot.limits.lower, dtype=float), np.array(robot.limits.upper, dtype=float)
-    lo = np.maximum(lo, -math.pi * np.array([1.0 if k == "angle" else np.inf for k in robot.joint_kinds]))
-    hi = np.minimum(hi, math.pi * np.array([1.0 if k == "angle" else np.inf for k in robot.joint_kinds]))
-    return rng.uniform(lo, hi, size=(n, robot.dof))
+    """``n`` joint readings drawn uniformly inside the limits (a continuous joint's are one turn, -pi .. pi)."""
+    return rng.uniform(np.array(robot.limits.lower), np.array(robot.limits.upper), size=(n, robot.dof))
 
 
 def structural_count(chain: ChainModel, seed: int = 0, tol: float = IDENTIFY_TOL, yaw_weight: float = 0.1) -> int:

@@ -11,7 +11,6 @@ generates, so the user sees what the overlay loses against the calibrated URDF.
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
@@ -19,6 +18,7 @@ import numpy as np
 
 from ..description import SCHEMAS, generate_urdf
 from ..errors import InvalidInputError
+from ..kinematics.planar2r import wrap
 from ..model import Robot
 from .chain import ChainModel, read_triple
 from .results import CalibrationResult, ResidualStats
@@ -73,10 +73,6 @@ def _origins(urdf: str, names: list[str]) -> np.ndarray:
                                            read_triple(joints[n].find("origin"), "rpy")]) for n in names])  # fmt: skip
 
 
-def _wrap(a: np.ndarray) -> np.ndarray:
-    return np.remainder(a + math.pi, 2 * math.pi) - math.pi
-
-
 def yaml_overlay(result: CalibrationResult) -> YamlOverlay:
     """The yaml overlay of a calibrated configured robot (see the module docstring).
 
@@ -92,12 +88,12 @@ def yaml_overlay(result: CalibrationResult) -> YamlOverlay:
     nominal = np.concatenate([np.concatenate([o.xyz, o.rpy]) for o in chain.origins])
     target = np.concatenate([np.concatenate(v) for v in chain.calibrated_origins(result.theta).values()]) - nominal
     rpy = np.tile(np.repeat([False, True], 3), len(names))
-    target[rpy] = _wrap(target[rpy])
+    target[rpy] = wrap(target[rpy])
     kinematic = SCHEMAS[params.kind].files["kinematics.yaml"]
     S = np.empty((len(target), len(kinematic)))
     for k, name in enumerate(kinematic):
         moved = _origins(generate_urdf(params, {name: params.values[name] + STEP}), names) - nominal
-        moved[rpy] = _wrap(moved[rpy])
+        moved[rpy] = wrap(moved[rpy])
         S[:, k] = moved / STEP
     S[np.abs(S) < 1e-9] = 0.0  # float noise of the generated text
     acting = np.flatnonzero(np.abs(S).sum(axis=0) > 0)
@@ -117,6 +113,6 @@ def yaml_overlay(result: CalibrationResult) -> YamlOverlay:
     out, _ = chain_o.predict(theta_o, chain_o.pinocchio_q(used.q), result.device0, jacobian=False)
     r = out - used.values()
     if chain.yaw:
-        r[:, 3] = _wrap(r[:, 3])
+        r[:, 3] = wrap(r[:, 3])
     return YamlOverlay(chain.robot.name, values, tuple(lab for lab, m in zip(labels, miss) if m),
                        ResidualStats.of(r), result.after)  # fmt: skip
