@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInputError
-from ..limits import MAX_PLAN_POSES, check_count
+from ..limits import MAX_PLAN_POSES, MAX_PLAN_WORK, check_count
 from ..model import Robot
 from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame
 from .fit import _random_poses, structural_count
@@ -102,7 +102,7 @@ class ExperimentPlan:
 
 def _scores(M: np.ndarray, A: np.ndarray) -> np.ndarray:
     """Per candidate block A[c] (rows x r): log det(I + A M^-1 A^T), the gain in log det M of adding it."""
-    B = np.einsum("ckr,rs,cls->ckl", A, np.linalg.inv(M), A) + np.eye(A.shape[1])
+    B = (A @ np.linalg.inv(M)) @ np.transpose(A, (0, 2, 1)) + np.eye(A.shape[1])
     sign, logdet = np.linalg.slogdet(B)
     return np.where(sign > 0, logdet, -np.inf)
 
@@ -144,7 +144,8 @@ def plan_experiment(
         raise InvalidInputError(f"--plan {n}: {n} poses for {count} identifiable parameters: at least {count} "
                                 f"poses are needed (a few times more average the measurement noise)")  # fmt: skip
     k = candidates if candidates is not None else min(max(20 * n, 500), MAX_CANDIDATES)
-    k = max(check_count("candidate poses", k, 50 * MAX_PLAN_POSES), n)
+    k = max(check_count("candidate poses", k, MAX_PLAN_WORK), n)
+    check_count(f"the plan's work ({n} poses x {k} candidates)", n * k, MAX_PLAN_WORK, "ask fewer candidates or poses")
     rng = np.random.default_rng(seed)
     pool = _random_poses(robot, k, rng)
     _, J = chain.predict(np.zeros(chain.size), chain.pinocchio_q(pool), pin.SE3.Identity())

@@ -148,7 +148,7 @@ def register(sub: Any) -> None:
     m.add_argument("--criterion", default="det", choices=("det", "min-sv"),
                    help="with --plan: maximise the determinant (D-optimal, default) or the smallest singular value "
                    "(E-optimal) of the identification matrix")  # fmt: skip
-    m.add_argument("--candidates", type=integer_type("--candidates", 1, 500_000), metavar="K",
+    m.add_argument("--candidates", type=integer_type("--candidates", 1, 4_000_000), metavar="K",
                    help="with --plan: random candidate poses to choose from (default 20 per pose, 500 .. 4000)")
     m.add_argument("--seed", type=integer_type("--seed", 0, 2**32 - 1), default=0,
                    help="seed of the random poses (plan, structural count) and of the folds (default 0)")
