@@ -450,3 +450,31 @@ def test_cli_refusals(tmp_path, capsys) -> None:
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert err.startswith("error: ") and err.count("\n") == 1 and message in err, err
+
+
+def test_urdf_edit_touches_only_the_named_origins() -> None:
+    from scara_pin.calibration.urdf_edit import edit_origins
+
+    text = """<robot name="r">
+  <transmission name="t1"><joint name="j1"><hardwareInterface>x</hardwareInterface></joint></transmission>
+  <link name="a"/><link name="b"/><link name="c"/>
+  <!-- <joint name="j1" type="revolute"><origin xyz="9 9 9"/></joint> -->
+  <joint name="j1" type="revolute">
+    <parent link="a"/><child link="b"/>
+    <origin rpy='0 0 0' xyz='0.1 0 0'/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="j2" type="fixed">
+    <parent link="b"/><child link="c"/>
+  </joint>
+</robot>
+"""
+    out = edit_origins(text, {"j1": (np.array([0.1001, 0.0, -0.0]), None),
+                              "j2": (None, np.array([0.0, 0.0, 0.25]))})  # fmt: skip
+    assert """<origin rpy='0 0 0' xyz="0.1001 0.0 0.0"/>""" in out
+    assert '<origin xyz="0.0 0.0 0.0" rpy="0.0 0.0 0.25"/>' in out  # a joint without <origin> gets one
+    assert out.count("9 9 9") == 1 and "<transmission" in out  # the comment and the transmission untouched
+    import difflib
+
+    diff = [d for d in difflib.ndiff(text.splitlines(), out.splitlines()) if d[:2] in ("- ", "+ ")]
+    assert [d[:2] for d in diff] == ["- ", "+ ", "+ "], diff  # j1's origin changed, j2's added: nothing else

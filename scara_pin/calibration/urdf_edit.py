@@ -18,7 +18,7 @@ import numpy as np
 __all__ = ["edit_origins", "triple_text"]
 
 _COMMENT = re.compile(r"<!--.*?-->", re.S)
-_JOINT = re.compile(r"<joint\b[^>]*>")
+_JOINT = re.compile(r"<joint\b[^>]*\stype\s*=[^>]*>")  # a joint has a type; a <transmission>'s <joint> has none
 _NAME = re.compile(r"""\sname\s*=\s*(?:"([^"]*)"|'([^']*)')""")
 _ORIGIN = re.compile(r"<origin\b[^>]*?(/?)>")
 
