@@ -7,7 +7,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= build
 
-.PHONY: demo test browser bench bench-ik lint clean
+.PHONY: demo test browser bench bench-ik bench-calibration lint clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -50,10 +50,17 @@ bench-ik: $(VENV)/.installed-test
 	$(RTB_VENV)/bin/python -m pip install -q roboticstoolbox-python -e .
 	$(RTB_VENV)/bin/python benchmarks/bench_ik.py
 
+# FIGAROH (geometric calibration, PyPI figaroh) is a benchmark-only dependency: its own environment too
+FIGAROH_VENV ?= .venv-figaroh
+bench-calibration: $(VENV)/.installed-test
+	test -x $(FIGAROH_VENV)/bin/python || $(PYTHON) -m venv $(FIGAROH_VENV)
+	$(FIGAROH_VENV)/bin/python -m pip install -q figaroh==1.0.2
+	$(BIN)/python benchmarks/bench_calibration.py
+
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[test,lint]'
 	$(BIN)/ruff check scara_pin tests benchmarks
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
 clean:
-	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(RTB_VENV) $(FIGAROH_VENV) $(OUT) .pytest_cache

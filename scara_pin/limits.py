@@ -28,6 +28,7 @@ from typing import IO
 from .errors import InvalidInputError
 
 __all__ = [
+    "MAX_CALIBRATION_ROWS",
     "MAX_CHECK_ELEMENTS",
     "MAX_DOCUMENT_BYTES",
     "MAX_FRAMES",
@@ -38,6 +39,8 @@ __all__ = [
     "MAX_PAGE_MESH_BYTES",
     "MAX_PAGE_MESH_READ",
     "MAX_PATH_POINTS",
+    "MAX_PLAN_POSES",
+    "MAX_PLAN_WORK",
     "MAX_ROWS",
     "MAX_SAMPLES",
     "MAX_URDF_ELEMENTS",
@@ -64,6 +67,12 @@ MAX_FRAMES = 200_000
 """Animation frames of one ``view`` page or live animation."""
 MAX_ROWS = 20_000_000
 """Data rows of one batch file (``ik --input``)."""
+MAX_CALIBRATION_ROWS = 20_000
+"""Lines of one calibration measurement file (each fit evaluates the model on every row, about 0.1 ms each)."""
+MAX_PLAN_POSES = 1_000
+"""Poses of one calibration experiment plan (``calibrate --plan N``)."""
+MAX_PLAN_WORK = 4_000_000
+"""Poses times candidate poses of one plan (each choice scores every candidate: about 1 s per million)."""
 MAX_LINE_CHARS = 65_536
 """Characters of one line of a CSV input."""
 MAX_DOCUMENT_BYTES = 64 * 1024 * 1024

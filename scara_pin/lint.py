@@ -26,10 +26,12 @@ Findings (``code``: severity):
   ``prismatic-position`` (not third in the chain, e.g. a lifting column first: supported),
   ``near-parallel`` (axes 1e-6 .. 1e-2 rad from vertical, e.g. pi written as 3.14: the tilt and the tool
   position error the closed form would make without refinement, measured on sampled configurations;
-  the toolkit refines its solutions on the model; ``info`` below 1 micrometre),
+  the toolkit refines its solutions on the model; ``info`` below 1 micrometre, and ``info`` when no
+  ``rpy-approximate`` warning explains the tilt: deliberate tilts, e.g. a calibrated robot's, are handled exactly),
   ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an ``rpy`` value such as
   3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle error times the
-  distance from that joint to the tool at q = 0; ``info`` below 1 micrometre);
+  distance from that joint to the tool at q = 0; ``info`` below 1 micrometre; a value written with 15
+  significant digits or more is deliberate, e.g. a calibrated origin, never reported);
 - ``info``: ``joints`` (types and order), ``no-wrist`` (3 joints), ``axis-near-parallel`` (per joint, its
   tilt up to 1e-2 rad), ``axis-down`` (a quill whose q grows downward: the usual
   convention), ``zero-pose-direction`` (the arm points along +y or elsewhere than +x at q = 0: handled
@@ -72,6 +74,9 @@ TILT_TOL = 1e-6
 """[rad] an axis further than this from the base z axis is not vertical (near-parallel up to NEAR_PARALLEL_TOL)."""
 RPY_NEAR = 0.01
 """[rad] an rpy value this close to a nonzero multiple of pi/2 (but not equal to it) is an approximation."""
+FULL_PRECISION = 15
+"""Significant digits from which an rpy value near k pi/2 is deliberate (a calibrated origin), not a typed
+approximation such as 3.14 or 1.5708 (one typed with 15 digits is within RPY_EXACT of k pi/2 anyway)."""
 RPY_EXACT = 1e-12
 """[rad] closer than this to k pi/2 is taken as exact (a float's repr of pi is 1.2e-16 away)."""
 REVOLUTE_RANGE = 4 * math.pi
@@ -240,6 +245,12 @@ def _parse(text: str) -> tuple[Element, dict[Element, int]]:
     parser.EndElementHandler = builder.end
     parser.Parse(text, True)
     return builder.close(), lines
+
+
+def _full_precision(value: float) -> bool:
+    """Whether ``value`` needs FULL_PRECISION significant digits or more: written by a program, not typed."""
+    digits = repr(abs(value)).split("e")[0].replace(".", "").lstrip("0")
+    return len(digits) >= FULL_PRECISION
 
 
 def _rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
@@ -624,7 +635,7 @@ class _Checker:
             for _k, (axis_name, value) in enumerate(zip(("roll", "pitch", "yaw"), j.rpy)):
                 n = round(value / (math.pi / 2))
                 err = value - n * math.pi / 2
-                if n == 0 or not RPY_EXACT < abs(err) < RPY_NEAR:
+                if n == 0 or not RPY_EXACT < abs(err) < RPY_NEAR or _full_precision(value):
                     continue
                 exact = {1: "pi/2", -1: "-pi/2", 2: "pi", -2: "-pi"}.get(n, f"{n}*pi/2")
                 dist = float(np.linalg.norm(p_tool - (bMo @ j.world)[:3, 3])) if tool else 0.0
@@ -669,7 +680,10 @@ class _Checker:
         if tilt <= EXACT_TILT:
             return
         err = unrefined_error(robot)
-        sev = Severity.WARNING if err.position >= 1e-6 else Severity.INFO
+        # a tilt that comes with an approximate rpy (3.14) is a typo to fix; one written deliberately (measured,
+        # calibrated: scara-pin calibrate writes its origins at full precision) is handled exactly: information
+        typo = any(f.code == "rpy-approximate" and f.severity is Severity.WARNING for f in self.findings)
+        sev = Severity.WARNING if err.position >= 1e-6 and typo else Severity.INFO
         yaw = f" and {err.yaw:.3g} rad of yaw" if robot.dof == 4 else ""
         self.add(sev, "near-parallel",
                  f"the joint axes are up to {tilt:.3g} rad ({math.degrees(tilt):.3g} deg) from the base z axis: "

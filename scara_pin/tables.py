@@ -19,6 +19,7 @@ Errors are :class:`~scara_pin.errors.InvalidInputError` (exit code 2) naming the
 from __future__ import annotations
 
 import csv
+import math
 import os
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -58,6 +59,7 @@ def csv_rows(
     exact: bool = False,
     max_rows: int = MAX_ROWS,
     progress: Callable[[int], object] | None = None,
+    optional: Sequence[str] = (),
 ) -> Iterator[tuple[int, list[float]]]:
     """Stream ``(line number, values of the wanted columns)`` from a CSV file, in bounded memory.
 
@@ -70,6 +72,8 @@ def csv_rows(
         exact: the header must be exactly ``columns`` (in order, nothing else).
         max_rows: the most lines read (a cap, refused above).
         progress: called with the bytes of each line read (for a progress bar).
+        optional: column names read when the header has them, their values after the wanted ones; NaN for
+            a column the header lacks (a cell is never NaN: ``nan`` is refused).
 
     Raises:
         InvalidInputError: unreadable text (see :func:`~scara_pin.limits.text_lines`), not CSV, a header
@@ -100,25 +104,35 @@ def csv_rows(
             raise InvalidInputError(f"{origin}: the header has no column {', '.join(missing)}; it must name "
                                     f"{','.join(columns)} (header: {','.join(header)[:200]})")  # fmt: skip
         index = [names.index(c) for c in wanted]
+        extra = [names.index(c) if c in names else -1 for c in (o.strip().lower() for o in optional)]
         for row in reader:
             if len(row) != len(header):
                 raise InvalidInputError(f"{origin}, line {line}: {len(row)} values, expected {len(header)} "
                                         f"({','.join(header)[:200]})")  # fmt: skip
-            yield line, [_cell(origin, line, header[i], row[i]) for i in index]
+            values = [_cell(origin, line, header[i], row[i]) for i in index]
+            yield line, values + [_cell(origin, line, header[i], row[i]) if i >= 0 else math.nan for i in extra]
     except csv.Error as exc:
         raise InvalidInputError(f"{origin}, line {line}: not CSV ({exc})") from None
 
 
 def read_csv(
-    path: str | os.PathLike[str], columns: Sequence[str], *, exact: bool = False, max_rows: int = MAX_ROWS
+    path: str | os.PathLike[str],
+    columns: Sequence[str],
+    *,
+    exact: bool = False,
+    max_rows: int = MAX_ROWS,
+    optional: Sequence[str] = (),
 ) -> np.ndarray:
     """The wanted columns of a CSV file as an (n, len(columns)) float array, n >= 1 (see :func:`csv_rows`).
+
+    With ``optional`` columns: (n, len(columns) + len(optional)), NaN in an optional column the file lacks.
 
     Raises:
         InvalidInputError: as :func:`csv_rows`, and a file with no data row.
     """
     with open_csv(path) as handle:
-        rows = [values for _, values in csv_rows(handle, str(path), columns, exact=exact, max_rows=max_rows)]
+        rows = [values for _, values in csv_rows(handle, str(path), columns, exact=exact, max_rows=max_rows,
+                                                 optional=optional)]  # fmt: skip
     if not rows:
         raise InvalidInputError(f"{path}: no data row after the header")
     return np.array(rows, dtype=float)

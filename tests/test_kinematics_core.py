@@ -424,6 +424,7 @@ LAYERS = (
     ("_checks", "tables", "_urdf_checks"),
     ("model",),
     ("kinematics",),
+    ("calibration",),  # beside kinematics: imports description, model, kinematics; nothing lower imports it
     ("robots", "workspace", "lint"),
     ("motion",),
     ("viz",),

@@ -24,6 +24,14 @@ def test_columns_by_name_comments_blanks_and_quotes() -> None:
     assert _rows(text, ("a", "b")) == [(4, [2.0, 1.0]), (7, [0.45, 3.0])]
 
 
+def test_optional_columns_read_when_present_nan_when_absent() -> None:
+    assert _rows("a,yaw,b\n1,0.5,2\n", ("a", "b"), optional=("YAW",)) == [(2, [1.0, 2.0, 0.5])]
+    (line, values), = _rows("a,b\n1,2\n", ("a", "b"), optional=("yaw",))
+    assert line == 2 and values[:2] == [1.0, 2.0] and math.isnan(values[2])
+    with pytest.raises(InvalidInputError, match="line 2: yaw = 'nan' is not a plain number"):
+        _rows("a,b,yaw\n1,2,nan\n", ("a", "b"), optional=("yaw",))
+
+
 def test_exact_header() -> None:
     assert _rows("t,q\n0,1\n", ("t", "q"), exact=True) == [(2, [0.0, 1.0])]
     with pytest.raises(InvalidInputError, match="first line must be the header t,q"):

@@ -1,0 +1,162 @@
+"""The ``calibrate`` command: identify the robot from measured points, or plan the poses to measure."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from ..errors import InvalidInputError
+from ..files import check_output_path
+from ._common import Units, _add_robot_options, _add_units, _load, integer_type, number_type, write_atomic
+
+_GROUPS = ("offsets", "scale", "origins", "tool")
+
+
+def _groups(text: str) -> frozenset[Any]:
+    """``--model``: ``full`` or a comma-separated list of error groups."""
+    from ..calibration.chain import ALL_GROUPS, Group
+
+    if text.strip() == "full":
+        return ALL_GROUPS
+    names = [t.strip() for t in text.split(",") if t.strip()]
+    bad = [n for n in names if n not in _GROUPS]
+    if bad or not names:
+        raise InvalidInputError(f"--model {text[:80]!r}: give full or a comma-separated list of {', '.join(_GROUPS)}")
+    return frozenset(Group(n) for n in names)
+
+
+def cmd_calibrate(args: argparse.Namespace) -> int:
+    """Calibrate from a measurement file, or (``--plan N``) propose the poses to measure."""
+    from ..calibration.chain import MeasurementFrame
+
+    if (args.measurements is None) == (args.plan is None):
+        raise InvalidInputError("give --measurements FILE (calibrate) or --plan N (the poses to measure), one of them")
+    for path in (args.out, args.plot, args.overlay):
+        if path not in (None, "-"):  # refused before any work
+            check_output_path(path)
+    if args.overlay is not None and args.urdf is not None:
+        raise InvalidInputError("--overlay writes the yaml parameters of a configured robot (--robot), "
+                                "not of a URDF file")  # fmt: skip
+    units = Units(args.deg, args.mm)
+    groups = _groups(args.model)
+    frame = MeasurementFrame(args.frame)
+    robot = _load(args, units)
+    if args.plan is not None:
+        return _plan(args, robot, groups, frame)
+    from ..calibration.fit import CalibrationOptions, calibrate
+    from ..calibration.measurements import Measurements
+    from ..calibration.results import Loss
+
+    options = CalibrationOptions(groups=groups, frame=frame, loss=Loss(args.loss), f_scale=args.f_scale,
+                                 outlier_sigmas=args.outlier_sigmas, yaw_weight=args.yaw_weight, folds=args.folds,
+                                 seed=args.seed)  # fmt: skip
+    measurements = Measurements.from_csv(args.measurements, robot.dof)
+    result = calibrate(robot, measurements, options)
+    written: dict[str, str] = {}
+    if args.out is not None:
+        if args.out == "-":
+            sys.stdout.write(result.urdf)
+            return 0
+        write_atomic(Path(args.out), result.urdf)
+        written["urdf"] = args.out
+    overlay = None
+    if args.overlay is not None:
+        from ..calibration.overlay import yaml_overlay
+
+        overlay = yaml_overlay(result)
+        write_atomic(Path(args.overlay), overlay.to_yaml())
+        written["overlay"] = args.overlay
+    if args.plot is not None:
+        from ..calibration.plot import plot_residuals
+
+        plot_residuals(result, args.plot)
+        written["plot"] = args.plot
+    if args.json:
+        doc = result.to_dict()
+        doc["written"] = written
+        if overlay is not None:
+            doc["overlay"] = {"values": overlay.values, "unexpressed": list(overlay.unexpressed),
+                              "residual": overlay.residual.to_dict()}  # fmt: skip
+        print(json.dumps(doc))
+        return 0
+    print(result.report(units.length_name, units.angle_name))
+    if overlay is not None:
+        print(f"overlay: {len(overlay.values)} yaml parameter(s) changed; with them alone the residual is rms "
+              f"{overlay.residual.rms * units.length:.4g} {units.length_name}")  # fmt: skip
+    for what, path in written.items():
+        print(f"wrote {path} ({what})")
+    return 0
+
+
+def _plan(args: argparse.Namespace, robot: Any, groups: frozenset[Any], frame: Any) -> int:
+    from ..calibration.design import Criterion, plan_experiment
+
+    if args.plot is not None or args.overlay is not None:
+        raise InvalidInputError("--plot and --overlay go with --measurements, not --plan")
+    plan = plan_experiment(robot, args.plan, criterion=Criterion(args.criterion), yaw=args.yaw, frame=frame,
+                           groups=groups, seed=args.seed, candidates=args.candidates)  # fmt: skip
+    if args.out not in (None, "-"):
+        write_atomic(Path(args.out), plan.to_csv())
+    if args.json:
+        doc = plan.to_dict()
+        doc["written"] = {"plan": args.out} if args.out not in (None, "-") else {}
+        print(json.dumps(doc))
+        return 0
+    if args.out in (None, "-"):
+        sys.stdout.write(plan.to_csv())
+        return 0
+    print(f"plan: {len(plan.q)} poses for robot {plan.robot!r}, criterion {plan.criterion.value} (log det "
+          f"{plan.log_det:.6g}, smallest singular value {plan.min_sv:.6g}, condition {plan.condition:.6g}); "
+          f"{len(plan.identified)} identifiable errors; {plan.candidates} candidates, seed {plan.seed}")  # fmt: skip
+    print(f"wrote {args.out}: measure the tool at each pose, replace x, y, z by the measurements, then "
+          f"scara-pin calibrate --measurements {args.out}")  # fmt: skip
+    return 0
+
+
+def register(sub: Any) -> None:
+    """Add the ``calibrate`` command to the ``scara-pin`` subparsers."""
+    from ..limits import MAX_PLAN_POSES
+
+    p = sub.add_parser("calibrate", help="identify the robot from measured tool positions; write the calibrated "
+                       "URDF (--plan N: the poses to measure)")  # fmt: skip
+    g = p.add_argument_group("input")
+    g.add_argument("--measurements", metavar="CSV", help="measured poses: columns q1..qN (joint readings, SI), x, y, z "
+                   "[m] and optionally yaw [rad]; other columns ignored")  # fmt: skip
+    g.add_argument("--plan", type=integer_type("--plan", 1, MAX_PLAN_POSES), metavar="N",
+                   help="propose N well-conditioned poses to measure (CSV with the nominal x, y, z to replace)")
+    g.add_argument("--frame", choices=("base", "device"), default="base",
+                   help="frame of the measured positions: the robot's base (default) or the measuring device's own "
+                   "(its placement is identified and reported; the URDF keeps its base)")  # fmt: skip
+    g.add_argument("--yaw", action="store_true", help="with --plan: the yaw will be measured too")
+    m = p.add_argument_group("model and fit")
+    m.add_argument("--model", default="full", metavar="MODEL",
+                   help=f"error groups to identify: full (default) or a comma-separated list of {', '.join(_GROUPS)}")
+    m.add_argument("--loss", default="linear", choices=("linear", "soft_l1", "huber", "cauchy", "arctan"),
+                   help="least-squares loss; a robust one finds outliers, lists them and leaves them out")
+    m.add_argument("--f-scale", type=number_type("--f-scale"), default=1e-4, metavar="M",
+                   help="the robust loss's inlier scale [m] (default 1e-4)")
+    m.add_argument("--outlier-sigmas", type=number_type("--outlier-sigmas"), default=5.0, metavar="K",
+                   help="with a robust loss: an outlier is off by more than K robust standard deviations (default 5)")
+    m.add_argument("--yaw-weight", type=number_type("--yaw-weight"), default=0.1, metavar="M_PER_RAD",
+                   help="weight of a yaw residual against a position one [m/rad] (position noise / yaw noise; "
+                   "default 0.1)")  # fmt: skip
+    m.add_argument("--folds", type=integer_type("--folds", 0, 100), default=5, metavar="K",
+                   help="k-fold cross-validation on held-out poses (0: none; default 5)")
+    m.add_argument("--criterion", default="det", choices=("det", "min-sv"),
+                   help="with --plan: maximise the determinant (D-optimal, default) or the smallest singular value "
+                   "(E-optimal) of the identification matrix")  # fmt: skip
+    m.add_argument("--candidates", type=integer_type("--candidates", 1, 4_000_000), metavar="K",
+                   help="with --plan: random candidate poses to choose from (default 20 per pose, 500 .. 4000)")
+    m.add_argument("--seed", type=integer_type("--seed", 0, 2**32 - 1), default=0,
+                   help="seed of the random poses (plan, structural count) and of the folds (default 0)")
+    o = p.add_argument_group("output")
+    o.add_argument("--out", metavar="FILE", help="the calibrated URDF (the input's text with the calibrated origins); "
+                   "with --plan: the poses (CSV); written atomically; - for stdout")  # fmt: skip
+    o.add_argument("--overlay", metavar="YAML", help="a configured robot's changed yaml parameters (flat names)")
+    o.add_argument("--plot", metavar="PNG", help="each pose's position error before and after")
+    _add_units(p, inputs=False, json_help="print one JSON object (SI units)")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_calibrate)
