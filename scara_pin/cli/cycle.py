@@ -9,6 +9,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError, ParameterError
+from ._points import add_points_options, use_points
 from ._common import (
     Units,
     _acceleration,
@@ -56,6 +57,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     L = units.length
     robot = _load(args, units)
     _needs_wrist(robot, "cycle")
+    use_points(args, robot, units, "cycle")  # --points FILE --from-point P1 --to-point P2: --from, --direction, --span
     if not (math.isfinite(args.rate) and args.rate > 0):
         raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
     span = _number("--span", args.span) / L
@@ -137,4 +139,5 @@ def register(sub: Any) -> None:
     g.add_argument("--plot", metavar="PNG", help="side and plan view of the tool path; joint rates against limits")
     _add_units(p, inputs=True, json_help='print one JSON object {"cycle_time", "legs", "limits", ...}')
     _add_robot_options(p)
+    add_points_options(p, "cycle")
     p.set_defaults(func=cmd_cycle)
