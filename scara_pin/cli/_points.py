@@ -28,8 +28,11 @@ _SAME = 1e-9  # [m, rad] the cycle's two points share their height and yaw to th
 
 
 def add_points_options(p: argparse.ArgumentParser, command: str) -> None:
-    """Add ``--points FILE`` and the point names of ``command`` (``traj``: ``--through``; ``cycle``:
-    ``--from-point``, ``--to-point``). Call after the command's other options (it records their defaults)."""
+    """Add ``--points FILE`` and the point names of ``command``.
+
+    ``traj``: ``--through``; ``cycle``: ``--from-point``, ``--to-point``. Call after the command's other options
+    (it records their defaults).
+    """
     g = p.add_argument_group("taught points (a points file of `scara-pin teach`: docs/teach-pendant.md)")
     g.add_argument("--points", metavar="FILE", help="points file (.yaml, .yml or .csv) naming joint configurations")
     if command == "traj":

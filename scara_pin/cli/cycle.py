@@ -9,7 +9,6 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError, ParameterError
-from ._points import add_points_options, use_points
 from ._common import (
     Units,
     _acceleration,
@@ -20,6 +19,7 @@ from ._common import (
     _needs_wrist,
     _number,
 )
+from ._points import add_points_options, use_points
 
 if TYPE_CHECKING:
     pass

@@ -11,7 +11,6 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import check_output_path
-from ._points import add_points_options, use_points
 from ._common import (
     Units,
     _acceleration,
@@ -28,6 +27,7 @@ from ._common import (
     number_type,
     write_atomic,
 )
+from ._points import add_points_options, use_points
 from .cycle import _payload
 
 if TYPE_CHECKING:

@@ -193,8 +193,10 @@ class PointSet:
         return replace(self, points=tuple(p for p in self.points if p.name != name))
 
     def check(self, robot: Robot, origin: str = "points") -> None:
-        """Refuse points that do not fit ``robot``: another joint count, or a written pose that is not the
-        FK of its q on this robot (beyond :data:`POSE_TOL`; the yaw compared modulo 2 pi).
+        """Refuse points that do not fit ``robot``.
+
+        Another joint count, or a written pose that is not the FK of its q on this robot (beyond
+        :data:`POSE_TOL`; the yaw compared modulo 2 pi).
 
         Raises:
             InvalidInputError: naming the point and what differs.
@@ -356,9 +358,9 @@ def _parse_yaml(text: str, origin: str) -> PointSet:
         if extra:
             raise InvalidInputError(f"point #{i + 1}: unknown key(s) {', '.join(extra)} (keys: name, q, pose)")
         name = check_point_name(item["name"])
-        points.append(TaughtPoint(name, _yaml_numbers(f"point {name}: q", item["q"]),
-                                  None if item.get("pose") is None else _yaml_numbers(f"point {name}: pose",
-                                                                                      item["pose"])))  # fmt: skip
+        q = np.array(_yaml_numbers(f"point {name}: q", item["q"]))
+        pose = None if item.get("pose") is None else np.array(_yaml_numbers(f"point {name}: pose", item["pose"]))
+        points.append(TaughtPoint(name, q, pose))
     return PointSet(tuple(points), **meta)
 
 
@@ -388,7 +390,8 @@ def _parse_csv(text: str, origin: str) -> PointSet:
     header = [h.strip() for h in next(csv.reader([header_text]))]
     dof = sum(1 for h in header if re.fullmatch(r"q\d", h))
     expected = ["name", *(f"q{i + 1}" for i in range(dof))]
-    if dof not in (3, 4) or header[: len(expected)] != expected or header[len(expected):] not in ([], list(_POSE_NAMES)):
+    rest = header[len(expected) :]
+    if dof not in (3, 4) or header[: len(expected)] != expected or rest not in ([], list(_POSE_NAMES)):
         raise InvalidInputError(f"line {header_line}: the header must be name,q1,q2,q3,q4 (or name,q1,q2,q3), "
                                 f"optionally followed by x,y,z,yaw; got {header_text[:80]!r}")  # fmt: skip
     with_pose = len(header) > len(expected)
