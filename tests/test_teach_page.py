@@ -32,7 +32,7 @@ from sigint import default_sigint
 from scara_pin import Robot
 from scara_pin.cli import main
 from scara_pin.motion import plan as plan_module
-from scara_pin.motion.points import read_points
+from scara_pin.motion.points import parse_points, read_points
 from scara_pin.viz.teach import CONTROL_PERIOD, WATCHDOG
 from scara_pin.workspace import workspace
 
@@ -289,14 +289,22 @@ def test_points_taught_in_the_page_round_trip_and_traj_reaches_them(
     page.wait_for_function("(n) => window.scaraReplies > n", arg=before)
     assert [r["name"] for r in server.state()["points"]] == ["home", "pick", "P2"]
     click_and_wait(page, "#points-save")
-    assert "saved 3 point(s)" in page.inner_text("#ik-status")
+    page.set_viewport_size({"width": 1280, "height": 800})  # the third laptop size: the status in view there too
+    page.evaluate("() => { document.getElementById('pendant').scrollTop = 0; }")
+    assert "saved 3 point(s)" in status_in_view(page, (1280, 800))
     ARTIFACTS.mkdir(exist_ok=True)
-    page.screenshot(path=str(ARTIFACTS / "teach_points_1024x600.png"))  # docs/teach-pendant.png is this one
+    page.screenshot(path=str(ARTIFACTS / "teach_pendant_1280x800.png"))  # docs/teach-pendant.png is this one
     click_and_wait(page, "#points tr[data-point=home] button")  # go
     np.testing.assert_array_equal(server.q(), Q_S1)
 
     points = read_points(server.points, robot_s1)
     assert points.names == ("home", "pick", "P2")
+    for fmt in ("yaml", "csv"):  # the page's download links: the same points, bit for bit
+        status, text = server.call("GET", f"/api/points/export?format={fmt}")
+        downloaded = parse_points(text, fmt)
+        assert status == 200 and downloaded.names == points.names
+        for a, b in zip(points, downloaded, strict=True):
+            np.testing.assert_array_equal(a.q, b.q)
     np.testing.assert_array_equal(points["home"].q, Q_S1)
     assert main(["traj", "--robot", "s1", "--points", str(server.points), "--through", "home", "pick", "P2",
                  "--linear"]) == 0  # fmt: skip

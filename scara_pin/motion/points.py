@@ -61,6 +61,7 @@ __all__ = [
     "PointSet",
     "TaughtPoint",
     "check_point_name",
+    "parse_points",
     "points_format",
     "read_points",
     "write_points",
@@ -303,7 +304,7 @@ def read_points(path: str | Path, robot: Robot | None = None) -> PointSet:
     """
     fmt = points_format(path)
     text = read_text(check_input_file(path, "points file", MAX_POINTS_BYTES), "points file", MAX_POINTS_BYTES)
-    points = parse_points(text, fmt, str(path))
+    points = parse_points(text, fmt, f"points file {path}")
     if robot is not None:
         points.check(robot, f"points file {path}")
     return points

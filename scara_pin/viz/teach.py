@@ -574,8 +574,8 @@ class TeachServer:
     def _tick(self) -> None:
         try:
             self.session.tick()
-        except Exception:  # a bug must not kill the timer: the hold stops, the server goes on
-            log.exception("hold-to-jog tick failed; the hold stops")
+        except Exception as exc:  # a bug must not kill the timer: the hold stops, the server goes on (one line)
+            log.error("internal error in a hold-to-jog (%s: %s); the hold stops", type(exc).__name__, exc)
             self.session.release()
 
     def _app(self) -> Any:
