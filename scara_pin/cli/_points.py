@@ -41,7 +41,9 @@ def add_points_options(p: argparse.ArgumentParser, command: str) -> None:
     else:
         g.add_argument("--from-point", metavar="NAME", help="with --points: the cycle starts at this point")
         g.add_argument("--to-point", metavar="NAME", help="with --points: the traverse ends at this point's pose")
-        p.set_defaults(_span_default=p.get_default("span"))
+        # (a command not being run gets a parser stand-in that keeps nothing: no default to record)
+        get_default = getattr(p, "get_default", None)
+        p.set_defaults(_span_default=None if get_default is None else get_default("span"))
 
 
 def _load(args: argparse.Namespace, robot: Robot, names: list[str]) -> PointSet:
