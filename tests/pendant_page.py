@@ -1,4 +1,5 @@
-"""Helpers of the pendant page tests: read the page's rounded readouts back in SI, checking their format."""
+"""Helpers of the pendant tests: the tool pose from Pinocchio (computed here), and the page's rounded readouts read
+back in SI, checking their format."""
 
 from __future__ import annotations
 
@@ -35,3 +36,18 @@ def readout(page: Any) -> tuple[np.ndarray, list[str]]:
 def resolution(units: list[str]) -> np.ndarray:
     """Half a unit of the last shown decimal, in SI (what rounding may change), per value."""
     return np.array([0.5 * 10.0 ** -DECIMALS[u] * TO_SI[u] for u in units])
+
+
+def pin_placement(robot: Any, q: np.ndarray) -> Any:
+    """The tool frame in the base frame (a ``pin.SE3``) from Pinocchio's frame placements, computed here."""
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, robot.to_pinocchio_q(q))
+    return data.oMf[robot.model.getFrameId(robot.base_frame)].actInv(data.oMf[robot.model.getFrameId(robot.tool_frame)])
+
+
+def pin_pose(robot: Any, q: np.ndarray) -> np.ndarray:
+    """(x, y, z, yaw) of :func:`pin_placement` [m, rad], the yaw as atan2(R[1, 0], R[0, 0])."""
+    M = pin_placement(robot, q)
+    return np.array([*M.translation, math.atan2(M.rotation[1, 0], M.rotation[0, 0])])

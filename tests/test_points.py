@@ -14,8 +14,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 import pytest
+from pendant_page import pin_pose
 from scipy.optimize import minimize_scalar
 
 from scara_pin import InvalidInputError, Robot
@@ -25,14 +25,6 @@ from scara_pin.motion import plan as plan_module
 from scara_pin.motion.points import PointSet, TaughtPoint, read_points, write_points
 
 Q_S1 = np.array([0.3, 0.9, 0.02, -0.5])
-
-
-def pin_pose(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """(x, y, z, yaw) of the tool frame in the base frame from Pinocchio's frame placements (written here)."""
-    data = robot.model.createData()
-    pin.framesForwardKinematics(robot.model, data, robot.to_pinocchio_q(q))
-    M = data.oMf[robot.model.getFrameId(robot.base_frame)].actInv(data.oMf[robot.model.getFrameId(robot.tool_frame)])
-    return np.array([*M.translation, math.atan2(M.rotation[1, 0], M.rotation[0, 0])])
 
 
 def taught(robot: Robot, rng: np.random.Generator, n: int) -> PointSet:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 import pytest
-from pendant_page import readout, resolution
+from pendant_page import pin_placement, readout, resolution
 
 from scara_pin import InvalidInputError, Robot, load_robot
 from scara_pin.cli import main
@@ -84,13 +84,6 @@ def test_the_camera_sees_the_whole_workspace(shipped: dict[str, Robot], name: st
 
 
 # ------------------------------------------------------------------------------------------ session logic
-def pin_placement(robot: Robot, q: np.ndarray) -> pin.SE3:
-    """The tool frame in the base frame from Pinocchio's frame placements, computed here."""
-    data = robot.model.createData()
-    pin.framesForwardKinematics(robot.model, data, robot.to_pinocchio_q(q))
-    return data.oMf[robot.model.getFrameId(robot.base_frame)].actInv(data.oMf[robot.model.getFrameId(robot.tool_frame)])
-
-
 def test_jog_moves_the_tool_by_the_step_and_keeps_the_rest(robot_s1: Robot) -> None:
     session = TeachSession(robot_s1, Q_S1)
     for axis, step in ((JogAxis.X, 0.01), (JogAxis.Y, -0.01), (JogAxis.Z, 0.005), (JogAxis.YAW, math.radians(5))):
@@ -433,3 +426,9 @@ def test_offline_sliders_move_the_robot_and_the_readout_is_fk(
     page.wait_for_function("() => window.scaraPendant")
     assert page.is_visible(".dg.main .close-button") and page.is_checked("#show-controls")
     assert page.errors == []
+
+
+def test_the_pose_readout_names_the_real_tool_and_base_frames(tmp_path: Path) -> None:
+    robot = load_robot("s1", tool="flange", base="base_link")
+    text = export_html(robot, tmp_path / "p.html").read_text()
+    assert '<h2 id="pose-title">flange in base_link</h2>' in text and "tool0 in" not in text

@@ -23,10 +23,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 import psutil
 import pytest
-from pendant_page import read_values, readout, resolution
+from pendant_page import pin_placement, read_values, readout, resolution
 from sigint import default_sigint
 
 from scara_pin import Robot
@@ -106,13 +105,6 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
     with socket.socket() as s, pytest.raises(OSError):
         s.settimeout(2)
         s.connect(("127.0.0.1", port))
-
-
-def pin_placement(robot: Robot, q: np.ndarray) -> pin.SE3:
-    """The tool frame in the base frame from Pinocchio's frame placements, computed here."""
-    data = robot.model.createData()
-    pin.framesForwardKinematics(robot.model, data, robot.to_pinocchio_q(q))
-    return data.oMf[robot.model.getFrameId(robot.base_frame)].actInv(data.oMf[robot.model.getFrameId(robot.tool_frame)])
 
 
 # ------------------------------------------------------------------------------------------ HTTP (issue 24, 13)
