@@ -326,14 +326,13 @@ def parse_points(text: str, fmt: str, origin: str = "points") -> PointSet:
 def _parse_yaml(text: str, origin: str) -> PointSet:
     import yaml
 
-    from ..description.yaml_units import load_yaml
+    from ..description.yaml_units import load_yaml, yaml_problem
 
     try:
         tree = load_yaml(text)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" line {mark.line + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or type(exc).__name__
+        line, problem = yaml_problem(exc)
+        where = f" line {line}" if line is not None else ""
         raise InvalidInputError(f"{origin}{where}: not valid YAML ({problem})") from None
     if not isinstance(tree, dict) or not isinstance(tree.get("points"), list):
         raise InvalidInputError("a YAML points file is a mapping with a 'points' list")
