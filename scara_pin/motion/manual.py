@@ -88,6 +88,7 @@ sqrt(2 mm (l1 + l2) / (l1 l2)): 0.14 rad for l1 = l2 = 0.2 m, 0.6 rad for l1 = l
 BISECT_TOL = 1e-10
 """[m or rad] the bisection of the first refused sample stops this close to it."""
 _EDGE = 1e-9  # [m] a ray edge this close is where the tool is (the workspace's EDGE_TOL)
+_AIM = 0.999  # a shortened hold step aims at this fraction of the speed limits (1 would converge from above)
 
 
 class JogAxis(enum.Enum):
@@ -306,7 +307,7 @@ def _cartesian_step(robot: Robot, q0: np.ndarray, motion: JogMotion, length: flo
     branch = branch_of(robot, q0) or "all"
     end, hit = length, None
     if d[3] == 0.0 and robot.kind == "scara":
-        hit = _ray(robot, pose0, d[:3], ws)
+        hit = _ray(robot, q0, pose0, d[:3], ws)
         if hit is not None and hit.distance < length:
             if hit.distance <= _EDGE:
                 return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, f"on the edge: {hit.description}",
@@ -364,14 +365,28 @@ def _at_limits(robot: Robot, q: np.ndarray) -> list[str]:
     return out
 
 
-def _ray(robot: Robot, pose0: np.ndarray, u: np.ndarray, ws: Workspace | None) -> RayHit | None:
-    """The workspace's edge along ``u`` from the tool point, or None where the region does not apply."""
+def _region(robot: Robot, q: np.ndarray) -> Workspace | None:
+    """The workspace of the tool point at q's yaw (:func:`scara_pin.motion.jog.edge_workspace`), or None.
+
+    None where it is not defined (a tool offset with J4 limited to less than a turn): the IK decides.
+    """
     from .jog import edge_workspace
 
     try:
-        region = ws if ws is not None else edge_workspace(robot, float(pose0[3]))
+        return edge_workspace(robot, float(robot.tool_pose(q)[3]))
+    except ScaraError as exc:
+        log.debug("no workspace region: %s", exc)
+        return None
+
+
+def _ray(robot: Robot, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, ws: Workspace | None) -> RayHit | None:
+    """The workspace's edge along ``u`` from the tool point, or None where the region does not apply."""
+    region = ws if ws is not None else _region(robot, q0)
+    if region is None:
+        return None
+    try:
         return region.ray(pose0[:3], u)
-    except ScaraError as exc:  # outside the region by a rounding, or no fixed-yaw region: the IK decides
+    except ScaraError as exc:  # outside the region by a rounding: the IK decides
         log.debug("no workspace ray: %s", exc)
         return None
 
@@ -418,6 +433,8 @@ def hold_advance(
     velocity = _limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
     override = _override(override)
     length = nominal_rate(robot, motion, override) * dt
+    if ws is None and motion.axis not in (None, JogAxis.YAW) and robot.kind == "scara":
+        ws = _region(robot, q0)  # built once for the period's trial steps
     move = jog_step(robot, q0, motion, length, ws=ws)
     ratio = _speed_ratio(robot, q0, move.q, dt, override, velocity)
     if not move.moved or ratio <= 1.0:
@@ -425,21 +442,21 @@ def hold_advance(
     # too fast: shorten the step by the ratio (exact where the move is linear in the step), a few times, keeping
     # the longest step within the speeds; near a singularity (a square-root law) bisect instead
     best: JogMove | None = None
-    trial_length = move.travelled / ratio
+    trial_length = move.travelled * _AIM / ratio
     for _ in range(4):
         trial = jog_step(robot, q0, motion, trial_length, ws=ws)
         r = _speed_ratio(robot, q0, trial.q, dt, override, velocity)
         if r <= 1.0 and (best is None or trial.travelled > best.travelled):
             best = trial
-        if 0.999 <= r <= 1.0 or not trial.moved:
+        if _AIM - 1e-3 <= r <= 1.0 or not trial.moved:
             break
-        trial_length = trial.travelled / r
+        trial_length = trial.travelled * _AIM / r
     if best is not None:
         return best
     lo, hi = 0.0, move.travelled / ratio
     good = JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, "too close to a singularity to move at the "
                    "jog's speed", "singular", 0.0, length, Solver.NONE)  # fmt: skip
-    for _ in range(40):
+    for _ in range(20):  # to a millionth of the step
         mid = 0.5 * (lo + hi)
         trial = jog_step(robot, q0, motion, mid, ws=ws)
         if _speed_ratio(robot, q0, trial.q, dt, override, velocity) <= 1.0:
