@@ -80,6 +80,10 @@ MAX_DOCUMENT_BYTES = 64 * 1024 * 1024
 MAX_URDF_ELEMENTS = 2_000
 """Links plus joints of one URDF (a SCARA has about 12). urdfdom and Pinocchio walk the tree recursively:
 a chain about 5,000 links deep overflows the C stack (a crash, not an error), 3,000 does not."""
+MAX_POINTS = 10_000
+"""Taught points of one points file (``teach --points``, ``traj --points``): a cell has tens."""
+MAX_POINTS_BYTES = 4 * 1024 * 1024
+"""Bytes of one points file (10,000 points at full precision take about 1.5 MB)."""
 MAX_CHECK_ELEMENTS = 50_000
 """Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
 

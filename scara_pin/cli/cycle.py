@@ -19,6 +19,7 @@ from ._common import (
     _number,
     number_type,
 )
+from ._points import add_points_options, use_points
 
 if TYPE_CHECKING:
     pass
@@ -56,6 +57,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     L = units.length
     robot = _load(args, units)
     _needs_wrist(robot, "cycle")
+    use_points(args, robot, units, "cycle")  # --points FILE --from-point P1 --to-point P2: --from, --direction, --span
     if not args.rate > 0:  # parsed by the one number grammar (number_type): finite, ASCII digits
         raise ParameterError("--rate", args.rate, "must be > 0", "Hz")
     span = _number("--span", args.span) / L
@@ -138,4 +140,5 @@ def register(sub: Any) -> None:
     g.add_argument("--plot", metavar="PNG", help="side and plan view of the tool path; joint rates against limits")
     _add_units(p, inputs=True, json_help='print one JSON object {"cycle_time", "legs", "limits", ...}')
     _add_robot_options(p)
+    add_points_options(p, "cycle")
     p.set_defaults(func=cmd_cycle)

@@ -27,6 +27,7 @@ from ._common import (
     number_type,
     write_atomic,
 )
+from ._points import add_points_options, use_points
 from .cycle import _payload
 
 if TYPE_CHECKING:
@@ -54,6 +55,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     _check_outputs(args, (args.out, args.setpoints, args.plot))
     robot = _load(args, units)
+    use_points(args, robot, units, "traj")  # --points FILE --through P1 .. Pn: their q as --from, --via, --to
     for flag in ("linear", "arch", "plot", "payload"):
         if getattr(args, flag, None):
             _needs_wrist(robot, f"traj --{flag}")  # 3-joint arms: joint-space trajectories (quintic, TOPP-RA)
@@ -277,6 +279,7 @@ def register(sub: Any) -> None:
     g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")
     _add_units(p, inputs=True, json_help="print one JSON object (with the samples unless --out)")
     _add_robot_options(p)
+    add_points_options(p, "traj")
     p.set_defaults(func=cmd_traj)
     p = sub.add_parser("jog", help="jog to the edge: straight tool move ending at rest on the workspace edge")
     p.add_argument("--from", dest="from_q", nargs=4, metavar="Q", required=True, help="current configuration")

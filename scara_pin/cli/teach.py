@@ -1,4 +1,4 @@
-"""The ``teach`` command: the browser as a teach pendant (joint sliders, Cartesian jog with IK) on 127.0.0.1."""
+"""The ``teach`` command: the browser as a teach pendant (joint and Cartesian jogs, taught points) on 127.0.0.1."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def cmd_teach(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     robot = _load(args, units)
     q = _q_values(args.q, units) if args.q else None
-    server = TeachServer(robot, port=args.port, q=q)
+    server = TeachServer(robot, port=args.port, q=q, points_file=args.points, controls=args.controls)
     try:  # from the line that says so on, Ctrl-C stops the server
         print(f"teach pendant: {server.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
         if args.open:
@@ -35,11 +35,13 @@ def cmd_teach(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
-    p = sub.add_parser("teach", help="teach pendant in the browser: joint sliders, Cartesian jog with IK (127.0.0.1)")
+    p = sub.add_parser("teach", help="teach pendant in the browser: joint and Cartesian jogs, points (127.0.0.1)")
     p.add_argument("--port", type=integer_type("--port", 0, 65535), default=0,
                    help="port on 127.0.0.1 (default 0: a free one)")
     p.add_argument("--q", nargs=4, metavar="Q", help="start configuration (default: zero)")
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
+    p.add_argument("--points", metavar="FILE", help="points file (.yaml or .csv) the page saves; read if it exists")
+    p.add_argument("--controls", action="store_true", help="show meshcat's own control panel (hidden by default)")
     _add_units(p, json_help=None)
     _add_robot_options(p)
     p.set_defaults(func=cmd_teach)

@@ -182,7 +182,7 @@ def load_dh_table(path: str | Path) -> DHTable:
     origin = str(path)
     from ..errors import InvalidInputError
     from ..limits import read_text
-    from .yaml_units import load_yaml
+    from .yaml_units import load_yaml, yaml_problem
 
     try:
         text = read_text(path, "D-H table")  # bounded: /dev/zero or a huge file is refused, not read whole
@@ -192,9 +192,8 @@ def load_dh_table(path: str | Path) -> DHTable:
     try:
         data = load_yaml(text)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or type(exc).__name__
+        line, problem = yaml_problem(exc)
+        where = f" (line {line})" if line is not None else ""
         raise DHTableError(origin, None, None, "yaml", ParameterError.NOTHING,
                            f"must be valid yaml{where}: {problem}") from None  # fmt: skip
     return parse_dh_table(data, origin=origin)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 from typing import Any
 
-__all__ = ["load_yaml", "unit_tags"]
+__all__ = ["load_yaml", "unit_tags", "yaml_problem"]
 
 
 @functools.cache
@@ -57,3 +57,9 @@ def load_yaml(text: str) -> Any:
     import yaml
 
     return yaml.load(text, Loader=_loader())  # noqa: S506 (a SafeLoader subclass)
+
+
+def yaml_problem(exc: Exception) -> tuple[int | None, str]:
+    """(line number from 1, or None; what is wrong) of a :class:`yaml.YAMLError`, for a one-line message."""
+    mark = getattr(exc, "problem_mark", None)
+    return (None if mark is None else mark.line + 1), getattr(exc, "problem", None) or type(exc).__name__

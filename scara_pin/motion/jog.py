@@ -25,7 +25,7 @@ from ..model import Robot
 from ..workspace.scara import Limit, RayHit, Workspace, workspace
 from .trajectory import Trajectory, cartesian_path, joint_pose, timed
 
-__all__ = ["JogResult", "jog_to_edge"]
+__all__ = ["JogResult", "edge_workspace", "jog_to_edge"]
 
 CHECK_RATE = 10_000.0
 """[Hz] sampling rate of the limit check of a jog (ten times the 1 kHz promise)."""
@@ -90,10 +90,8 @@ def jog_to_edge(
         raise ParameterError("direction", d.tolist(), "must be 2 or 3 finite numbers, not all zero")
     u = d / np.linalg.norm(d)
     pose0 = joint_pose(robot, q0)
-    geo = robot.kinematics.geometry
     if ws is None:
-        offset = math.hypot(*geo.tool) > 0
-        ws = workspace(robot, yaw=float(pose0[3])) if offset else workspace(robot)
+        ws = edge_workspace(robot, float(pose0[3]))
     start = pose0[: len(u)]
     hit = ws.ray(start, u)
     travel = hit.distance - margin
@@ -120,6 +118,19 @@ def jog_to_edge(
         traj = timed(path, k * max(ratio, math.sqrt(ratio)))
         ratio = max(_ratios(robot, traj))
     return JogResult(traj, hit, pose0, end, travel, ratio)
+
+
+def edge_workspace(robot: Robot, yaw: float) -> Workspace:
+    """The region a jog's tool point moves in at a constant ``yaw`` [rad].
+
+    The wrist region, or with a plan-view tool offset the tool point's region at that yaw
+    (:func:`scara_pin.workspace.workspace`).
+
+    Raises:
+        ParameterError: a tool offset with J4 limited to less than a turn (no fixed-yaw region is defined).
+    """
+    offset = math.hypot(*robot.kinematics.geometry.tool) > 0
+    return workspace(robot, yaw=yaw) if offset else workspace(robot)
 
 
 def _ratios(robot: Robot, traj: Trajectory) -> tuple[float, float]:

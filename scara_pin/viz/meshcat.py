@@ -707,6 +707,8 @@ class _Scene:
             ],
             "base": f"meshcat/{self.frame_paths[robot.base_frame]}",
             "tool": f"meshcat/{self.frame_paths[robot.tool_frame]}",
+            "base_frame": robot.base_frame,
+            "tool_frame": robot.tool_frame,
             "target": list(f.target),
             "camera": list(f.position),
         }

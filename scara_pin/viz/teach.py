@@ -1,59 +1,97 @@
 """The browser as a teach pendant: a session of the robot's q, and a local web server for it.
 
-The session is answered by the library's IK and FK; the server (tornado, meshcat's own dependency) serves
-the pendant page and its JSON requests.
+:class:`TeachSession` is the logic, without a browser, in SI units (m, rad):
 
-:class:`TeachSession` is the logic, without a browser: set the joints, jog the tool along x, y, z or about
-its yaw in the base frame, or go to a pose; each Cartesian request is answered by the closed-form IK nearest
-to the current q (:meth:`scara_pin.model.Robot.ik_nearest`, on the selected branch), or by the numeric solver
-(:func:`scara_pin.kinematics.numeric.solve_numeric`) where the closed form refuses the robot's model. A refused
-move leaves q unchanged and says why (the IK status code and its reason).
+- joint jogs (:meth:`~TeachSession.jog_joint`) and Cartesian jogs in the BASE or the TOOL frame
+  (:meth:`~TeachSession.jog`), by steps that stop ON the edge and name what stopped them
+  (:mod:`scara_pin.motion.manual`); the jogs keep the elbow branch and J4's turn;
+- hold-to-jog (:meth:`~TeachSession.hold`, :meth:`~TeachSession.alive`, :meth:`~TeachSession.release`,
+  :meth:`~TeachSession.tick`): the motion advances every :data:`CONTROL_PERIOD` at a rate limited by the
+  speed override, and stops on release, on the edge, or when nothing was heard from the page for
+  :data:`WATCHDOG` (a closed or frozen page);
+- go to a pose (:meth:`~TeachSession.go_to`, the IK solution nearest to q on the chosen branch) or to joint
+  values (:meth:`~TeachSession.set_q`);
+- taught points (:meth:`~TeachSession.record`, :meth:`~TeachSession.rename`, :meth:`~TeachSession.delete`,
+  :meth:`~TeachSession.go_to_point`), saved to and loaded from a points file
+  (:mod:`scara_pin.motion.points`) that ``traj --points`` and ``cycle --points`` read.
 
-:class:`TeachServer` serves the page (:mod:`scara_pin.viz.page`, with meshcat's viewer script) and the
-routes ``GET /api/state``, ``POST /api/q``, ``/api/jog``, ``/api/goto`` (JSON bodies, JSON answers) on
-127.0.0.1 only. It runs in the calling process: it stops with it.
+A refused request leaves q unchanged and says why (a status code and its reason).
+
+:class:`TeachServer` serves the page (:mod:`scara_pin.viz.page`, with meshcat's viewer script) and the JSON
+routes of :meth:`TeachSession.handle` under ``/api/`` on 127.0.0.1 only, in the calling process (it stops with
+it). Every route checks the Host header (only ``127.0.0.1:PORT`` and ``localhost:PORT``: a DNS-rebinding
+page is refused); a malformed body is a 400 with a one-line JSON error.
 """
 
 from __future__ import annotations
 
-import enum
 import json
 import logging
 import math
+import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import _vector
-from ..errors import InvalidInputError, NoSolutionError, ScaraError, UrdfError
+from ..errors import InvalidInputError, ParameterError, ScaraError
+from ..motion.manual import (
+    JogAxis,
+    JogFrame,
+    JogMotion,
+    JogMove,
+    JogOutcome,
+    Solver,
+    branch_of,
+    hold_advance,
+    jog_step,
+    pose_ik,
+)
+from ..motion.points import PointSet, TaughtPoint, points_format, read_points, write_points
 
 if TYPE_CHECKING:
     from ..model import Robot
 
-__all__ = ["JogAxis", "Solver", "TeachReply", "TeachServer", "TeachSession"]
+__all__ = [
+    "CONTROL_PERIOD",
+    "KEEPALIVE",
+    "MAX_STEP_ANGLE",
+    "MAX_STEP_LENGTH",
+    "MIN_STEP_ANGLE",
+    "MIN_STEP_LENGTH",
+    "WATCHDOG",
+    "JogAxis",
+    "JogFrame",
+    "Solver",
+    "TeachReply",
+    "TeachServer",
+    "TeachSession",
+]
 
 log = logging.getLogger(__name__)
 
 HOST = "127.0.0.1"
 _MAX_BODY = 64 * 1024
 
+CONTROL_PERIOD = 0.05
+"""[s] a hold-to-jog advances once per period (the server's timer)."""
+KEEPALIVE = 0.1
+"""[s] the page says "still held" this often while a jog button is held."""
+WATCHDOG = 0.25
+"""[s] a hold not heard from for this long stops (a closed, frozen or disconnected page): two and a half
+keep-alives, so that a browser timer's usual jitter (tens of ms) does not stop a held jog."""
+MIN_STEP_LENGTH = 1e-6
+"""[m] the smallest step jog of a length (1 um: the readout's resolution)."""
+MAX_STEP_LENGTH = 1.0
+"""[m] the largest step jog of a length."""
+MIN_STEP_ANGLE = math.radians(1e-3)
+"""[rad] the smallest step jog of an angle (0.001 deg: the readout's resolution)."""
+MAX_STEP_ANGLE = math.pi
+"""[rad] the largest step jog of an angle (half a turn)."""
 
-class JogAxis(enum.Enum):
-    """A Cartesian jog direction in the base frame: along x, y, z [m] or about the tool's yaw [rad]."""
-
-    X = 0
-    Y = 1
-    Z = 2
-    YAW = 3
-
-
-class Solver(enum.Enum):
-    """What answered a request."""
-
-    NONE = "none"  # nothing solved (a joint move, or a refusal before any solver)
-    CLOSED_FORM = "closed-form"
-    NUMERIC = "numeric"
+_AXES = {"x": JogAxis.X, "y": JogAxis.Y, "z": JogAxis.Z, "yaw": JogAxis.YAW}
+_FRAMES = {f.value: f for f in JogFrame}
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,13 +100,20 @@ class TeachReply:
 
     Attributes:
         q: the joint values after the request [rad or m] (unchanged when refused).
-        pose: tool0 in the base frame at ``q``: (x, y, z, yaw) [m, rad], Pinocchio's FK.
+        pose: the tool frame in the base frame at ``q``: (x, y, z, yaw) [m, rad], Pinocchio's FK.
         branch: the IK branch of ``q`` ("right"/"left", "up"/"down"; "" when the model has none).
-        moved: whether the request was carried out.
-        status: ``"OK"``, or the refusal's code (an IK status name such as ``OUT_OF_REACH``, ``JOINT_LIMIT``,
-            ``NUMERIC_NO_SOLUTION``).
-        message: the reason of a refusal ("" when moved).
+        moved: whether q changed.
+        status: ``"OK"``, ``"STOPPED"`` (moved, and stopped ON an edge or limit), ``"AT_EDGE"``, or the code of
+            a refusal (an IK status name such as ``OUT_OF_REACH``, ``JOINT_LIMIT``; ``WATCHDOG`` for a hold the
+            page stopped confirming).
+        message: what stopped or refused it ("" otherwise).
         solver: what answered.
+        limit: what stopped a jog: a joint limit (``joint2_upper``), a workspace limit (``outer``), or the IK's
+            code beyond the stop; "" when nothing did.
+        travelled: how far the jog went [m or rad]; requested: how far it was asked to go.
+        angle: whether ``travelled`` and ``requested`` are angles [rad] (else lengths [m]).
+        holding: whether a hold-to-jog is running after this request.
+        points: the taught points, in replies that change or list them (None otherwise).
     """
 
     q: np.ndarray
@@ -78,20 +123,42 @@ class TeachReply:
     status: str
     message: str
     solver: Solver
+    limit: str = ""
+    travelled: float = 0.0
+    requested: float = 0.0
+    angle: bool = False
+    holding: bool = False
+    points: PointSet | None = None
 
     def to_json(self) -> dict[str, Any]:
-        """The reply as the page reads it; the ``*_text`` values are ``repr`` (full precision)."""
-        return {
+        """The reply as the page reads it (SI; full precision: the page rounds for display)."""
+        out: dict[str, Any] = {
             "q": [float(v) for v in self.q],
             "pose": [float(v) for v in self.pose],
-            "q_text": [repr(float(v)) for v in self.q],
-            "pose_text": [repr(float(v)) for v in self.pose],
             "branch": self.branch,
             "moved": self.moved,
             "status": self.status,
             "message": self.message,
             "solver": self.solver.value,
+            "limit": self.limit,
+            "travelled": self.travelled,
+            "requested": self.requested,
+            "angle": self.angle,
+            "holding": self.holding,
         }
+        if self.points is not None:
+            out["points"] = [p.to_dict() for p in self.points]
+        return out
+
+
+@dataclass
+class _Hold:
+    """A running hold-to-jog: what it moves, how fast, and when the page was last heard [s, monotonic]."""
+
+    motion: JogMotion
+    override: float
+    heard: float
+    ticked: float
 
 
 class TeachSession:
@@ -100,16 +167,27 @@ class TeachSession:
     Example::
 
         session = TeachSession(robot)
-        reply = session.jog(JogAxis.X, 0.01)          # 10 mm along x of the base frame
+        reply = session.jog(JogAxis.X, 0.01)                       # 10 mm along x of the base frame
+        reply = session.jog(JogAxis.X, 0.01, JogFrame.TOOL)        # 10 mm along the tool's own x
+        reply = session.jog_joint(1, math.radians(5))              # J2 by +5 deg
         if not reply.moved:
             print(reply.status, reply.message)
+        session.record("P1")
+        session.save_points("cell.yaml")
     """
 
-    def __init__(self, robot: Robot, q: object | None = None) -> None:
+    def __init__(self, robot: Robot, q: object | None = None, *, points_file: str | Path | None = None) -> None:
         """Start at ``q`` (default: zero), which must be inside the joint limits.
 
+        Args:
+            robot: the robot.
+            q: the start configuration [rad, m].
+            points_file: the points file (.yaml, .yml or .csv) :meth:`save_points` writes and
+                :meth:`load_points` reads; read now when it exists.
+
         Raises:
-            InvalidInputError: ``q`` is not 4 finite numbers, or is outside the limits.
+            InvalidInputError: ``q`` is not 4 finite numbers or is outside the limits; a points file with a
+                bad name, or unreadable, or taught on another robot.
         """
         self.robot = robot
         start = np.zeros(robot.dof) if q is None else robot.check_q(q)
@@ -117,6 +195,14 @@ class TeachSession:
         if outside:
             raise InvalidInputError(f"the start configuration is outside the limits: {'; '.join(outside)}")
         self._q = start.copy()
+        self._hold: _Hold | None = None
+        self._last_end: TeachReply | None = None  # how the last hold ended, told once to the page
+        self.points_file = None if points_file is None else Path(points_file)
+        self._points = PointSet(robot=robot.name, base=robot.base_frame, tool=robot.tool_frame)
+        if self.points_file is not None:
+            points_format(self.points_file)  # the name says the format: refused now, not at the first save
+            if self.points_file.exists():
+                self._points = self._adopt(read_points(self.points_file, robot))
 
     # ----------------------------------------------------------------- state
     @property
@@ -126,24 +212,35 @@ class TeachSession:
 
     @property
     def branches(self) -> tuple[str, ...]:
-        """The branch names the IK takes ("all" first: the nearest solution on any branch)."""
+        """The branch names the go-to IK takes ("all" first: the nearest solution on any branch)."""
         return ("all", "up", "down") if self.robot.kind == "palletizer" else ("all", "right", "left")
 
-    def _branch_of(self, q: np.ndarray) -> str:
-        try:
-            return self.robot.branch_of(q)
-        except UrdfError:  # a model the closed form does not know has no named branches
-            return ""
+    @property
+    def points(self) -> PointSet:
+        """The taught points."""
+        return self._points
 
-    def _reply(self, moved: bool, status: str = "OK", message: str = "", solver: Solver = Solver.NONE) -> TeachReply:
+    @property
+    def holding(self) -> bool:
+        """Whether a hold-to-jog is running."""
+        return self._hold is not None
+
+    def _reply(self, moved: bool, status: str = "OK", message: str = "", solver: Solver = Solver.NONE, *,
+               move: JogMove | None = None, motion: JogMotion | None = None, points: bool = False,
+               ) -> TeachReply:  # fmt: skip
         q = self.q
-        return TeachReply(q, self.robot.tool_pose(q), self._branch_of(q), moved, status, message, solver)
+        extra: dict[str, Any] = {}
+        if move is not None:
+            extra = {"limit": move.limit, "travelled": move.travelled, "requested": move.requested,
+                     "angle": motion is not None and motion.is_angle(self.robot)}
+        return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), moved, status, message, solver,
+                          holding=self.holding, points=self._points if points else None, **extra)  # fmt: skip
 
     def state(self) -> TeachReply:
-        """The current state (moved is False, status OK)."""
-        return self._reply(False)
+        """The current state and the points (moved is False, status OK)."""
+        return self._reply(False, points=True)
 
-    # ----------------------------------------------------------------- requests
+    # ----------------------------------------------------------------- moves
     def set_q(self, q: object) -> TeachReply:
         """Move the joints to ``q`` (refused, status ``JOINT_LIMIT``, outside the limits)."""
         values = self.robot.check_q(q)
@@ -153,72 +250,277 @@ class TeachSession:
         self._q = values.copy()
         return self._reply(True)
 
-    def jog(self, axis: JogAxis, step: float, branch: str = "all") -> TeachReply:
-        """Move the tool by ``step`` [m, or rad for the yaw] along ``axis`` of the base frame, the rest kept.
+    def jog(self, axis: JogAxis, step: float, frame: JogFrame = JogFrame.BASE) -> TeachReply:
+        """Move the tool by ``step`` [m, or rad for the yaw; the sign is the sense] along ``axis`` of ``frame``.
 
-        The target is the current FK pose plus the step; the answer the IK solution nearest to q.
+        A straight move that keeps the elbow branch; it stops ON the edge (status ``STOPPED``, ``limit`` names
+        what stopped it) or does not move when already there (``AT_EDGE``).
+
+        Raises:
+            InvalidInputError: a step that is not a finite number, or whose size is outside
+                [:data:`MIN_STEP_LENGTH`, :data:`MAX_STEP_LENGTH`] ([:data:`MIN_STEP_ANGLE`, :data:`MAX_STEP_ANGLE`]
+                for the yaw); a turn in a tool frame whose z is not vertical.
         """
         if not isinstance(axis, JogAxis):
             raise InvalidInputError(f"axis {axis!r} must be a JogAxis (X, Y, Z or YAW)")
-        if not (isinstance(step, (int, float)) and math.isfinite(step)):
-            raise InvalidInputError(f"jog step is {step!r}; it must be a finite number [m or rad]")
-        target = self.robot.tool_pose(self._q)
-        target[axis.value] += float(step)
-        return self.go_to(target, branch)
+        sign, size = _signed_step(step, axis is JogAxis.YAW)
+        return self._step(JogMotion(sign, axis=axis, frame=frame), size)
+
+    def jog_joint(self, joint: int | str, step: float) -> TeachReply:
+        """Move one joint (its index in q, or its name) by ``step`` [rad or m; the sign is the sense].
+
+        The joint moves by exactly ``step``, or stops ON its limit (status ``STOPPED``).
+        """
+        j = self._joint_index(joint)
+        sign, size = _signed_step(step, self.robot.joint_kinds[j] == "angle")
+        return self._step(JogMotion(sign, joint=j), size)
+
+    def _joint_index(self, joint: object) -> int:
+        names = self.robot.joint_names
+        if isinstance(joint, str) and joint in names:
+            return names.index(joint)
+        if isinstance(joint, int) and not isinstance(joint, bool) and 0 <= joint < self.robot.dof:
+            return joint
+        raise InvalidInputError(f"joint {joint!r} must be an index 0..{self.robot.dof - 1} or one of "
+                                f"{', '.join(names)}")  # fmt: skip
+
+    def _step(self, motion: JogMotion, size: float) -> TeachReply:
+        self._stop_hold()  # a step while a hold runs: the hold ends first
+        move = jog_step(self.robot, self._q, motion, size)
+        return self._apply(move, motion)
+
+    def _apply(self, move: JogMove, motion: JogMotion) -> TeachReply:
+        if move.moved:
+            self._q = np.array(move.q, dtype=float)
+        return self._reply(move.moved, move.status, move.message, move.solver, move=move, motion=motion)
 
     def go_to(self, pose: object, branch: str = "all") -> TeachReply:
-        """Move to the pose (x, y, z, yaw) of tool0 in the base frame [m, rad]: the IK solution nearest to q."""
-        target = _vector("pose", pose)
+        """Move to the pose (x, y, z, yaw) of the tool frame in the base frame [m, rad].
+
+        The IK solution nearest to q on ``branch`` (``"all"``: any branch).
+        """
         if branch not in self.branches:
             raise InvalidInputError(f"branch {branch!r} must be one of {', '.join(self.branches)}")
+        self._stop_hold()
+        answer = pose_ik(self.robot, pose, self._q, branch)
+        if answer.q is None:
+            return self._reply(False, answer.status, answer.message, answer.solver)
+        self._q = answer.q.copy()
+        return self._reply(True, solver=answer.solver)
+
+    # ----------------------------------------------------------------- hold-to-jog
+    def hold(self, motion: JogMotion, override: float, now: float | None = None) -> TeachReply:
+        """Start a hold-to-jog of ``motion`` at ``override`` (a fraction in (0, 1]).
+
+        It runs on :meth:`tick` until :meth:`release`, an edge, or :data:`WATCHDOG` without :meth:`alive`.
+
+        ``now`` [s] is the monotonic clock (default ``time.monotonic()``); tests pass their own.
+        """
+        if not isinstance(motion, JogMotion):
+            raise InvalidInputError("hold needs a JogMotion")
+        if motion.joint is not None:
+            self._joint_index(motion.joint)
+        if not (isinstance(override, (int, float)) and not isinstance(override, bool) and 0.0 < override <= 1.0):
+            raise ParameterError("speed override", override, "must be a fraction in (0, 1] (1 = 100 %)")
+        now = time.monotonic() if now is None else float(now)
+        self._hold = _Hold(motion, float(override), now, now)
+        return self._reply(False)
+
+    def alive(self, now: float | None = None) -> TeachReply:
+        """The page still holds the button: the watchdog restarts.
+
+        The reply says whether the hold runs, and after it ended (edge, watchdog) why, once.
+        """
+        now = time.monotonic() if now is None else float(now)
+        if self._hold is None:
+            return self._ended_reply()
+        self._hold.heard = now
+        return self._reply(False)
+
+    def release(self, now: float | None = None) -> TeachReply:
+        """The button is released: the hold stops now (no further advance).
+
+        When the hold had ended before (on an edge, by the watchdog), the reply says why.
+        """
+        if self._hold is None:
+            return self._ended_reply()
+        self._stop_hold()
+        return self._reply(False, "OK", "released")
+
+    def tick(self, now: float | None = None) -> TeachReply | None:
+        """Advance a running hold by the time since the last tick (at most two periods); None without a hold.
+
+        The hold ends when the page was not heard from for :data:`WATCHDOG` (status ``WATCHDOG``), or when the
+        advance stops on an edge or is refused.
+        """
+        hold = self._hold
+        if hold is None:
+            return None
+        now = time.monotonic() if now is None else float(now)
+        if now - hold.heard > WATCHDOG:
+            self._hold = None
+            self._last_end = self._reply(False, "WATCHDOG", f"the page did not confirm the held button for "
+                                         f"{now - hold.heard:.3f} s (> {WATCHDOG} s): jog stopped")  # fmt: skip
+            return self._last_end
+        dt = min(now - hold.ticked, 2 * CONTROL_PERIOD)
+        if not dt > 0:
+            return self._reply(False)
+        hold.ticked = now
         try:
-            q = self.robot.ik_nearest(target, self._q, branch=branch)
-            solver = Solver.CLOSED_FORM
-        except NoSolutionError as exc:
-            return self._reply(False, getattr(exc.status, "name", str(exc.status)), exc.reason, Solver.CLOSED_FORM)
-        except UrdfError as exc:  # the closed form refuses this model (NotScaraError): the numeric solver
-            from ..kinematics.numeric import solve_numeric
+            move = hold_advance(self.robot, self._q, hold.motion, dt, hold.override)
+        except ScaraError as exc:
+            self._hold = None
+            self._last_end = self._reply(False, "REFUSED", " ".join(str(exc).split()))
+            return self._last_end
+        if move.outcome is not JogOutcome.OK:
+            self._hold = None
+        reply = self._apply(move, hold.motion)
+        if self._hold is None:
+            self._last_end = reply
+        return reply
 
-            log.debug("closed-form IK refused (%s); numeric IK", exc)
-            result = solve_numeric(self.robot, target, q0=self._q)
-            if not result.success:
-                return self._reply(
-                    False,
-                    "NUMERIC_NO_SOLUTION",
-                    f"the numeric IK did not reach the target (residual {result.residual:.3g} after "
-                    f"{result.iterations} iterations, {result.reason.name}); the closed form refuses this model: {exc}",
-                    Solver.NUMERIC,
-                )
-            q, solver = np.asarray(result.q, dtype=float), Solver.NUMERIC
-        self._q = np.array(q, dtype=float)
-        return self._reply(True, solver=solver)
+    def _stop_hold(self) -> None:
+        if self._hold is not None:
+            self._hold = None
+            self._last_end = None
 
-    def handle(self, route: str, body: dict[str, Any] | None) -> TeachReply:
-        """Answer one request of the page (``state``, ``q``, ``jog``, ``goto``) in SI from its JSON body.
+    def _ended_reply(self) -> TeachReply:
+        ended, self._last_end = self._last_end, None
+        if ended is None:
+            return self._reply(False)
+        q = self.q  # the hold's end, reported once, with the current state
+        return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), False, ended.status, ended.message,
+                          ended.solver, ended.limit, ended.travelled, ended.requested, ended.angle,
+                          self.holding)  # fmt: skip
 
-        The page's jog step and go-to pose are in millimetres and degrees; converted here.
+    # ----------------------------------------------------------------- points
+    def _adopt(self, points: PointSet) -> PointSet:
+        return PointSet(points.points, self.robot.name, self.robot.base_frame, self.robot.tool_frame)
+
+    def record(self, name: str | None = None) -> TeachReply:
+        """Record the current q as a point named ``name`` (default: the first free ``P1``, ``P2``, ...)."""
+        name = self._points.next_name() if name in (None, "") else name
+        self._points = self._points.added(TaughtPoint.at(self.robot, str(name), self._q))
+        return self._reply(False, points=True)
+
+    def rename(self, old: str, new: str) -> TeachReply:
+        """Rename point ``old`` to ``new``."""
+        self._points = self._points.renamed(old, new)
+        return self._reply(False, points=True)
+
+    def delete(self, name: str) -> TeachReply:
+        """Delete point ``name``."""
+        self._points = self._points.removed(name)
+        return self._reply(False, points=True)
+
+    def go_to_point(self, name: str) -> TeachReply:
+        """Move to point ``name``'s joint values (its own branch and J4 turn)."""
+        point = self._points[name]
+        self._stop_hold()
+        return self.set_q(point.q)
+
+    def save_points(self, path: str | Path | None = None) -> TeachReply:
+        """Write the points to ``path`` (default: the session's points file), atomically."""
+        target = self._file(path)
+        write_points(target, self._points)
+        return self._reply(False, "OK", f"saved {len(self._points)} point(s) to {target}", points=True)
+
+    def load_points(self, path: str | Path | None = None) -> TeachReply:
+        """Replace the points by those of ``path`` (default: the session's points file)."""
+        source = self._file(path)
+        self._points = self._adopt(read_points(source, self.robot))
+        return self._reply(False, "OK", f"loaded {len(self._points)} point(s) from {source}", points=True)
+
+    def _file(self, path: str | Path | None) -> Path:
+        if path is None:
+            if self.points_file is None:
+                raise InvalidInputError("no points file: start the pendant with --points FILE (.yaml or .csv)")
+            return self.points_file
+        return Path(path)
+
+    # ----------------------------------------------------------------- the page's requests
+    def handle(self, route: str, body: dict[str, Any] | None, now: float | None = None) -> TeachReply:
+        """Answer one request of the page from its JSON body, in SI units (m, rad; the page converts).
+
+        Routes: ``state``; ``q`` {q}; ``jog`` {axis: x|y|z|yaw, frame: base|tool | joint: index, direction: +1|-1,
+        step: > 0}; ``goto`` {pose, branch}; ``hold`` {the jog's fields without step, speed: percent in (0, 100]};
+        ``alive``; ``release``; ``points/record`` {name?}; ``points/rename`` {old, new}; ``points/delete``
+        {name}; ``points/goto`` {name}; ``points/save``; ``points/load``.
 
         Raises:
-            InvalidInputError: an unknown route or a malformed body.
+            InvalidInputError: an unknown route or a malformed body (the message names the field).
         """
         body = body or {}
         if route == "state":
             return self.state()
         if route == "q":
-            return self.set_q(_vector("q", body.get("q")))
-        branch = str(body.get("branch", "all"))
+            return self.set_q(body.get("q"))
         if route == "jog":
-            names = {a.name.lower(): a for a in JogAxis}
-            axis = names.get(str(body.get("axis")))
-            if axis is None:
-                raise InvalidInputError(f"jog axis {body.get('axis')!r} must be one of {', '.join(names)}")
-            step = _vector("step", [body.get("step")], 1)[0]
-            scale = math.radians(1.0) if axis is JogAxis.YAW else 1e-3  # deg, mm -> rad, m
-            return self.jog(axis, float(step) * scale, branch)
+            motion = self._motion(body)
+            size = _step_size(body.get("step"), motion.is_angle(self.robot))
+            return self._step(motion, size)
         if route == "goto":
-            x, y, z, yaw = _vector("pose", body.get("pose")).tolist()
-            return self.go_to([x * 1e-3, y * 1e-3, z * 1e-3, math.radians(yaw)], branch)
+            return self.go_to(body.get("pose"), str(body.get("branch", "all")))
+        if route == "hold":
+            speed = body.get("speed")
+            if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not 0 < speed <= 100:
+                raise ParameterError("speed", speed, "must be a number in (0, 100]", "%")
+            return self.hold(self._motion(body), float(speed) / 100.0, now)
+        if route == "alive":
+            return self.alive(now)
+        if route == "release":
+            return self.release(now)
+        if route == "points/record":
+            return self.record(None if body.get("name") is None else _text(body, "name"))
+        if route == "points/rename":
+            return self.rename(_text(body, "old"), _text(body, "new"))
+        if route == "points/delete":
+            return self.delete(_text(body, "name"))
+        if route == "points/goto":
+            return self.go_to_point(_text(body, "name"))
+        if route == "points/save":
+            return self.save_points()
+        if route == "points/load":
+            return self.load_points()
         raise InvalidInputError(f"unknown request {route!r}")
+
+    def _motion(self, body: dict[str, Any]) -> JogMotion:
+        sense = body.get("direction")
+        if sense not in (1, -1) or isinstance(sense, bool):
+            raise InvalidInputError(f"direction {sense!r} must be 1 or -1")
+        if "joint" in body:
+            return JogMotion(int(sense), joint=self._joint_index(body["joint"]))
+        axis = _AXES.get(body.get("axis"))  # type: ignore[arg-type]
+        if axis is None:
+            raise InvalidInputError(f"jog axis {body.get('axis')!r} must be one of {', '.join(_AXES)} (or give joint)")
+        frame = _FRAMES.get(body.get("frame", "base"))  # type: ignore[arg-type]
+        if frame is None:
+            raise InvalidInputError(f"jog frame {body.get('frame')!r} must be one of {', '.join(_FRAMES)}")
+        return JogMotion(int(sense), axis=axis, frame=frame)
+
+
+def _signed_step(step: object, angle: bool) -> tuple[int, float]:
+    if isinstance(step, bool) or not isinstance(step, (int, float)) or not math.isfinite(step) or step == 0:
+        raise ParameterError("jog step", step, "must be a finite number, not 0", "rad" if angle else "m")
+    return (1 if step > 0 else -1), _step_size(abs(float(step)), angle)
+
+
+def _step_size(step: object, angle: bool) -> float:
+    """``step`` if it is a number within the step range of its kind, else a :class:`ParameterError`."""
+    lo, hi, unit = (MIN_STEP_ANGLE, MAX_STEP_ANGLE, "rad") if angle else (MIN_STEP_LENGTH, MAX_STEP_LENGTH, "m")
+    if isinstance(step, bool) or not isinstance(step, (int, float)):
+        raise ParameterError("jog step", step if isinstance(step, str) else ParameterError.NOTHING,
+                             f"must be a number in [{lo:.6g}, {hi:.6g}] {unit}")  # fmt: skip
+    if not (math.isfinite(step) and lo * (1 - 1e-12) <= step <= hi):
+        raise ParameterError("jog step", step, f"must be in [{lo:.6g}, {hi:.6g}]", unit)
+    return float(step)
+
+
+def _text(body: dict[str, Any], key: str) -> str:
+    value = body.get(key)
+    if not isinstance(value, str):
+        raise InvalidInputError(f"{key} must be a text")
+    return value
 
 
 # ------------------------------------------------------------------------------------------ the server
@@ -231,21 +533,30 @@ class TeachServer:
         url: the page's address.
     """
 
-    def __init__(self, robot: Robot, port: int = 0, q: object | None = None) -> None:
+    def __init__(self, robot: Robot, port: int = 0, q: object | None = None, *,
+                 points_file: str | Path | None = None, controls: bool = False) -> None:  # fmt: skip
         """Build the page and listen on 127.0.0.1:``port`` (0: a free port).
 
+        Args:
+            robot: the robot.
+            port: the port (0: a free one).
+            q: the start configuration [rad, m].
+            points_file: the session's points file (see :class:`TeachSession`).
+            controls: show meshcat's own control panel (hidden by default; the page's ``?controls=1`` shows it).
+
         Raises:
-            InvalidInputError: a bad port or start configuration, or the port is taken.
+            InvalidInputError: a bad port, start configuration or points file, or the port is taken.
         """
         import asyncio
 
         if not (isinstance(port, int) and 0 <= port <= 65535):
             raise InvalidInputError(f"port is {port!r}; it must be a whole number in [0, 65535]")
-        self.session = TeachSession(robot, q)
-        self.page = _teach_page(robot, self.session)
+        self.session = TeachSession(robot, q, points_file=points_file)
+        self.page = _teach_page(robot, self.session, controls)
         self._loop = asyncio.new_event_loop()
         asyncio.set_event_loop(self._loop)
         import tornado.httpserver
+        import tornado.ioloop
         import tornado.netutil
 
         app = self._app()
@@ -257,37 +568,85 @@ class TeachServer:
         self._server.add_sockets(sockets)
         self.port = int(sockets[0].getsockname()[1])
         self.url = f"http://{HOST}:{self.port}/"
+        self._timer = tornado.ioloop.PeriodicCallback(self._tick, CONTROL_PERIOD * 1000.0)
+        self._timer.start()
+
+    def _tick(self) -> None:
+        try:
+            self.session.tick()
+        except Exception as exc:  # a bug must not kill the timer: the hold stops, the server goes on (one line)
+            log.error("internal error in a hold-to-jog (%s: %s); the hold stops", type(exc).__name__, exc)
+            self.session.release()
 
     def _app(self) -> Any:
         import tornado.web
 
         server = self
 
-        class Page(tornado.web.RequestHandler):
+        class Base(tornado.web.RequestHandler):
+            """Every route: only our own Host (a DNS-rebinding page is refused), errors as one JSON line."""
+
+            def prepare(self) -> None:
+                if self.request.host not in (f"{HOST}:{server.port}", f"localhost:{server.port}"):
+                    raise tornado.web.HTTPError(403, reason="Forbidden Host")
+
+            def write_error(self, status_code: int, **kwargs: Any) -> None:
+                reason = self._reason if status_code != 500 else "internal error"
+                self.set_header("Content-Type", "application/json; charset=utf-8")
+                self.finish(json.dumps({"error": f"{status_code} {reason}"}) + "\n")
+
+            def log_exception(self, typ: Any, value: Any, tb: Any) -> None:
+                if isinstance(value, tornado.web.HTTPError):
+                    log.debug("%s %s: %s", self.request.method, self.request.uri, value)
+                else:  # one line, never a traceback on the terminal
+                    log.error("%s %s: internal error (%s: %s)", self.request.method, self.request.uri,
+                              type(value).__name__, value)  # fmt: skip
+
+        class Page(Base):
             def get(self) -> None:
                 self.set_header("Content-Type", "text/html; charset=utf-8")
                 self.set_header("Cache-Control", "no-store")
                 self.write(server.page)
 
-        class Api(tornado.web.RequestHandler):
+        class Missing(Base):
             def prepare(self) -> None:
-                # another site's page must not drive the pendant: only our own host name, and JSON bodies
-                # (a cross-site form cannot send those without a CORS preflight, which is never granted)
-                host = self.request.host
-                if host not in (f"{HOST}:{server.port}", f"localhost:{server.port}"):
-                    raise tornado.web.HTTPError(403, reason="wrong Host")
+                super().prepare()
+                raise tornado.web.HTTPError(404, reason="Not Found")
+
+        class Export(Base):
+            def get(self) -> None:
+                fmt = self.get_query_argument("format", "yaml")
+                if fmt not in ("yaml", "csv"):
+                    raise tornado.web.HTTPError(400, reason="format must be yaml or csv")
+                points = server.session.points
+                kind = "text/csv" if fmt == "csv" else "application/yaml"
+                self.set_header("Content-Type", kind + "; charset=utf-8")
+                self.set_header("Content-Disposition", f'attachment; filename="points.{fmt}"')
+                self.set_header("Cache-Control", "no-store")
+                self.write(points.to_csv() if fmt == "csv" else points.to_yaml())
+
+        class Api(Base):
+            def prepare(self) -> None:
+                super().prepare()
+                # another site's page must not drive the pendant: JSON bodies only (a cross-site form cannot
+                # send those without a CORS preflight, which is never granted)
                 if self.request.method == "POST" and not self.request.headers.get("Content-Type", "").startswith(
                     "application/json"
                 ):
                     raise tornado.web.HTTPError(415, reason="JSON only")
 
             def get(self, route: str) -> None:
+                if route != "state":
+                    raise tornado.web.HTTPError(405, reason="POST only")
                 self._answer(route, None)
 
             def post(self, route: str) -> None:
                 try:
                     body = json.loads(self.request.body or b"{}")
-                except ValueError:
+                except RecursionError:
+                    self._error("the request body is nested too deeply")
+                    return
+                except ValueError:  # not JSON, not UTF-8
                     self._error("the request body is not JSON")
                     return
                 if not isinstance(body, dict):
@@ -301,6 +660,9 @@ class TeachServer:
                 except ScaraError as exc:
                     self._error(" ".join(str(exc).split()))
                     return
+                except RecursionError:  # a deeply nested value inside a valid body
+                    self._error("a value of the request body is nested too deeply")
+                    return
                 self.set_header("Cache-Control", "no-store")
                 self.write(reply.to_json())
 
@@ -311,7 +673,8 @@ class TeachServer:
         def access(handler: Any) -> None:  # requests are logged at debug level (-v), not on stderr
             log.debug("%d %s %s", handler.get_status(), handler.request.method, handler.request.uri)
 
-        return tornado.web.Application([(r"/", Page), (r"/api/(state|q|jog|goto)", Api)], log_function=access)
+        routes = [(r"/", Page), (r"/api/points/export", Export), (r"/api/([a-z]+(?:/[a-z]+)?)", Api)]
+        return tornado.web.Application(routes, log_function=access, default_handler_class=Missing)
 
     def serve_forever(self) -> None:
         """Serve until interrupted (KeyboardInterrupt passes to the caller) or :meth:`stop`."""
@@ -325,11 +688,13 @@ class TeachServer:
         self._loop.call_soon_threadsafe(self._loop.stop)
 
     def close(self) -> None:
-        """Stop listening (idempotent)."""
+        """Stop listening and stop any hold (idempotent)."""
+        self._timer.stop()
+        self.session.release()
         self._server.stop()
 
 
-def _teach_page(robot: Robot, session: TeachSession) -> str:
+def _teach_page(robot: Robot, session: TeachSession, controls: bool = False) -> str:
     """The pendant page of the live teach server (no motion player; a ``teach`` section)."""
     from .meshcat import _page, _Scene, _Window
 
@@ -338,6 +703,15 @@ def _teach_page(robot: Robot, session: TeachSession) -> str:
     scene.display(session.q)
     data = scene.page_data()
     data["q"] = [float(v) for v in session.q]
+    data["controls"] = bool(controls)
     labels = {"all": "nearest (any branch)"}
-    data["teach"] = {"api": "/api", "branches": [[b, labels.get(b, b)] for b in session.branches]}
+    data["teach"] = {
+        "api": "/api",
+        "branches": [[b, labels.get(b, b)] for b in session.branches],
+        "points_file": "" if session.points_file is None else str(session.points_file),
+        "control_period": CONTROL_PERIOD,
+        "keepalive": KEEPALIVE,
+        "step_length": [MIN_STEP_LENGTH, MAX_STEP_LENGTH],
+        "step_angle": [MIN_STEP_ANGLE, MAX_STEP_ANGLE],
+    }
     return _page(f"scara-pin teach: {robot.name}", window.recorder.commands(), data)

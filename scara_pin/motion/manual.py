@@ -1,0 +1,482 @@
+"""Manual-mode moves of a teach pendant: step jogs that stop ON the edge, and hold-to-jog advances.
+
+What moves. A :class:`JogMotion` is one joint (J1..J4 by its index in q, in its + or - sense) or the tool
+frame along x, y or z, or turning about the vertical (:attr:`JogAxis.YAW`), in the BASE frame or in the
+TOOL frame (the tool's own axes at the current q). A Schoenflies robot turns its tool only about the
+vertical: in the tool frame, + turns about the tool's own z axis, vertical up or down, so the yaw changes by
++step or -step; a tool frame whose z axis is not vertical cannot be turned and the jog is refused.
+
+A Cartesian jog is a straight move of the tool frame, followed continuously: the IK keeps the current
+elbow branch (a straight line cannot flip the elbow) and each joint's turn (no jump of 2 pi in J4). It is
+checked every :data:`SAMPLE_LENGTH` (:data:`SAMPLE_ANGLE` for turns), at most :data:`MAX_STEP_SAMPLES`
+times per step; two consecutive samples whose revolute joints differ by more than :data:`JUMP` are not
+one continuous move.
+
+Where it stops. When the reachable set ends before the step does, the move ends ON the edge and says what
+stopped it (``limit``):
+
+- a joint step: the joint's limit (``joint2_upper``);
+- a translation of a SCARA: the first edge along the step of the exact workspace
+  (:meth:`scara_pin.workspace.Workspace.ray`, J3's stroke included), whose arc names the joint limit or the
+  singular pose (``joint1_lower``, ``outer``); the tool goes to the ray's point;
+- before that edge, or where no ray applies (turns, the palletizer, a model the closed form refuses): the
+  first sample the continuous IK refuses, bisected to :data:`BISECT_TOL`; the refusal just beyond it names
+  the limit (``JOINT_LIMIT: ... joint4 ...``, ``OUT_OF_REACH``).
+
+Hold-to-jog (:func:`hold_advance`): the motion advances one control period at a time, at the manual
+reduced speed of ISO 10218-1 (:data:`MANUAL_SPEED`, 250 mm/s of the tool frame's origin) times the speed
+override for translations, :data:`MANUAL_TURN_RATE` times the override for turns, and the joint's velocity
+limit times the override for joint jogs. Whatever is jogged, each period's step is shortened until no joint
+moves faster than its velocity limit times the override and the tool frame's origin no faster than
+:data:`MANUAL_SPEED` times the override (measured over the period: near a singularity the tool slows down).
+No acceleration ramp is simulated: a hold starts and stops at once.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .._checks import _limit_vector, _vector
+from ..errors import InvalidInputError, NoSolutionError, ParameterError, ScaraError, UrdfError
+
+if TYPE_CHECKING:
+    from ..model import Robot
+    from ..workspace.scara import RayHit, Workspace
+
+__all__ = [
+    "BISECT_TOL",
+    "JUMP",
+    "MANUAL_SPEED",
+    "MANUAL_TURN_RATE",
+    "MAX_STEP_SAMPLES",
+    "SAMPLE_ANGLE",
+    "SAMPLE_LENGTH",
+    "JogAxis",
+    "JogFrame",
+    "JogMotion",
+    "JogMove",
+    "JogOutcome",
+    "PoseAnswer",
+    "Solver",
+    "hold_advance",
+    "jog_step",
+    "pose_ik",
+]
+
+log = logging.getLogger(__name__)
+
+MANUAL_SPEED = 0.25
+"""[m/s] the manual reduced speed of ISO 10218-1 (5.7.3): the tool frame's origin never jogs faster."""
+MANUAL_TURN_RATE = math.pi / 2
+"""[rad/s] the turning rate of a hold-to-jog about the vertical at 100 % override (90 deg/s)."""
+SAMPLE_LENGTH = 1e-3
+"""[m] the continuity check's sample spacing along a Cartesian step (at most :data:`MAX_STEP_SAMPLES`)."""
+SAMPLE_ANGLE = math.radians(1.0)
+"""[rad] the sample spacing of a turn."""
+MAX_STEP_SAMPLES = 200
+"""Samples of one step at most (a longer step is sampled more coarsely)."""
+JUMP = math.pi / 2
+"""[rad] a revolute joint moving more than this between two samples is a jump (an elbow flip, a 2 pi turn
+of J4): not one continuous move. Near the stretched arm a 1 mm sample moves the elbow by about
+sqrt(2 mm (l1 + l2) / (l1 l2)): 0.14 rad for l1 = l2 = 0.2 m, 0.6 rad for l1 = l2 = 0.05 m."""
+BISECT_TOL = 1e-10
+"""[m or rad] the bisection of the first refused sample stops this close to it."""
+_EDGE = 1e-9  # [m] a ray edge this close is where the tool is (the workspace's EDGE_TOL)
+_AIM = 0.999  # a shortened hold step aims at this fraction of the speed limits (1 would converge from above)
+
+
+class JogAxis(enum.Enum):
+    """A Cartesian jog direction: along x, y, z [m] or about the vertical (the yaw) [rad]."""
+
+    X = 0
+    Y = 1
+    Z = 2
+    YAW = 3
+
+
+class JogFrame(enum.Enum):
+    """The frame a Cartesian jog's axes are taken in."""
+
+    BASE = "base"
+    TOOL = "tool"
+
+
+class Solver(enum.Enum):
+    """What answered a request."""
+
+    NONE = "none"  # nothing solved (a joint move, or a refusal before any solver)
+    CLOSED_FORM = "closed-form"
+    NUMERIC = "numeric"
+
+
+class JogOutcome(enum.Enum):
+    """How a jog ended."""
+
+    OK = "OK"  # moved by the whole step
+    STOPPED = "STOPPED"  # moved, and stopped short ON an edge or a limit (named)
+    AT_EDGE = "AT_EDGE"  # did not move: already on the edge or the limit in that direction
+    REFUSED = "REFUSED"  # did not move: the request cannot be carried out (the status says why)
+
+
+@dataclass(frozen=True)
+class JogMotion:
+    """What a jog moves.
+
+    Attributes:
+        sign: +1 or -1, the sense.
+        joint: the joint's index in q for a joint jog; None for a Cartesian one.
+        axis: the Cartesian axis (None for a joint jog).
+        frame: the frame of ``axis``.
+    """
+
+    sign: int
+    joint: int | None = None
+    axis: JogAxis | None = None
+    frame: JogFrame = JogFrame.BASE
+
+    def __post_init__(self) -> None:
+        if self.sign not in (1, -1) or isinstance(self.sign, bool):
+            raise InvalidInputError(f"jog sense {self.sign!r} must be +1 or -1")
+        if (self.joint is None) == (self.axis is None):
+            raise InvalidInputError("a jog moves either a joint or the tool along an axis, not both")
+        if self.axis is not None and not isinstance(self.axis, JogAxis):
+            raise InvalidInputError(f"axis {self.axis!r} must be a JogAxis (X, Y, Z or YAW)")
+        if not isinstance(self.frame, JogFrame):
+            raise InvalidInputError(f"frame {self.frame!r} must be a JogFrame (BASE or TOOL)")
+        if self.joint is not None and (isinstance(self.joint, bool) or not isinstance(self.joint, int)):
+            raise InvalidInputError(f"joint {self.joint!r} must be an index into q (0 for J1)")
+
+    def is_angle(self, robot: Robot) -> bool:
+        """Whether the step is an angle [rad] (a revolute joint, a turn) rather than a length [m]."""
+        if self.joint is not None:
+            return robot.joint_kinds[self.joint] == "angle"
+        return self.axis is JogAxis.YAW
+
+
+@dataclass(frozen=True, eq=False)
+class PoseAnswer:
+    """The IK's answer for one pose: ``q`` (None when refused), what solved it, and why not."""
+
+    q: np.ndarray | None
+    solver: Solver
+    status: str = "OK"
+    message: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class JogMove:
+    """The result of one jog step.
+
+    Attributes:
+        q: the joint values after it [rad, m] (the start when it did not move).
+        outcome: how it ended.
+        status: ``"OK"``, ``"STOPPED"``, ``"AT_EDGE"``, or the code of the refusal (an IK status name).
+        message: what stopped or refused it ("" for a whole step).
+        limit: what stopped it: a joint limit (``joint2_upper``), a workspace :class:`~scara_pin.workspace.Limit`
+            value (``outer``), or the IK's refusal code beyond the stop; "" when nothing did.
+        travelled: how far it moved along the motion [m or rad] (>= 0).
+        requested: the step asked for [m or rad] (> 0).
+        solver: what answered the last IK.
+    """
+
+    q: np.ndarray
+    outcome: JogOutcome
+    status: str
+    message: str
+    limit: str
+    travelled: float
+    requested: float
+    solver: Solver
+
+    @property
+    def moved(self) -> bool:
+        """Whether q changed."""
+        return self.outcome in (JogOutcome.OK, JogOutcome.STOPPED)
+
+
+# ------------------------------------------------------------------------------------------ IK
+def pose_ik(robot: Robot, target: object, reference: np.ndarray, branch: str = "all") -> PoseAnswer:
+    """The IK solution of ``target`` (x, y, z, yaw) [m, rad] nearest to ``reference`` on ``branch``.
+
+    The closed form (:meth:`scara_pin.model.Robot.ik_nearest`) where it takes the robot's model, else the
+    numeric solver (:func:`scara_pin.kinematics.numeric.solve_numeric`) started at ``reference``. A refusal
+    is an answer (``q`` None, its status code and reason), never an exception.
+    """
+    pose = _vector("pose", target)
+    try:
+        return PoseAnswer(np.asarray(robot.ik_nearest(pose, reference, branch=branch), dtype=float),
+                          Solver.CLOSED_FORM)  # fmt: skip
+    except NoSolutionError as exc:
+        return PoseAnswer(None, Solver.CLOSED_FORM, getattr(exc.status, "name", str(exc.status)), exc.reason)
+    except UrdfError as exc:  # the closed form refuses this model (NotScaraError): the numeric solver
+        from ..kinematics.numeric import solve_numeric
+
+        log.debug("closed-form IK refused (%s); numeric IK", exc)
+        result = solve_numeric(robot, pose, q0=reference)
+        if not result.success:
+            return PoseAnswer(None, Solver.NUMERIC, "NUMERIC_NO_SOLUTION",
+                              f"the numeric IK did not reach the target (residual {result.residual:.3g} after "
+                              f"{result.iterations} iterations, {result.reason.name}); the closed form refuses "
+                              f"this model: {exc}")  # fmt: skip
+        return PoseAnswer(np.asarray(result.q, dtype=float), Solver.NUMERIC)
+
+
+def branch_of(robot: Robot, q: np.ndarray) -> str:
+    """The IK branch of ``q`` ("" when the robot's model has no named branches)."""
+    try:
+        return robot.branch_of(q)
+    except UrdfError:
+        return ""
+
+
+# ------------------------------------------------------------------------------------------ steps
+def jog_step(robot: Robot, q: object, motion: JogMotion, step: float, *, ws: Workspace | None = None) -> JogMove:
+    """Move by ``step`` [m or rad] > 0 in the sense and along the axis (or joint) of ``motion``.
+
+    See the module docstring for where it stops. ``ws`` is the workspace of the jog's tool point, when
+    already built (:func:`scara_pin.motion.jog.edge_workspace`); otherwise built here for SCARA translations.
+
+    Raises:
+        InvalidInputError: a step that is not a finite number > 0, a joint index out of range, a turn in a
+            tool frame whose z axis is not vertical.
+    """
+    q0 = robot.check_q(q)
+    if isinstance(step, bool) or not isinstance(step, (int, float)) or not (math.isfinite(step) and step > 0):
+        raise ParameterError("jog step", step, "must be a finite number > 0", "m or rad")
+    length = float(step)
+    if motion.joint is not None:
+        return _joint_step(robot, q0, motion.joint, motion.sign, length)
+    return _cartesian_step(robot, q0, motion, length, ws)
+
+
+def _joint_step(robot: Robot, q0: np.ndarray, j: int, sign: int, length: float) -> JogMove:
+    if not 0 <= j < robot.dof:
+        raise InvalidInputError(f"joint index {j} must be in [0, {robot.dof - 1}] (J1..J{robot.dof})")
+    q = q0.copy()
+    q[j] = q0[j] + sign * length
+    if robot.continuous[j]:
+        return JogMove(q, JogOutcome.OK, "OK", "", "", length, length, Solver.NONE)
+    name = robot.joint_names[j]
+    side, bound = ("upper", robot.limits.upper[j]) if sign > 0 else ("lower", robot.limits.lower[j])
+    if (q[j] <= bound) if sign > 0 else (q[j] >= bound):
+        return JogMove(q, JogOutcome.OK, "OK", "", "", length, length, Solver.NONE)
+    unit = "rad" if robot.joint_kinds[j] == "angle" else "m"
+    room = (bound - q0[j]) * sign
+    if not room > 0:
+        return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value,
+                       f"{name} is at its {side} limit {bound:.9g} {unit}", f"{name}_{side}", 0.0, length,
+                       Solver.NONE)  # fmt: skip
+    q[j] = bound
+    return JogMove(q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, f"stopped at {name}'s {side} limit {bound:.9g} "
+                   f"{unit}", f"{name}_{side}", float(room), length, Solver.NONE)  # fmt: skip
+
+
+def direction(robot: Robot, q: np.ndarray, motion: JogMotion) -> np.ndarray:
+    """The (dx, dy, dz, dyaw) of the tool per unit of step for a Cartesian ``motion`` at ``q`` (unit length).
+
+    Raises:
+        InvalidInputError: a turn in the tool frame whose z axis is not vertical.
+    """
+    if motion.axis is None:
+        raise InvalidInputError("a joint jog has no Cartesian direction")
+    d = np.zeros(4)
+    if motion.frame is JogFrame.BASE:
+        d[motion.axis.value] = motion.sign
+        return d
+    R = np.asarray(robot.tool_placement(q).rotation)
+    if motion.axis is JogAxis.YAW:
+        up = float(R[2, 2])
+        if not abs(abs(up) - 1.0) <= 1e-9:
+            raise InvalidInputError(f"the tool's z axis is not vertical (its z component is {up:.6g}); a 4-axis robot "
+                                    "turns only about the vertical: turn in the base frame")  # fmt: skip
+        d[3] = motion.sign * math.copysign(1.0, up)
+        return d
+    d[:3] = motion.sign * R[:, motion.axis.value]
+    return d
+
+
+def _cartesian_step(robot: Robot, q0: np.ndarray, motion: JogMotion, length: float, ws: Workspace | None) -> JogMove:
+    d = direction(robot, q0, motion)
+    pose0 = np.asarray(robot.tool_pose(q0), dtype=float)
+    branch = branch_of(robot, q0) or "all"
+    end, hit = length, None
+    if d[3] == 0.0 and robot.kind == "scara":
+        hit = _ray(robot, q0, pose0, d[:3], ws)
+        if hit is not None and hit.distance < length:
+            if hit.distance <= _EDGE:
+                return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, f"on the edge: {hit.description}",
+                               hit.limit.value, 0.0, length, Solver.NONE)  # fmt: skip
+            end = hit.distance
+        else:
+            hit = None
+
+    def target(s: float) -> np.ndarray:
+        if hit is not None and s == end:  # the ray's own edge point
+            return np.array([*hit.point, pose0[3]])
+        return pose0 + s * d
+
+    spacing = SAMPLE_ANGLE if d[3] != 0.0 else SAMPLE_LENGTH
+    n = min(MAX_STEP_SAMPLES, max(1, math.ceil(end / spacing)))
+    last_s, last_q, solver = 0.0, q0, Solver.NONE
+    for k in range(1, n + 1):
+        s = end if k == n else end * k / n
+        answer = _continuous(robot, target(s), last_q, branch)
+        if answer.q is None:
+            break
+        last_s, last_q, solver = s, answer.q, answer.solver
+    else:
+        if hit is None:
+            return JogMove(last_q, JogOutcome.OK, "OK", "", "", length, length, solver)
+        here = _at_limits(robot, last_q)  # which joints the robot has at a limit there (the edge may have two names)
+        message = f"stopped on the edge: {hit.description}" + (f" (here {', '.join(here)})" if here else "")
+        return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, message, hit.limit.value, end, length,
+                       solver)  # fmt: skip
+    # the first refused sample: bisect between the last reachable one and it
+    lo, hi, refusal = last_s, s, answer
+    while hi - lo > BISECT_TOL:
+        mid = 0.5 * (lo + hi)
+        answer = _continuous(robot, pose0 + mid * d, last_q, branch)
+        if answer.q is None:
+            hi, refusal = mid, answer
+        else:
+            lo, last_q, solver = mid, answer.q, answer.solver
+    if lo == 0.0:
+        return JogMove(q0, JogOutcome.AT_EDGE, refusal.status, refusal.message, refusal.status, 0.0, length,
+                       refusal.solver)  # fmt: skip
+    return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value,
+                   f"stopped where the IK stops; just beyond: {refusal.status}: {refusal.message}", refusal.status, lo,
+                   length, solver)  # fmt: skip
+
+
+def _at_limits(robot: Robot, q: np.ndarray) -> list[str]:
+    """The joints of ``q`` at a position limit (within 1e-9), as "joint2 at its upper limit 2.61799388 rad"."""
+    out = []
+    for i, name in enumerate(robot.joint_names):
+        unit = "rad" if robot.joint_kinds[i] == "angle" else "m"
+        for side, bound in (("lower", robot.limits.lower[i]), ("upper", robot.limits.upper[i])):
+            if not robot.continuous[i] and abs(q[i] - bound) <= 1e-9:
+                out.append(f"{name} at its {side} limit {bound:.9g} {unit}")
+    return out
+
+
+def _region(robot: Robot, q: np.ndarray) -> Workspace | None:
+    """The workspace of the tool point at q's yaw (:func:`scara_pin.motion.jog.edge_workspace`), or None.
+
+    None where it is not defined (a tool offset with J4 limited to less than a turn): the IK decides.
+    """
+    from .jog import edge_workspace
+
+    try:
+        return edge_workspace(robot, float(robot.tool_pose(q)[3]))
+    except ScaraError as exc:
+        log.debug("no workspace region: %s", exc)
+        return None
+
+
+def _ray(robot: Robot, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, ws: Workspace | None) -> RayHit | None:
+    """The workspace's edge along ``u`` from the tool point, or None where the region does not apply."""
+    region = ws if ws is not None else _region(robot, q0)
+    if region is None:
+        return None
+    try:
+        return region.ray(pose0[:3], u)
+    except ScaraError as exc:  # outside the region by a rounding: the IK decides
+        log.debug("no workspace ray: %s", exc)
+        return None
+
+
+def _continuous(robot: Robot, pose: np.ndarray, previous: np.ndarray, branch: str) -> PoseAnswer:
+    """The IK of ``pose`` on ``branch`` nearest ``previous``, refused when a revolute joint jumps (> JUMP)."""
+    answer = pose_ik(robot, pose, previous, branch)
+    if answer.q is None:
+        return answer
+    for i, kind in enumerate(robot.joint_kinds):
+        if kind == "angle" and abs(answer.q[i] - previous[i]) > JUMP:
+            name = robot.joint_names[i]
+            mid = 0.5 * (robot.limits.lower[i] + robot.limits.upper[i])
+            side = "upper" if previous[i] > mid else "lower"
+            bound = robot.limits.upper[i] if side == "upper" else robot.limits.lower[i]
+            return PoseAnswer(None, answer.solver, "JOINT_LIMIT",
+                              f"{name} would pass its {side} limit {bound:.9g} rad (the only solution there turns it "
+                              f"by {answer.q[i] - previous[i]:.6g} rad at once: not a continuous move)")  # fmt: skip
+    return answer
+
+
+# ------------------------------------------------------------------------------------------ hold-to-jog
+def nominal_rate(robot: Robot, motion: JogMotion, override: float) -> float:
+    """The hold-to-jog rate [m/s or rad/s] before the limits of the period (see the module docstring)."""
+    override = _override(override)
+    if motion.joint is not None:
+        velocity = _limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
+        return override * float(velocity[motion.joint])
+    return override * (MANUAL_TURN_RATE if motion.axis is JogAxis.YAW else MANUAL_SPEED)
+
+
+def hold_advance(
+    robot: Robot, q: object, motion: JogMotion, dt: float, override: float, *, ws: Workspace | None = None
+) -> JogMove:
+    """One control period of a hold-to-jog.
+
+    The step of ``dt`` [s] at the rate of ``motion`` and ``override`` (a fraction in (0, 1]), shortened until
+    every joint and the tool's origin keep their speeds (module docstring), stopping ON the edge as
+    :func:`jog_step` does.
+    """
+    q0 = robot.check_q(q)
+    if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+        raise ParameterError("control period", dt, "must be a finite number > 0", "s")
+    velocity = _limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
+    override = _override(override)
+    length = nominal_rate(robot, motion, override) * dt
+    if ws is None and motion.axis not in (None, JogAxis.YAW) and robot.kind == "scara":
+        ws = _region(robot, q0)  # built once for the period's trial steps
+    move = jog_step(robot, q0, motion, length, ws=ws)
+    ratio = _speed_ratio(robot, q0, move.q, dt, override, velocity)
+    if not move.moved or ratio <= 1.0:
+        return move
+    # too fast: shorten the step by the ratio (exact where the move is linear in the step), a few times, keeping
+    # the longest step within the speeds; near a singularity (a square-root law) bisect instead
+    best: JogMove | None = None
+    trial_length = move.travelled * _AIM / ratio
+    for _ in range(4):
+        trial = jog_step(robot, q0, motion, trial_length, ws=ws)
+        r = _speed_ratio(robot, q0, trial.q, dt, override, velocity)
+        if r <= 1.0 and (best is None or trial.travelled > best.travelled):
+            best = trial
+        if _AIM - 1e-3 <= r <= 1.0 or not trial.moved:
+            break
+        trial_length = trial.travelled * _AIM / r
+    if best is not None:
+        return best
+    lo, hi = 0.0, move.travelled / ratio
+    good = JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, "too close to a singularity to move at the "
+                   "jog's speed", "singular", 0.0, length, Solver.NONE)  # fmt: skip
+    for _ in range(20):  # to a millionth of the step
+        mid = 0.5 * (lo + hi)
+        trial = jog_step(robot, q0, motion, mid, ws=ws)
+        if _speed_ratio(robot, q0, trial.q, dt, override, velocity) <= 1.0:
+            lo, good = mid, trial
+        else:
+            hi = mid
+    return good
+
+
+def _override(value: float) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.0 < value <= 1.0):
+        raise ParameterError("speed override", value, "must be a fraction in (0, 1] (1 = 100 %)")
+    return float(value)
+
+
+def _speed_ratio(
+    robot: Robot, q0: np.ndarray, q1: np.ndarray, dt: float, override: float, velocity: np.ndarray
+) -> float:
+    """The largest of |dq_i| / (override vmax_i dt) and |dp| / (override MANUAL_SPEED dt) over one period."""
+    joints = float(np.max(np.abs(q1 - q0) / (override * velocity * dt)))
+    p0 = np.asarray(robot.tool_placement(q0).translation)
+    p1 = np.asarray(robot.tool_placement(q1).translation)
+    return max(joints, float(np.linalg.norm(p1 - p0)) / (override * MANUAL_SPEED * dt))

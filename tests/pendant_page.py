@@ -1,0 +1,53 @@
+"""Helpers of the pendant tests: the tool pose from Pinocchio (computed here), and the page's rounded readouts read
+back in SI, checking their format."""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Any
+
+import numpy as np
+
+DECIMALS = {"mm": 3, "deg": 3, "m": 6, "rad": 6}
+"""The readouts' decimals per unit: 1 um and 0.001 deg (1e-6 m, 1e-6 rad)."""
+TO_SI = {"mm": 1e-3, "m": 1.0, "deg": math.pi / 180, "rad": 1.0}
+
+
+def read_values(text: str, names: tuple[str, ...]) -> tuple[np.ndarray, list[str]]:
+    """``name = value unit`` lines as SI values and their units; each value has its unit's decimals, never ``-0``."""
+    found = {name: (value, unit) for name, value, unit in re.findall(r"(\w+) = (\S+) (mm|m|deg|rad)\b", text)}
+    assert set(found) >= set(names), text
+    values, units = [], []
+    for name in names:
+        value, unit = found[name]
+        assert re.fullmatch(rf"-?\d+\.\d{{{DECIMALS[unit]}}}", value), (name, value, unit)
+        assert float(value) != 0 or not value.startswith("-"), f"negative zero in {text!r}"
+        values.append(float(value) * TO_SI[unit])
+        units.append(unit)
+    return np.array(values), units
+
+
+def readout(page: Any) -> tuple[np.ndarray, list[str]]:
+    """The tool pose readout (x, y, z [m], yaw [rad]) and the units it was shown in."""
+    return read_values(page.inner_text("#tool-pose"), ("x", "y", "z", "yaw"))
+
+
+def resolution(units: list[str]) -> np.ndarray:
+    """Half a unit of the last shown decimal, in SI (what rounding may change), per value."""
+    return np.array([0.5 * 10.0 ** -DECIMALS[u] * TO_SI[u] for u in units])
+
+
+def pin_placement(robot: Any, q: np.ndarray) -> Any:
+    """The tool frame in the base frame (a ``pin.SE3``) from Pinocchio's frame placements, computed here."""
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, robot.to_pinocchio_q(q))
+    return data.oMf[robot.model.getFrameId(robot.base_frame)].actInv(data.oMf[robot.model.getFrameId(robot.tool_frame)])
+
+
+def pin_pose(robot: Any, q: np.ndarray) -> np.ndarray:
+    """(x, y, z, yaw) of :func:`pin_placement` [m, rad], the yaw as atan2(R[1, 0], R[0, 0])."""
+    M = pin_placement(robot, q)
+    return np.array([*M.translation, math.atan2(M.rotation[1, 0], M.rotation[0, 0])])
