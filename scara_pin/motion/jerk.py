@@ -35,8 +35,9 @@ import numpy as np
 
 from .._checks import _positive
 from ..errors import ParameterError
-from .timing import TimingError, TimingOptions, _limits, _rnea
+from .timing import TimingError, TimingOptions
 from .trajectory import GeometricPath, Motion, ProfileLaw, TimeLaw, Trajectory
+from .verify import _limits, _rnea, jerk_vector, joint_jerk, path_third_derivative
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -49,8 +50,6 @@ _ACCEPT = 1.0 + 1e-10
 _SUB = 16
 """Checked points inside each interval between the law's breakpoints (besides both ends and the rate grid):
 16 keep the acceleration between checked points within 1e-6 of its limit (4 left 1.2e-4 at 8 kHz)."""
-_FD_STEP = 1e-4
-"""Finite-difference step of q''' relative to the width of the smooth piece of the path."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,49 +117,6 @@ class FilteredLaw(TimeLaw):
         """Times [s] where the path jerk changes (it is constant between them)."""
         t = np.concatenate([self.base.t, self.base.t + self.window])
         return np.unique(np.clip(t * self.k, 0.0, self.duration))
-
-
-def path_third_derivative(path: GeometricPath, s: np.ndarray) -> np.ndarray:
-    """q'''(s), (n, 4): finite differences of the exact q'' inside each smooth piece (between knots).
-
-    Central differences of step h = 1e-4 of the piece's width; second-order one-sided ones within h of
-    a knot, so a difference never straddles a knot.
-    """
-    s = np.asarray(s, dtype=float).ravel()
-    knots = np.unique(np.clip(path.knots(), 0.0, 1.0))
-    i = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, len(knots) - 2)
-    lo, hi = knots[i], knots[i + 1]
-    h = _FD_STEP * (hi - lo)
-    left = s - h < lo
-    right = s + h > hi
-    # offsets (in units of h) of the three points: centred (-1, 0, 1), forward (0, 1, 2), backward (-2, -1, 0)
-    base = np.where(left, s, np.where(right, s - 2 * h, s - h))
-    pts = np.concatenate([base, base + h, base + 2 * h])
-    n = len(s)
-    _, _, d2 = path.evaluate(pts, 2)
-    f0, f1, f2 = d2[:n], d2[n : 2 * n], d2[2 * n :]
-    central = (f2 - f0) / 2.0
-    forward = (-3.0 * f0 + 4.0 * f1 - f2) / 2.0
-    backward = (f0 - 4.0 * f1 + 3.0 * f2) / 2.0
-    out = np.where(left[:, None], forward, np.where(right[:, None], backward, central))
-    return out / h[:, None]
-
-
-def joint_jerk(motion: Motion, tau: np.ndarray) -> np.ndarray:
-    """Joint jerk (n, 4) of a motion at local times ``tau``: q' sddd + 3 q'' sd sdd + q''' sd^3.
-
-    A :class:`FilteredLaw` has its own path jerk; a :class:`ProfileLaw` has none between grid points
-    (sddd = 0 there; its jerk at the grid points is unbounded, which this does not show).
-    """
-    law = motion.law
-    if isinstance(law, FilteredLaw):
-        s, sd, sdd, sddd = law.evaluate_jerk(tau)
-    else:
-        s, sd, sdd = law.evaluate(tau)
-        sddd = np.zeros_like(s)
-    _, d1, d2 = motion.path.evaluate(s, 2)
-    d3 = path_third_derivative(motion.path, s)
-    return d1 * sddd[:, None] + 3.0 * d2 * (sd * sdd)[:, None] + d3 * (sd**3)[:, None]
 
 
 @dataclass(frozen=True)
@@ -281,10 +237,7 @@ def jerk_limited(
         ParameterError: a jerk limit is not finite and > 0, or a motion is not a TOPP-RA profile.
     """
     opts = TimingOptions() if options is None else options
-    jv = np.broadcast_to(np.asarray(jerk, dtype=float), (4,)) if np.ndim(jerk) == 0 else np.asarray(jerk, float)
-    if jv.shape != (4,) or not (np.isfinite(jv).all() and (jv > 0).all()):
-        raise ParameterError("jerk limit", np.asarray(jerk).tolist(), "must be one number or 4, each finite and > 0",
-                             "rad/s^3 or m/s^3")  # fmt: skip
+    jv = jerk_vector(jerk)
     lim = _limits(robot, limits, None, torque)
     v, a, e = lim.velocity, lim.acceleration, lim.effort
     out: list[Motion] = []
