@@ -89,3 +89,56 @@ def test_verify_torque_with_payload_against_an_appended_body(robot):
     ratio = np.abs(tau) / np.array(robot.limits.effort)
     assert v.torque.ratio >= ratio.max() - 1e-12
     assert v.torque.ratio == pytest.approx(ratio.max(), rel=1e-3)
+
+
+# --------------------------------------------------------------------------------------------- jerk-limited timing
+def test_one_joint_move_matches_ruckig(robot):
+    """A pure J1 rotation on a joint line: ruckig's time-optimal jerk-limited profile is exact; ours within 0.5 %."""
+    from ruckig import InputParameter, Ruckig
+    from ruckig import Trajectory as RuckigTrajectory
+
+    from scara_pin.motion.jerk import JerkLaw, time_optimal_jerk
+
+    q0, q1 = np.array([-1.0, 0.5, 0.05, 0.0]), np.array([1.0, 0.5, 0.05, 0.0])
+    jmax = 2000.0
+    res = time_optimal_jerk(robot, JointLine(q0, q1), jmax)
+    inp = InputParameter(1)
+    inp.current_position, inp.target_position = [q0[0]], [q1[0]]
+    inp.max_velocity = [robot.limits.velocity[0]]
+    inp.max_acceleration = [robot.limits.acceleration[0]]
+    inp.max_jerk = [jmax]
+    ref = RuckigTrajectory(1)
+    Ruckig(1).calculate(inp, ref)
+    T = res.trajectory.duration
+    assert ref.duration <= T <= ref.duration * 1.005
+    assert isinstance(res.trajectory.pieces[0].law, JerkLaw)
+    v = verify(robot, res.trajectory, jerk=jmax, q_start=q0, q_end=q1).check()
+    assert v.jerk.ratio > 0.99 and v.velocity.ratio > 0.99  # the limits are used, not a slow motion
+
+
+@pytest.mark.parametrize("limit", ["1e-9", "1e-100"])
+def test_tiny_jerk_limit_refused_before_any_work(limit, capsys):
+    """Issue 24 item 7: the implied duration is sized first (here > 2000 s: 2e7 verified samples at 10 kHz)."""
+    import resource
+    import time
+
+    from scara_pin.cli import main
+
+    start = time.perf_counter()
+    code = main(["cycle", "--jerk-limit", limit])
+    elapsed = time.perf_counter() - start
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert len(err.splitlines()) == 1 and "above the cap of 2,000,000" in err and "jerk" in err
+    assert elapsed < 30.0
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss < 2_000_000  # kB: no runaway allocation
+
+
+def test_traj_jerk_limit_options(capsys):
+    from scara_pin.cli import main
+
+    base = ["traj", "--from", "0", "0.1", "0", "0", "--to", "0.5", "0.6", "0.02", "0.3"]
+    assert main([*base, "--jerk-limit", "1", "2"]) == 2
+    assert "one number or 4" in capsys.readouterr().err
+    assert main([*base, "--jerk-limit", "100", "--duration", "2"]) == 2
+    assert "--duration does not apply" in capsys.readouterr().err

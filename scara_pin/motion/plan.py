@@ -49,6 +49,8 @@ class Method(enum.Enum):
     LINE_QUINTIC = "straight line, quintic time law"
     LINE_TOPPRA = "straight line, time-optimal (TOPP-RA)"
     ARCH = "arch (jump) move, time-optimal (TOPP-RA)"
+    JOINT_JERK = "joint path, jerk-limited time-optimal"
+    LINE_JERK = "straight line, jerk-limited time-optimal"
 
 
 def _optional_vector(name: str, value: object) -> np.ndarray | None:
@@ -71,6 +73,7 @@ class MotionRequest:
         rise: [m] the arch's traverse height above the higher pose; None: the standard one.
         blend: [m] the arch's corner blend distance; None: as large as allowed.
         payload: a payload at the tool (``torque`` moves and arches); None: none.
+        jerk: joint jerk limits [rad/s^3, m/s^3], one per joint, for a jerk-limited time-optimal move; None: none.
     """
 
     start_q: np.ndarray | None = None
@@ -86,6 +89,7 @@ class MotionRequest:
     rise: float | None = None
     blend: float | None = None
     payload: Payload | None = field(default=None)
+    jerk: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
@@ -105,6 +109,10 @@ class MotionRequest:
             raise InvalidInputError("an arch move takes no via (one arch between two poses)")
         if self.arch and self.duration is not None:
             raise InvalidInputError("an arch move is time-optimal: a duration does not apply")
+        if self.jerk is not None and self.duration is not None:
+            raise InvalidInputError("--jerk-limit is time-optimal: --duration does not apply")
+        if self.jerk is not None and self.tool_speed is not None:
+            raise InvalidInputError("--jerk-limit with --tool-speed is not supported: give one of them")
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,6 +162,10 @@ def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
 
 
 def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Trajectory:
+    if request.jerk is not None:
+        from .jerk import time_optimal_jerk
+
+        return time_optimal_jerk(robot, path, request.jerk, torque=request.torque).trajectory  # type: ignore[arg-type]
     from .timing import time_optimal
 
     return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque)  # type: ignore[arg-type]
@@ -167,7 +179,8 @@ def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
     path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
     if request.duration is not None:
         return MotionPlan(tr.timed(path, request.duration), Method.LINE_QUINTIC, robot)
-    return MotionPlan(_time_optimal(robot, path, request), Method.LINE_TOPPRA, robot)
+    method = Method.LINE_TOPPRA if request.jerk is None else Method.LINE_JERK
+    return MotionPlan(_time_optimal(robot, path, request), method, robot)
 
 
 def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -183,10 +196,11 @@ def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
             path = tr.joint_path(robot, [q_from, *vias, q_to])
             return MotionPlan(tr.timed(path, request.duration), Method.JOINT_SPLINE_QUINTIC, robot)
         return MotionPlan(tr.quintic(q_from, q_to, request.duration), Method.JOINT_QUINTIC, robot)
-    if not vias and request.tool_speed is None and not request.torque:
+    if not vias and request.tool_speed is None and not request.torque and request.jerk is None:
         lim = robot.limits
         return MotionPlan(tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), Method.JOINT_TRAPEZOID, robot)
-    return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), Method.JOINT_TOPPRA, robot)
+    method = Method.JOINT_TOPPRA if request.jerk is None else Method.JOINT_JERK
+    return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), method, robot)
 
 
 def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -197,10 +211,10 @@ def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
     poses = np.array([first, last], dtype=float)
     if request.rise is None:
         move = arch_move(robot, poses, blend=request.blend, payload=request.payload, torque=request.torque,
-                         start=request.start_q)  # fmt: skip
+                         start=request.start_q, jerk=request.jerk)  # fmt: skip
     else:
         move = arch_move(robot, poses, rise=request.rise, blend=request.blend, payload=request.payload,
-                         torque=request.torque, start=request.start_q)  # fmt: skip
+                         torque=request.torque, start=request.start_q, jerk=request.jerk)  # fmt: skip
     return MotionPlan(move.trajectory, Method.ARCH, robot, move)
 
 
