@@ -37,6 +37,7 @@ import numpy as np
 
 from .._checks import _positive
 from ..errors import ParameterError
+from .jerk import JerkRatios
 from .timing import TimingError, TimingOptions
 from .trajectory import GeometricPath, Motion, ProfileLaw, TimeLaw, Trajectory
 from .verify import Quantity, _Limits, _limits, jerk_vector, joint_jerk, path_third_derivative, time_scale
@@ -119,26 +120,6 @@ class FilteredLaw(TimeLaw):
         """Times [s] where the path jerk changes (it is constant between them)."""
         t = np.concatenate([self.base.t, self.base.t + self.window])
         return np.unique(np.clip(t * self.k, 0.0, self.duration))
-
-
-@dataclass(frozen=True)
-class JerkRatios:
-    """Worst |value| / limit over the checked samples of a jerk-limited trajectory.
-
-    Attributes:
-        velocity, acceleration, jerk: max over joints and samples.
-        torque: of the effort limits, or None when not limited.
-    """
-
-    velocity: float
-    acceleration: float
-    jerk: float
-    torque: float | None = None
-
-    @property
-    def worst(self) -> float:
-        """The largest of the ratios."""
-        return max(v for v in (self.velocity, self.acceleration, self.jerk, self.torque) if v is not None)
 
 
 def _knot_times(law: FilteredLaw, knots: np.ndarray) -> np.ndarray:
