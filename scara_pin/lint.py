@@ -640,9 +640,9 @@ class _Checker:
     # ------------------------------------------------------------------------------------- loading
     def load(self) -> None:
         from .errors import UrdfError
+        from .kinematics.kinds import kinematics_for
         from .kinematics.scara import NotScaraError
         from .model import Robot
-        from .robots import kinematics_for
 
         try:
             robot = Robot(self.text, origin=self.source, tool_frame=self.tool_asked, base_frame=self.base_asked,

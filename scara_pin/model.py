@@ -47,7 +47,7 @@ _LWA = pin.LOCAL_WORLD_ALIGNED
 
 
 class Kinematics(Protocol):
-    """What each robot kind provides, read from the loaded model (see :mod:`scara_pin.robots`).
+    """What each robot kind provides, read from the loaded model (see :mod:`scara_pin.kinematics.kinds`).
 
     The robot holds one (``Robot.kinematics``) and knows nothing else of inverse kinematics.
     """
@@ -74,10 +74,6 @@ class Kinematics(Protocol):
 
     def branch_of(self, q: ArrayLike) -> str:
         """The branch of a configuration."""
-        ...
-
-    def workspace(self) -> Any:
-        """The reachable region (the kind's own description of it)."""
         ...
 
 
@@ -236,7 +232,7 @@ class Robot:
             origin: how to name the source in error messages (a file name).
             package_path: where ``package://`` names are looked for (meshes); default: none.
             kinematics: builds the robot's kinematics object from the loaded robot (its kind's; see
-                :func:`scara_pin.robots.kinematics_for`, which :func:`scara_pin.load_robot` passes).
+                :func:`scara_pin.kinematics.kinds.kinematics_for`, which :func:`scara_pin.load_robot` passes).
 
         Raises:
             UrdfError: unreadable, invalid or disconnected URDF, not a 4-joint robot, an unusable joint
@@ -356,14 +352,14 @@ class Robot:
         Pinocchio never reads a mesh file: :func:`scara_pin.viz.meshes.visual_meshes` reads them (found
         and checked as that module says) under the same geometry names.
         """
-        from .viz.meshes import placeholder_urdf
+        from .description.placeholders import placeholder_urdf
 
         return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.VISUAL)
 
     @cached_property
     def collision_model(self) -> pin.GeometryModel:
         """Collision geometry of the URDF, built on first use (meshes as placeholder boxes, as above)."""
-        from .viz.meshes import placeholder_urdf
+        from .description.placeholders import placeholder_urdf
 
         return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
 
@@ -384,7 +380,7 @@ class Robot:
             if self._kinematics_factory is None:
                 raise UrdfError(
                     f"robot {self.name!r} was loaded without its kinematics: load it with "
-                    "scara_pin.load_robot(...) (or pass kinematics=scara_pin.robots.kinematics_for)"
+                    "scara_pin.load_robot(...) (or pass kinematics=scara_pin.kinematics_for)"
                 )
             kin = self.__dict__["_kinematics"] = self._kinematics_factory(self)
         return kin  # type: ignore[no-any-return]

@@ -277,7 +277,8 @@ def test_cli_check_now_warns(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_batch_ik_agrees_with_the_single_target_solver(robot: Robot) -> None:
-    from scara_pin.kinematics.scara import IKStatus, branch_of, solve_batch
+    from scara_pin.kinematics.scara import IKStatus, branch_of
+    from scara_pin.kinematics.scara_batch import solve_batch
 
     qs = sample_qs(200, seed=8)
     targets = np.array([irb920_fk(q) for q in qs])

@@ -35,7 +35,8 @@ from hypothesis import strategies as st
 
 import scara_pin
 from scara_pin import Robot, UrdfError, load_robot, robot_from_urdf
-from scara_pin.kinematics.scara import IKStatus, NotScaraError, ScaraGeometry, branch_of, solve, solve_batch
+from scara_pin.kinematics.scara import IKStatus, NotScaraError, ScaraGeometry, branch_of, solve
+from scara_pin.kinematics.scara_batch import solve_batch
 
 POSE_TOL = 1e-9
 Q_TOL = 1e-9

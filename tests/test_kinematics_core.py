@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -414,30 +415,80 @@ def test_q1_on_its_limit_with_a_nearly_stretched_elbow_is_solved() -> None:
         assert min(s.distance(q) for s in res.solutions) <= singular_tol(g, q), (q.tolist(), res.solutions)
 
 
-def test_no_import_cycle() -> None:
-    """model knows nothing of the kinematics; kinematics imports no workspace; robots assembles them."""
+# the layers, lowest first (STYLE.md: description -> model -> kinematics -> workspace -> motion -> viz -> cli);
+# a module may import its own layer and those below, never one above
+LAYERS = (
+    ("_typing", "errors"),
+    ("limits", "files", "urdf_rules"),
+    ("description",),
+    ("_checks", "tables", "_urdf_checks"),
+    ("model",),
+    ("kinematics",),
+    ("robots", "workspace", "lint"),
+    ("motion",),
+    ("viz",),
+    ("cli",),
+    ("__init__",),
+)
+
+
+def _runtime_imports(path: Path, root: Path) -> list[tuple[int, str]]:
+    """(line, target module) of every relative import of a module that runs: at the top, in a function, in a
+    method; not the imports under ``if TYPE_CHECKING:`` (they name types and never execute)."""
     import ast
-    from pathlib import Path
 
+    pkg = ".".join(path.relative_to(root.parent).with_suffix("").parts)
+    if path.name == "__init__.py":
+        pkg += ".__init__"
+    tree = ast.parse(path.read_text())
+    skipped: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            skipped.update(id(n) for stmt in node.body for n in ast.walk(stmt))
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level and id(node) not in skipped:
+            base = pkg.split(".")[: -node.level]
+            out.append((node.lineno, ".".join(base + ([node.module] if node.module else []))))
+    return out
+
+
+def test_layers_import_only_downward() -> None:
+    """No module of the package imports a higher layer (issue 21 part 8), at the top or inside a function."""
     root = Path(sp.__file__).parent
+    layer = {name: k for k, names in enumerate(LAYERS) for name in names}
+    bad = []
+    for f in sorted(root.rglob("*.py")):
+        rel = f.relative_to(root).with_suffix("").parts
+        src = rel[0] if rel != ("__init__",) else "__init__"
+        assert src in layer, f"{f}: add its layer to LAYERS"
+        for line, target in _runtime_imports(f, root):
+            parts = target.split(".")
+            dst = parts[1] if len(parts) > 1 else "__init__"
+            if dst == "__init__" and len(parts) > 2:
+                dst = parts[1]
+            if layer[dst] > layer[src]:
+                bad.append(f"{f.relative_to(root.parent)}:{line} imports {target} ({dst} is above {src})")
+    assert not bad, "\n".join(bad)
 
-    def imports(path: Path) -> set[str]:
-        pkg = ".".join(path.relative_to(root.parent).with_suffix("").parts)
-        if path.name == "__init__.py":
-            pkg += ".__init__"
-        out = set()
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.ImportFrom) and node.level:
-                base = pkg.split(".")[: -node.level]
-                out.add(".".join(base + ([node.module] if node.module else [])))
-        return out
 
-    model = imports(root / "model.py")
-    assert not any(m.startswith(("scara_pin.kinematics.scara", "scara_pin.kinematics.palletizer", "scara_pin.robots",
-                                 "scara_pin.workspace")) for m in model), model  # fmt: skip
-    for f in (root / "kinematics").glob("*.py"):
-        upward = ("scara_pin.workspace", "scara_pin.robots", "scara_pin.motion")
-        assert not any(m.startswith(upward) for m in imports(f)), f
+def test_fk_imports_no_inverse_kinematics() -> None:
+    """`scara-pin fk` loads the model and computes FK: no IK kind, closed form, palletizer or workspace module."""
+    import subprocess
+    import sys
+    import textwrap
+
+    code = textwrap.dedent("""
+        import sys
+        from scara_pin.cli import main
+        rc = main(["fk", "0.1", "0.2", "0.05", "0.3"])
+        loaded = sorted(m for m in sys.modules if m.startswith(("scara_pin.kinematics.", "scara_pin.workspace")))
+        print(rc, loaded)
+    """)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    rc, loaded = done.stdout.strip().splitlines()[-1].split(" ", 1)
+    assert rc == "0"
+    assert loaded == "['scara_pin.kinematics.kinds']", loaded
 
 
 def test_no_compiled_twin() -> None:

@@ -22,7 +22,8 @@ from scara_pin.cli import main
 from scara_pin.kinematics.polish import polish_result
 from scara_pin.kinematics.results import IKResult, IKSolution
 from scara_pin.kinematics.scara import EXACT_TILT, NEAR_PARALLEL_TOL, IKStatus, NotScaraError
-from scara_pin.robots import ScaraKinematics, load_robot, robot_from_urdf
+from scara_pin.kinematics.scara_kinematics import ScaraKinematics
+from scara_pin.robots import load_robot, robot_from_urdf
 
 DATA = Path(__file__).parent / "data" / "near_parallel"
 FILES = {"scara_rpy_3_14.urdf": math.pi - 3.14, "scara_rpy_3_14159.urdf": math.pi - 3.14159}

@@ -43,6 +43,7 @@ from scara_pin.kinematics.palletizer import (
 )
 from scara_pin.kinematics.results import IKResult
 from scara_pin.kinematics.validate import validate_ik
+from scara_pin.workspace import workspace_of
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIG = REPO / "urdf" / "config"
@@ -583,7 +584,7 @@ def test_the_3d_workspace_wireframe_is_the_reach_boundary(tmp_path: Path) -> Non
     solution gives it back to 1e-9 m), the planes are at the waist limits, and 1 mm beyond the outermost
     circle nothing is reachable."""
     robot = load_robot("palletizer")
-    env = robot.kinematics.workspace()
+    env = workspace_of(robot)
     lines = env.wireframe(n=24)
     lo, hi = robot.limits.lower[0], robot.limits.upper[0]
     assert hi - lo < 2 * math.pi and len(lines) == 2 * len(env.arcs) + 3

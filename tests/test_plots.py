@@ -23,13 +23,14 @@ def test_plots_leave_the_callers_matplotlib_alone(tmp_path: Path) -> None:
         from scara_pin.viz.cycle import plot_cycle
         from scara_pin.viz.plots import plot_trajectory
         from scara_pin.workspace.palletizer import plot_envelope
+        from scara_pin.workspace import workspace_of
         from scara_pin.workspace.scara import plot_workspace, workspace
 
         out = Path({str(tmp_path)!r})
         robot = load_robot("default")
         (out / "ws.png").write_text("OLD")
         plot_workspace(workspace(robot), str(out / "ws.png"))
-        plot_envelope(load_robot("palletizer").kinematics.workspace(), str(out / "env.png"))
+        plot_envelope(workspace_of(load_robot("palletizer")), str(out / "env.png"))
         q0, q1 = np.array([0.2, 0.6, 0.01, 0.1]), np.array([0.9, 1.3, 0.04, -0.4])
         plot_trajectory(plan_motion(robot, MotionRequest(start_q=q0, end_q=q1)).trajectory, out / "traj.png",
                         robot=robot)

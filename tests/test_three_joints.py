@@ -16,7 +16,9 @@ import pytest
 
 from scara_pin.cli import main
 from scara_pin.errors import InvalidInputError
-from scara_pin.robots import Scara3Kinematics, load_robot
+from scara_pin.kinematics.scara3_kinematics import Scara3Kinematics
+from scara_pin.robots import load_robot
+from scara_pin.workspace import workspace_of
 
 DATA = Path(__file__).parent / "data" / "three_joint"
 RRP = DATA / "arm3_rrp.urdf"
@@ -103,7 +105,7 @@ def test_a_yaw_is_refused(case: tuple) -> None:
 def test_workspace_area_against_monte_carlo(case: tuple) -> None:
     """Area of the plan region vs the fraction of random points the IK solves (brute force, seeded)."""
     robot, fk, lo, hi = case
-    ws = robot.kinematics.workspace()
+    ws = workspace_of(robot)
     rng = np.random.default_rng(11)
     n, R = 40000, 0.7
     pts = rng.uniform(-R, R, size=(n, 2))
@@ -168,7 +170,7 @@ def test_cli_commands_without_3_joint_support_refuse(capsys: pytest.CaptureFixtu
 def test_cli_workspace(capsys: pytest.CaptureFixture[str]) -> None:
     rc, out, _ = run(capsys, ["workspace", "--urdf", str(PRR), "--json"])
     assert rc == 0
-    assert json.loads(out)["workspace"]["area"] == pytest.approx(load_robot(urdf=PRR).kinematics.workspace().area)
+    assert json.loads(out)["workspace"]["area"] == pytest.approx(workspace_of(load_robot(urdf=PRR)).area)
 
 
 def test_cli_trajectory_three_joints(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:

@@ -44,12 +44,12 @@ def cmd_view(args: argparse.Namespace) -> int:
         times, qs = viz.read_trajectory_csv(args.traj, robot.dof)
     polylines = None
     if args.workspace:
-        from ..workspace.scara import workspace
+        from ..workspace import Workspace, workspace_of
 
-        if robot.kind == "palletizer":  # the arm-plane envelope at the waist limits, and its sweep
-            polylines = robot.kinematics.workspace().wireframe()
+        ws = workspace_of(robot)
+        if not isinstance(ws, Workspace):  # a palletizer: the arm-plane envelope at the waist limits, and its sweep
+            polylines = ws.wireframe()
         else:
-            ws = workspace(robot)
             polylines = [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
     if args.html:
         viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines,

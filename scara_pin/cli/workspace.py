@@ -77,11 +77,11 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
 def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     """The palletizer's reach envelope of tool0 in its arm plane (r from the waist axis, z)."""
-    from ..workspace.palletizer import plot_envelope
+    from ..workspace.palletizer import arm_plane_envelope, plot_envelope
 
     if args.ray or args.z is not None or args.dz is not None:
         raise InvalidInputError("--ray/--z/--dz are SCARA-only for now; a palletizer gets its arm-plane envelope")
-    env = robot.kinematics.workspace()
+    env = arm_plane_envelope(robot.kinematics.geometry)
     if args.plot:
         plot_envelope(env, args.plot)
     if args.json:

@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from .._checks import MAGNITUDE_MAX, _floats, _vector
+from .._checks import _vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 from .planar2r import (
     FREE_R,
@@ -59,7 +59,7 @@ from .planar2r import (
     wrap,
 )
 from .results import BatchIKResult, IKResult, result_of
-from .targets import check_magnitude, parse_target, reference_floats, weight_floats
+from .targets import batch_inputs, parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -389,7 +389,7 @@ def solve_nearest(
 def solve_batch(
     geo: PalletizerGeometry, targets: ArrayLike, *, branch: str = "nearest", reference: ArrayLike | None = None
 ) -> BatchIKResult:
-    """One solution per target, vectorised (as the SCARA's :func:`~scara_pin.kinematics.scara.solve_batch`).
+    """One solution per target, vectorised (as the SCARA's :func:`~scara_pin.kinematics.scara_batch.solve_batch`).
 
     The same formulas as :func:`solve` on arrays (:meth:`Planar2R.solve_array`, the turns by
     :func:`~scara_pin.kinematics.planar2r.nearest_turn_array`): for each target the four candidates (reaching
@@ -401,16 +401,7 @@ def solve_batch(
     Returns:
         BatchIKResult: q (NaN rows without a solution), PalletizerIKStatus codes, branch +1 up / -1 down.
     """
-    T = _floats("targets", targets, "must be an (N, 4) array of x, y, z, yaw")
-    if T.ndim != 2 or T.shape[1] != 4:
-        raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
-    if branch not in ("nearest", *BRANCHES):
-        raise InvalidInputError(f"branch {branch!r} must be 'nearest', 'up' or 'down'")
-    if T.size and not (T.max() <= MAGNITUDE_MAX and T.min() >= -MAGNITUDE_MAX):  # NaN fails the comparisons
-        check_magnitude(T[int(np.argmax(~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)))].tolist())
-    ref = np.zeros(4) if reference is None else _floats("reference", reference, "must be 4 values or (N, 4)")
-    if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
-        raise ParameterError("reference", f"array of shape {ref.shape}", "must be 4 finite values or (N, 4)")
+    T, ref = batch_inputs(targets, reference, branch, BRANCHES)
     refs = [ref[j] if ref.ndim == 1 else ref[:, j] for j in range(4)]
     n = len(T)
     lo, hi, cont, arm = geo.lower, geo.upper, geo.continuous, geo.arm

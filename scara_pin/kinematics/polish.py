@@ -29,17 +29,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .planar2r import LIMIT_TOL, TWO_PI, nearest_turn
 from .results import IKResult, IKSolution
-from .scara import BRANCHES, IKStatus, ScaraGeometry, branch_of, wrist_point
+from .scara_geometry import BRANCHES, IKStatus, ScaraGeometry, branch_of, wrist_point
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    from .._typing import ArrayLike
     from ..model import Robot
     from .results import BatchIKResult
 
@@ -53,6 +54,7 @@ __all__ = [
     "polish_batch",
     "polish_result",
     "refine",
+    "row_solver",
     "seed_geometry",
     "solve_refined",
     "unrefined_error",
@@ -339,3 +341,18 @@ def unrefined_error(robot: Robot, samples: int = 200, seed: int = 0) -> Unrefine
             if n == 4:
                 yaw = max(yaw, abs(math.remainder(float(e[3]), TWO_PI)))
     return UnrefinedError(pos, yaw, samples, seed)
+
+
+def row_solver(kin: Any, T: np.ndarray, reference: ArrayLike | None, branch: str) -> Any:
+    """solve_row(i) for :func:`~scara_pin.kinematics.polish.polish_batch`: row i by ``kin.solve``, nearest kept."""
+    ref = None if reference is None else np.asarray(reference, dtype=float)
+
+    def solve_row(i: int) -> tuple[np.ndarray | None, int, int]:
+        row_ref = np.zeros(kin.dof) if ref is None else (ref if ref.ndim == 1 else ref[i])
+        res = kin.solve(T[i], branch="all" if branch == "nearest" else branch, reference=row_ref)
+        best = res.nearest(row_ref) if res.success else None
+        if best is None:
+            return None, int(res.status) if not res.success else int(IKStatus.NOT_REFINED), 0
+        return best.q, 0, 1 if best.branch == "right" else -1
+
+    return solve_row

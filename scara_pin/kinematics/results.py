@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, NoSolutionError
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -193,3 +193,20 @@ class BatchIKResult:
     q: np.ndarray
     status: np.ndarray
     branch: np.ndarray
+
+
+def nearest_q(res: IKResult, reference: ArrayLike | None, weights: ArrayLike | None, branch: str,
+                n: int) -> np.ndarray:  # fmt: skip
+    """The solution of ``res`` nearest ``reference`` (weighted, ``n`` joints), as a new array.
+
+    Raises:
+        NoSolutionError: ``res`` has no solution (on ``branch``).
+    """
+    from .targets import reference_floats, weight_floats  # (targets imports pinocchio: on first use)
+
+    ref = reference_floats(reference, n)
+    w = None if weights is None else weight_floats(weights, n)
+    best = res.nearest(ref, w, branch) if res.success else None
+    if best is None:
+        raise NoSolutionError(res.status, res.message if not res.success else f"no {branch} solution")
+    return best.q.copy()

@@ -14,7 +14,7 @@ from ..errors import ParameterError
 if TYPE_CHECKING:
     from .._typing import ArrayLike
 
-__all__ = ["check_magnitude", "parse_target", "placement_matrix", "reference_floats", "weight_floats"]
+__all__ = ["batch_inputs", "check_magnitude", "parse_target", "placement_matrix", "reference_floats", "weight_floats"]
 
 _F64 = np.dtype(np.float64)
 _isfinite = math.isfinite
@@ -106,3 +106,33 @@ def weight_floats(weights: object, n: int = 4) -> list[float]:
     if (w < 0).any():
         raise ParameterError("weights", w.tolist(), "must be >= 0")
     return w.tolist()  # type: ignore[no-any-return]
+
+
+def batch_inputs(targets: object, reference: object, branch: str, branches: tuple[str, ...]
+                 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The checked (N, 4) targets and the (4,) or (N, 4) reference of a vectorised closed form.
+
+    Args:
+        targets: (N, 4) x, y, z, yaw [m, rad], finite, within +/-MAGNITUDE_MAX.
+        reference: (4,) or (N, 4) finite joint values, or None (zeros).
+        branch: ``"nearest"`` or one of ``branches``.
+        branches: the kind's branch names.
+
+    Raises:
+        ParameterError: a shape, or a value that is not finite or out of range.
+        InvalidInputError: an unknown branch.
+    """
+    from ..errors import InvalidInputError
+
+    T = _floats("targets", targets, "must be an (N, 4) array of x, y, z, yaw")
+    if T.ndim != 2 or T.shape[1] != 4:
+        raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
+    if branch not in ("nearest", *branches):
+        names = ", ".join(repr(b) for b in ("nearest", *branches))
+        raise InvalidInputError(f"branch {branch!r} must be {names.rsplit(', ', 1)[0]} or {names.rsplit(', ', 1)[1]}")
+    if T.size and not (T.max() <= MAGNITUDE_MAX and T.min() >= -MAGNITUDE_MAX):  # NaN fails the comparisons
+        check_magnitude(T[int(np.argmax(~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)))].tolist())
+    ref = np.zeros(4) if reference is None else _floats("reference", reference, "must be 4 values or (N, 4)")
+    if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
+        raise ParameterError("reference", f"array of shape {ref.shape}", "must be 4 finite values or (N, 4)")
+    return T, ref

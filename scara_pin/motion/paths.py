@@ -26,7 +26,8 @@ import pinocchio as pin
 
 from .._checks import _limit_vector, _positive, _rows, _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..kinematics.scara import IKStatus, branch_of, solve_batch
+from ..kinematics.scara_batch import solve_batch
+from ..kinematics.scara_geometry import IKStatus, branch_of
 from ..limits import MAX_PATH_POINTS, check_count
 
 if TYPE_CHECKING:

@@ -12,10 +12,11 @@ the robot's file. Rules:
 - STL, DAE (COLLADA) and OBJ are read with trimesh; ``scale`` is applied to the vertices.
 
 A mesh that is refused, missing or unreadable is reported as one ``warning:`` naming the file; the viewer
-keeps the placeholder box it draws for every mesh (:func:`placeholder_urdf`), never failing on it.
+keeps the placeholder box it draws for every mesh
+(:func:`scara_pin.description.placeholders.placeholder_urdf`), never failing on it.
 
 Pinocchio's geometry models of the robot (``robot.visual_model``) are built from
-:func:`placeholder_urdf` (each mesh a :data:`PLACEHOLDER_SIZE` box at the mesh's origin), so Pinocchio
+:func:`~scara_pin.description.placeholders.placeholder_urdf` (each mesh a small box at the mesh's origin), so Pinocchio
 never reads a mesh file; :func:`visual_meshes` gives the real shapes, under Pinocchio's geometry names.
 """
 
@@ -30,16 +31,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..description.placeholders import PLACEHOLDER_SIZE
+
 if TYPE_CHECKING:
     from ..description.packages import PackagePath
     from ..model import Robot
 
-__all__ = ["MAX_MESH_BYTES", "PLACEHOLDER_SIZE", "VisualMesh", "placeholder_urdf", "resolve_mesh", "visual_meshes"]
+__all__ = ["MAX_MESH_BYTES", "VisualMesh", "resolve_mesh", "visual_meshes"]
 
 log = logging.getLogger(__name__)
 
-PLACEHOLDER_SIZE = 0.02
-"""[m] edge of the box drawn where a mesh is (and stays, when the mesh cannot be read)."""
 MAX_MESH_BYTES = 200 * 1024 * 1024
 """[bytes] a mesh file larger than this is not read (a placeholder is drawn)."""
 _FORMATS = {".stl": "stl", ".dae": "dae", ".obj": "obj"}
@@ -163,18 +164,6 @@ def _mesh_elements(root: ET.Element) -> list[tuple[str, int, ET.Element, ET.Elem
             if geometry is not None and mesh is not None:
                 out.append((link.get("name", ""), i, geometry, mesh))
     return out
-
-
-def placeholder_urdf(urdf: str) -> str:
-    """The URDF text with every ``<mesh>`` (visual and collision) replaced by a :data:`PLACEHOLDER_SIZE` box."""
-    root = ET.fromstring(urdf)
-    changed = False
-    for geometry in root.iter("geometry"):
-        for mesh in geometry.findall("mesh"):
-            geometry.remove(mesh)
-            ET.SubElement(geometry, "box", size=" ".join([repr(PLACEHOLDER_SIZE)] * 3))
-            changed = True
-    return ET.tostring(root, encoding="unicode") if changed else urdf
 
 
 def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:

@@ -487,7 +487,8 @@ def workspace(
     """Build the exact workspace of a robot.
 
     Args:
-        robot: a :class:`~scara_pin.model.Robot` or its :class:`~scara_pin.kinematics.scara.ScaraGeometry`.
+        robot: a :class:`~scara_pin.model.Robot` or its :class:`~scara_pin.kinematics.scara.ScaraGeometry`
+            (a 3-joint SCARA: the region of its tool point; ``lower``/``upper`` then take 3 values, no yaw).
         lower: lower joint limits in q order replacing the model's (e.g. a software range) [rad, m].
         upper: upper joint limits in q order replacing the model's [rad, m].
         yaw: a fixed tool yaw [rad]: the region is then the tool point's at that yaw (needs J4 to span at
@@ -501,6 +502,11 @@ def workspace(
             or a yaw with J4 limited to less than a turn and a tool offset.
     """
     geo = robot if isinstance(robot, ScaraGeometry) else robot.kinematics.geometry
+    if not isinstance(robot, ScaraGeometry) and robot.dof == 3:  # the virtual wrist (index 3) turns freely
+        if yaw is not None:
+            raise InvalidInputError("a SCARA without a wrist cannot hold a yaw: its workspace is the tool point's")
+        lower = None if lower is None else ([*lower, -math.inf] if len(lower) == 3 else lower)
+        upper = None if upper is None else ([*upper, math.inf] if len(upper) == 3 else upper)
     if lower is not None or upper is not None:
         lo = tuple(float(v) for v in (geo.lower if lower is None else lower))
         hi = tuple(float(v) for v in (geo.upper if upper is None else upper))

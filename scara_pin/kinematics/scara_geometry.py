@@ -1,0 +1,319 @@
+"""The SCARA's geometry, read from the Pinocchio model: the numbers every SCARA closed form uses.
+
+Every joint axis is vertical in the ``base`` frame. Rotations about vertical axes commute with vertical
+translations, so with the product of exponentials at the zero configuration the tool pose is
+
+    p_xy(q) = A1 + R(phi1) [u1 + R(phi2) [u2 + R(phi4) t]],   z(q) = z0 + s3 q3,
+    yaw(q) = yaw0 + phi1 + phi2 + phi4,                          phi_i = s_i q_i,
+
+where A1 is the shoulder axis (first revolute joint), u1 and u2 the plan-view vectors from it to the
+elbow axis and from the elbow to the wrist axis (third revolute joint), t the tool point's offset from
+the wrist axis, s_i = +/-1 each axis' direction (+z up), and R(phi) a rotation by phi about z; all at
+q = 0. The prismatic joint may sit anywhere in the chain. Arm lengths l1 = |u1|, l2 = |u2|; the zero
+offsets beta1 = atan2(u1), beta2 = atan2(u2) allow arms that are not stretched along +x at q = 0.
+
+Branches (as on industrial controllers' lefty/righty arms): ``right``: the elbow turns counterclockwise
+seen from above (sin gamma > 0, gamma the elbow angle from arm 1 to arm 2), like a human right arm seen
+from above, elbow out to the right; ``left``: the mirror image (:func:`branch_of`).
+
+The closed form on this geometry is :mod:`scara_pin.kinematics.scara` (one target) and
+:mod:`scara_pin.kinematics.scara_batch` (N targets, vectorised).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, overload
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import ParameterError, UrdfError
+from .planar2r import (
+    LIMIT_TOL,
+    REACH_TOL,
+    TWO_PI,
+    Planar2R,
+    turner,
+    wrap,
+)
+
+if TYPE_CHECKING:
+    from .._typing import ArrayLike
+    from ..model import Robot
+
+__all__ = [
+    "BRANCHES",
+    "EXACT_TILT",
+    "NEAR_PARALLEL_TOL",
+    "YAW_POSE_TOL",
+    "IKStatus",
+    "NotScaraError",
+    "ScaraGeometry",
+    "branch_of",
+    "wrist_point",
+]
+
+YAW_POSE_TOL = 1e-9
+"""[rad] the largest tilt of a target rotation still taken as a pure yaw."""
+NEAR_PARALLEL_TOL = 1e-2
+"""[rad] the largest angle between a joint axis and the base z axis for a SCARA: beyond EXACT_TILT the
+axes are near-parallel (pi written as 3.14 in an rpy) and the closed form's solutions are refined on the
+model (:mod:`scara_pin.kinematics.polish`)."""
+EXACT_TILT = 1e-12
+"""[rad] a model whose axes tilt less than this is solved by the closed form alone (no refinement)."""
+BRANCHES = ("right", "left")
+"""The SCARA's elbow branches, in the order solutions are listed."""
+
+_sin, _cos = math.sin, math.cos
+
+
+class NotScaraError(UrdfError):
+    """The model is not a SCARA the closed form can solve (the reason names the joint)."""
+
+
+class IKStatus(enum.IntEnum):
+    """Why a target has (or has no) solution. Stable codes: the names are part of the interface."""
+
+    OK = 0
+    OUT_OF_REACH = 1
+    INSIDE_INNER_LIMIT = 2
+    J1_LIMIT = 3
+    J2_LIMIT = 4
+    J3_STROKE = 5
+    J4_LIMIT = 6
+    NOT_A_YAW_POSE = 7
+    NOT_REFINED = 8
+    """Near-parallel axes: the closed form's seed did not converge on the model, or left its branch."""
+
+
+@dataclass(frozen=True)
+class ScaraGeometry:
+    """The SCARA geometry read from a Pinocchio model (see the module docstring for the symbols).
+
+    Attributes:
+        revolute: indices in q of the shoulder, elbow and wrist joints (chain order).
+        prismatic: index in q of the vertical joint.
+        names: joint names in q order.
+        signs: per q index, +1 when the axis (or the prismatic direction) is base +z, -1 for -z.
+        a1: (x, y) of the shoulder axis in the base frame [m].
+        u1, u2: plan-view vectors shoulder -> elbow axis and elbow -> wrist axis at q = 0 [m].
+        tool: plan-view offset of the tool point from the wrist axis at q = 0 [m].
+        z0: tool z at q = 0 [m]. yaw0: tool yaw at q = 0 [rad].
+        R0: tool rotation in the base frame at q = 0.
+        lower, upper: joint limits in q order (a continuous joint: -inf, inf).
+        continuous: per joint in q order, whether it is continuous (no limits).
+        arm: the planar two-link arm (l1, l2).
+        tilt: the largest angle between a joint axis of the model and the base z axis [rad] (0 for the
+            ideal geometry; up to NEAR_PARALLEL_TOL: the closed form seeds a refinement on the model).
+    """
+
+    revolute: tuple[int, int, int]
+    prismatic: int
+    names: tuple[str, ...]
+    signs: tuple[float, ...]
+    a1: tuple[float, float]
+    u1: tuple[float, float]
+    u2: tuple[float, float]
+    tool: tuple[float, float]
+    z0: float
+    yaw0: float
+    R0: np.ndarray
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    continuous: tuple[bool, ...] = (False, False, False, False)
+    tilt: float = 0.0
+    l1: float = field(init=False)
+    l2: float = field(init=False)
+    beta1: float = field(init=False)
+    beta2: float = field(init=False)
+    arm: Planar2R = field(init=False, repr=False, compare=False)
+    _radius: tuple[float, float] = field(init=False, repr=False, compare=False)
+    _k: tuple[Any, ...] = field(init=False, repr=False, compare=False)
+    _turn: tuple[Any, ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "l1", math.hypot(*self.u1))
+        object.__setattr__(self, "l2", math.hypot(*self.u2))
+        object.__setattr__(self, "beta1", math.atan2(self.u1[1], self.u1[0]))
+        object.__setattr__(self, "beta2", math.atan2(self.u2[1], self.u2[0]))
+        object.__setattr__(self, "arm", Planar2R(self.l1, self.l2))
+        for i, name in enumerate(self.names):
+            lo, hi = self.lower[i], self.upper[i]
+            if self.continuous[i]:
+                continue
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+                raise ParameterError(f"limits of {name}", (lo, hi), "must be finite numbers with lower <= upper")
+        object.__setattr__(self, "_radius", self._radius_range())
+        # the numbers the per-call path reads, unpacked once per call (the geometry is frozen)
+        ra, rb, rc = self.revolute
+        ip = self.prismatic
+        s, lower, upper = self.signs, self.lower, self.upper
+        object.__setattr__(self, "_k", (
+            ra, rb, rc, ip, s[ra], s[rb], s[rc], s[ip], lower[ip] - LIMIT_TOL, upper[ip] + LIMIT_TOL,
+            self.z0, self.a1[0], self.a1[1], self.tool[0], self.tool[1], self._radius[0] - REACH_TOL,
+            self.beta1, self.beta2 - self.beta1,
+        ))  # fmt: skip
+        # each joint's turn choice with its limits bound (planar2r.turner), in q order (None: prismatic)
+        object.__setattr__(self, "_turn", tuple(turner(lower[j], upper[j], self.continuous[j]) if j != ip else None
+                                                for j in range(4)))  # fmt: skip
+
+    @classmethod
+    def from_robot(cls, robot: Robot) -> ScaraGeometry:
+        """Read the geometry from a loaded robot; raise :class:`NotScaraError` naming what is wrong.
+
+        Axes up to ``NEAR_PARALLEL_TOL`` from the base z axis are accepted: the geometry is then the ideal
+        vertical-axis one read at q = 0 (plan-view positions of the axes), ``tilt`` says how far the model
+        departs from it, and :mod:`scara_pin.kinematics.polish` refines the closed form on the model.
+        """
+        return cls._read(robot, wrist=True)
+
+    @classmethod
+    def without_wrist(cls, robot: Robot) -> ScaraGeometry:
+        """The geometry of a 3-joint SCARA (two revolute joints and one prismatic, in any order, no wrist).
+
+        It is read as a 4-joint SCARA whose wrist, virtual and continuous, is index 3 of q and turns about
+        the tool point (tool offset 0): arm 2 runs from the elbow axis to the tool point. The closed form
+        and the workspace then apply unchanged; the virtual wrist's value is the tool's free yaw, dropped
+        by :class:`scara_pin.kinematics.scara3_kinematics.Scara3Kinematics`.
+        """
+        return cls._read(robot, wrist=False)
+
+    @classmethod
+    def _read(cls, robot: Robot, wrist: bool) -> ScaraGeometry:
+        model = robot.model
+        data = model.createData()
+        names = tuple(model.names[j] for j in range(1, model.njoints))
+        n = 4 if wrist else 3
+        if model.njoints - 1 != n:
+            raise NotScaraError(f"a SCARA has {n} joints; this model has {model.njoints - 1}: {', '.join(names)}")
+        for j in range(2, model.njoints):
+            if model.parents[j] != j - 1:
+                raise NotScaraError(f"joint {model.names[j]} does not follow {model.names[j - 1]}: not a serial chain")
+        tool_parent = model.frames[robot.tool_id].parentJoint
+        if tool_parent != model.njoints - 1:
+            raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint {names[-1]}")
+        q0 = pin.neutral(model)  # q = 0 (a continuous joint's (cos, sin) = (1, 0))
+        pin.computeJointJacobians(model, data, q0)
+        pin.updateFramePlacements(model, data)
+        oMb = data.oMf[robot.base_id]
+        Rbo = oMb.rotation.T
+        revolute: list[int] = []
+        prismatic: list[int] = []
+        signs = [0.0] * 4
+        points: dict[int, np.ndarray] = {}
+        worst = 0.0
+        for j in range(1, model.njoints):
+            jm = model.joints[j]
+            name = model.names[j]
+            continuous = jm.nq == 2 and jm.nv == 1 and robot.continuous[j - 1]
+            if (jm.nq != 1 and not continuous) or jm.nv != 1:
+                raise NotScaraError(f"joint {name} ({jm.shortname()}) has nq = {jm.nq}, nv = {jm.nv}; "
+                                    "a SCARA's joints are single-DOF revolute or prismatic")  # fmt: skip
+            col = pin.getJointJacobian(model, data, j, pin.LOCAL_WORLD_ALIGNED)[:, jm.idx_v]
+            lin, ang = Rbo @ col[:3], Rbo @ col[3:]
+            if np.linalg.norm(lin) < 1e-12 and abs(np.linalg.norm(ang) - 1) < 1e-12:
+                axis, kind = ang, revolute
+            elif np.linalg.norm(ang) < 1e-12 and abs(np.linalg.norm(lin) - 1) < 1e-12:
+                axis, kind = lin, prismatic
+            else:
+                raise NotScaraError(f"joint {name} ({jm.shortname()}) is neither revolute nor prismatic")
+            tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
+            if tilt > NEAR_PARALLEL_TOL:
+                raise NotScaraError(
+                    f"joint {name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
+                    f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
+                )
+            worst = max(worst, tilt)
+            signs[j - 1] = 1.0 if axis[2] > 0 else -1.0
+            kind.append(j - 1)
+            points[j - 1] = oMb.actInv(data.oMi[j]).translation
+        if len(revolute) != n - 1 or len(prismatic) != 1:
+            kinds = ", ".join(f"{n} ({'revolute' if i in revolute else 'prismatic'})" for i, n in enumerate(names))
+            raise NotScaraError(f"a SCARA has {n - 1} revolute joints and 1 prismatic joint; this model has {kinds}")
+        bMt = oMb.actInv(data.oMf[robot.tool_id])
+        if not wrist:  # the virtual wrist: index 3, on the tool point, continuous, +z
+            revolute.append(3)
+            points[3] = bMt.translation
+            signs[3] = 1.0
+        ra, rb, rc = revolute
+        a1, a2, a4 = points[ra][:2], points[rb][:2], points[rc][:2]
+        u1, u2, t = a2 - a1, a4 - a2, bMt.translation[:2] - a4
+        wrist_name = names[rc] if wrist else f"the tool point ({robot.tool_frame})"
+        for vec, what in ((u1, f"{names[rb]}'s axis coincides with {names[ra]}'s"),
+                          (u2, f"{wrist_name} lies on {names[rb]}'s axis")):  # fmt: skip
+            if math.hypot(*vec) < 1e-9:
+                raise NotScaraError(f"{what}: the arm has no length")
+        R0 = bMt.rotation.copy()
+        if math.hypot(R0[0, 0], R0[1, 0]) < 1e-6:
+            raise NotScaraError("the tool frame's x axis is vertical at q = 0: its yaw is undefined")
+        cont = tuple(robot.continuous) + (() if wrist else (True,))
+        return cls(
+            revolute=(ra, rb, rc),
+            prismatic=prismatic[0],
+            names=names if wrist else (*names, "(no wrist)"),
+            signs=tuple(signs),
+            a1=(float(a1[0]), float(a1[1])),
+            u1=(float(u1[0]), float(u1[1])),
+            u2=(float(u2[0]), float(u2[1])),
+            tool=(float(t[0]), float(t[1])),
+            z0=float(bMt.translation[2]),
+            yaw0=math.atan2(R0[1, 0], R0[0, 0]),
+            R0=R0,
+            # continuous joints have no limits; others: the model's limits
+            lower=tuple(-math.inf if cont[i] else float(model.lowerPositionLimit[model.joints[i + 1].idx_q])
+                        for i in range(4)),
+            upper=tuple(math.inf if cont[i] else float(model.upperPositionLimit[model.joints[i + 1].idx_q])
+                        for i in range(4)),
+            continuous=cont,
+            tilt=worst,
+        )  # fmt: skip
+
+    # ---------------------------------------------------------------------------------------- derived
+    @overload
+    def elbow_angle(self, q_elbow: float) -> float: ...
+
+    @overload
+    def elbow_angle(self, q_elbow: np.ndarray) -> np.ndarray: ...
+
+    def elbow_angle(self, q_elbow: float | np.ndarray) -> float | np.ndarray:
+        """Gamma (angle from arm 1 to arm 2, counterclockwise from above) at an elbow joint value (or array)."""
+        return self.signs[self.revolute[1]] * q_elbow + self.beta2 - self.beta1
+
+    def radius_range(self) -> tuple[float, float]:
+        """(r_min, r_max) of the wrist axis from the shoulder axis allowed by the elbow's limits [m]."""
+        return self._radius
+
+    def _radius_range(self) -> tuple[float, float]:
+        # r(gamma) falls as |gamma| grows to pi: r_min from the allowed gamma nearest pi, r_max nearest 0
+        e = self.revolute[1]
+        arm = self.arm
+        if self.continuous[e] or self.upper[e] - self.lower[e] >= TWO_PI:
+            return arm.d12, arm.l12
+        g_lo, g_hi = sorted((self.elbow_angle(self.lower[e]), self.elbow_angle(self.upper[e])))
+
+        def reaches(angle: float) -> bool:  # some angle + 2 pi k inside [g_lo, g_hi]
+            return angle + math.ceil((g_lo - angle) / TWO_PI) * TWO_PI <= g_hi
+
+        r_max = arm.l12 if reaches(0.0) else max(arm.radius(g_lo), arm.radius(g_hi))
+        r_min = arm.d12 if reaches(math.pi) else min(arm.radius(g_lo), arm.radius(g_hi))
+        return r_min, r_max
+
+
+def branch_of(geo: ScaraGeometry, q: ArrayLike) -> str:
+    """The branch (``"right"``/``"left"``) of a configuration: the sign of sin(gamma); ``right`` at gamma = 0."""
+    g = wrap(geo.elbow_angle(float(q[geo.revolute[1]])))
+    if abs(g) < 1e-12:
+        return "right"
+    return "right" if 0.0 < g < math.pi else "left"
+
+
+def wrist_point(geo: ScaraGeometry, x: float, y: float, alpha: float) -> tuple[float, float]:
+    """W = p - R(alpha) t - A1: the wrist axis relative to the shoulder axis for a tool at (x, y), yaw0 + alpha."""
+    tx, ty = geo.tool
+    ca, sa = _cos(alpha), _sin(alpha)
+    return x - (ca * tx - sa * ty) - geo.a1[0], y - (sa * tx + ca * ty) - geo.a1[1]
+
+
