@@ -6,13 +6,14 @@ enforced. Cycle = out and back (the back move of every planner here is the rever
 
 (a) **Optimality.** For several robots (default, s1, the palletizer) and placements, with velocity and
     acceleration limits, then with jerk limits: ours (``jump_move``, the defaults, median compute time of 3
-    runs) against an INDEPENDENT minimum written here: another transcription -- SINGLE shooting (every
-    state an explicit expression of the controls; ours is multiple shooting with states as variables),
-    piecewise-constant controls on a grid 2.4 times finer (24 / 36 / 24 intervals; 32 / 48 / 32 with a jerk
-    limit), the clearance at every node and interval midpoint, no tie-breaking terms, no refinement,
-    warm-started from zero controls -- solved by IPOPT. (A transcription with continuous piecewise-linear
-    controls was tried first: it cannot switch a bang-bang control inside an interval and stayed 0.4 %
-    above ours at 4 times our grid, 15 minutes per jerk-limited solve.) Its tool position and torques are
+    runs) against an INDEPENDENT minimum written here: its own transcription, on a grid 3 times finer
+    (30 / 42 / 30 intervals; 48 / 72 / 48 with a jerk limit), piecewise-constant controls (the class that
+    holds a bang-bang solution), every bound written at the start, the middle and the end of every interval
+    (no convex-hull bounds, no refinement, no tie-breaking terms), the clearance at every node and interval
+    midpoint, warm-started from its own joint lines -- solved by IPOPT. (Two other transcriptions were
+    tried and dropped: continuous piecewise-linear controls cannot switch a bang-bang control inside an
+    interval and stayed 0.4 % above ours at 4 times our grid, 15 minutes per jerk-limited solve; single
+    shooting made CasADi's exact Hessian of the torques explode.) Its tool position and torques are
     the CasADi expressions of :mod:`scara_pin.motion.symbolic` (equal to Pinocchio's to 1e-12:
     tests/test_jump.py). Every reference solution is then checked DENSELY, by Pinocchio at 20 kHz: its
     worst limit ratio and its worst miss of the clearance are printed (a reference that bends a limit
@@ -43,8 +44,8 @@ from scara_pin.motion.symbolic import symbolic_model
 
 JERK = {"default": [20000.0, 40000.0, 2000.0, 100000.0], "s1": [100.0, 100.0, 5.0, 200.0],
         "palletizer": [20.0, 20.0, 20.0, 60.0]}  # fmt: skip
-REF_GRID = (24, 36, 24)
-REF_GRID_JERK = (32, 48, 32)
+REF_GRID = (30, 42, 30)
+REF_GRID_JERK = (48, 72, 48)
 CHECK_RATE = 20_000.0
 
 
@@ -82,10 +83,17 @@ def reference(robot, A, B, q0, q1, rise, jerk=None):
     lo, hi = np.array(lim.lower), np.array(lim.upper)
     jmax = None if jerk is None else np.asarray(jerk, dtype=float)
     umax = a if jmax is None else jmax
+    order = 2 if jmax is None else 3  # states (q, v) or (q, v, a) at the nodes
     sym = symbolic_model(robot)
     n = sum(N)
     T = ca.SX.sym("T", 3)
-    U = ca.SX.sym("U", 4, n)  # the control over its limit, constant on each interval
+    X = ca.SX.sym("X", 4 * order, n + 1)
+    U = ca.SX.sym("U", 4, n)
+    scale = np.concatenate([v * 0.1, v, a][:order])
+    Xs = ca.repmat(ca.DM(scale), 1, n + 1) * X
+    Us = ca.repmat(ca.DM(umax), 1, n) * U
+    st = [Xs[4 * i : 4 * i + 4, :] for i in range(order)]
+    H = ca.repmat(ca.horzcat(*[ca.repmat(T[p] / N[p], 1, N[p]) for p in range(3)]), 4, 1)
     g, lb, ub = [], [], []
 
     def add(e, lo_, hi_):
@@ -94,58 +102,70 @@ def reference(robot, A, B, q0, q1, rise, jerk=None):
         lb.append(np.full(e.shape[0], lo_))
         ub.append(np.full(e.shape[0], hi_))
 
-    # single shooting: every state is an explicit expression of the controls (no state variables)
-    hs = [T[p] / N[p] for p in np.repeat(np.arange(3), N)]
-    q, vv, aa = ca.DM(q0), ca.DM.zeros(4), ca.DM.zeros(4)
-    nodes, mids = [(q, vv, aa, 0)], []
-    for k in range(n):
-        u = U[:, k] * ca.DM(umax)
-        for frac, store in ((0.5, mids), (1.0, nodes)):
-            s = hs[k] * frac
-            if jmax is None:
-                st = (q + vv * s + u * s**2 / 2, vv + u * s, u)
-            else:
-                st = (q + vv * s + aa * s**2 / 2 + u * s**3 / 6, vv + aa * s + u * s**2 / 2, aa + u * s)
-            store.append((*st, k))
-        q, vv, aa = nodes[-1][:3]
-        if jmax is None:  # the torque on both sides of the node (the acceleration steps there)
-            add(sym.inverse_dynamics(nodes[-2][0], nodes[-2][1], u) / ca.DM(eff), -1.0, 1.0)
-            add(sym.inverse_dynamics(q, vv, u) / ca.DM(eff), -1.0, 1.0)
-    add(q - ca.DM(q1), 0.0, 0.0)
-    add(vv / ca.DM(v), 0.0, 0.0)
-    if jmax is not None:
-        add(aa / ca.DM(a), 0.0, 0.0)
+    def at(frac):  # (q, v, a) at a fraction of every interval, from its start state and constant control
+        s = H * frac
+        q, vv = st[0][:, :-1], st[1][:, :-1]
+        if jmax is None:
+            return q + vv * s + Us * s**2 / 2, vv + Us * s, Us
+        aa = st[2][:, :-1]
+        return q + vv * s + aa * s**2 / 2 + Us * s**3 / 6, vv + aa * s + Us * s**2 / 2, aa + Us * s
+
+    end = at(1.0)
+    for i in range(order):
+        add((end[i] - st[i][:, 1:]) / ca.repmat(ca.DM(scale[4 * i : 4 * i + 4]), 1, n), 0.0, 0.0)
     top = max(A[2], B[2]) + rise
-    bounds = (N[0], N[0] + N[1])
-    for i, (qq, vq, aq, k) in enumerate(nodes + mids):
-        node = i < len(nodes)
-        kk = i if node else k
-        phases = ((kk <= bounds[0], bounds[0] <= kk <= bounds[1], kk >= bounds[1]) if node
-                  else (k < bounds[0], bounds[0] <= k < bounds[1], k >= bounds[1]))  # fmt: skip
-        p = sym.tool_position(qq)
-        for ph, c in ((0, A), (2, B)):
-            if phases[ph]:
-                add(((p[0] - c[0]) ** 2 + (p[1] - c[1]) ** 2) / STANDARD_CLEARANCE**2, -np.inf, 1.0)
-        if phases[1]:
-            add((p[2] - top) / rise, 0.0, np.inf)
-        add(vq / ca.DM(v), -1.0, 1.0)
-        add((qq - ca.DM(lo)) / ca.DM(hi - lo), 0.0, 1.0)
-        if jmax is not None:
-            add(aq / ca.DM(a), -1.0, 1.0)
-            add(sym.inverse_dynamics(qq, vq, aq) / ca.DM(eff), -1.0, 1.0)
-    # its own warm start: the durations of joint lines A -> above A -> above B -> B, zero controls
-    tops = [robot.ik(np.array([P[0], P[1], top, P[3]])).nearest(qq).q for P, qq in ((A, q0), (B, q1))]
+    k = np.arange(n + 1)
+    node_phase = [k <= N[0], (k >= N[0]) & (k <= N[0] + N[1]), k >= N[0] + N[1]]
+    interval_phase = [np.repeat(np.arange(3), N) == p for p in range(3)]
+    # each interval's start: its acceleration is its own control (acceleration control) or the state (jerk control)
+    start = (st[0][:, :-1], st[1][:, :-1], Us if jmax is None else st[2][:, :-1])
+    for (q, vv, acc), phases in ((start, interval_phase), (end, interval_phase), (at(0.5), interval_phase),
+                                 ((st[0], st[1], None), node_phase)):  # fmt: skip
+        m = q.shape[1]
+        if acc is None:  # the nodes: the clearance of each node's phase(s)
+            p = sym.tool_position.map(m)(q)
+            for ph, c in ((0, A), (2, B)):
+                cols = np.nonzero(phases[ph])[0].tolist()
+                add(((p[0, cols] - c[0]) ** 2 + (p[1, cols] - c[1]) ** 2) / STANDARD_CLEARANCE**2, -np.inf, 1.0)
+            add((p[2, np.nonzero(phases[1])[0].tolist()] - top) / rise, 0.0, np.inf)
+            continue
+        add(vv / ca.repmat(ca.DM(v), 1, m), -1.0, 1.0)
+        add(acc / ca.repmat(ca.DM(a), 1, m), -1.0, 1.0)
+        add((q - ca.repmat(ca.DM(lo), 1, m)) / ca.repmat(ca.DM(hi - lo), 1, m), 0.0, 1.0)
+        add(sym.inverse_dynamics.map(m)(q, vv, acc) / ca.repmat(ca.DM(eff), 1, m), -1.0, 1.0)
+    p = sym.tool_position.map(n)(at(0.5)[0])  # the interval midpoints: the clearance of their phase
+    for ph, c in ((0, A), (2, B)):
+        cols = np.nonzero(interval_phase[ph])[0].tolist()
+        add(((p[0, cols] - c[0]) ** 2 + (p[1, cols] - c[1]) ** 2) / STANDARD_CLEARANCE**2, -np.inf, 1.0)
+    add((p[2, np.nonzero(interval_phase[1])[0].tolist()] - top) / rise, 0.0, np.inf)
+    lbx = np.full((4 * order, n + 1), -np.inf)
+    ubx = np.full((4 * order, n + 1), np.inf)
+    for col, q in ((0, q0), (n, q1)):
+        lbx[:, col] = ubx[:, col] = 0.0
+        lbx[:4, col] = ubx[:4, col] = q / scale[:4]
+    # its own warm start: joint lines A -> above A -> above B -> B, quintic in time over a guessed duration
+    tops = [robot.ik(np.array([P[0], P[1], top, P[3]])).nearest(q).q for P, q in ((A, q0), (B, q1))]
     legs = (q0, tops[0], tops[1], q1)
     Tg = np.array([max(np.max(np.abs(legs[i + 1] - legs[i]) / v) * 2.0, 0.05) for i in range(3)])
-    nlp = {"x": ca.vertcat(T, ca.vec(U)), "f": ca.sum1(T), "g": ca.vertcat(*g)}
+    x0 = np.zeros((4 * order, n + 1))
+    col = 0
+    for ph in range(3):
+        x = np.linspace(0.0, 1.0, N[ph] + 1)[(1 if ph else 0) :]
+        dq = legs[ph + 1] - legs[ph]
+        x0[:4, col : col + len(x)] = (legs[ph][:, None] + dq[:, None] * (10 * x**3 - 15 * x**4 + 6 * x**5)) / scale[
+            :4, None]
+        col += len(x)
+    nlp = {"x": ca.vertcat(T, ca.vec(X), ca.vec(U)), "f": ca.sum1(T), "g": ca.vertcat(*g)}
     solver = ca.nlpsol("ref", "ipopt", nlp, {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False,
                                              "ipopt.tol": 1e-9, "ipopt.max_iter": 3000})  # fmt: skip
-    sol = solver(x0=np.concatenate([Tg, np.zeros(4 * n)]), lbx=np.r_[[1e-3] * 3, -np.ones(4 * n)],
-                 ubx=np.r_[[100.0] * 3, np.ones(4 * n)], lbg=np.concatenate(lb), ubg=np.concatenate(ub))  # fmt: skip
+    sol = solver(x0=np.concatenate([Tg, x0.ravel(order="F"), np.zeros(4 * n)]),
+                 lbx=np.concatenate([[1e-3] * 3, lbx.ravel(order="F"), -np.ones(4 * n)]),
+                 ubx=np.concatenate([[100.0] * 3, ubx.ravel(order="F"), np.ones(4 * n)]),
+                 lbg=np.concatenate(lb), ubg=np.concatenate(ub))  # fmt: skip
     status = solver.stats()["return_status"]
     seconds = time.perf_counter() - t0
     x = np.array(sol["x"]).ravel()
-    Tsol, Usol = x[:3], x[3:].reshape((n, 4)) * umax
+    Tsol, Usol = x[:3], x[3 + 4 * order * (n + 1) :].reshape((n, 4)) * umax
     check = dense_check(robot, Tsol, Usol, N, q0, A, B, top, jmax)
     return float(Tsol.sum()), seconds, status, check
 

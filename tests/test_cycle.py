@@ -22,7 +22,7 @@ import pytest
 from scara_pin import load_robot
 from scara_pin.cli import main
 from scara_pin.motion.cycle import STANDARD_RISE, STANDARD_SPAN, standard_cycle, trajectory_jerk
-from scara_pin.motion.jerk import FilteredLaw
+from scara_pin.motion.jerk import JerkLaw
 from scara_pin.motion.payload import Payload
 from scara_pin.motion.timing import TimingOptions
 
@@ -107,7 +107,7 @@ def _check_times(traj):
     t = [np.arange(0.0, traj.duration, 1e-3)]
     t0 = 0.0
     for m in traj.pieces:
-        assert isinstance(m.law, FilteredLaw)
+        assert isinstance(m.law, JerkLaw)
         bp = m.law.breakpoints()
         t += [t0 + bp, t0 + bp[:-1] + np.diff(bp) * (1 - 1e-9)]
         t0 += m.duration

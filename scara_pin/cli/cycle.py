@@ -15,6 +15,7 @@ from ._common import (
     _add_acceleration,
     _add_robot_options,
     _add_units,
+    _jerk,
     _load,
     _needs_wrist,
     _number,
@@ -34,17 +35,6 @@ def _payload(args: argparse.Namespace, units: Units) -> Any:
     if args.payload_com is not None:
         com = tuple(_number(f"--payload-com {n}", v) / units.length for n, v in zip("XYZ", args.payload_com))
     return Payload(mass, com)  # type: ignore[arg-type]
-
-
-def _jerk(args: argparse.Namespace) -> list[float] | None:
-    if args.jerk_limit is None:
-        return None
-    if len(args.jerk_limit) not in (1, 4):
-        raise ParameterError("--jerk-limit", " ".join(args.jerk_limit), "must be one number or 4 (one per joint)")
-    values = [_number("--jerk-limit", v) for v in args.jerk_limit]
-    if not all(v > 0 for v in values):
-        raise ParameterError("--jerk-limit", values, "must be > 0", "rad/s^3 or m/s^3")
-    return values * 4 if len(values) == 1 else values
 
 
 def cmd_cycle(args: argparse.Namespace) -> int:

@@ -18,6 +18,7 @@ from ._common import (
     _add_robot_options,
     _add_units,
     _fmt,
+    _jerk,
     _joint_arg,
     _load,
     _needs_wrist,
@@ -84,6 +85,9 @@ def cmd_traj(args: argparse.Namespace) -> int:
         if args.duration is not None:
             raise InvalidInputError("--arch is time-optimal: --duration does not apply")
     L = units.length
+    jerk = _jerk(args)
+    if jerk is not None and robot.dof != 4:
+        raise InvalidInputError("--jerk-limit needs a 4-joint robot for now")
     request = MotionRequest(
         start_q=q_from, end_q=_joint_arg(robot, args.to_q, units, "--to") if args.to_q else None,
         start_pose=None if pose_from is None else np.array(pose_from),
@@ -91,6 +95,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
         linear=args.linear, arch=args.arch, tool_speed=tool_speed, torque=args.torque, payload=_payload(args, units),
         rise=None if args.rise is None else _number("--rise", args.rise) / L,
         blend=None if args.blend is None else _number("--blend", args.blend) / L,
+        jerk=None if jerk is None else tuple(jerk),
         path=args.path or "jump",
         clearance_radius=None if args.clearance_radius is None else _number("--clearance-radius",
                                                                              args.clearance_radius) / L,
@@ -267,8 +272,8 @@ def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) ->
     tool_speed = None if args.tool_speed is None else args.tool_speed / units.length
     try:
         return jump_move(robot, robot.tool_pose(q0), robot.tool_pose(q1), rise=rise, max_height=ceiling,
-                         payload=move.payload, torque=args.torque, tool_speed=tool_speed, start=q0,
-                         end=q1).duration  # fmt: skip
+                         payload=move.payload, torque=args.torque, tool_speed=tool_speed, start=q0, end=q1,
+                         jerk=move.jerk).duration  # fmt: skip
     except ScaraError:
         return None
 
@@ -335,6 +340,8 @@ def register(sub: Any) -> None:
     g.add_argument("--tool-speed", type=number_type("--tool-speed"), metavar="V",
                    help="also limit the tool speed [m/s, or mm/s with --mm]")  # fmt: skip
     g.add_argument("--torque", action="store_true", help="also respect the effort limits (RNEA, URDF inertias)")
+    g.add_argument("--jerk-limit", nargs="+", metavar="J",
+                   help="joint jerk limit, one or 4 (rad/s^3, m/s^3): jerk-limited time-optimal timing")  # fmt: skip
     g.add_argument("--strict", action="store_true", help="refuse (exit 3) a --duration that exceeds a limit")
     g.add_argument("--payload", metavar="KG", help="payload at the tool, for --torque (and --arch) [kg]")
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")

@@ -43,12 +43,13 @@ import numpy as np
 
 from .._checks import _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from .jerk import jerk_limited, joint_jerk
+from .jerk import jerk_limited
 from .jump import STANDARD_CLEARANCE, STANDARD_RISE, JumpMove, JumpOptions, Leg, LowerBound, jump_move, lower_bound
 from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
 from .payload import Payload, with_payload
-from .timing import TimingOptions, _limits, _rnea, parameterize
+from .timing import TimingOptions, _limits, parameterize
 from .trajectory import Motion, Trajectory
+from .verify import state_ratios, trajectory_jerk
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -527,27 +528,8 @@ def _legs(
 def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: np.ndarray | None) -> dict[str, Any]:
     """|value| / limit per sample and joint, per quantity."""
     q, qd, qdd = traj.sample(t)
-    out = {"velocity": np.abs(qd) / lim.velocity, "acceleration": np.abs(qdd) / lim.acceleration}
-    if lim.effort is not None:
-        out["torque"] = np.abs(_rnea(robot, q, qd, qdd)) / lim.effort
-    if jerk is not None:
-        out["jerk"] = np.abs(trajectory_jerk(traj, t)) / jerk
-    return out
-
-
-def trajectory_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
-    """Joint jerk (n, 4) of a trajectory of motions at times t (zero at rest outside)."""
-    t = np.asarray(t, dtype=float)
-    out = np.zeros((len(t), 4))
-    t0 = 0.0
-    for p in traj.pieces:
-        if not isinstance(p, Motion):
-            raise InvalidInputError("jerk needs a trajectory of motions")
-        sel = (t >= t0) & (t <= t0 + p.duration)
-        if sel.any():
-            out[sel] = joint_jerk(p, t[sel] - t0)
-        t0 += p.duration
-    return out
+    qddd = None if jerk is None else trajectory_jerk(traj, t)
+    return {k.value: v for k, v in state_ratios(robot, lim, q, qd, qdd, qddd, jerk).items()}
 
 
 # ---------------------------------------------------------------------------------------------- the cycle

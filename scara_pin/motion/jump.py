@@ -74,8 +74,18 @@ from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
 from .payload import Payload, with_payload
 from .polynomial import PolynomialPiece
-from .timing import _limits, _rnea
 from .trajectory import Trajectory, line_optimal_duration
+from .verify import (
+    ENDPOINT_TOL,
+    TOLERANCE,
+    VERIFY_RATE,
+    LimitViolation,
+    _limits,
+    _rnea,
+    jerk_vector,
+    state_ratios,
+    verify,
+)
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -86,7 +96,6 @@ if TYPE_CHECKING:
 __all__ = [
     "STANDARD_CLEARANCE",
     "STANDARD_RISE",
-    "VERIFY_RATE",
     "Binding",
     "JumpError",
     "JumpMove",
@@ -105,14 +114,8 @@ STANDARD_RISE = 0.025
 """[m] the vertical stroke of the standard cycle, and the default rise of a jump."""
 STANDARD_CLEARANCE = 0.005
 """[m] the default clearance radius R: within R of an endpoint (horizontally) the tool may be low."""
-VERIFY_RATE = 10_000.0
-"""[Hz] the rate at which every output is verified (besides its breakpoints)."""
-TOLERANCE = 1e-6
-"""Relative excess of a limit the verification accepts (a ratio up to 1 + 1e-6)."""
 CLEARANCE_TOL = 1e-6
 """[m] how far below z_top (outside both circles), or above the ceiling, the verified tool may be."""
-ENDPOINT_TOL = 1e-9
-"""[m] the largest distance between the tool at the ends (Pinocchio's FK) and the poses asked for."""
 BINDING = 0.999
 """A limit is binding on a leg where its ratio reaches this."""
 _CHECK_POINTS = 32
@@ -165,7 +168,8 @@ class JumpOptions:
 
     Attributes:
         intervals: (lift, traverse, descend) interval counts; None: (10, 14, 10) under acceleration control,
-            (16, 24, 16) with a jerk limit (within 0.1 % of the converged minimum on the standard cycle).
+            (16, 24, 16) with a jerk limit (within 0.1 % of the converged minimum on the standard cycle), the
+            traverse's doubled with a tool-speed limit.
         tolerance: IPOPT's convergence tolerance (scaled problem).
         max_iterations: per solve.
         refinements: at most this many re-solves with constraints added inside intervals.
@@ -374,6 +378,9 @@ class _Problem:
 
     robot: Robot
     sym: SymbolicModel
+    base: Robot
+    payload: Payload
+    limits: JointLimits | None
     A: np.ndarray
     B: np.ndarray
     qA: np.ndarray
@@ -634,7 +641,7 @@ def jump_move(
         ceiling = float(_vector("max_height", [max_height], 1)[0])
     payload = Payload() if payload is None else payload
     lim = _limits(robot, limits, tool_speed, torque)
-    jv = None if jerk is None else _jerk_vector(jerk)
+    jv = None if jerk is None else jerk_vector(jerk)
     D = float(np.hypot(*(B[:2] - A[:2])))
     if D <= 2.0 * R:
         raise InvalidInputError(f"the poses are {D:.6g} m apart horizontally, not more than twice the clearance "
@@ -657,12 +664,11 @@ def jump_move(
         _holds_still(loaded, (qA, qB, *tops), lim.effort)
     from .symbolic import symbolic_model
 
-    N = options.intervals if options.intervals is not None else ((10, 14, 10) if jv is None else (16, 24, 16))
-    lo, hi = np.array(robot.limits.lower if limits is None else limits.lower), np.array(
-        robot.limits.upper if limits is None else limits.upper)
-    prob = _Problem(loaded, symbolic_model(loaded), A, B, qA, qB, tops, z_top, R, ceiling, lo, hi,
-                    ~np.array(robot.continuous), lim.velocity, lim.acceleration, jv, lim.effort, lim.tool_speed,
-                    N, max(bound.duration / 3.0, 1e-3))  # fmt: skip
+    N = _default_intervals(jv is not None, tool_speed is not None) if options.intervals is None else options.intervals
+    lim_all = robot.limits if limits is None else limits
+    prob = _Problem(loaded, symbolic_model(loaded), robot, payload, limits, A, B, qA, qB, tops, z_top, R, ceiling,
+                    np.array(lim_all.lower), np.array(lim_all.upper), ~np.array(robot.continuous), lim.velocity,
+                    lim.acceleration, jv, lim.effort, lim.tool_speed, N, max(bound.duration / 3.0, 1e-3))  # fmt: skip
     piece, T, stats = _solve(prob, options)
     traj = Trajectory((piece,))
     check = _verify(prob, traj)
@@ -671,14 +677,6 @@ def jump_move(
     return JumpMove(traj, A, B, qA, qB, rise, R, z_top, ceiling, (float(T[0]), float(T[1]), float(T[2])), legs,
                     check.ratios, check.clearance_error, check.peak, check.bulge, payload,
                     None if jv is None else tuple(jv.tolist()), lim.tool_speed, bound, stats)  # fmt: skip
-
-
-def _jerk_vector(jerk: float | ArrayLike) -> np.ndarray:
-    arr = np.atleast_1d(np.asarray(jerk, dtype=float))
-    if arr.shape not in ((1,), (4,)) or not (np.isfinite(arr).all() and (arr > 0).all()):
-        raise ParameterError("jerk", np.asarray(jerk).tolist(), "must be one or 4 finite numbers > 0",
-                             "rad/s^3 or m/s^3")  # fmt: skip
-    return np.broadcast_to(arr, (4,)).astype(float)
 
 
 def _given(robot: Robot, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarray:
@@ -741,6 +739,15 @@ def _quill(robot: Robot, q: np.ndarray) -> int | None:
     row = robot.task_jacobian(q)[2]
     moving = np.abs(row) > 1e-12
     return int(np.argmax(moving)) if moving.sum() == 1 else None
+
+
+def _default_intervals(jerk: bool, tool_speed: bool) -> tuple[int, int, int]:
+    """(lift, traverse, descend) intervals: 10 / 14 / 10, or 16 / 24 / 16 with a jerk limit.
+
+    A tool-speed limit, which binds along the whole traverse, doubles the traverse's (0.6 % shorter there).
+    """
+    lift, traverse = (16, 24) if jerk else (10, 14)
+    return lift, traverse * (2 if tool_speed else 1), lift
 
 
 def _holds_still(robot: Robot, configurations: tuple[np.ndarray, ...], effort: np.ndarray) -> None:
@@ -1005,83 +1012,73 @@ class _Check:
     bulge: float
 
 
-def _verify(prob: _Problem, traj: Trajectory, rate: float = VERIFY_RATE) -> _Check:
-    """Verify by an independent route (Pinocchio's FK and RNEA; module docstring); JumpError if anything fails."""
+def _verify(prob: _Problem, traj: Trajectory) -> _Check:
+    """Verify by independent routes (module docstring); JumpError naming what fails.
+
+    1. The package's verifier (:func:`~scara_pin.motion.verify.verify`): Pinocchio at 10 kHz, the jerk by third
+       differences, the torques with the payload, the tool speed, the endpoints and the rest.
+    2. The same ratios (:func:`~scara_pin.motion.verify.state_ratios`) at every breakpoint on both sides (where
+       the velocity peaks under acceleration control and the acceleration under jerk control), inside every
+       interval and at the polynomial extrema, with the piece's exact jerk.
+    3. The clearance and the ceiling (Pinocchio's FK), the joint ranges, the end poses.
+    """
     piece = traj.pieces[0]
     if not isinstance(piece, PolynomialPiece):  # pragma: no cover - _solve makes them
         raise InvalidInputError("the verification takes a polynomial piece")
+    lim = _limits(prob.base, prob.limits, prob.tool_speed, prob.effort is not None)
+    try:
+        found = verify(prob.base, traj, limits=prob.limits, jerk=prob.jerk, torque=prob.effort is not None,
+                       payload=prob.payload, tool_speed=prob.tool_speed, q_start=prob.qA, q_end=prob.qB).check()
+    except LimitViolation as exc:
+        raise JumpError("VerificationFailed", exc.reason) from None
     T = traj.duration
-    h = 1.0 / rate
-    n_grid = math.ceil(T * rate - 1e-9)
-    grid = np.arange(-3, n_grid + 4) * h
-    b = piece.breaks
+    b = piece.breakpoints()
     dt = np.diff(b)
     ek, es = _extrema(piece)
+    grid = np.arange(math.floor(T * VERIFY_RATE + 1e-9) + 1) / VERIFY_RATE
     inner = (b[:-1, None] + dt[:, None] * (np.arange(1, 8) / 8.0)[None, :]).ravel()
-    extra = np.concatenate([b, b[1:] - 1e-9 * dt, b[:-1] + 1e-9 * dt, inner, b[ek] + es * dt[ek]])
-    t = np.concatenate([grid, extra])
-    on_grid = np.zeros(len(t), dtype=bool)
-    on_grid[3 : 3 + n_grid + 1] = True
-    inside = (t >= 0.0) & (t <= T)
+    t = np.clip(np.concatenate([grid, b, b[1:] - 1e-9 * dt, inner, b[ek] + es * dt[ek]]), 0.0, T)
+    on_grid = np.arange(len(t)) < len(grid)
     q, qd, qdd = traj.sample(t)
-    k = np.clip(np.searchsorted(b, t, side="right") - 1, 0, len(dt) - 1)
-    left = np.isin(np.arange(len(t)), np.arange(len(grid) + len(b), len(grid) + 2 * len(b) - 1))
-    table = {"velocity": np.abs(qd) / prob.velocity, "acceleration": np.abs(qdd) / prob.acceleration}
-    ratios: dict[str, float | None] = {name: None for name in _QUANTITIES}
-    floor = 0.0
-    if prob.jerk is not None:
-        jerk = np.where(inside[:, None], piece.jerk(np.clip(t, 0.0, T)), 0.0)
-        jerk[left] = piece._local(k[left] - 0, t[left] - b[k[left]], 3)
-        table["jerk"] = np.abs(jerk) / prob.jerk
-        qg = q[: len(grid)]
-        d3 = (qg[3:] - 3.0 * qg[2:-1] + 3.0 * qg[1:-2] - qg[:-3]) * rate**3
-        floor = float(np.max(8.0 * np.finfo(float).eps * np.max(np.abs(qg), axis=0) * rate**3 / prob.jerk))
-        ratios["jerk"] = max(float(np.max(table["jerk"])), float(np.max(np.abs(d3) / prob.jerk)))
-    if prob.effort is not None:
-        table["torque"] = np.abs(_rnea(prob.robot, q, qd, qdd)) / prob.effort
-    poses = np.array([prob.robot.tool_pose(qk) for qk in q])
-    if prob.tool_speed is not None:
-        speed = np.array([np.linalg.norm(prob.robot.task_jacobian(q[i])[:3] @ qd[i]) for i in range(len(t))])
-        table["tool speed"] = (speed / prob.tool_speed)[:, None]
+    qddd = None if prob.jerk is None else piece.jerk(t)  # (a left side b - 1e-9 dt is inside its own interval)
+    ratios = state_ratios(prob.robot, lim, q, qd, qdd, qddd, prob.jerk)
+    table = {quantity.value: r for quantity, r in ratios.items()}
+    worst: dict[str, float | None] = {name: None for name in _QUANTITIES}
+    for name, value in found.ratios().items():
+        worst[name] = value
     for name, r in table.items():
-        if name != "jerk" or ratios["jerk"] is None:
-            ratios[name] = float(np.max(r))
-    for name, value in ratios.items():
-        if value is not None and not value <= 1.0 + TOLERANCE + (floor if name == "jerk" else 0.0):
-            arr = table[name]
-            i, j = np.unravel_index(int(np.argmax(arr)), arr.shape)
+        top = float(np.max(r))
+        worst[name] = top if worst.get(name) is None else max(top, worst[name] or 0.0)
+        if not top <= 1.0 + TOLERANCE:
+            i, j = np.unravel_index(int(np.argmax(r)), r.shape)
             who = "the tool" if name == "tool speed" else JOINT_NAMES[j]
-            raise JumpError("VerificationFailed", f"the {name} of {who} reaches {value:.9g} of its limit at t = "
+            raise JumpError("VerificationFailed", f"the {name} of {who} reaches {top:.9g} of its limit at t = "
                             f"{float(t[i]):.6g} s (more than 1 + {TOLERANCE:g})")  # fmt: skip
+    poses = np.array([prob.robot.tool_pose(qk) for qk in q])
     dA = np.hypot(poses[:, 0] - prob.A[0], poses[:, 1] - prob.A[1]) - prob.R
     dB = np.hypot(poses[:, 0] - prob.B[0], poses[:, 1] - prob.B[1]) - prob.R
     below = np.minimum(np.minimum(np.maximum(dA, 0.0), np.maximum(dB, 0.0)), np.maximum(prob.z_top - poses[:, 2], 0.0))
-    clearance_error = float(np.max(below))
     if prob.max_height is not None:
-        clearance_error = max(clearance_error, float(np.max(poses[:, 2] - prob.max_height)))
+        below = np.maximum(below, poses[:, 2] - prob.max_height)
+    clearance_error = float(np.max(below))
     if clearance_error > CLEARANCE_TOL:
         where = float(t[int(np.argmax(below))])
         raise JumpError("VerificationFailed", f"the tool misses the clearance (or the ceiling) by "
                         f"{clearance_error:.3g} m near t = {where:.6g} s (more than {CLEARANCE_TOL:g} m)")  # fmt: skip
-    lo = np.where(prob.ranged, prob.lower, -np.inf) - 1e-9
-    hi = np.where(prob.ranged, prob.upper, np.inf) + 1e-9
+    lo = np.where(prob.ranged, prob.lower, -np.inf) - ENDPOINT_TOL
+    hi = np.where(prob.ranged, prob.upper, np.inf) + ENDPOINT_TOL
     if ((q < lo) | (q > hi)).any():
         i, j = np.argwhere((q < lo) | (q > hi))[0]
         raise JumpError("VerificationFailed", f"{JOINT_NAMES[j]} leaves its range at t = {float(t[i]):.6g} s "
                         f"(q = {float(q[i, j]):.9g})")  # fmt: skip
-    ends = traj.sample(np.array([0.0, T]))
-    for end, pose, name in ((0, prob.A, "pose_from"), (1, prob.B, "pose_to")):
-        err = _pose_error(prob.robot.tool_pose(ends[0][end]), pose)
-        rest = float(np.max(np.abs(ends[1][end]) / prob.velocity))
-        if prob.jerk is not None:
-            rest = max(rest, float(np.max(np.abs(ends[2][end]) / prob.acceleration)))
-        if err > ENDPOINT_TOL or rest > 1e-9:
-            raise JumpError("VerificationFailed", f"the move misses {name} by {err:.3g} m or is not at rest there "
-                            f"({rest:.3g} of the limits)")  # fmt: skip
+    for end, pose, name in ((0, prob.A, "pose_from"), (-1, prob.B, "pose_to")):
+        err = _pose_error(prob.robot.tool_pose(traj.sample(0.0 if end == 0 else T)[0]), pose)
+        if err > ENDPOINT_TOL:
+            raise JumpError("VerificationFailed", f"the move misses {name} by {err:.3g} m")
     u = prob.B[:2] - prob.A[:2]
     u = u / np.linalg.norm(u)
     bulge = float(np.max(np.abs((poses[:, 0] - prob.A[0]) * u[1] - (poses[:, 1] - prob.A[1]) * u[0])))
-    return _Check(t, on_grid, table, ratios, clearance_error, float(np.max(poses[:, 2]) - prob.z_top), bulge)
+    return _Check(t, on_grid, table, worst, clearance_error, float(np.max(poses[:, 2]) - prob.z_top), bulge)
 
 
 def _legs(prob: _Problem, check: _Check, T: np.ndarray) -> tuple[Leg, ...]:

@@ -52,6 +52,8 @@ class Method(enum.Enum):
     LINE_TOPPRA = "straight line, time-optimal (TOPP-RA)"
     JUMP = "jump (arch move), time-optimal, joint path free"
     ARCH = "straight-leg arch (lift, traverse, descend, blended), time-optimal (TOPP-RA)"
+    JOINT_JERK = "joint path, jerk-limited time-optimal"
+    LINE_JERK = "straight line, jerk-limited time-optimal"
 
 
 def _optional_vector(name: str, value: object) -> np.ndarray | None:
@@ -74,6 +76,8 @@ class MotionRequest:
         rise: [m] the arch's clearance above the higher pose; None: the standard one.
         blend: [m] the straight-leg arch's corner blend distance; None: as large as allowed (path "lines").
         payload: a payload at the tool (``torque`` moves and arches); None: none.
+        jerk: joint jerk limits [rad/s^3, m/s^3], one per joint, for a jerk-limited time-optimal move (arches
+            too); None: none.
         path: "jump" (the time-optimal jump, the joint path free) or "lines" (the straight-leg arch).
         clearance_radius: [m] the jump's clearance radius; None: the standard one (path "jump").
         max_height: [m] a ceiling for the tool's z during the arch, or None.
@@ -92,6 +96,7 @@ class MotionRequest:
     rise: float | None = None
     blend: float | None = None
     payload: Payload | None = field(default=None)
+    jerk: tuple[float, ...] | None = None
     path: str = "jump"
     clearance_radius: float | None = None
     max_height: float | None = None
@@ -114,6 +119,10 @@ class MotionRequest:
             raise InvalidInputError("an arch move takes no via (one arch between two poses)")
         if self.arch and self.duration is not None:
             raise InvalidInputError("an arch move is time-optimal: a duration does not apply")
+        if self.jerk is not None and self.duration is not None:
+            raise InvalidInputError("--jerk-limit is time-optimal: --duration does not apply")
+        if self.jerk is not None and self.tool_speed is not None:
+            raise InvalidInputError("--jerk-limit with --tool-speed is not supported: give one of them")
         if self.path not in ("jump", "lines"):
             raise ParameterError("path", self.path, "must be 'jump' or 'lines'")
         if self.path == "jump" and self.blend is not None:
@@ -173,6 +182,10 @@ def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
 
 
 def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Trajectory:
+    if request.jerk is not None:
+        from .jerk import time_optimal_jerk
+
+        return time_optimal_jerk(robot, path, request.jerk, torque=request.torque).trajectory  # type: ignore[arg-type]
     from .timing import time_optimal
 
     return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque)  # type: ignore[arg-type]
@@ -186,7 +199,8 @@ def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
     path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
     if request.duration is not None:
         return MotionPlan(tr.timed(path, request.duration), Method.LINE_QUINTIC, robot)
-    return MotionPlan(_time_optimal(robot, path, request), Method.LINE_TOPPRA, robot)
+    method = Method.LINE_TOPPRA if request.jerk is None else Method.LINE_JERK
+    return MotionPlan(_time_optimal(robot, path, request), method, robot)
 
 
 def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -202,10 +216,11 @@ def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
             path = tr.joint_path(robot, [q_from, *vias, q_to])
             return MotionPlan(tr.timed(path, request.duration), Method.JOINT_SPLINE_QUINTIC, robot)
         return MotionPlan(tr.quintic(q_from, q_to, request.duration), Method.JOINT_QUINTIC, robot)
-    if not vias and request.tool_speed is None and not request.torque:
+    if not vias and request.tool_speed is None and not request.torque and request.jerk is None:
         lim = robot.limits
         return MotionPlan(tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), Method.JOINT_TRAPEZOID, robot)
-    return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), Method.JOINT_TOPPRA, robot)
+    method = Method.JOINT_TOPPRA if request.jerk is None else Method.JOINT_JERK
+    return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), method, robot)
 
 
 def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -219,7 +234,7 @@ def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
         raise InfeasibleError(f"max_height {request.max_height:.6g} m is below the traverse height "
                               f"{max(poses[:, 2]) + rise:.6g} m of the arch")  # fmt: skip
     move = arch_move(robot, poses, rise=rise, blend=request.blend, payload=request.payload, torque=request.torque,
-                     start=request.start_q, tool_speed=request.tool_speed)  # fmt: skip
+                     start=request.start_q, tool_speed=request.tool_speed, jerk=request.jerk)  # fmt: skip
     return MotionPlan(move.trajectory, Method.ARCH, robot, move)
 
 
@@ -233,7 +248,7 @@ def _jump(robot: Robot, request: MotionRequest) -> MotionPlan:
                      clearance_radius=STANDARD_CLEARANCE if request.clearance_radius is None
                      else request.clearance_radius, max_height=request.max_height, payload=request.payload,
                      torque=request.torque, tool_speed=request.tool_speed, start=request.start_q,
-                     end=request.end_q)  # fmt: skip
+                     end=request.end_q, jerk=request.jerk)  # fmt: skip
     return MotionPlan(move.trajectory, Method.JUMP, robot, move)
 
 
