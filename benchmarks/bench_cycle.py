@@ -58,7 +58,7 @@ def placements() -> list[tuple[str, str, np.ndarray, np.ndarray, float]]:
     A1, B1, _ = cycle_placement(s1)
     pal = load_robot("palletizer")
     qa, qb = np.array([-0.6, 0.3, 1.6, 0.0]), np.array([0.6, 0.5, 1.4, 0.0])
-    qc, qd = np.array([-0.3, 0.2, 1.2, 0.5]), np.array([0.4, 0.4, 1.5, -0.5])
+    qc, qd = np.array([-0.3, 0.2, 1.2, 0.5]), np.array([0.4, 0.2, 1.6, -0.5])
     return [
         ("default", "issue: across 305 mm along +y", issue, issue + [0.0, 0.305, 0.0, 0.0], STANDARD_RISE),
         ("default", "default placement", A0, B0, STANDARD_RISE),
@@ -67,7 +67,7 @@ def placements() -> list[tuple[str, str, np.ndarray, np.ndarray, float]]:
         ("s1", "default placement", A1, B1, STANDARD_RISE),
         ("s1", "short diagonal", np.array([0.12, -0.05, 0.05, 0.0]), np.array([0.16, 0.07, 0.04, 0.3]), 0.02),
         ("palletizer", "1.9 m sweep, rise 0.1 m", pal.tool_pose(qa), pal.tool_pose(qb), 0.1),
-        ("palletizer", "turn and reach, rise 0.1 m", pal.tool_pose(qc), pal.tool_pose(qd), 0.1),
+        ("palletizer", "turn, reach and drop 0.4 m", pal.tool_pose(qc), pal.tool_pose(qd), 0.1),
     ]
 
 

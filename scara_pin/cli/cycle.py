@@ -127,8 +127,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
           f"[{Ln}]" + (f"; clearance radius {radius * L:g} {Ln})" if path is CyclePath.JUMP
                        else f"; blend {result.blend * L:g} {Ln})"))  # fmt: skip
     if bound is not None:
-        print(f"bound       {bound.duration:.6g} s: no cycle under these limits is faster ({bound.reason}); this one "
-              f"is {100 * (result.gap or 0.0):.1f} % above it")  # fmt: skip
+        print(f"bound       {bound.duration:.6g} s ({bound.reason}): no cycle under these limits is faster; this "
+              f"one is {100 * (result.gap or 0.0):.1f} % above it")  # fmt: skip
     a, b = result.start, result.end
     print(f"placement   from ({a[0] * L:.6g}, {a[1] * L:.6g}, {a[2] * L:.6g}) to ({b[0] * L:.6g}, {b[1] * L:.6g}, "
           f"{b[2] * L:.6g}) {Ln}: {result.placement}")  # fmt: skip

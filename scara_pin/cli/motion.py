@@ -246,7 +246,8 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
     print(f"duration  {traj.duration:.9g} s", file=text)
     if jump:
         b, L, Ln = move.lower_bound, units.length, units.length_name
-        print(f"bound     {b.duration:.6g} s ({b.reason}): {100 * move.gap:.1f} % above it", file=text)
+        print(f"bound     {b.duration:.6g} s ({b.reason}): no move under these limits is faster; this one is "
+              f"{100 * move.gap:.1f} % above it", file=text)  # fmt: skip
         print(f"arch      up to {(move.z_top + move.peak) * L:.6g} {Ln}, {move.bulge * L:.3g} {Ln} off the straight "
               f"line in plan view; solved in {move.stats.seconds:.3g} s", file=text)  # fmt: skip
     for leg in move.legs:

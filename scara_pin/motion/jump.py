@@ -825,12 +825,13 @@ def lower_bound(
             up = abs(q_tops[0][j] - q_from[j])
             down = abs(q_tops[1][j] - q_to[j])
             t = _one_dof(j, up, velocity, acceleration, None) + _one_dof(j, down, velocity, acceleration, None)
-            why = (f"{JOINT_NAMES[j]} must rise {up:.6g} and come down {down:.6g} (the rise), each at least its own "
-                   "minimum time from rest to rest (velocity and acceleration limits)")  # fmt: skip
+            why = (f"{JOINT_NAMES[j]} alone, up {up:.6g} m and down {down:.6g} m, each from rest to rest, velocity and "
+                   "acceleration limits")  # fmt: skip
         else:
             d = float(q_to[j] - q_from[j])
             t = _one_dof(j, abs(d), velocity, acceleration, jerk, exact_jerk)
-            why = f"{JOINT_NAMES[j]} must move {abs(d):.6g}: its own minimum time from rest to rest ({kind} limits)"
+            unit = "m" if robot.joint_kinds[j] == "length" else "rad"
+            why = f"{JOINT_NAMES[j]} alone, {abs(d):.6g} {unit} from rest to rest, {kind} limits"
         if t > best.duration:
             best = LowerBound(t, JOINT_NAMES[j], why)
     return best
