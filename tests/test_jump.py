@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from test_cycle import _loaded_model  # the tests' own payload route (appendBodyToJoint)
 
 from scara_pin import InfeasibleError, InvalidInputError, load_robot, robot_from_urdf
 from scara_pin.cli import main
@@ -69,14 +70,6 @@ def va_cycle(robot):
 @pytest.fixture(scope="module")
 def jerk_cycle(robot):
     return standard_cycle(robot, start=FROM, direction=(0.0, 1.0), jerk=2000.0, payload=Payload(MASS, COM))
-
-
-def _loaded_model(robot, mass, com):  # the test's own payload route
-    model = pin.Model(robot.model)
-    frame = model.frames[robot.tool_id]
-    model.appendBodyToJoint(frame.parentJoint, pin.Inertia(mass, frame.placement.act(np.array(com)), np.zeros((3, 3))),
-                            pin.SE3.Identity())  # fmt: skip
-    return model
 
 
 def _verified(robot, traj, *, jerk=None, model=None, fk=None, A=None, B=None, rise=STANDARD_RISE, radius=R,

@@ -1,6 +1,10 @@
-"""Arch (jump) moves and the standard SCARA cycle, timed under velocity, acceleration, torque and jerk limits.
+"""The standard SCARA cycle, and the straight-leg arch move, timed under velocity, acceleration, torque and jerk limits.
 
-**Arch move** (Epson's JUMP, others' gate or arch motion) from pose A to pose B: lift vertically to the
+The cycle's moves are, by default, time-optimal JUMPS (:mod:`~scara_pin.motion.jump`: the joint path free
+over a clearance, out and back by time reversal). The straight-leg arch below (``path="lines"``) is the
+simpler plan, kept for comparison and for controllers that want straight tool legs: it is slower.
+
+**Straight-leg arch** (Epson's JUMP, others' gate or arch motion) from pose A to pose B: lift vertically to the
 traverse height ``z_top = max(z_A, z_B) + rise``, move horizontally, descend to B. It is ONE path of
 straight tool lines (:class:`~scara_pin.motion.paths.CartesianSegment`, same elbow branch, J4 continuous)
 whose two corners are replaced by blends. A blend at a corner C between the incoming unit direction e1

@@ -24,22 +24,37 @@ are (q, qd) (or (q, qd, qdd)), linked by the EXACT integrals
 so the trajectory between nodes is the polynomial itself (:class:`~scara_pin.motion.polynomial.
 PolynomialPiece`), not an interpolation. Minimise T_1 + T_2 + T_3 with IPOPT (CasADi, exact Hessians of
 the robot's tool position and inverse dynamics written from its Pinocchio model,
-:mod:`~scara_pin.motion.symbolic`). A bound on a quantity linear in time on an interval holds everywhere
-on it when it holds at its two ends: velocity and acceleration under acceleration control, acceleration
-under jerk control; those are variable bounds at the nodes (both sides of each interval for the
-torques, which depend on the control). What is not linear in time between nodes -- the clearance, the
-ceiling, the joint range, the torque, the tool speed, the velocity under jerk control -- is checked on
-every interval at 32 points and at the polynomial extrema; wherever it is exceeded a constraint is added
-at that point of that interval (its state is the polynomial of the interval's node and control) and the
-problem is solved again, warm-started (at most ``JumpOptions.refinements`` times).
+:mod:`~scara_pin.motion.symbolic`). Where each bound holds:
+
+- a quantity LINEAR in time on an interval is bounded everywhere on it by its two ends: the velocity and
+  acceleration under acceleration control, the acceleration under jerk control; variable bounds at the
+  nodes, both ends at rest;
+- a POLYNOMIAL one is bounded by the Bernstein control points of its interval (a polynomial stays in their
+  convex hull): the joint range (q quadratic or cubic) and, under jerk control, the velocity (quadratic);
+  e.g. for q = q0 + v0 t + a0 t^2 / 2 + j t^3 / 6 on [0, h] the points are q0, q0 + v0 h / 3,
+  q0 + 2 v0 h / 3 + a0 h^2 / 6, q(h). Slightly conservative where the polynomial peaks inside (0.004 % on
+  the jerk-limited s1 cycle);
+- the clearance, the ceiling and the tool speed are constraints at the nodes (the clearance of each
+  node's phase or phases); the torque, costly to differentiate and seldom binding, is left out at first;
+- then every interval is checked at 33 points and at the polynomial extrema: where the clearance or the
+  ceiling is missed by more than 2e-7 m, or the tool speed exceeded by more than 1e-7 relative, a
+  constraint is added at that point of that interval (its state is the polynomial of the interval's node
+  and control); where the torque comes within 2 % of a limit, constraints on both sides of the interval's
+  nodes (and at the point, if exceeded); and the problem is solved again, warm-started, at most
+  ``JumpOptions.refinements`` times.
+
+Among the minimum-time motions (the time is unique, the path is not: the joints that do not bind can
+move in many ways) the objective's tie-breaking terms pick the calmest (:data:`_TIE_VELOCITY`,
+:data:`_TIE_SMOOTH`): the quill brakes at once after the lift and holds (the lowest single-hump arch).
 
 **Output.** The states are integrated again from A in floating point with the solved controls, and the
 rounding left at B (about the solver's tolerance) is removed by the least-norm change of the controls
 that ends exactly at rest at B (the end state is linear in the controls). The result is then verified
-by an independent route (:func:`_verify`): Pinocchio's FK and RNEA at 10 kHz, at every breakpoint on
-both sides and inside every interval, the third differences of q for the jerk; a ratio above
-1 + 1e-6, a clearance missed by more than 1e-6 m, an end missed by more than 1e-9 m is an error, never
-an output.
+by independent routes (:func:`_verify`): the package's verifier (:func:`~scara_pin.motion.verify.verify`:
+Pinocchio at 10 kHz, the jerk by third differences, the torques with the payload, endpoints, rest), the
+same ratios at every breakpoint on both sides and at the polynomial extrema, and the clearance, ceiling,
+joint ranges and end poses by Pinocchio's FK; a ratio above 1 + 1e-6, a clearance missed by more than
+1e-6 m, an end missed by more than 1e-9 m is an error (:class:`JumpError`), never an output.
 
 **Warm start.** The straight joint lines A -> above A -> above B -> B at z_top (closed-form IK of the two
 top poses), each with the quintic law over its synchronised time-optimal duration.
