@@ -86,6 +86,7 @@ import numpy as np
 from .._checks import _positive, _vector
 from ..description import JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..kinematics.validate import _pose_error
 from ..limits import MAX_SAMPLES, check_count
 from .payload import Payload, with_payload
 from .polynomial import PolynomialPiece
@@ -327,8 +328,8 @@ class JumpMove:
         legs: the legs with their times and binding limits.
         ratios: worst verified ratio per quantity ("velocity", "acceleration", "jerk", "torque", "tool speed";
             None where not limited).
-        clearance: [m] the smallest verified z - z_top where the tool is outside both circles (may be
-            negative by at most 1e-6 m; +inf if it never is).
+        clearance: [m] how far the verified tool came from the allowed region (below z_top while outside
+            both circles, or above the ceiling): 0 when kept, never more than 1e-6 m.
         peak: [m] the highest tool z above z_top.
         bulge: [m] the largest horizontal distance of the tool from the straight line A-B in plan view.
         payload: the payload carried; jerk: the jerk limits per joint, or None; tool_speed: [m/s] or None.
@@ -697,7 +698,7 @@ def jump_move(
 def _given(robot: Robot, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarray:
     """A configuration given for a pose, checked: FK within ENDPOINT_TOL of the pose, inside the limits."""
     qq = np.array(robot.check_q(q), dtype=float)
-    err = _pose_error(robot.tool_pose(qq), pose)
+    err = _pose_error(robot, qq, pose)
     if err > ENDPOINT_TOL:
         raise InvalidInputError(f"{name} {np.round(qq, 9).tolist()} puts the tool {err:.3g} m (or rad) from its pose")
     outside = robot.outside_limits(qq)
@@ -727,12 +728,6 @@ def _endpoints(
     if sol is None:
         raise InfeasibleError(f"pose_to {B.tolist()} is out of reach on the {br} branch: {res.message}")
     return np.array(qA, dtype=float), np.array(sol.q, dtype=float)
-
-
-def _pose_error(pose: np.ndarray, target: np.ndarray) -> float:
-    """[m] the position error (the yaw is held by the IK; its error is checked as an angle of 1e-9 rad)."""
-    yaw = abs(math.remainder(float(pose[3] - target[3]), 2.0 * math.pi))
-    return max(float(np.linalg.norm(pose[:3] - target[:3])), yaw)
 
 
 def _top(robot: Robot, pose: np.ndarray, z_top: float, near: np.ndarray, name: str, rise: float) -> np.ndarray:
@@ -1088,7 +1083,7 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
         raise JumpError("VerificationFailed", f"{JOINT_NAMES[j]} leaves its range at t = {float(t[i]):.6g} s "
                         f"(q = {float(q[i, j]):.9g})")  # fmt: skip
     for end, pose, name in ((0, prob.A, "pose_from"), (-1, prob.B, "pose_to")):
-        err = _pose_error(prob.robot.tool_pose(traj.sample(0.0 if end == 0 else T)[0]), pose)
+        err = _pose_error(prob.robot, traj.sample(0.0 if end == 0 else T)[0], pose)
         if err > ENDPOINT_TOL:
             raise JumpError("VerificationFailed", f"the move misses {name} by {err:.3g} m")
     u = prob.B[:2] - prob.A[:2]
