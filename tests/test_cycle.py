@@ -1,4 +1,5 @@
-"""The standard cycle and arch moves (scara_pin.motion.cycle, jerk, payload; scara-pin cycle / traj --arch).
+"""The straight-leg arch and its standard cycle (scara_pin.motion.cycle ``path="lines"``, jerk, payload;
+``scara-pin cycle --path lines`` / ``traj --arch --path lines``). The jump, the default, is tests/test_jump.py.
 
 Independent routes: limits re-checked from the samples (numpy); torques by Pinocchio's RNEA on a model the
 test loads itself with the payload appended as a body (appendBodyToJoint, not the library's route); the
@@ -21,7 +22,7 @@ import pytest
 from scara_pin import load_robot
 from scara_pin.cli import main
 from scara_pin.motion.cycle import STANDARD_RISE, STANDARD_SPAN, standard_cycle, trajectory_jerk
-from scara_pin.motion.jerk import FilteredLaw
+from scara_pin.motion.jerk import JerkLaw
 from scara_pin.motion.payload import Payload
 from scara_pin.motion.timing import TimingOptions
 
@@ -50,7 +51,7 @@ def robot():
 
 @pytest.fixture(scope="module")
 def jerk_cycle(robot):
-    return standard_cycle(robot, payload=Payload(MASS, COM), jerk=JERK)
+    return standard_cycle(robot, payload=Payload(MASS, COM), jerk=JERK, path="lines")
 
 
 @dataclasses.dataclass
@@ -63,8 +64,9 @@ class CliRun:
 
 @pytest.fixture(scope="module")
 def cli_corners(tmp_path_factory):
-    """``cycle --no-blend --plot --out --json`` run once, in-process. standard_cycle is wrapped (not replaced)
-    to record what the command planned, so the library tests below share that planning instead of repeating it."""
+    """``cycle --path lines --no-blend --plot --out --json`` run once, in-process. standard_cycle is wrapped (not
+    replaced) to record what the command planned, so the library tests below share that planning instead of
+    repeating it."""
     import scara_pin.motion.cycle as cycle_module
 
     folder = tmp_path_factory.mktemp("cycle-cli")
@@ -78,21 +80,26 @@ def cli_corners(tmp_path_factory):
     out = io.StringIO()
     with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out):
         mp.setattr(cycle_module, "standard_cycle", recording)
-        code = main(["cycle", "--no-blend", "--plot", str(folder / "c.png"), "--out", str(folder / "c.csv"), "--json"])
+        code = main(["cycle", "--path", "lines", "--no-blend", "--plot", str(folder / "c.png"), "--out",
+                     str(folder / "c.csv"), "--json"])
     return CliRun(code, out.getvalue(), folder, planned)
 
 
 @pytest.fixture(scope="module")
 def plain(robot, cli_corners):
-    """(blended, corners): ``standard_cycle(robot)``, and ``standard_cycle(robot, blend=0.0)`` as the CLI's
-    --no-blend planned it (asserted here: that call is this one, every other argument at its default)."""
-    assert len(cli_corners.planned) == 1
+    """(blended, corners): ``standard_cycle(robot, path="lines")``, and the same with ``blend=0.0`` as the CLI's
+    --no-blend planned it (asserted here: that call is this one, every other argument at its default; the
+    command's second call is the jump it compares with)."""
+    assert len(cli_corners.planned) == 2
     kwargs, corners = cli_corners.planned[0]
     assert kwargs["blend"] == 0.0 and kwargs["span"] == STANDARD_SPAN and kwargs["rise"] == STANDARD_RISE
     assert kwargs["start"] is None and kwargs["direction"] is None and kwargs["jerk"] is None
-    assert kwargs["payload"] == Payload() and kwargs["limits"] == robot.limits
-    assert kwargs.keys() == {"start", "direction", "span", "rise", "blend", "payload", "jerk", "limits"}
-    return standard_cycle(robot), corners
+    assert kwargs["payload"] == Payload() and kwargs["limits"] == robot.limits and kwargs["max_height"] is None
+    assert kwargs["path"].value == "lines"
+    assert kwargs.keys() == {"start", "direction", "span", "rise", "blend", "payload", "jerk", "limits", "path",
+                             "max_height"}  # fmt: skip
+    assert cli_corners.planned[1][0]["path"].value == "jump"
+    return standard_cycle(robot, path="lines"), corners
 
 
 def _check_times(traj):
@@ -100,7 +107,7 @@ def _check_times(traj):
     t = [np.arange(0.0, traj.duration, 1e-3)]
     t0 = 0.0
     for m in traj.pieces:
-        assert isinstance(m.law, FilteredLaw)
+        assert isinstance(m.law, JerkLaw)
         bp = m.law.breakpoints()
         t += [t0 + bp, t0 + bp[:-1] + np.diff(bp) * (1 - 1e-9)]
         t0 += m.duration
@@ -151,7 +158,8 @@ def test_more_payload_never_faster(robot):
     # the ordering of the times is the point here, not the limits between samples (checked elsewhere):
     # the verification's default density of 16 points per grid segment is enough and 4 times faster
     coarse = TimingOptions(check_subdivisions=16)
-    times = [standard_cycle(robot, payload=Payload(m), limits=lim, options=coarse).cycle_time for m in (0.0, 1.0, 2.0)]
+    times = [standard_cycle(robot, payload=Payload(m), limits=lim, options=coarse, path="lines").cycle_time
+             for m in (0.0, 1.0, 2.0)]  # fmt: skip
     assert times[0] < times[1] < times[2]
 
 
@@ -183,6 +191,8 @@ def test_cli_plot_json_and_text(cli_corners, plain):
     assert cli_corners.code == 0
     summary = json.loads(cli_corners.out)
     assert summary["cycle_time"] == plain[1].cycle_time  # what the command planned is what it reports
+    assert summary["path"] == "lines" and summary["jump_cycle_time"] == cli_corners.planned[1][1].cycle_time
+    assert summary["jump_cycle_time"] < summary["cycle_time"]  # the jump is faster (and the output says so)
     assert {"cycle_time", "legs", "limits"} <= summary.keys()
     assert [leg["name"] for leg in summary["legs"]] == ["lift", "traverse", "descend"] * 2
     assert abs(sum(leg["duration"] for leg in summary["legs"]) - summary["cycle_time"]) < 1e-9
@@ -200,8 +210,9 @@ def test_cli_plot_json_and_text(cli_corners, plain):
         (["--rise", "nan"], 2, "finite"),
         (["--span", "2.0"], 2, "beyond the reach"),
         (["--jerk-limit", "1", "2"], 2, "one number or 4"),
-        (["--arch", "0.01", "--no-blend"], 2, "exclude"),
-        (["--from", "0.3", "0", "-0.0875", "0", "--direction", "1", "0"], 3, "path fails"),
+        (["--path", "lines", "--arch", "0.01", "--no-blend"], 2, "exclude"),
+        (["--arch", "0.01"], 2, "--path lines"),
+        (["--path", "lines", "--from", "0.3", "0", "-0.0875", "0", "--direction", "1", "0"], 3, "path fails"),
     ],
 )
 def test_cli_errors(argv, code, words, capsys):
@@ -221,9 +232,12 @@ def test_urdf_needs_accelerations(tmp_path, capsys):
 
 def test_traj_arch_and_payload(tmp_path, capsys):
     base = ["traj", "--from-pose", "0.3", "-0.1", "-0.1", "0", "--to-pose", "0.25", "0.15", "-0.08", "1"]
-    assert main([*base, "--arch", "--torque", "--payload", "1", "--json", "--out", str(tmp_path / "a.csv")]) == 0
+    argv = [*base, "--arch", "--path", "lines", "--torque", "--payload", "1", "--json", "--out",
+            str(tmp_path / "a.csv")]
+    assert main(argv) == 0
     arch = json.loads(capsys.readouterr().out)
-    assert arch["method"].startswith("arch") and arch["limit_ratios"]["torque"] > 0
+    assert arch["method"].startswith("straight-leg arch") and arch["limit_ratios"]["torque"] > 0
+    assert arch["jump_duration"] < arch["duration"]
     assert main([*base, "--payload", "1"]) == 2  # payload without --torque
     assert "--torque" in capsys.readouterr().err
 

@@ -82,7 +82,7 @@ def test_linear_moves_keep_the_tool_on_the_line(robot_default: Robot) -> None:
 
 def test_arch_returns_the_move(robot_default: Robot) -> None:
     p0, p1 = np.array([0.30, -0.10, -0.09, 0.0]), np.array([0.25, 0.15, -0.09, 0.3])
-    plan = plan_motion(robot_default, MotionRequest(start_pose=p0, end_pose=p1, arch=True))
+    plan = plan_motion(robot_default, MotionRequest(start_pose=p0, end_pose=p1, arch=True, path="lines"))
     assert plan.method is Method.ARCH and plan.arch is not None
     assert plan.trajectory is plan.arch.trajectory
     top = max(robot_default.tool_pose(q)[2] for q in plan.trajectory.sample(np.linspace(0, plan.trajectory.duration,
@@ -96,7 +96,7 @@ def test_refusals() -> None:
     with pytest.raises(InvalidInputError, match="SCARA-only"):
         plan_motion(pal, MotionRequest(start_q=q0, end_q=q0 + 0.1, linear=True))
     with pytest.raises(InvalidInputError, match="SCARA-only"):
-        plan_motion(pal, MotionRequest(start_q=q0, end_q=q0 + 0.1, arch=True))
+        plan_motion(pal, MotionRequest(start_q=q0, end_q=q0 + 0.1, arch=True, path="lines"))
     default = load_robot("default")
     with pytest.raises(InvalidInputError, match="--torque"):
         plan_motion(default, MotionRequest(start_q=Q0, end_q=Q1, payload=Payload(1.0, (0.0, 0.0, 0.0))))

@@ -122,6 +122,18 @@ def integer_type(name: str, low: int, high: int) -> Callable[[str], int]:
     return parse
 
 
+def _jerk(args: argparse.Namespace) -> list[float] | None:
+    """``--jerk-limit J`` or ``J1 J2 J3 J4`` [rad/s^3, m/s^3] through the number grammar, or None."""
+    if getattr(args, "jerk_limit", None) is None:
+        return None
+    if len(args.jerk_limit) not in (1, 4):
+        raise ParameterError("--jerk-limit", " ".join(args.jerk_limit), "must be one number or 4 (one per joint)")
+    values = [_number("--jerk-limit", v) for v in args.jerk_limit]
+    if not all(v > 0 for v in values):
+        raise ParameterError("--jerk-limit", values, "must be > 0", "rad/s^3 or m/s^3")
+    return values * 4 if len(values) == 1 else values
+
+
 def _parse_sets(items: Sequence[str] | None) -> dict[str, float]:
     """``--set KEY=VALUE`` items; each value goes through :func:`_number` (never to xacro as text)."""
     overrides: dict[str, float] = {}

@@ -14,6 +14,7 @@ from ._common import (
     _add_acceleration,
     _add_robot_options,
     _add_units,
+    _jerk,
     _load,
     _needs_wrist,
     _number,
@@ -37,24 +38,22 @@ def _payload(args: argparse.Namespace, units: Units) -> Any:
     return Payload(mass, com)  # type: ignore[arg-type]
 
 
-def _jerk(args: argparse.Namespace) -> list[float] | None:
-    if args.jerk_limit is None:
-        return None
-    if len(args.jerk_limit) not in (1, 4):
-        raise ParameterError("--jerk-limit", " ".join(args.jerk_limit), "must be one number or 4 (one per joint)")
-    values = [_number("--jerk-limit", v) for v in args.jerk_limit]
-    if not all(v > 0 for v in values):
-        raise ParameterError("--jerk-limit", values, "must be > 0", "rad/s^3 or m/s^3")
-    return values * 4 if len(values) == 1 else values
-
-
 def cmd_cycle(args: argparse.Namespace) -> int:
     """The standard cycle: up, across, down and back, time-optimal under the robot's limits."""
-    from ..motion.cycle import limits_dict, standard_cycle
+    from ..motion.cycle import STANDARD_CLEARANCE, CyclePath, limits_dict, standard_cycle
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units(args.deg, args.mm)
     L = units.length
+    path = CyclePath(args.path)
+    if path is CyclePath.JUMP:
+        for flag, given in (("--arch", args.arch is not None), ("--no-blend", args.no_blend)):
+            if given:
+                raise InvalidInputError(f"{flag} shapes the straight-leg arch: it needs --path lines (the jump, the "
+                                        "default, has no corners to blend)")  # fmt: skip
+    elif args.clearance_radius is not None:
+        raise InvalidInputError("--clearance-radius applies to the jump (--path jump): the straight-leg arch lifts "
+                                "vertically and blends its corners")  # fmt: skip
     robot = _load(args, units)
     _needs_wrist(robot, "cycle")
     use_points(args, robot, units, "cycle")  # --points FILE --from-point P1 --to-point P2: --from, --direction, --span
@@ -65,6 +64,9 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     blend = 0.0 if args.no_blend else (None if args.arch is None else _number("--arch", args.arch) / L)
     if args.no_blend and args.arch is not None:
         raise InvalidInputError("--arch and --no-blend exclude each other")
+    radius = STANDARD_CLEARANCE if args.clearance_radius is None else _number("--clearance-radius",
+                                                                              args.clearance_radius) / L
+    ceiling = None if args.max_height is None else _number("--max-height", args.max_height) / L
     start = None
     if args.from_pose is not None:
         start = [_number(n, t) / s for n, t, s in zip(("x", "y", "z", "yaw"), args.from_pose, (L, L, L, units.angle))]
@@ -72,8 +74,12 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     _acceleration(robot, args.acceleration, units)  # a URDF file has none: given, or refused
     limits = robot.limits
     jerk = _jerk(args)
-    result = standard_cycle(robot, start=start, direction=direction, span=span, rise=rise, blend=blend,
-                            payload=_payload(args, units), jerk=jerk, limits=limits)  # fmt: skip
+    common = {"start": start, "direction": direction, "span": span, "rise": rise, "payload": _payload(args, units),
+              "jerk": jerk, "limits": limits, "max_height": ceiling}  # fmt: skip
+    if path is CyclePath.JUMP:
+        result = standard_cycle(robot, path=path, clearance_radius=radius, **common)  # type: ignore[arg-type]
+    else:
+        result = standard_cycle(robot, path=path, blend=blend, **common)  # type: ignore[arg-type]
     move = result.move
     outputs: dict[str, str] = {}
     if args.out:
@@ -82,38 +88,86 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.cycle import plot_cycle
 
-        plot_cycle(robot, move, args.plot, limits=limits, title=f"{robot.name}: standard cycle "
+        plot_cycle(robot, move, args.plot, limits=limits, title=f"{robot.name}: standard cycle ({path.value}) "
                    f"{result.cycle_time:.4g} s, payload {move.payload.mass:g} kg")  # fmt: skip
         outputs["plot"] = args.plot
+    compare = _jump_for_comparison(robot, result, common, radius) if path is CyclePath.LINES else None
+    bound = result.lower_bound
     if args.json:
-        print(json.dumps({
+        summary: dict[str, Any] = {
             "robot": robot.name,
+            "path": path.value,
             "cycle_time": result.cycle_time,
+            "lower_bound": None if bound is None else bound.to_dict(),
+            "gap": result.gap,
             "legs": [leg.to_dict() for leg in move.legs],
             "limits": limits_dict(robot, limits, move.jerk),
             "limit_ratios": move.ratios,
             "placement": {"from": result.start.tolist(), "to": result.end.tolist(), "rule": result.placement,
                           "min_manipulability": result.min_manipulability},
             "span": result.span, "rise": result.rise, "blend": result.blend,
+            "clearance_radius": result.clearance_radius, "max_height": result.max_height,
             "payload": move.payload.to_dict(),
             "q_start": move.trajectory.q_start.tolist(),
             "outputs": outputs,
             "units": {"length": "m", "angle": "rad", "time": "s"},
-        }))  # fmt: skip
+        }  # fmt: skip
+        if path is CyclePath.JUMP:
+            summary["solver"] = move.stats.to_dict()  # type: ignore[union-attr]
+            summary["arch"] = {"peak_above_clearance": move.peak, "bulge": move.bulge,  # type: ignore[union-attr]
+                               "clearance_error": move.clearance}  # type: ignore[union-attr]
+        else:
+            summary["jump_cycle_time"] = compare[0] if compare else None
+        print(json.dumps(summary))
         return 0
-    print(f"robot       {robot.name}: standard cycle, payload {move.payload.mass:g} kg"
-          + (f", jerk limit {move.jerk}" if move.jerk else ""))  # fmt: skip
+    Ln = units.length_name
+    what = ("jump (time-optimal, joint path free)" if path is CyclePath.JUMP
+            else "straight-leg arch (lines and blends, TOPP-RA timing)")  # fmt: skip
+    print(f"robot       {robot.name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
+          + (f", jerk limit {list(move.jerk)}" if move.jerk else ""))  # fmt: skip
     print(f"cycle time  {result.cycle_time:.6g} s (up {result.rise * L:g}, across {result.span * L:g}, down and back "
-          f"[{units.length_name}]; blend {result.blend * L:g} {units.length_name})")  # fmt: skip
+          f"[{Ln}]" + (f"; clearance radius {radius * L:g} {Ln})" if path is CyclePath.JUMP
+                       else f"; blend {result.blend * L:g} {Ln})"))  # fmt: skip
+    if bound is not None:
+        print(f"bound       {bound.duration:.6g} s ({bound.reason}): no cycle under these limits is faster; this "
+              f"one is {100 * (result.gap or 0.0):.1f} % above it")  # fmt: skip
     a, b = result.start, result.end
     print(f"placement   from ({a[0] * L:.6g}, {a[1] * L:.6g}, {a[2] * L:.6g}) to ({b[0] * L:.6g}, {b[1] * L:.6g}, "
-          f"{b[2] * L:.6g}) {units.length_name}: {result.placement}")  # fmt: skip
+          f"{b[2] * L:.6g}) {Ln}: {result.placement}")  # fmt: skip
+    if path is CyclePath.JUMP:
+        jm = move
+        print(f"arch        up to {(jm.z_top + jm.peak) * L:.6g} {Ln} ({jm.peak * L:.3g} above the clearance height), "  # type: ignore[union-attr]
+              f"{jm.bulge * L:.3g} {Ln} off the straight line in plan view; solved in {jm.stats.seconds:.3g} s "  # type: ignore[union-attr]
+              f"({jm.stats.iterations} IPOPT iterations, {jm.stats.solves} solve(s))")  # type: ignore[union-attr]
+    print("legs        (binding limits: the share of the leg's time at >= 99.9 % of the limit)")
     for leg in move.legs:
+        binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in leg.binding)
         print(f"  {'out ' if leg.move == 0 else 'back'} {leg.name:<11} {leg.duration:9.6f} s   "
-              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit")  # fmt: skip
+              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit" + (f"; binding: {binding}" if binding
+                                                                                else ""))  # fmt: skip
+    if path is CyclePath.LINES:
+        if compare is not None:
+            slower = 100.0 * (result.cycle_time / compare[0] - 1.0)
+            print(f"note        the straight-leg arch is slower: the jump (--path jump, the default) takes "
+                  f"{compare[0]:.6g} s under the same limits ({slower:.1f} % less)")
+        else:
+            print("note        the straight-leg arch is slower than the jump (--path jump, the default)")
     for kind, where in outputs.items():
         print(f"wrote       {kind}: {where}")
     return 0
+
+
+def _jump_for_comparison(robot: Any, result: Any, common: dict[str, Any], radius: float) -> tuple[float] | None:
+    """The jump cycle's time at the same placement and limits, or None if it cannot be planned."""
+    from ..errors import ScaraError
+    from ..motion.cycle import CyclePath, standard_cycle
+
+    kwargs = dict(common, start=result.start, direction=(result.end - result.start)[:2])
+    try:
+        jump = standard_cycle(robot, path=CyclePath.JUMP, clearance_radius=radius, **kwargs)
+    except ScaraError:
+        return None
+    return (jump.cycle_time,)
 
 
 def register(sub: Any) -> None:
@@ -125,9 +179,14 @@ def register(sub: Any) -> None:
     g.add_argument("--direction", nargs=2, metavar="D", help="traverse direction DX DY (with --from; default 1 0)")
     g.add_argument("--span", default="0.305", metavar="L", help="horizontal stroke (default 0.305 m)")
     g.add_argument("--rise", default="0.025", metavar="H", help="vertical stroke (default 0.025 m)")
+    g.add_argument("--path", choices=("jump", "lines"), default="jump",
+                   help="jump: time-optimal, joint path free (default); lines: the straight-leg arch (slower)")
+    g.add_argument("--clearance-radius", metavar="R",
+                   help="jump: within R of an end (horizontally) the tool may be below the rise (default 0.005 m)")
+    g.add_argument("--max-height", metavar="Z", help="a ceiling for the tool's z (base frame)")
     g.add_argument("--arch", metavar="B",
-                   help="blend distance at each corner, along each line (default: the whole rise)")
-    g.add_argument("--no-blend", action="store_true", help="stop at the corners (three straight lines)")
+                   help="lines: blend distance at each corner, along each line (default: the whole rise)")
+    g.add_argument("--no-blend", action="store_true", help="lines: stop at the corners (three straight lines)")
     g = p.add_argument_group("load and limits")
     g.add_argument("--payload", metavar="KG", help="payload mass at the tool (default 0)")
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")

@@ -18,6 +18,7 @@ from ._common import (
     _add_robot_options,
     _add_units,
     _fmt,
+    _jerk,
     _joint_arg,
     _load,
     _needs_wrist,
@@ -48,7 +49,6 @@ def cmd_traj(args: argparse.Namespace) -> int:
     """A trajectory between configurations or poses: quintic, time-optimal, or a straight tool line."""
     import numpy as np
 
-    from ..motion import trajectory as tr
     from ..motion.plan import MotionRequest, plan_motion
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
@@ -80,24 +80,34 @@ def cmd_traj(args: argparse.Namespace) -> int:
         if not args.tool_speed > 0:
             raise ParameterError("--tool-speed", args.tool_speed, "must be > 0")
         tool_speed = args.tool_speed / units.length
-    if args.arch and not args.linear and robot.kind == "scara":
+    _arch_options(args)
+    if args.arch and not args.linear:
         if args.via:
             raise InvalidInputError("--arch takes no --via (one arch between two poses)")
         if args.duration is not None:
             raise InvalidInputError("--arch is time-optimal: --duration does not apply")
+    L = units.length
+    jerk = _jerk(args)
+    if jerk is not None and robot.dof != 4:
+        raise InvalidInputError("--jerk-limit needs a 4-joint robot for now")
     request = MotionRequest(
         start_q=q_from, end_q=_joint_arg(robot, args.to_q, units, "--to") if args.to_q else None,
         start_pose=None if pose_from is None else np.array(pose_from),
         end_pose=None if pose_to is None else np.array(pose_to), vias=tuple(vias), duration=args.duration,
         linear=args.linear, arch=args.arch, tool_speed=tool_speed, torque=args.torque, payload=_payload(args, units),
-        rise=_number("--rise", args.rise) / units.length if args.arch else None,
-        blend=None if args.blend is None or not args.arch else _number("--blend", args.blend) / units.length,
+        rise=None if args.rise is None else _number("--rise", args.rise) / L,
+        blend=None if args.blend is None else _number("--blend", args.blend) / L,
+        jerk=None if jerk is None else tuple(jerk),
+        path=args.path or "jump",
+        clearance_radius=None if args.clearance_radius is None else _number("--clearance-radius",
+                                                                             args.clearance_radius) / L,
+        max_height=None if args.max_height is None else _number("--max-height", args.max_height) / L,
     )
     if args.plot and robot.kind != "scara" and not args.arch:
         raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     plan = plan_motion(robot, request)
     if plan.arch is not None:
-        return _print_arch(args, plan.robot, plan.arch)
+        return _print_arch(args, plan.robot, plan.arch, units, plan.method)
     robot, traj, method = plan.robot, plan.trajectory, plan.method.value
     from ..motion.timing import limit_ratios
 
@@ -114,20 +124,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
         traj.save(args.out, rate=args.rate)
         outputs["trajectory"] = str(args.out)
     if args.setpoints:
-        motor = None
-        if args.gear or args.steps_per_rev or args.screw_lead is not None:
-            if not (args.gear and args.steps_per_rev and args.screw_lead is not None):
-                raise InvalidInputError("motor steps need --gear G1..G4, --steps-per-rev S1..S4 and --screw-lead L")
-            motor = tr.MotorUnits.from_drive(
-                [_number("--gear", g) for g in args.gear],
-                [_number("--steps-per-rev", v) for v in args.steps_per_rev],
-                _number("--screw-lead", args.screw_lead) / units.length,
-                prismatic=robot.joint_kinds.index("length"),
-            )
-        delays = [_number("--delays", d) for d in args.delays] if args.delays else None
-        rate = args.setpoint_rate if args.setpoint_rate is not None else args.rate
-        sp = traj.setpoints(rate, delays=delays, motor=motor)
-        write_atomic(Path(args.setpoints), sp.csv_text())
+        _write_setpoints(args, robot, traj, units)
         outputs["setpoints"] = args.setpoints
     if args.plot:
         from ..viz.plots import plot_trajectory
@@ -162,37 +159,126 @@ def cmd_traj(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_arch(args: argparse.Namespace, robot: Any, move: Any) -> int:
-    """``traj --arch``: write and print the arch (jump) move (lift, traverse, descend, blended corners)."""
+_ARCH_ONLY = ("rise", "blend", "clearance_radius", "max_height", "path")
+_SETPOINTS_ONLY = ("setpoint_rate", "delays", "gear", "steps_per_rev", "screw_lead")
+
+
+def _flag(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def _arch_options(args: argparse.Namespace) -> None:
+    """Refuse (exit 2) an option given with a motion kind it does not act on, naming the combination."""
+    for name in _SETPOINTS_ONLY:
+        if getattr(args, name) is not None and not args.setpoints:
+            raise InvalidInputError(f"{_flag(name)} shapes the controller setpoints: it needs --setpoints")
+    if not args.arch:
+        for name in _ARCH_ONLY:
+            if getattr(args, name) is not None:
+                raise InvalidInputError(f"{_flag(name)} shapes an arch move: it needs --arch")
+        return
+    if (args.path or "jump") == "jump":
+        if args.blend is not None:
+            raise InvalidInputError("--blend shapes the straight-leg arch: it needs --arch --path lines (the jump, "
+                                    "the default, has no corners to blend)")  # fmt: skip
+    elif args.clearance_radius is not None:
+        raise InvalidInputError("--clearance-radius applies to the jump (--path jump): the straight-leg arch "
+                                "(--path lines) lifts vertically and blends its corners")  # fmt: skip
+    if args.payload is not None and not args.torque:
+        raise InvalidInputError("--payload changes only the torques: give --torque too")
+
+
+def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Units) -> None:
+    """``--setpoints``: the controller setpoints of ``traj`` (motor steps, latency compensation), atomically."""
+    from ..motion import trajectory as tr
+
+    motor = None
+    if args.gear or args.steps_per_rev or args.screw_lead is not None:
+        if not (args.gear and args.steps_per_rev and args.screw_lead is not None):
+            raise InvalidInputError("motor steps need --gear G1..G4, --steps-per-rev S1..S4 and --screw-lead L")
+        motor = tr.MotorUnits.from_drive(
+            [_number("--gear", g) for g in args.gear],
+            [_number("--steps-per-rev", v) for v in args.steps_per_rev],
+            _number("--screw-lead", args.screw_lead) / units.length,
+            prismatic=robot.joint_kinds.index("length"),
+        )
+    delays = [_number("--delays", d) for d in args.delays] if args.delays else None
+    rate = args.setpoint_rate if args.setpoint_rate is not None else args.rate
+    sp = traj.setpoints(rate, delays=delays, motor=motor)
+    write_atomic(Path(args.setpoints), sp.csv_text())
+
+
+def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any) -> int:
+    """``traj --arch``: write and print the arch move (the jump, or the straight-leg arch with ``--path lines``)."""
     from ..motion.plan import Method
 
     traj = move.trajectory
+    jump = method is Method.JUMP
     outputs: dict[str, str] = {}
     if args.out:
         traj.save(args.out, rate=args.rate)
         outputs["trajectory"] = str(args.out)
+    if args.setpoints:
+        _write_setpoints(args, robot, traj, units)
+        outputs["setpoints"] = args.setpoints
     if args.plot:
         from ..viz.cycle import plot_cycle
 
-        plot_cycle(robot, move, args.plot, title=f"{robot.name}: arch move {traj.duration:.4g} s")
+        plot_cycle(robot, move, args.plot, title=f"{robot.name}: {method.value}, {traj.duration:.4g} s")
         outputs["plot"] = args.plot
+    faster = None if jump else _jump_time(robot, move, args, units)
     if args.json:
-        summary = {"robot": robot.name, "method": Method.ARCH.value,
+        summary = {"robot": robot.name, "method": method.value, "path": "jump" if jump else "lines",
                    "duration": traj.duration, "q_from": traj.q_start.tolist(), "q_to": traj.q_end.tolist(),
                    "legs": [leg.to_dict() for leg in move.legs], "limit_ratios": move.ratios,
                    "payload": move.payload.to_dict(), "outputs": outputs,
                    "units": {"length": "m", "angle": "rad", "time": "s"}}  # fmt: skip
+        if jump:
+            summary.update({"lower_bound": move.lower_bound.to_dict(), "solver": move.stats.to_dict(),
+                            "arch": {"z_top": move.z_top, "peak_above_clearance": move.peak, "bulge": move.bulge,
+                                     "clearance_error": move.clearance}})  # fmt: skip
+        else:
+            summary["jump_duration"] = faster
         if not args.out:
             summary["samples"] = traj.resample(args.rate).to_dict()
         print(json.dumps(summary))
         return 0
-    print(f"robot     {robot.name}: {Method.ARCH.value}")
-    print(f"duration  {traj.duration:.9g} s")
+    text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
+    print(f"robot     {robot.name}: {method.value}", file=text)
+    print(f"duration  {traj.duration:.9g} s", file=text)
+    if jump:
+        b, L, Ln = move.lower_bound, units.length, units.length_name
+        print(f"bound     {b.duration:.6g} s ({b.reason}): no move under these limits is faster; this one is "
+              f"{100 * move.gap:.1f} % above it", file=text)  # fmt: skip
+        print(f"arch      up to {(move.z_top + move.peak) * L:.6g} {Ln}, {move.bulge * L:.3g} {Ln} off the straight "
+              f"line in plan view; solved in {move.stats.seconds:.3g} s", file=text)  # fmt: skip
     for leg in move.legs:
-        print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit")
+        binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in getattr(leg, "binding", ()))
+        print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
+              + (f"; binding: {binding}" if binding else ""), file=text)  # fmt: skip
+    if not jump:
+        print("note      the straight-leg arch is slower than the jump (--path jump, the default)"
+              + (f", which takes {faster:.6g} s" if faster is not None else ""), file=text)  # fmt: skip
     for kind, where in outputs.items():
-        print(f"wrote     {kind}: {where}")
+        print(f"wrote     {kind}: {where}", file=text)
     return 0
+
+
+def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) -> float | None:
+    """The jump's duration between the same configurations and limits, or None if it cannot be planned."""
+    from ..errors import ScaraError
+    from ..motion.jump import STANDARD_RISE, jump_move
+
+    q0, q1 = move.trajectory.q_start, move.trajectory.q_end
+    rise = STANDARD_RISE if args.rise is None else _number("--rise", args.rise) / units.length
+    ceiling = None if args.max_height is None else _number("--max-height", args.max_height) / units.length
+    tool_speed = None if args.tool_speed is None else args.tool_speed / units.length
+    try:
+        return jump_move(robot, robot.tool_pose(q0), robot.tool_pose(q1), rise=rise, max_height=ceiling,
+                         payload=move.payload, torque=args.torque, tool_speed=tool_speed, start=q0, end=q1,
+                         jerk=move.jerk).duration  # fmt: skip
+    except ScaraError:
+        return None
 
 
 def cmd_jog(args: argparse.Namespace) -> int:
@@ -257,13 +343,22 @@ def register(sub: Any) -> None:
     g.add_argument("--tool-speed", type=number_type("--tool-speed"), metavar="V",
                    help="also limit the tool speed [m/s, or mm/s with --mm]")  # fmt: skip
     g.add_argument("--torque", action="store_true", help="also respect the effort limits (RNEA, URDF inertias)")
+    g.add_argument("--jerk-limit", nargs="+", metavar="J",
+                   help="joint jerk limit, one or 4 (rad/s^3, m/s^3): jerk-limited time-optimal timing")  # fmt: skip
     g.add_argument("--strict", action="store_true", help="refuse (exit 3) a --duration that exceeds a limit")
     g.add_argument("--payload", metavar="KG", help="payload at the tool, for --torque (and --arch) [kg]")
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")
     g = p.add_argument_group("arch (jump) move between --from-pose and --to-pose")
-    g.add_argument("--arch", action="store_true", help="lift, traverse, descend, corners blended (time-optimal)")
-    g.add_argument("--rise", default="0.025", metavar="H", help="traverse height above the higher pose (0.025 m)")
-    g.add_argument("--blend", metavar="B", help="blend distance at each corner (default: as large as allowed)")
+    g.add_argument("--arch", action="store_true",
+                   help="jump over a clearance: time-optimal, joint path free (or --path lines)")
+    g.add_argument("--path", choices=("jump", "lines"),
+                   help="jump (default) or lines: the straight-leg arch, lift, traverse, descend, corners blended "
+                   "(slower)")
+    g.add_argument("--rise", metavar="H", help="clearance above the higher pose (default 0.025 m)")
+    g.add_argument("--clearance-radius", metavar="R",
+                   help="jump: within R of an end (horizontally) the tool may be lower (default 0.005 m)")
+    g.add_argument("--max-height", metavar="Z", help="a ceiling for the tool's z (base frame)")
+    g.add_argument("--blend", metavar="B", help="lines: blend distance at each corner (default: as large as allowed)")
     _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",

@@ -1,6 +1,10 @@
-"""Arch (jump) moves and the standard SCARA cycle, timed under velocity, acceleration, torque and jerk limits.
+"""The standard SCARA cycle, and the straight-leg arch move, timed under velocity, acceleration, torque and jerk limits.
 
-**Arch move** (Epson's JUMP, others' gate or arch motion) from pose A to pose B: lift vertically to the
+The cycle's moves are, by default, time-optimal JUMPS (:mod:`~scara_pin.motion.jump`: the joint path free
+over a clearance, out and back by time reversal). The straight-leg arch below (``path="lines"``) is the
+simpler plan, kept for comparison and for controllers that want straight tool legs: it is slower.
+
+**Straight-leg arch** (Epson's JUMP, others' gate or arch motion) from pose A to pose B: lift vertically to the
 traverse height ``z_top = max(z_A, z_B) + rise``, move horizontally, descend to B. It is ONE path of
 straight tool lines (:class:`~scara_pin.motion.paths.CartesianSegment`, same elbow branch, J4 continuous)
 whose two corners are replaced by blends. A blend at a corner C between the incoming unit direction e1
@@ -34,6 +38,7 @@ arm; this is the place the robot reaches best, with symmetric joint motion about
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -42,11 +47,13 @@ import numpy as np
 
 from .._checks import _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from .jerk import jerk_limited, joint_jerk
+from .jerk import jerk_limited
+from .jump import STANDARD_CLEARANCE, STANDARD_RISE, JumpMove, JumpOptions, Leg, LowerBound, jump_move, lower_bound
 from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
 from .payload import Payload, with_payload
-from .timing import TimingOptions, _limits, _rnea, parameterize
+from .timing import TimingOptions, _limits, parameterize
 from .trajectory import Motion, Trajectory
+from .verify import state_ratios, trajectory_jerk
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -54,11 +61,13 @@ if TYPE_CHECKING:
     from ..model import Robot
 
 __all__ = [
+    "STANDARD_CLEARANCE",
     "STANDARD_RISE",
     "STANDARD_SPAN",
     "ArchMove",
     "ArchPath",
     "BlendSegment",
+    "CyclePath",
     "CycleResult",
     "Leg",
     "arch_move",
@@ -71,8 +80,6 @@ __all__ = [
 
 STANDARD_SPAN = 0.305
 """[m] the horizontal stroke of the standard cycle."""
-STANDARD_RISE = 0.025
-"""[m] the vertical stroke of the standard cycle."""
 _STEP = 2e-3  # [m] checkpoint spacing along a blend (as cartesian_path's default)
 _QUANTITIES = ("velocity", "acceleration", "torque", "jerk")
 
@@ -322,38 +329,6 @@ def _nonneg(name: str, value: object, strict: bool = False) -> float:
 
 
 # ---------------------------------------------------------------------------------------------- results
-@dataclass(frozen=True)
-class Leg:
-    """One leg of a move: its time span and the limit that is active (closest to 1) on it.
-
-    Attributes:
-        name: "lift", "blend up", "traverse", "blend down" or "descend".
-        move: index of the move in the cycle (0 out, 1 back).
-        t_start, t_end: [s] in the whole trajectory.
-        active: the quantity ("velocity", "acceleration", "torque", "jerk") with the largest ratio on it.
-        joint: the joint where that ratio is reached.
-        ratio: |value| / limit there (1.0: on the limit).
-    """
-
-    name: str
-    move: int
-    t_start: float
-    t_end: float
-    active: str
-    joint: str
-    ratio: float
-
-    @property
-    def duration(self) -> float:
-        """[s]."""
-        return self.t_end - self.t_start
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
-                "duration": self.duration, "active_limit": self.active, "joint": self.joint, "ratio": self.ratio}
-
-
 @dataclass(frozen=True, eq=False)
 class ArchMove:
     """A timed arch move (or several, joined rest to rest) and how its limits are used.
@@ -380,19 +355,32 @@ class ArchMove:
         return self.trajectory.duration
 
 
+class CyclePath(enum.Enum):
+    """How the cycle's moves are made; the value is the ``--path`` word."""
+
+    JUMP = "jump"
+    LINES = "lines"
+
+
 @dataclass(frozen=True, eq=False)
 class CycleResult:
     """The standard cycle: out and back, with its placement.
 
     Attributes:
-        move: the timed cycle (two moves).
+        move: the timed cycle (two moves): a :class:`~scara_pin.motion.jump.JumpMove` (``path`` JUMP) or an
+            :class:`ArchMove` (``path`` LINES).
         start, end: the poses at the ends of the traverse (x, y, z, yaw) [m, rad].
-        span, rise, blend: the strokes and the blend distance used [m] (blend 0: none).
+        span, rise, blend: the strokes and the blend distance used [m] (blend 0: none; the jump has none).
         placement: how the placement was chosen (a sentence), and its smallest manipulability.
         min_manipulability: the smallest |det J| along the traverse at the start height.
+        path: the kind of move.
+        clearance_radius: [m] R of the jump (None for the straight-leg arch, which lifts vertically).
+        max_height: [m] the ceiling, or None.
+        lower_bound: what no cycle under these limits can beat (twice a move's bound, see
+            :func:`~scara_pin.motion.jump.lower_bound`).
     """
 
-    move: ArchMove
+    move: ArchMove | JumpMove
     start: np.ndarray
     end: np.ndarray
     span: float
@@ -400,11 +388,20 @@ class CycleResult:
     blend: float
     placement: str
     min_manipulability: float
+    path: CyclePath = CyclePath.LINES
+    clearance_radius: float | None = None
+    max_height: float | None = None
+    lower_bound: LowerBound | None = None
 
     @property
     def cycle_time(self) -> float:
         """[s] out and back."""
         return self.move.duration
+
+    @property
+    def gap(self) -> float | None:
+        """The cycle time above the lower bound, relative (0.2: 20 % above)."""
+        return None if self.lower_bound is None else self.cycle_time / self.lower_bound.duration - 1.0
 
 
 # ---------------------------------------------------------------------------------------------- timing
@@ -421,6 +418,7 @@ def arch_move(
     start: ArrayLike | None = None,
     branch: str | None = None,
     options: TimingOptions | None = None,
+    tool_speed: float | None = None,
 ) -> ArchMove:
     """Time-optimal arch moves through ``poses`` (rest at each), under the robot's limits.
 
@@ -436,11 +434,14 @@ def arch_move(
         start: the configuration at ``poses[0]`` (fixes branch and J4 turn).
         branch: ``"right"`` or ``"left"``.
         options: TOPP-RA grid and verification options.
+        tool_speed: [m/s] a limit of the tool origin's speed (not with ``jerk``), or None.
 
     Raises:
         ParameterError, InvalidInputError: bad input (exit 2); PathError, TimingError: infeasible (exit 3).
     """
     payload = Payload() if payload is None else payload
+    if tool_speed is not None and jerk is not None:
+        raise InvalidInputError("the straight-leg arch takes a tool-speed limit or a jerk limit, not both")
     P = np.asarray(poses, dtype=float)
     if P.ndim != 2 or P.shape[1] != 4 or P.shape[0] < 2:
         raise ParameterError("poses", f"shape {P.shape}", "must be (m, 4) with m >= 2")
@@ -457,7 +458,7 @@ def arch_move(
     # acceleration between verified points within 1e-6 of its limit (16 left 2.9e-5 at 400 kHz; 128 leave 8e-7)
     options = options if options is not None else TimingOptions(check_subdivisions=128)
     for path in paths:
-        res = parameterize(loaded, path, torque=torque, limits=limits, options=options)
+        res = parameterize(loaded, path, torque=torque, limits=limits, options=options, tool_speed=tool_speed)
         pieces.extend(p for p in res.trajectory.pieces if isinstance(p, Motion))
     traj = Trajectory(tuple(pieces))
     jv = None
@@ -531,27 +532,8 @@ def _legs(
 def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: np.ndarray | None) -> dict[str, Any]:
     """|value| / limit per sample and joint, per quantity."""
     q, qd, qdd = traj.sample(t)
-    out = {"velocity": np.abs(qd) / lim.velocity, "acceleration": np.abs(qdd) / lim.acceleration}
-    if lim.effort is not None:
-        out["torque"] = np.abs(_rnea(robot, q, qd, qdd)) / lim.effort
-    if jerk is not None:
-        out["jerk"] = np.abs(trajectory_jerk(traj, t)) / jerk
-    return out
-
-
-def trajectory_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
-    """Joint jerk (n, 4) of a trajectory of motions at times t (zero at rest outside)."""
-    t = np.asarray(t, dtype=float)
-    out = np.zeros((len(t), 4))
-    t0 = 0.0
-    for p in traj.pieces:
-        if not isinstance(p, Motion):
-            raise InvalidInputError("jerk needs a trajectory of motions")
-        sel = (t >= t0) & (t <= t0 + p.duration)
-        if sel.any():
-            out[sel] = joint_jerk(p, t[sel] - t0)
-        t0 += p.duration
-    return out
+    qddd = None if jerk is None else trajectory_jerk(traj, t)
+    return {k.value: v for k, v in state_ratios(robot, lim, q, qd, qdd, qddd, jerk).items()}
 
 
 # ---------------------------------------------------------------------------------------------- the cycle
@@ -622,32 +604,46 @@ def standard_cycle(
     limits: JointLimits | None = None,
     branch: str = "right",
     options: TimingOptions | None = None,
+    path: CyclePath | str = CyclePath.JUMP,
+    clearance_radius: float = STANDARD_CLEARANCE,
+    max_height: float | None = None,
+    jump_options: JumpOptions | None = None,
 ) -> CycleResult:
     """The standard cycle: up ``rise``, across ``span``, down, and back the same way (rest at both ends).
 
     Args:
-        robot: a SCARA.
+        robot: a SCARA (the palletizer too with ``path`` JUMP and an explicit ``start``).
         start: the start pose (x, y, z, yaw) [m, rad]; default :func:`cycle_placement`.
         direction: (dx, dy) of the traverse; with ``start`` (default: perpendicular to the arm direction
             at mid J1 range).
         span: [m] > 0, the horizontal stroke.
         rise: [m] > 0, the vertical stroke.
-        blend: [m] >= 0, largest blend distance (None: as large as allowed, i.e. the whole rise; 0: none).
-        payload: carried by the tool (torque limits always apply, RNEA with the payload).
+        blend: [m] >= 0, largest blend distance of the straight-leg arch (None: as large as allowed, i.e.
+            the whole rise; 0: none); LINES only.
+        payload: carried by the tool (torque limits always apply, with the payload).
         jerk: joint jerk limit, one or four numbers, or None.
         limits: limits instead of ``robot.limits``.
         branch: the elbow branch.
-        options: TOPP-RA grid and verification options.
+        options: TOPP-RA grid and verification options (LINES).
+        path: JUMP (the default: :func:`~scara_pin.motion.jump.jump_move` out, its time reversal back) or
+            LINES (the straight-leg arch, :func:`arch_move`: slower).
+        clearance_radius: [m] R of the jump (JUMP).
+        max_height: [m] a ceiling for the tool's z (JUMP; LINES: refused below the traverse height).
+        jump_options: the jump's grid and solver options (JUMP).
 
     Raises:
-        ParameterError, InvalidInputError: bad input (exit 2); InfeasibleError (PathError, TimingError): the
-        robot cannot do it (exit 3).
+        ParameterError, InvalidInputError: bad input (exit 2); InfeasibleError (PathError, TimingError,
+        JumpError): the robot cannot do it (exit 3).
     """
+    path = CyclePath(path)
     span = _nonneg("span", span, strict=True)
     rise = _nonneg("rise", rise, strict=True)
-    if robot.kind != "scara":
-        raise InvalidInputError(f"the cycle is SCARA-only for now; robot {robot.name!r} is a {robot.kind} (the "
-                                "straight tool lines it is built on use the SCARA closed form)")  # fmt: skip
+    if path is CyclePath.JUMP and blend is not None:
+        raise InvalidInputError("a blend distance applies to the straight-leg arch (path lines), not to the jump")
+    if robot.kind != "scara" and (path is CyclePath.LINES or start is None):
+        raise InvalidInputError(f"robot {robot.name!r} is a {robot.kind}: its cycle needs the jump (path jump) and "
+                                "a start pose (--from; the default placement and the straight-leg arch are "
+                                "SCARA-only)")  # fmt: skip
     if start is None and direction is not None:
         raise InvalidInputError("--direction needs --from (the start pose)")
     if start is None:
@@ -664,14 +660,43 @@ def standard_cycle(
         b[:2] += span * dvec / norm
         why = "given by --from and --direction"
         wmin = math.nan
-    move = arch_move(robot, np.array([a, b, a]), rise=rise, blend=blend, payload=payload, jerk=jerk, torque=True,
-                     limits=limits, branch=branch, options=options)  # fmt: skip
+    if path is CyclePath.JUMP:
+        out = jump_move(robot, a, b, rise=rise, clearance_radius=clearance_radius, max_height=max_height,
+                        payload=payload, jerk=jerk, torque=True, limits=limits, branch=branch,
+                        options=jump_options)  # fmt: skip
+        move: ArchMove | JumpMove = out.and_back()
+        bound = LowerBound(2.0 * out.lower_bound.duration, out.lower_bound.joint,
+                           out.lower_bound.reason + ", out and back")  # fmt: skip
+        used = 0.0
+    else:
+        if max_height is not None and max_height < max(a[2], b[2]) + rise:
+            raise InfeasibleError(f"max_height {max_height:.6g} m is below the traverse height "
+                                  f"{max(a[2], b[2]) + rise:.6g} m")  # fmt: skip
+        move = arch_move(robot, np.array([a, b, a]), rise=rise, blend=blend, payload=payload, jerk=jerk, torque=True,
+                         limits=limits, branch=branch, options=options)  # fmt: skip
+        used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
+        bound = _lines_bound(robot, move, a, b, rise, limits, jerk)
     if wmin != wmin:  # the smallest manipulability along the traverse of the given placement
         q0 = move.trajectory.q_start
         pts = [np.array([*(a[:2] + f * (b[:2] - a[:2])), a[2], a[3]]) for f in np.linspace(0.0, 1.0, 41)]
         wmin = min(robot.manipulability(robot.ik_nearest(p, q0)) for p in pts)
-    used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
-    return CycleResult(move, a, b, span, rise, used, why, float(wmin))
+    return CycleResult(move, a, b, span, rise, used, why, float(wmin), path,
+                       clearance_radius if path is CyclePath.JUMP else None, max_height, bound)  # fmt: skip
+
+
+def _lines_bound(
+    robot: Robot, move: ArchMove, a: np.ndarray, b: np.ndarray, rise: float, limits: JointLimits | None,
+    jerk: float | ArrayLike | None,
+) -> LowerBound:
+    """The cycle's lower bound (the jump's: it holds for any motion) for the straight-leg arch's endpoints."""
+    lim = robot.limits if limits is None else limits
+    q_a, q_b = move.trajectory.q_start, move.paths[0].q_end
+    top = max(a[2], b[2]) + rise
+    tops = (robot.ik_nearest(np.array([a[0], a[1], top, a[3]]), q_a),
+            robot.ik_nearest(np.array([b[0], b[1], top, b[3]]), q_b))  # fmt: skip
+    jv = None if jerk is None else np.broadcast_to(np.asarray(jerk, dtype=float), (4,))
+    one = lower_bound(robot, q_a, q_b, tops, np.array(lim.velocity), np.array(lim.acceleration), jv)
+    return LowerBound(2.0 * one.duration, one.joint, one.reason + ", out and back")
 
 
 def limits_dict(robot: Robot, limits: JointLimits | None, jerk: tuple[float, ...] | None) -> dict[str, Any]:

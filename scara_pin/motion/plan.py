@@ -6,7 +6,8 @@ parses its arguments into a request and prints the plan):
 ==============================  ==========================================  =========================
 request                         path                                        time law
 ==============================  ==========================================  =========================
-``arch``                        lift, traverse, descend (SCARA)             TOPP-RA, blended corners
+``arch`` (path jump)            free joint path over the clearance          minimum time (IPOPT), jump
+``arch``, path lines            lift, traverse, descend, blended (SCARA)    TOPP-RA
 ``linear`` and ``duration``     straight tool line through the poses        quintic
 ``linear``                      straight tool line through the poses        TOPP-RA
 ``duration``, vias              joint spline through the waypoints          quintic
@@ -35,6 +36,7 @@ from . import trajectory as tr
 if TYPE_CHECKING:
     from ..model import Robot
     from .cycle import ArchMove
+    from .jump import JumpMove
     from .payload import Payload
 
 __all__ = ["Method", "MotionPlan", "MotionRequest", "plan_motion"]
@@ -48,7 +50,10 @@ class Method(enum.Enum):
     JOINT_TOPPRA = "joint path, time-optimal (TOPP-RA)"
     LINE_QUINTIC = "straight line, quintic time law"
     LINE_TOPPRA = "straight line, time-optimal (TOPP-RA)"
-    ARCH = "arch (jump) move, time-optimal (TOPP-RA)"
+    JUMP = "jump (arch move), time-optimal, joint path free"
+    ARCH = "straight-leg arch (lift, traverse, descend, blended), time-optimal (TOPP-RA)"
+    JOINT_JERK = "joint path, jerk-limited time-optimal"
+    LINE_JERK = "straight line, jerk-limited time-optimal"
 
 
 def _optional_vector(name: str, value: object) -> np.ndarray | None:
@@ -68,9 +73,14 @@ class MotionRequest:
         arch: an arch (jump) move between the two poses (SCARA; not with ``linear``, vias or a duration).
         tool_speed: a tool speed limit [m/s] for time-optimal moves; None: no limit.
         torque: respect the effort limits (time-optimal moves).
-        rise: [m] the arch's traverse height above the higher pose; None: the standard one.
-        blend: [m] the arch's corner blend distance; None: as large as allowed.
+        rise: [m] the arch's clearance above the higher pose; None: the standard one.
+        blend: [m] the straight-leg arch's corner blend distance; None: as large as allowed (path "lines").
         payload: a payload at the tool (``torque`` moves and arches); None: none.
+        jerk: joint jerk limits [rad/s^3, m/s^3], one per joint, for a jerk-limited time-optimal move (arches
+            too); None: none.
+        path: "jump" (the time-optimal jump, the joint path free) or "lines" (the straight-leg arch).
+        clearance_radius: [m] the jump's clearance radius; None: the standard one (path "jump").
+        max_height: [m] a ceiling for the tool's z during the arch, or None.
     """
 
     start_q: np.ndarray | None = None
@@ -86,6 +96,10 @@ class MotionRequest:
     rise: float | None = None
     blend: float | None = None
     payload: Payload | None = field(default=None)
+    jerk: tuple[float, ...] | None = None
+    path: str = "jump"
+    clearance_radius: float | None = None
+    max_height: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
@@ -105,6 +119,19 @@ class MotionRequest:
             raise InvalidInputError("an arch move takes no via (one arch between two poses)")
         if self.arch and self.duration is not None:
             raise InvalidInputError("an arch move is time-optimal: a duration does not apply")
+        if self.jerk is not None and self.duration is not None:
+            raise InvalidInputError("--jerk-limit is time-optimal: --duration does not apply")
+        if self.jerk is not None and self.tool_speed is not None:
+            raise InvalidInputError("--jerk-limit with --tool-speed is not supported: give one of them")
+        if self.path not in ("jump", "lines"):
+            raise ParameterError("path", self.path, "must be 'jump' or 'lines'")
+        if self.path == "jump" and self.blend is not None:
+            raise InvalidInputError("a blend distance shapes the straight-leg arch (path 'lines'), not the jump")
+        if self.path == "lines" and self.clearance_radius is not None:
+            raise InvalidInputError("a clearance radius applies to the jump (path 'jump'): the straight-leg arch lifts "
+                                    "vertically")  # fmt: skip
+        if not self.arch and (self.rise, self.blend, self.clearance_radius, self.max_height) != (None,) * 4:
+            raise InvalidInputError("rise, blend, clearance radius and max height shape an arch move: set arch")
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,13 +142,13 @@ class MotionPlan:
         trajectory: the timed joint trajectory.
         method: how it was made.
         robot: the robot it was planned for (the request's payload attached, when one was given).
-        arch: the arch move (its legs, ratios and payload) for ``Method.ARCH``; else None.
+        arch: the arch move (its legs, ratios and payload) for ``Method.JUMP`` and ``Method.ARCH``; else None.
     """
 
     trajectory: tr.Trajectory
     method: Method
     robot: Robot
-    arch: ArchMove | None = None
+    arch: ArchMove | JumpMove | None = None
 
 
 def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -129,22 +156,23 @@ def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
 
     Raises:
         InvalidInputError: a straight line or an arch asked of a robot other than a SCARA, an arch with
-            ``linear``, a payload without ``torque`` outside an arch.
+            ``linear``, a payload without ``torque``.
         InfeasibleError: a pose out of reach, a path the robot cannot follow, or a timing failure.
     """
     if request.linear and robot.kind != "scara":
         raise InvalidInputError(f"a straight tool line (--linear) is SCARA-only for now; robot {robot.name!r} is a "
                                 f"{robot.kind} (joint-space --duration and TOPP-RA timing work)")  # fmt: skip
+    payload = request.payload
+    if payload is not None and payload.mass and not request.torque:
+        raise InvalidInputError("--payload changes only the torques: give --torque too")
     if request.arch:
         if request.linear:
             raise InvalidInputError("--arch is a SCARA move on its own (not with --linear)")
-        if robot.kind != "scara":
-            raise InvalidInputError(f"traj --arch is SCARA-only; robot {robot.name!r} is a {robot.kind}")
-        return _arch(robot, request)
-    payload = request.payload
+        if robot.kind != "scara" and request.path == "lines":
+            raise InvalidInputError(f"the straight-leg arch (--path lines) is SCARA-only; robot {robot.name!r} is a "
+                                    f"{robot.kind} (the jump, --path jump, works)")  # fmt: skip
+        return _jump(robot, request) if request.path == "jump" else _arch(robot, request)
     if payload is not None and payload.mass:
-        if not request.torque:
-            raise InvalidInputError("--payload changes only the torques: give --torque too")
         from .payload import with_payload
 
         robot = with_payload(robot, payload)
@@ -154,6 +182,10 @@ def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
 
 
 def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Trajectory:
+    if request.jerk is not None:
+        from .jerk import time_optimal_jerk
+
+        return time_optimal_jerk(robot, path, request.jerk, torque=request.torque).trajectory  # type: ignore[arg-type]
     from .timing import time_optimal
 
     return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque)  # type: ignore[arg-type]
@@ -167,7 +199,8 @@ def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
     path = tr.cartesian_path(robot, poses, start=q_from, end=q_to)
     if request.duration is not None:
         return MotionPlan(tr.timed(path, request.duration), Method.LINE_QUINTIC, robot)
-    return MotionPlan(_time_optimal(robot, path, request), Method.LINE_TOPPRA, robot)
+    method = Method.LINE_TOPPRA if request.jerk is None else Method.LINE_JERK
+    return MotionPlan(_time_optimal(robot, path, request), method, robot)
 
 
 def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -183,25 +216,40 @@ def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
             path = tr.joint_path(robot, [q_from, *vias, q_to])
             return MotionPlan(tr.timed(path, request.duration), Method.JOINT_SPLINE_QUINTIC, robot)
         return MotionPlan(tr.quintic(q_from, q_to, request.duration), Method.JOINT_QUINTIC, robot)
-    if not vias and request.tool_speed is None and not request.torque:
+    if not vias and request.tool_speed is None and not request.torque and request.jerk is None:
         lim = robot.limits
         return MotionPlan(tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), Method.JOINT_TRAPEZOID, robot)
-    return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), Method.JOINT_TOPPRA, robot)
+    method = Method.JOINT_TOPPRA if request.jerk is None else Method.JOINT_JERK
+    return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), method, robot)
 
 
 def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
-    from .cycle import arch_move
+    from .cycle import STANDARD_RISE, arch_move
 
     first = request.start_pose if request.start_q is None else tr.joint_pose(robot, request.start_q)
     last = request.end_pose if request.end_q is None else tr.joint_pose(robot, request.end_q)
     poses = np.array([first, last], dtype=float)
-    if request.rise is None:
-        move = arch_move(robot, poses, blend=request.blend, payload=request.payload, torque=request.torque,
-                         start=request.start_q)  # fmt: skip
-    else:
-        move = arch_move(robot, poses, rise=request.rise, blend=request.blend, payload=request.payload,
-                         torque=request.torque, start=request.start_q)  # fmt: skip
+    rise = STANDARD_RISE if request.rise is None else request.rise
+    if request.max_height is not None and request.max_height < max(poses[:, 2]) + rise:
+        raise InfeasibleError(f"max_height {request.max_height:.6g} m is below the traverse height "
+                              f"{max(poses[:, 2]) + rise:.6g} m of the arch")  # fmt: skip
+    move = arch_move(robot, poses, rise=rise, blend=request.blend, payload=request.payload, torque=request.torque,
+                     start=request.start_q, tool_speed=request.tool_speed, jerk=request.jerk)  # fmt: skip
     return MotionPlan(move.trajectory, Method.ARCH, robot, move)
+
+
+def _jump(robot: Robot, request: MotionRequest) -> MotionPlan:
+    from .jump import STANDARD_CLEARANCE, STANDARD_RISE, jump_move
+
+    first = request.start_pose if request.start_q is None else tr.joint_pose(robot, request.start_q)
+    last = request.end_pose if request.end_q is None else tr.joint_pose(robot, request.end_q)
+    move = jump_move(robot, np.asarray(first, dtype=float), np.asarray(last, dtype=float),
+                     rise=STANDARD_RISE if request.rise is None else request.rise,
+                     clearance_radius=STANDARD_CLEARANCE if request.clearance_radius is None
+                     else request.clearance_radius, max_height=request.max_height, payload=request.payload,
+                     torque=request.torque, tool_speed=request.tool_speed, start=request.start_q,
+                     end=request.end_q, jerk=request.jerk)  # fmt: skip
+    return MotionPlan(move.trajectory, Method.JUMP, robot, move)
 
 
 def _pose_to_q(robot: Robot, pose: np.ndarray | None, near: np.ndarray, what: str) -> np.ndarray:

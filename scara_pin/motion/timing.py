@@ -36,6 +36,7 @@ functions of this module (it costs more than a second).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from collections.abc import Sequence
@@ -43,7 +44,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pinocchio as pin
 
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, ParameterError
@@ -56,10 +56,10 @@ from .trajectory import (
     Motion,
     ProfileLaw,
     Trajectory,
-    _limit_vector,
     _positive,
     joint_path,
 )
+from .verify import Quantity, _Limits, _limits, _rnea, _tool_rows, time_scale, verify
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -189,23 +189,6 @@ class TimingResult:
     options: TimingOptions = field(default_factory=TimingOptions)
 
 
-@dataclass(frozen=True)
-class _Limits:
-    velocity: np.ndarray
-    acceleration: np.ndarray
-    effort: np.ndarray | None
-    tool_speed: float | None
-
-
-def _limits(robot: Robot, limits: JointLimits | None, tool_speed: float | None, torque: bool) -> _Limits:
-    lim = robot.limits if limits is None else limits
-    v = _limit_vector("velocity", lim.velocity, "rad/s or m/s")
-    a = _limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2")
-    e = _limit_vector("effort", lim.effort, "N m or N") if torque else None
-    vt = None if tool_speed is None else _positive("tool_speed", tool_speed, "m/s")
-    return _Limits(v, a, e, vt)
-
-
 def time_optimal(
     robot: Robot,
     path: GeometricPath | CartesianPath | Sequence[ArrayLike] | np.ndarray,
@@ -290,19 +273,6 @@ def _grid(path: GeometricPath, n: int) -> np.ndarray:
     grid = np.unique(np.concatenate([uniform[~near], knots, [0.0, 1.0]]))
     grid[0], grid[-1] = 0.0, 1.0
     return grid
-
-
-def _tool_rows(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
-    """|J_xyz(q) dq| per row."""
-    return np.array([np.linalg.norm(robot.task_jacobian(q[k])[:3] @ dq[k]) for k in range(len(q))])
-
-
-def _rnea(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-    model = robot.model
-    data = model.createData()
-    if getattr(robot, "has_continuous", False):  # Pinocchio takes a continuous joint's (cos, sin)
-        return np.array([pin.rnea(model, data, robot.to_pinocchio_q(q[k]), v[k], a[k]) for k in range(len(q))])
-    return np.array([pin.rnea(model, data, q[k], v[k], a[k]) for k in range(len(q))])
 
 
 def _time_segment(
@@ -509,30 +479,19 @@ def _check(
     sub = extremes is None or lim.tool_speed is not None or lim.effort is not None
     t = _check_times(law, opts, sub, t_start)
     q, qd, qdd = motion.evaluate(t)
-    rv = float(np.max(np.abs(qd) / lim.velocity))
-    ra = float(np.max(np.abs(qdd) / lim.acceleration))
-    if extremes is not None and len(extremes[0]):
-        rv = max(rv, float(np.max(np.abs(extremes[0]) / lim.velocity)) / scale)
-        ra = max(ra, float(np.max(np.abs(extremes[1]) / lim.acceleration)) / (scale * scale))
-    k2 = max(rv * rv, ra)
-    rt = None
-    if lim.tool_speed is not None:
-        rt = float(np.max(_tool_rows(robot, q, qd)) / lim.tool_speed)
-        k2 = max(k2, rt * rt)
-    rtau = None
-    if lim.effort is not None:
-        E = lim.effort
-        zero = np.zeros_like(qd)
-        gq = _rnea(robot, q, zero, zero)
-        tau = _rnea(robot, q, qd, qdd)
-        dyn = tau - gq
-        rtau = float(np.max(np.abs(tau) / E))
-        room = np.where(dyn > 0, E - gq, E + gq)  # |dyn / k^2 + g| <= E  <=>  k^2 >= |dyn| / room
-        if (room <= 0).any():
-            k = int(np.argwhere(room <= 0)[0, 0])
-            raise TimingError("VerificationFailed", f"the static load exceeds an effort limit at t = {t[k]:.6g} s")
-        k2 = max(k2, float(np.max(np.abs(dyn) / room)))
-    return math.sqrt(k2), LimitRatios(rv, ra, rt, rtau)
+    try:
+        k, worst = time_scale(robot, lim, q, qd, qdd)
+    except InfeasibleError as exc:
+        raise TimingError("VerificationFailed", str(exc)) from None
+    if extremes is not None and len(extremes[0]):  # computed before the slow-down: qd / scale, qdd / scale^2
+        e_v, e_a = extremes[0] / scale, extremes[1] / (scale * scale)
+        only_va = dataclasses.replace(lim, effort=None, tool_speed=None)
+        k_e, worst_e = time_scale(robot, only_va, np.zeros_like(e_v), e_v, e_a)
+        k = max(k, k_e)
+        for quantity in (Quantity.VELOCITY, Quantity.ACCELERATION):
+            worst[quantity] = max(worst[quantity], worst_e[quantity])
+    return k, LimitRatios(worst[Quantity.VELOCITY], worst[Quantity.ACCELERATION], worst.get(Quantity.TOOL_SPEED),
+                          worst.get(Quantity.TORQUE))  # fmt: skip
 
 
 def _polynomial_extremes(path: GeometricPath, law: ProfileLaw) -> tuple[np.ndarray, np.ndarray]:
@@ -591,37 +550,6 @@ def limit_ratios(
     is checked at ``rate`` and at 65 points inside every piece (however short). An unknown limit (NaN, a
     URDF's acceleration) gives a NaN ratio, which no check passes.
     """
-    lim = _limits(robot, limits, tool_speed, torque)
-    times = [trajectory.times(rate)]
-    peak_v = np.zeros(trajectory.q_start.shape[0])
-    peak_a = np.zeros(trajectory.q_start.shape[0])
-    for start, piece in zip(trajectory.starts.tolist(), trajectory.pieces):
-        times.append(start + np.linspace(0.0, piece.duration, 65))
-        exact = _exact_peaks(piece)
-        if exact is not None:
-            peak_v, peak_a = np.maximum(peak_v, exact[0]), np.maximum(peak_a, exact[1])
-    t = np.unique(np.clip(np.concatenate(times), 0.0, trajectory.duration))
-    q, qd, qdd = trajectory.sample(t)
-    rt = None if lim.tool_speed is None else float(np.max(_tool_rows(robot, q, qd)) / lim.tool_speed)
-    rtau = None
-    if lim.effort is not None:
-        rtau = float(np.max(np.abs(_rnea(robot, q, qd, qdd)) / lim.effort))
-    v = np.maximum(np.max(np.abs(qd), axis=0), peak_v)
-    a = np.maximum(np.max(np.abs(qdd), axis=0), peak_a)
-    rv, ra = float(np.max(v / lim.velocity)), float(np.max(a / lim.acceleration))
-    return LimitRatios(rv, ra, rt, rtau)
-
-
-def _exact_peaks(piece: object) -> tuple[np.ndarray, np.ndarray] | None:
-    """Per joint (max |qd|, max |qdd|) of a straight joint move under a closed-form law, else None.
-
-    On a :class:`JointLine` q = q0 + s dq: qd = dq sd and qdd = dq sdd, so the maxima are |dq| times the
-    law's (:meth:`TimeLaw.peaks`).
-    """
-    if not (isinstance(piece, Motion) and isinstance(piece.path, JointLine)):
-        return None
-    peaks = piece.law.peaks()
-    if peaks is None:
-        return None
-    dq = np.abs(piece.path.q1 - piece.path.q0)
-    return dq * peaks[0], dq * peaks[1]
+    v = verify(robot, trajectory, rate=rate, tool_speed=tool_speed, torque=torque, limits=limits)
+    return LimitRatios(v.velocity.ratio, v.acceleration.ratio, None if v.tool_speed is None else v.tool_speed.ratio,
+                       None if v.torque is None else v.torque.ratio)  # fmt: skip

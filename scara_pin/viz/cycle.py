@@ -18,6 +18,8 @@ if TYPE_CHECKING:
     from ..description import JointLimits
     from ..model import Robot
     from ..motion.cycle import ArchMove
+    from ..motion.jump import JumpMove
+    from ..motion.trajectory import Trajectory
 
 __all__ = ["plot_cycle"]
 
@@ -28,7 +30,7 @@ _LEG_COLORS = {"lift": "tab:gray", "blend up": "tab:purple", "traverse": "tab:bl
 
 def plot_cycle(
     robot: Robot,
-    move: ArchMove,
+    move: ArchMove | JumpMove,
     path: str | os.PathLike[str],
     *,
     limits: JointLimits | None = None,
@@ -39,12 +41,12 @@ def plot_cycle(
     """Write a PNG of an arch move or cycle: the tool path, and the joint rates against their limits.
 
     Side view (horizontal progress vs z) and plan view (x, y) with the legs coloured (blends in purple);
-    |qd|/vmax, |qdd|/amax (and |qddd|/jmax with a jerk limit) per joint against time, the limit at 1.
+    for a jump, its clearance: the height z_top (dashed) outside the circles of radius R around the two poses
+    (dotted), and the straight line between them in plan view; |qd|/vmax, |qdd|/amax (and |qddd|/jmax with
+    a jerk limit) per joint against time, the limit at 1.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-
-    from ..motion.cycle import trajectory_jerk
 
     lim = robot.limits if limits is None else limits
     traj = move.trajectory
@@ -66,6 +68,17 @@ def plot_cycle(
         label = leg.name if leg.move == 0 else None
         side.plot(progress[sel] * 1e3, poses[sel, 2] * 1e3, color=color, lw=2, label=label)
         plan.plot(poses[sel, 0] * 1e3, poses[sel, 1] * 1e3, color=color, lw=2)
+    R = getattr(move, "clearance_radius", None)
+    if R is not None:  # the jump's clearance: z >= z_top wherever the tool is more than R from both ends
+        z_top, end = move.z_top, float(np.hypot(*(move.pose_to[:2] - move.pose_from[:2])))  # type: ignore[union-attr]
+        side.plot([R * 1e3, (end - R) * 1e3], [z_top * 1e3] * 2, "k--", lw=1, label="clearance")
+        for x in (R, end - R):
+            side.axvline(x * 1e3, color="k", ls=":", lw=1)
+        angle = np.linspace(0.0, 2.0 * np.pi, 100)
+        for pose in (move.pose_from, move.pose_to):  # type: ignore[union-attr]
+            plan.plot((pose[0] + R * np.cos(angle)) * 1e3, (pose[1] + R * np.sin(angle)) * 1e3, "k:", lw=1)
+        ends = np.array([move.pose_from[:2], move.pose_to[:2]]) * 1e3  # type: ignore[union-attr]
+        plan.plot(ends[:, 0], ends[:, 1], "k--", lw=1)
     side.set(xlabel="along the traverse [mm]", ylabel="z [mm]", title="side view (tool path)")
     side.legend(fontsize="small")
     plan.plot([0.0], [0.0], "k+", ms=12)
@@ -73,7 +86,7 @@ def plot_cycle(
     quantities = [("|qd| / vmax", np.abs(qd) / np.array(lim.velocity)),
                   ("|qdd| / amax", np.abs(qdd) / np.array(lim.acceleration))]  # fmt: skip
     if move.jerk is not None:
-        quantities.append(("|qddd| / jmax", np.abs(trajectory_jerk(traj, t)) / np.array(move.jerk)))
+        quantities.append(("|qddd| / jmax", np.abs(_jerk(traj, t)) / np.array(move.jerk)))
     for k, (name, ratio) in enumerate(quantities):
         ax = fig.add_subplot(grid[1 + k, :])
         for j in range(4):
@@ -87,3 +100,17 @@ def plot_cycle(
     if title:
         fig.suptitle(title)
     return save_figure(fig, path, dpi=dpi)
+
+
+def _jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
+    """Joint jerk at times t: each piece's own (a jump's polynomial), else the motions' chain rule."""
+    from ..motion.cycle import trajectory_jerk
+    from ..motion.polynomial import PolynomialPiece
+
+    if not all(isinstance(p, PolynomialPiece) for p in traj.pieces):
+        return trajectory_jerk(traj, t)
+    out = np.zeros((len(t), traj.dof))
+    for start, piece in zip(traj.starts.tolist(), traj.pieces):
+        sel = (t >= start) & (t <= start + piece.duration)
+        out[sel] = piece.jerk(t[sel] - start)  # type: ignore[attr-defined]
+    return out

@@ -1,0 +1,567 @@
+"""The one verifier of a timed trajectory: every limit ratio, where it peaks, the endpoints and the rest.
+
+Every planner's output (TOPP-RA, the jerk-limited timing, the jump moves, a quintic) is checked here, by
+the same formulas, so "the limits hold" means one thing everywhere. :func:`verify` samples the trajectory
+
+- on its own fixed-rate grid ``k / rate`` (:data:`VERIFY_RATE` = 10 kHz by default), padded with three
+  samples of rest on each side;
+- at the start and end of every piece and just inside them, at :data:`PIECE_POINTS` points of every
+  piece (a piece shorter than a sample period is checked too), and at the law's breakpoints and their
+  left sides when the law has them (``law.breakpoints()``, where the path jerk switches);
+
+and forms |value| / limit per joint for
+
+- **velocity** and **acceleration** (and the closed-form maxima of a straight joint move's law,
+  :meth:`~scara_pin.motion.trajectory.TimeLaw.peaks`, exact between samples);
+- **jerk**, two ways: the analytic joint jerk ``q' sddd + 3 q'' sd sdd + q''' sd^3`` of the motions whose
+  law has a jerk (``law.evaluate_jerk``), and the third differences of q on the padded grid,
+  ``(q[k+3] - 3 q[k+2] + 3 q[k+1] - q[k]) / h^3``, a B-spline-weighted mean of the true jerk over 3 h (so
+  never above its maximum): it sees every acceleration step, at the pieces' joins and at both rests,
+  whatever the law. Its rounding floor ``8 eps max|q| / h^3`` is reported and allowed on top of the
+  tolerance (about 2e-6 of a 2000 m/s^3 limit at 10 kHz on a 0.3 m stroke);
+- **torque**: Pinocchio's RNEA (gravity included) on the model carrying ``payload``
+  (:func:`~scara_pin.motion.payload.with_payload`);
+- **tool speed** |J_xyz(q) qd| when limited;
+
+and, separately, the **endpoints** (|q(0) - q_start|, |q(T) - q_end| when given) and the **rest** at both
+ends (|qd| / vmax, and with a jerk limit |qdd| / amax too, at t = 0 and t = T).
+
+The result, :class:`Verification`, is frozen: the worst ratio of each quantity with the time and joint
+where it occurs; :meth:`Verification.check` raises :class:`LimitViolation` (exit 3) naming the first
+quantity whose ratio exceeds 1 + :data:`TOLERANCE`, or an endpoint or rest beyond its tolerance.
+
+The evaluation of limits is shared with the planners: :func:`state_ratios` (ratios of given states),
+:func:`time_scale` (the uniform slow-down that brings the worst ratio to 1: velocity / k, acceleration
+and the dynamic torque / k^2, jerk / k^3), :func:`joint_jerk`, :func:`trajectory_jerk`.
+
+Interface stability: :func:`verify`, :class:`Verification`, :class:`Worst`, :class:`Quantity`,
+:class:`LimitViolation`, :func:`state_ratios`, :func:`time_scale`, :func:`joint_jerk`,
+:func:`trajectory_jerk` and :func:`jerk_vector` keep their signatures (new keyword arguments may be added
+with defaults).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pinocchio as pin
+
+from .._checks import _limit_vector, _positive
+from ..description import JOINT_NAMES, JointLimits
+from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..limits import MAX_SAMPLES, check_count
+from .paths import GeometricPath, JointLine, JointSpline
+from .payload import Payload, with_payload
+from .trajectory import Motion, Trajectory
+
+if TYPE_CHECKING:
+    from .._typing import ArrayLike
+    from ..model import Robot
+
+__all__ = [
+    "ENDPOINT_TOL",
+    "PIECE_POINTS",
+    "REST_TOL",
+    "TOLERANCE",
+    "VERIFY_RATE",
+    "LimitViolation",
+    "Quantity",
+    "Verification",
+    "Worst",
+    "jerk_vector",
+    "joint_jerk",
+    "path_third_derivative",
+    "state_ratios",
+    "time_scale",
+    "trajectory_jerk",
+    "verify",
+]
+
+VERIFY_RATE = 10_000.0
+"""[Hz] the default sampling rate of :func:`verify` (ten times the 1 kHz of a controller)."""
+TOLERANCE = 1e-6
+"""Relative excess of a limit that :meth:`Verification.check` tolerates: a ratio up to 1 + 1e-6 passes."""
+REST_TOL = 1e-9
+"""|qd| / vmax (and |qdd| / amax with a jerk limit) at t = 0 and t = T above which the ends are not at rest."""
+ENDPOINT_TOL = 1e-9
+"""[rad or m] the largest |q(0) - q_start| and |q(T) - q_end| accepted."""
+PIECE_POINTS = 65
+"""Points checked inside every piece, however short (besides the rate grid)."""
+_CHUNK = 50_000
+"""Samples evaluated at once (bounds the memory of a long trajectory at a high rate)."""
+_FD_STEP = 1e-4
+"""Finite-difference step of q''' relative to the width of the smooth piece of the path."""
+_LEFT = 1.0 - 1e-9
+"""Fraction of an interval where its left limit at the next breakpoint is checked."""
+
+
+class Quantity(enum.Enum):
+    """A limited quantity; the value is its name in messages and JSON."""
+
+    VELOCITY = "velocity"
+    ACCELERATION = "acceleration"
+    JERK = "jerk"
+    JERK_DIFFERENCES = "jerk (third differences)"
+    TORQUE = "torque"
+    TOOL_SPEED = "tool speed"
+
+
+@dataclass(frozen=True)
+class Worst:
+    """The largest |value| / limit of one quantity over the verified samples.
+
+    Attributes:
+        quantity: which quantity.
+        ratio: |value| / limit (1.0 = on the limit).
+        time: [s] where it occurs (a closed-form peak of a law: the start of its piece).
+        joint: the joint's index, or None for the tool speed.
+    """
+
+    quantity: Quantity
+    ratio: float
+    time: float
+    joint: int | None
+
+    @property
+    def where(self) -> str:
+        """``"joint2 at t = 0.1234 s"``."""
+        who = "the tool" if self.joint is None else JOINT_NAMES[self.joint]
+        return f"{who} at t = {self.time:.6g} s"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"ratio": self.ratio, "time": self.time,
+                "joint": None if self.joint is None else JOINT_NAMES[self.joint]}  # fmt: skip
+
+
+class LimitViolation(InfeasibleError):
+    """A verified trajectory exceeds a limit, misses an endpoint or does not rest at an end (exit code 3).
+
+    Attributes:
+        worst: the violated quantity's worst sample (None for an endpoint or rest failure).
+        reason: the sentence.
+    """
+
+    def __init__(self, reason: str, worst: Worst | None = None) -> None:
+        self.worst = worst
+        self.reason = reason
+        super().__init__(reason)
+
+
+@dataclass(frozen=True)
+class Verification:
+    """What :func:`verify` found.
+
+    Attributes:
+        duration: [s] of the trajectory.
+        rate: [Hz] of the verified grid.
+        samples: number of verified sample times.
+        velocity, acceleration: the worst joint ratios.
+        jerk: the worst analytic joint-jerk ratio (motions whose law has a jerk; None without a jerk limit
+            or when no piece has one).
+        jerk_differences: the worst third-difference jerk ratio (None without a jerk limit).
+        jerk_floor: the rounding floor of the third differences, as a ratio (allowed on top of the
+            tolerance; 0 without a jerk limit).
+        torque: the worst effort ratio (None when not limited).
+        tool_speed: the worst tool-speed ratio (None when not limited).
+        start_error, end_error: [rad or m] max |q(0) - q_start|, |q(T) - q_end| (None when not given).
+        rest: the largest |qd| / vmax at t = 0 and T (and |qdd| / amax with a jerk limit).
+    """
+
+    duration: float
+    rate: float
+    samples: int
+    velocity: Worst
+    acceleration: Worst
+    jerk: Worst | None = None
+    jerk_differences: Worst | None = None
+    jerk_floor: float = 0.0
+    torque: Worst | None = None
+    tool_speed: Worst | None = None
+    start_error: float | None = None
+    end_error: float | None = None
+    rest: float = 0.0
+    quantities: tuple[Worst, ...] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        found = (self.velocity, self.acceleration, self.jerk, self.jerk_differences, self.torque, self.tool_speed)
+        object.__setattr__(self, "quantities", tuple(w for w in found if w is not None))
+
+    @property
+    def worst(self) -> Worst:
+        """The quantity with the largest ratio (NaN counts as the largest: an unknown limit passes nothing)."""
+        return max(self.quantities, key=lambda w: math.inf if math.isnan(w.ratio) else w.ratio)
+
+    def ratios(self) -> dict[str, float | None]:
+        """{quantity name: worst ratio or None}, JSON-ready."""
+        found = {w.quantity: w.ratio for w in self.quantities}
+        return {q.value: found.get(q) for q in Quantity}
+
+    def check(self, tolerance: float = TOLERANCE) -> Verification:
+        """Self, if every ratio is <= 1 + ``tolerance`` and the endpoints and rest hold; else raise.
+
+        Raises:
+            LimitViolation: naming the quantity, the ratio, the joint and the time.
+        """
+        for w in self.quantities:
+            allowed = 1.0 + tolerance + (self.jerk_floor if w.quantity is Quantity.JERK_DIFFERENCES else 0.0)
+            if not w.ratio <= allowed:  # NaN fails
+                raise LimitViolation(f"the {w.quantity.value} of {w.where} is {w.ratio:.9g} of its limit "
+                                     f"(allowed: {allowed:.9g})", w)  # fmt: skip
+        for name, err in (("start", self.start_error), ("end", self.end_error)):
+            if err is not None and not err <= ENDPOINT_TOL:
+                raise LimitViolation(f"the trajectory misses its {name} by {err:.3g} (rad or m; allowed "
+                                     f"{ENDPOINT_TOL:g})")  # fmt: skip
+        if not self.rest <= REST_TOL:
+            raise LimitViolation(f"the trajectory is not at rest at an end: {self.rest:.3g} of a limit "
+                                 f"(allowed {REST_TOL:g})")  # fmt: skip
+        return self
+
+
+# ---------------------------------------------------------------------------------------------- limits
+@dataclass(frozen=True)
+class _Limits:
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    effort: np.ndarray | None
+    tool_speed: float | None
+
+
+def _limits(robot: Robot, limits: JointLimits | None, tool_speed: float | None, torque: bool) -> _Limits:
+    """The limits in force, each refused when NaN, zero, negative or infinite."""
+    lim = robot.limits if limits is None else limits
+    v = _limit_vector("velocity", lim.velocity, "rad/s or m/s")
+    a = _limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2")
+    e = _limit_vector("effort", lim.effort, "N m or N") if torque else None
+    vt = None if tool_speed is None else _positive("tool_speed", tool_speed, "m/s")
+    return _Limits(v, a, e, vt)
+
+
+def jerk_vector(jerk: float | ArrayLike, dof: int = 4) -> np.ndarray:
+    """One jerk limit for every joint, or one per joint, as a (dof,) array [rad/s^3 or m/s^3].
+
+    Raises:
+        ParameterError: not one number or ``dof``, or one that is not finite and > 0.
+    """
+    try:
+        arr = np.asarray(jerk, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError("jerk limit", jerk, "must be one number or one per joint", "rad/s^3 or m/s^3") from None
+    jv = np.full(dof, float(arr)) if arr.ndim == 0 else arr
+    if jv.shape != (dof,) or not (np.isfinite(jv).all() and (jv > 0).all()):
+        raise ParameterError("jerk limit", arr.tolist(), f"must be one number or {dof}, each finite and > 0",
+                             "rad/s^3 or m/s^3")  # fmt: skip
+    return jv
+
+
+def _tool_rows(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+    """|J_xyz(q) dq| per row."""
+    return np.array([np.linalg.norm(robot.task_jacobian(q[k])[:3] @ dq[k]) for k in range(len(q))])
+
+
+def _rnea(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Joint efforts (n, dof) by Pinocchio's RNEA, gravity included, row by row."""
+    model = robot.model
+    data = model.createData()
+    if getattr(robot, "has_continuous", False):  # Pinocchio takes a continuous joint's (cos, sin)
+        return np.array([pin.rnea(model, data, robot.to_pinocchio_q(q[k]), v[k], a[k]) for k in range(len(q))])
+    return np.array([pin.rnea(model, data, q[k], v[k], a[k]) for k in range(len(q))])
+
+
+def state_ratios(
+    robot: Robot,
+    lim: _Limits,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    qddd: np.ndarray | None = None,
+    jerk: np.ndarray | None = None,
+) -> dict[Quantity, np.ndarray]:
+    """|value| / limit per sample (rows) and joint (columns; one column for the tool speed), per quantity.
+
+    The torque needs ``lim.effort``, the tool speed ``lim.tool_speed``, the jerk ``qddd`` and ``jerk``.
+    """
+    return _ratios(robot, lim, q, qd, qdd, qddd, jerk)[0]
+
+
+def _ratios(
+    robot: Robot, lim: _Limits, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, qddd: np.ndarray | None,
+    jerk: np.ndarray | None,
+) -> tuple[dict[Quantity, np.ndarray], np.ndarray | None]:
+    """(:func:`state_ratios`, the efforts or None)."""
+    out = {Quantity.VELOCITY: np.abs(qd) / lim.velocity, Quantity.ACCELERATION: np.abs(qdd) / lim.acceleration}
+    tau = None
+    if lim.effort is not None:
+        tau = _rnea(robot, q, qd, qdd)
+        out[Quantity.TORQUE] = np.abs(tau) / lim.effort
+    if lim.tool_speed is not None:
+        out[Quantity.TOOL_SPEED] = (_tool_rows(robot, q, qd) / lim.tool_speed)[:, None]
+    if qddd is not None and jerk is not None:
+        out[Quantity.JERK] = np.abs(qddd) / jerk
+    return out, tau
+
+
+def time_scale(
+    robot: Robot,
+    lim: _Limits,
+    q: np.ndarray,
+    qd: np.ndarray,
+    qdd: np.ndarray,
+    qddd: np.ndarray | None = None,
+    jerk: np.ndarray | None = None,
+) -> tuple[float, dict[Quantity, float]]:
+    """(k, worst ratios): the time scale k that brings the worst ratio of these states to exactly 1.
+
+    Slowing a motion k times divides velocities and the tool speed by k, accelerations and the dynamic
+    part of the torque (``tau - g(q)``) by k^2, jerks by k^3. So k = max(r_v, sqrt(r_a), cbrt(r_j),
+    r_tool, sqrt(|tau - g| / room)) with ``room = E - g`` where ``tau - g > 0``, else ``E + g``; k < 1
+    speeds up.
+
+    Raises:
+        InfeasibleError: the static load alone reaches an effort limit (no k helps).
+    """
+    r, tau = _ratios(robot, lim, q, qd, qdd, qddd, jerk)
+    worst = {name: float(np.max(v)) if v.size else 0.0 for name, v in r.items()}
+    k = max(worst[Quantity.VELOCITY], math.sqrt(worst[Quantity.ACCELERATION]))
+    if Quantity.JERK in worst:
+        k = max(k, worst[Quantity.JERK] ** (1.0 / 3.0))
+    if Quantity.TOOL_SPEED in worst:
+        k = max(k, worst[Quantity.TOOL_SPEED])
+    if tau is not None and lim.effort is not None and len(q):
+        E = lim.effort
+        zero = np.zeros_like(qd)
+        g = _rnea(robot, q, zero, zero)
+        dyn = tau - g
+        room = np.where(dyn > 0, E - g, E + g)  # |dyn / k^2 + g| <= E  <=>  k^2 >= |dyn| / room
+        if (room <= 0).any():
+            i, j = np.argwhere(room <= 0)[0]
+            raise InfeasibleError(f"the static load on {JOINT_NAMES[j]} ({g[i, j]:.6g}) is not below its effort "
+                                  f"limit {E[j]:.6g}: the robot cannot even hold still there")  # fmt: skip
+        k = max(k, math.sqrt(float(np.max(np.abs(dyn) / room))))
+    return k, worst
+
+
+# ---------------------------------------------------------------------------------------------- jerk
+def path_third_derivative(path: GeometricPath, s: np.ndarray) -> np.ndarray:
+    """q'''(s), (n, dof): exact for joint lines (0) and splines; else finite differences of the exact q''.
+
+    The differences are central, of step h = 1e-4 of the width of the smooth piece (between knots);
+    second-order one-sided within h of a knot, so a difference never straddles a knot.
+    """
+    s = np.asarray(s, dtype=float).ravel()
+    if isinstance(path, JointLine):
+        return np.zeros((len(s), len(path.q0)))
+    if isinstance(path, JointSpline):
+        return np.asarray(path._spline(s, 3), dtype=float)
+    knots = np.unique(np.clip(path.knots(), 0.0, 1.0))
+    i = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, len(knots) - 2)
+    lo, hi = knots[i], knots[i + 1]
+    h = _FD_STEP * (hi - lo)
+    left = s - h < lo
+    right = s + h > hi
+    # offsets (in units of h) of the three points: centred (-1, 0, 1), forward (0, 1, 2), backward (-2, -1, 0)
+    base = np.where(left, s, np.where(right, s - 2 * h, s - h))
+    pts = np.concatenate([base, base + h, base + 2 * h])
+    n = len(s)
+    _, _, d2 = path.evaluate(pts, 2)
+    f0, f1, f2 = d2[:n], d2[n : 2 * n], d2[2 * n :]
+    central = (f2 - f0) / 2.0
+    forward = (-3.0 * f0 + 4.0 * f1 - f2) / 2.0
+    backward = (f0 - 4.0 * f1 + 3.0 * f2) / 2.0
+    out = np.where(left[:, None], forward, np.where(right[:, None], backward, central))
+    return out / h[:, None]
+
+
+def has_jerk(piece: object) -> bool:
+    """True for a motion whose law has a path jerk (``law.evaluate_jerk``)."""
+    return isinstance(piece, Motion) and callable(getattr(piece.law, "evaluate_jerk", None))
+
+
+def joint_jerk(motion: Motion, tau: np.ndarray) -> np.ndarray:
+    """Joint jerk (n, dof) of a motion at local times ``tau``: q' sddd + 3 q'' sd sdd + q''' sd^3.
+
+    A law with ``evaluate_jerk`` gives its own path jerk sddd; any other law is taken as sddd = 0 between
+    its breakpoints (a TOPP-RA profile's jerk is unbounded AT its grid points, which this does not show:
+    the third differences of :func:`verify` do).
+    """
+    law = motion.law
+    if has_jerk(motion):
+        s, sd, sdd, sddd = law.evaluate_jerk(tau)  # type: ignore[attr-defined]
+    else:
+        s, sd, sdd = law.evaluate(tau)
+        sddd = np.zeros_like(s)
+    _, d1, d2 = motion.path.evaluate(s, 2)
+    d3 = path_third_derivative(motion.path, s)
+    return d1 * sddd[:, None] + 3.0 * d2 * (sd * sdd)[:, None] + d3 * (sd**3)[:, None]
+
+
+def trajectory_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
+    """Joint jerk (n, dof) of a trajectory of motions at times t (zero at rest outside [0, T]).
+
+    Raises:
+        InvalidInputError: a piece is not a motion (imported samples have no jerk of their own).
+    """
+    t = np.asarray(t, dtype=float)
+    out = np.zeros((len(t), traj.dof))
+    for start, p in zip(traj.starts.tolist(), traj.pieces):
+        if not isinstance(p, Motion):
+            raise InvalidInputError("jerk needs a trajectory of motions")
+        sel = (t >= start) & (t <= start + p.duration)
+        if sel.any():
+            out[sel] = joint_jerk(p, t[sel] - start)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- verify
+def _exact_peaks(piece: object) -> tuple[np.ndarray, np.ndarray] | None:
+    """Per joint (max |qd|, max |qdd|) of a straight joint move under a closed-form law, else None.
+
+    On a :class:`JointLine` q = q0 + s dq: qd = dq sd and qdd = dq sdd, so the maxima are |dq| times the
+    law's (:meth:`TimeLaw.peaks`).
+    """
+    if not (isinstance(piece, Motion) and isinstance(piece.path, JointLine)):
+        return None
+    peaks = piece.law.peaks()
+    if peaks is None:
+        return None
+    dq = np.abs(piece.path.q1 - piece.path.q0)
+    return dq * peaks[0], dq * peaks[1]
+
+
+def _extra_times(traj: Trajectory) -> np.ndarray:
+    """Each piece's ends and just inside them, PIECE_POINTS inside it, its law's breakpoints and their left sides."""
+    parts = []
+    for start, piece in zip(traj.starts.tolist(), traj.pieces):
+        d = piece.duration
+        parts.append(start + np.linspace(0.0, d, PIECE_POINTS))
+        parts.append(start + d * np.array([1e-9, _LEFT]))
+        bp = getattr(getattr(piece, "law", None), "breakpoints", None)
+        if callable(bp):
+            b = np.asarray(bp(), dtype=float)
+            parts += [start + b, start + b[:-1] + np.diff(b) * _LEFT]
+    return np.concatenate(parts)
+
+
+class _Worst:
+    """Running maxima of |value| / limit per quantity: (ratio, time, joint)."""
+
+    def __init__(self) -> None:
+        self.best: dict[Quantity, tuple[float, float, int | None]] = {}
+
+    def add(self, quantity: Quantity, ratios: np.ndarray, t: np.ndarray, tool: bool = False) -> None:
+        if not ratios.size:
+            return
+        nan = np.isnan(ratios)
+        flat = int(np.argmax(nan)) if nan.any() else int(np.argmax(ratios))
+        i, j = divmod(flat, ratios.shape[1])
+        value = float(ratios[i, j])
+        old = self.best.get(quantity)
+        if old is None or math.isnan(value) or value > old[0]:
+            self.best[quantity] = (value, float(t[i]), None if tool else j)
+
+    def get(self, quantity: Quantity) -> Worst | None:
+        got = self.best.get(quantity)
+        return None if got is None else Worst(quantity, *got)
+
+
+def verify(
+    robot: Robot,
+    trajectory: Trajectory,
+    *,
+    limits: JointLimits | None = None,
+    jerk: float | ArrayLike | None = None,
+    torque: bool = False,
+    payload: Payload | None = None,
+    tool_speed: float | None = None,
+    rate: float = VERIFY_RATE,
+    q_start: ArrayLike | None = None,
+    q_end: ArrayLike | None = None,
+) -> Verification:
+    """Verify ``trajectory`` against the limits (module docstring); call ``.check()`` on the result to enforce.
+
+    Args:
+        robot: the robot (its limits unless ``limits``; its model for the torques and the tool speed).
+        trajectory: any trajectory (motions, or imported samples: those have no analytic jerk).
+        limits: joint limits instead of ``robot.limits``.
+        jerk: joint jerk limit(s) [rad/s^3 or m/s^3], one or one per joint; None: jerk not checked.
+        torque: check the effort limits (RNEA, gravity included).
+        payload: carried by the tool for the torques (:func:`~scara_pin.motion.payload.with_payload`).
+        tool_speed: [m/s] limit of the tool origin's speed, optional.
+        rate: [Hz] of the verified grid.
+        q_start: the configuration the trajectory must start at, optional.
+        q_end: the configuration it must end at, optional.
+
+    Raises:
+        ParameterError: a limit is NaN, zero, negative or not finite; a bad rate or jerk.
+        InvalidInputError: the samples would exceed :data:`~scara_pin.limits.MAX_SAMPLES`.
+    """
+    rate = _positive("rate", rate, "Hz")
+    lim = _limits(robot, limits, tool_speed, torque)
+    dof = trajectory.dof
+    jv = None if jerk is None else jerk_vector(jerk, dof)
+    loaded = with_payload(robot, payload) if torque else robot
+    T = trajectory.duration
+    h = 1.0 / rate
+    n_grid = math.ceil(T * rate - 1e-9)
+    extra = _extra_times(trajectory)
+    check_count(f"verified samples ({T:.6g} s at {rate:.6g} Hz)", n_grid + 7.0 + len(extra), MAX_SAMPLES,
+                "lower the rate or shorten the motion")  # fmt: skip
+    grid = np.arange(-3, n_grid + 4) * h  # three samples of rest on each side (the third differences see the ends)
+    times = np.concatenate([grid, np.clip(extra, 0.0, T)])
+    worst = _Worst()
+    q_grid = np.empty((len(grid), dof))
+    analytic = jv is not None and any(has_jerk(p) for p in trajectory.pieces)
+    for lo in range(0, len(times), _CHUNK):
+        t = times[lo : lo + _CHUNK]
+        q, qd, qdd = trajectory.sample(t)
+        inside = lo < len(grid)
+        if inside:
+            q_grid[lo : lo + len(t)] = q[: max(0, len(grid) - lo)]
+        qddd = None
+        if analytic:
+            sel = (t >= 0.0) & (t <= T)
+            qddd = np.zeros_like(q)
+            qddd[sel] = _analytic_jerk(trajectory, t[sel])
+        for quantity, r in state_ratios(loaded, lim, q, qd, qdd, qddd, jv).items():
+            worst.add(quantity, r, t, tool=quantity is Quantity.TOOL_SPEED)
+    for start, piece in zip(trajectory.starts.tolist(), trajectory.pieces):
+        peaks = _exact_peaks(piece)
+        if peaks is not None:
+            t0 = np.array([start])
+            worst.add(Quantity.VELOCITY, (peaks[0] / lim.velocity)[None, :], t0)
+            worst.add(Quantity.ACCELERATION, (peaks[1] / lim.acceleration)[None, :], t0)
+    floor = 0.0
+    if jv is not None:
+        d3 = (q_grid[3:] - 3.0 * q_grid[2:-1] + 3.0 * q_grid[1:-2] - q_grid[:-3]) * rate**3
+        worst.add(Quantity.JERK_DIFFERENCES, np.abs(d3) / jv, grid[:-3] + 1.5 * h)
+        floor = float(np.max(8.0 * np.finfo(float).eps * np.max(np.abs(q_grid), axis=0) * rate**3 / jv))
+    ends = np.array([0.0, T])
+    _, qd_e, qdd_e = trajectory.sample(ends)
+    rest = float(np.max(np.abs(qd_e) / lim.velocity))
+    if jv is not None:
+        rest = max(rest, float(np.max(np.abs(qdd_e) / lim.acceleration)))
+    start_err = end_err = None
+    if q_start is not None:
+        start_err = float(np.max(np.abs(trajectory.q_start - np.asarray(q_start, dtype=float))))
+    if q_end is not None:
+        end_err = float(np.max(np.abs(trajectory.q_end - np.asarray(q_end, dtype=float))))
+    v, a = worst.get(Quantity.VELOCITY), worst.get(Quantity.ACCELERATION)
+    if v is None or a is None:  # pragma: no cover - the grid is never empty
+        raise ParameterError("trajectory", "no samples", "must have a duration > 0")
+    return Verification(T, rate, len(times), v, a, worst.get(Quantity.JERK), worst.get(Quantity.JERK_DIFFERENCES),
+                        floor, worst.get(Quantity.TORQUE), worst.get(Quantity.TOOL_SPEED), start_err, end_err,
+                        rest)  # fmt: skip
+
+
+def _analytic_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
+    """The analytic joint jerk at times t of the pieces that have one (zero elsewhere)."""
+    out = np.zeros((len(t), traj.dof))
+    for start, p in zip(traj.starts.tolist(), traj.pieces):
+        sel = (t >= start) & (t <= start + p.duration)
+        if sel.any() and has_jerk(p):
+            out[sel] = joint_jerk(p, t[sel] - start)  # type: ignore[arg-type]
+    return out
