@@ -15,7 +15,9 @@ Findings (``code``: severity):
   ``not-loadable`` (Pinocchio or :class:`~scara_pin.model.Robot` refuses it; the reason is quoted),
   ``frame-missing`` (``--tool`` / ``--base`` names no link), ``xacro-failed`` (a ``.xacro`` file that
   cannot be expanded: a missing package, say), ``unreadable``;
-- ``warning`` (usable, but check it): ``continuous-joint`` (Pinocchio gives it nq = 2, cos/sin),
+- ``warning`` (usable, but check it): ``xacro-ignored`` (a URDF holding only ``<xacro:property>`` /
+  ``<xacro:arg>`` declarations it never substitutes: the loaders ignore them; any other xacro is
+  ``xacro-not-expanded``, the same rule as the loaders'), ``continuous-joint`` (Pinocchio gives it nq = 2, cos/sin),
   ``velocity-zero``, ``velocity-placeholder`` (100, 1000, 10000, or one value on every joint),
   ``limits-implausible`` (revolute limits beyond +/-4 pi: degrees?; strokes beyond 5 m: millimetres?),
   ``length-implausible`` (an origin offset beyond 10 m: millimetres?),
@@ -45,8 +47,9 @@ Status: ``unusable`` if any error (exit code 2), else ``warnings`` if any warnin
 from __future__ import annotations
 
 import enum
+import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -55,6 +58,7 @@ from xml.etree.ElementTree import Element, TreeBuilder
 import numpy as np
 
 from ._checks import number_text
+from ._urdf_checks import xacro_leftovers
 from .kinematics.scara import NEAR_PARALLEL_TOL  # beyond it an axis is tilted: the closed form refuses it
 from .urdf_rules import JointEdge, choose_frames, joint_problem
 
@@ -221,6 +225,13 @@ class CheckReport:
 
 
 # ----------------------------------------------------------------------------------------------- parsing
+class _Quiet(logging.Filter):
+    """Drops every record (the loader's warnings while ``check`` loads the file: they are findings)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return False
+
+
 class _Unusable(Exception):
     """Internal: stop the checks (the findings so far say why)."""
 
@@ -266,15 +277,18 @@ class _Joint:
     limit: dict[str, str] | None = None
     limit_line: int | None = None
     world: np.ndarray = field(default_factory=lambda: np.eye(4))  # joint frame at q = 0 in the root
+    mimic: tuple[str, float, float] | None = None  # (joint followed, multiplier, offset)
 
 
 class _Checker:
     def __init__(self, text: str, source: str, tool: str | None = None, base: str | None = None,
-                 load_kwargs: dict[str, Any] | None = None) -> None:  # fmt: skip
+                 load_kwargs: dict[str, Any] | None = None, lock: Mapping[str, float] | None = None
+                 ) -> None:  # fmt: skip
         self.text = text
         self.source = source
         self.tool_asked = tool
         self.base_asked = base
+        self.lock = dict(lock or {})
         self.load_kwargs = load_kwargs or {}
         self.findings: list[Finding] = []
         self.joints: dict[str, _Joint] = {}
@@ -339,11 +353,13 @@ class _Checker:
         if size > MAX_CHECK_ELEMENTS:
             self.error("too-large", f"{size} links and joints, above the cap of {MAX_CHECK_ELEMENTS:,}")
             raise _Unusable
-        xacro = next((el for el in root.iter() if el.tag.startswith("xacro:")), None)
-        if xacro is not None:
-            self.error("xacro-not-expanded", f"<{xacro.tag}> found: this is a xacro file; expand it with xacro first",
-                       lines.get(xacro))  # fmt: skip
-            raise _Unusable
+        leftover = xacro_leftovers(root)  # the loader's rule (scara_pin._urdf_checks)
+        if leftover is not None:
+            blocking, message, where = leftover
+            if blocking:
+                self.error("xacro-not-expanded", message, lines.get(where))
+                raise _Unusable
+            self.add(Severity.WARNING, "xacro-ignored", message, lines.get(where))
         links: dict[str, int | None] = {}
         for el in root.findall("link"):
             name = el.get("name")
@@ -394,6 +410,10 @@ class _Checker:
                     self.error(problem[0], problem[1], line, name)
             if limit is not None:
                 j.limit, j.limit_line = dict(limit.attrib), lines.get(limit)
+            mimic = el.find("mimic")
+            if mimic is not None and kind in _MOVABLE:
+                m, c = (number_text(mimic.get(a, d)) for a, d in (("multiplier", "1"), ("offset", "0")))
+                j.mimic = (mimic.get("joint", ""), m, c)
             self.joints[name] = j
         if any(f.severity is Severity.ERROR for f in self.findings):
             raise _Unusable
@@ -441,8 +461,40 @@ class _Checker:
         self.children = children
 
     # ------------------------------------------------------------------------------------- joints
+    def frames(self) -> None:
+        """The tool and base frames the loader takes (the same function, scara_pin.urdf_rules.choose_frames)."""
+        from .errors import UrdfError
+
+        try:
+            self.chosen = choose_frames(list(self.links), [JointEdge(j.name, j.type, j.parent, j.child)
+                                                           for j in self.joints.values()],
+                                        tool=self.tool_asked, base=self.base_asked, origin=self.source)  # fmt: skip
+        except UrdfError as exc:
+            self.error("frame-missing", str(exc).removeprefix(f"{self.source}: "))
+            raise _Unusable from None
+
     def joint_rules(self) -> None:
-        movable = [j for j in self.order if j.type in _MOVABLE]
+        # the chain: the movable joints between the root and the tool, as the loader keeps them
+        # (scara_pin.chain): geared (<mimic>) joints follow another, joints off the chain are locked
+        on_path: set[str] = set()
+        link = self.chosen.tool
+        while link in self.parent_of:
+            on_path.add(self.parent_of[link].name)
+            link = self.parent_of[link].parent
+        everything = [j for j in self.order if j.type in _MOVABLE]
+        movable = [j for j in everything if j.mimic is None and j.name in on_path and j.name not in self.lock]
+        off_chain = [j for j in everything if j.mimic is None and j.name not in on_path and j.name not in self.lock]
+        if off_chain:
+            shown = ", ".join(j.name for j in off_chain[:12]) + (" ..." if len(off_chain) > 12 else "")
+            self.add(Severity.INFO, "locked", f"{len(off_chain)} movable joint(s) not on the chain {self.root} -> "
+                     f"{self.chosen.tool} are locked (at 0, or the nearest limit; --lock JOINT=VALUE sets them): "
+                     f"{shown}")  # fmt: skip
+        for j in everything:
+            if j.mimic is not None:
+                src, m, c = j.mimic
+                unit = "m" if j.type == "prismatic" else "rad"
+                self.add(Severity.INFO, "geared", f"joint {j.name} follows {src} (<mimic>): {j.name} = {m:.9g} * {src} "
+                         f"+ {c:.9g} {unit}; not a degree of freedom (not in q), reported beside it", j.line, j.name)
         self.chain = movable
         listing = ", ".join(f"{j.name} ({j.type}, line {j.line})" for j in movable[:12])
         if len(movable) > 12:
@@ -450,17 +502,22 @@ class _Checker:
         self.add(Severity.INFO, "joints", f"{len(movable)} movable joints in chain order: {listing or 'none'}")
         from .description import JOINT_COUNTS  # the loader's rule
 
-        if len(movable) not in JOINT_COUNTS:
+        if len(movable) not in JOINT_COUNTS and off_chain:
+            # not one arm among others: where the tree branches off the chain (a joint hung on the wrong link)
+            free = [j for j in everything if j.mimic is None and j.name not in self.lock]
+            for a, b in zip(free, free[1:]):
+                if not self._is_ancestor(a, b):
+                    self.error("not-serial", f"joint {b.name} is not downstream of {a.name}: not a serial chain (the "
+                               f"chain {self.root} -> {self.chosen.tool} has {len(movable)} movable joints; --tool "
+                               "picks an arm's last link)", b.line, b.name)  # fmt: skip
+                    break
+        elif len(movable) not in JOINT_COUNTS:
             self.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic), or 3 without a "
                        f"wrist (2 revolute, 1 prismatic); this file has {len(movable)}: "
                        f"{listing or 'none'}")  # fmt: skip
         elif len(movable) == 3:
             self.add(Severity.INFO, "no-wrist", "3 movable joints: a SCARA without a wrist (2 revolute, 1 prismatic); "
                      "fk takes 3 joint values and ik a tool point X Y Z (the tool's yaw follows the arm)")  # fmt: skip
-        for a, b in zip(movable, movable[1:]):
-            if not self._is_ancestor(a, b):
-                self.error("not-serial", f"joint {b.name} is not downstream of {a.name}: not a serial chain",
-                           b.line, b.name)  # fmt: skip
         velocities: list[float] = []
         first_limit_line = next((j.limit_line for j in movable if j.limit is not None), None)
         for j in movable:
@@ -546,16 +603,7 @@ class _Checker:
 
     # ------------------------------------------------------------------------------------- geometry
     def geometry(self) -> None:
-        from .errors import UrdfError
-
-        # the frames the loader takes: the same function (scara_pin.urdf_rules.choose_frames)
-        try:
-            frames = choose_frames(list(self.links), [JointEdge(j.name, j.type, j.parent, j.child)
-                                                      for j in self.joints.values()],
-                                   tool=self.tool_asked, base=self.base_asked, origin=self.source)  # fmt: skip
-        except UrdfError as exc:
-            self.error("frame-missing", str(exc).removeprefix(f"{self.source}: "))
-            raise _Unusable from None
+        frames = self.chosen
         base = frames.base
         self.base = base
         bMo = np.linalg.inv(self.link_world[base])
@@ -644,12 +692,16 @@ class _Checker:
         from .kinematics.scara import NotScaraError
         from .model import Robot
 
+        quiet = _Quiet()  # the loader's warnings are findings here already (xacro-ignored): not logged twice
+        logging.getLogger("scara_pin").addFilter(quiet)
         try:
             robot = Robot(self.text, origin=self.source, tool_frame=self.tool_asked, base_frame=self.base_asked,
-                          kinematics=kinematics_for, **self.load_kwargs)  # the frames: the same choose_frames
+                          kinematics=kinematics_for, lock=self.lock, **self.load_kwargs)  # the same choose_frames
         except UrdfError as exc:
             self.error("not-loadable", f"the toolkit cannot load it: {exc}")
             return
+        finally:
+            logging.getLogger("scara_pin").removeFilter(quiet)
         try:
             kinematics = robot.kinematics
         except NotScaraError as exc:
@@ -680,6 +732,7 @@ class _Checker:
     def run(self) -> CheckReport:
         try:
             self.structure()
+            self.frames()
             self.joint_rules()
             self.geometry()
             if not any(f.severity is Severity.ERROR for f in self.findings):
@@ -694,7 +747,8 @@ class _Checker:
 
 
 def check_urdf(
-    text: str, *, origin: str = "URDF", tool: str | None = None, base: str | None = None
+    text: str, *, origin: str = "URDF", tool: str | None = None, base: str | None = None,
+    lock: Mapping[str, float] | None = None,
 ) -> CheckReport:
     """Lint URDF text.
 
@@ -704,15 +758,17 @@ def check_urdf(
         tool: the tool frame asked for (``--tool``); default as the loader picks it
             (:func:`scara_pin.urdf_rules.choose_frames`).
         base: the base frame asked for (``--base``); likewise.
+        lock: joints locked at a value (``--lock``, [rad, m]), as the loader takes them (:mod:`scara_pin.chain`).
 
     Returns:
         The report; its ``status`` and ``exit_code`` give the verdict. Never raises for bad input.
     """
-    return _Checker(text, origin, tool, base).run()
+    return _Checker(text, origin, tool, base, lock=lock).run()
 
 
 def check_urdf_file(
-    path: str | Path, *, tool: str | None = None, base: str | None = None, package_dirs: Sequence[str | Path] = ()
+    path: str | Path, *, tool: str | None = None, base: str | None = None, package_dirs: Sequence[str | Path] = (),
+    lock: Mapping[str, float] | None = None,
 ) -> CheckReport:
     """Lint a URDF file, or a xacro file (``.xacro``: expanded first, the lines are the expanded text's).
 
@@ -736,4 +792,4 @@ def check_urdf_file(
         code = "xacro-failed" if path.name.endswith(".xacro") and path.is_file() else "unreadable"
         reason = str(exc).removeprefix(f"{path}: ")
         return CheckReport(str(path), (Finding(Severity.ERROR, code, reason),))
-    return _Checker(text, str(path), tool, base, {"package_path": packages}).run()
+    return _Checker(text, str(path), tool, base, {"package_path": packages}, lock).run()

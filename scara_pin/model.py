@@ -16,6 +16,7 @@ Conventions (used by every command of the package):
 from __future__ import annotations
 
 import enum
+import logging
 import math
 from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
@@ -32,6 +33,7 @@ from .urdf_rules import choose_frames, read_tree
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
+    from .chain import GearedJoint, LockedJoint
     from .description.packages import PackagePath
     from .kinematics.results import BatchIKResult, IKResult
 
@@ -112,7 +114,7 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
     """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
     import xml.etree.ElementTree as ET
 
-    from ._urdf_checks import check_urdf_tree
+    from ._urdf_checks import check_urdf_tree, xacro_leftovers
 
     try:
         root = ET.fromstring(urdf)
@@ -123,6 +125,11 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
         raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
     # urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state):
     # its rules are checked first, in Python, so that it only sees documents it accepts.
+    leftover = xacro_leftovers(root)  # the rule `scara-pin check` applies (xacro-not-expanded / xacro-ignored)
+    if leftover is not None:
+        if leftover[0]:
+            raise UrdfError(f"{origin}: {leftover[1]}")
+        logging.getLogger("scara_pin").warning("%s: %s", origin, leftover[1])
     check_urdf_tree(root, origin)
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
     mimic = root.find("joint/mimic") is not None
@@ -188,6 +195,9 @@ class Robot:
         dof: the number of joint values in q, 4 or 3 (a SCARA without a wrist; :data:`JOINT_COUNTS`).
         base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
         frame_note: the notice when the tool frame was chosen by default without a ``tool0`` (else None).
+        geared: the joints that follow another (URDF ``<mimic>``; not in q): :class:`scara_pin.chain.GearedJoint`.
+        locked: the joints fixed at a value (another arm's, or asked for): :class:`scara_pin.chain.LockedJoint`;
+            ``lock_note``: the notice naming those locked without being asked for (else None).
         package_path: where ``package://`` names (meshes) are looked for (see
             :mod:`scara_pin.description.packages`).
     """
@@ -205,6 +215,9 @@ class Robot:
     base_frame: str
     tool_frame: str
     frame_note: str | None
+    geared: tuple[GearedJoint, ...]
+    locked: tuple[LockedJoint, ...]
+    lock_note: str | None
     package_path: PackagePath
 
     def __init__(
@@ -218,6 +231,7 @@ class Robot:
         origin: str = "URDF",
         package_path: PackagePath | None = None,
         kinematics: KinematicsFactory | None = None,
+        lock: Mapping[str, float] | None = None,
     ) -> None:
         """Load URDF text.
 
@@ -233,20 +247,33 @@ class Robot:
             package_path: where ``package://`` names are looked for (meshes); default: none.
             kinematics: builds the robot's kinematics object from the loaded robot (its kind's; see
                 :func:`scara_pin.kinematics.kinds.kinematics_for`, which :func:`scara_pin.load_robot` passes).
+            lock: joints to fix, with their values [rad, m] (:mod:`scara_pin.chain`); joints that are not on
+                the chain from the root to the tool (another arm) are locked anyway, at 0 by default.
 
         Raises:
             UrdfError: unreadable, invalid or disconnected URDF, not a 4-joint robot, an unusable joint
                 (inverted limits, zero axis: :func:`scara_pin.urdf_rules.joint_problem`), or a frame
                 asked for that is not a link of the file.
         """
+        from .chain import geared_joints, reduce_to_chain
         from .description.packages import PackagePath
 
         model = _parse_urdf(urdf, origin)
         links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
-        continuous = _continuous_joints(model, origin)
         frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
         base_frame, tool_frame = frames.base, frames.tool
+        edges = {j.name: j for j in joints}
+        # one arm of a multi-arm tree (or with --lock): the other joints fixed, the whole robot still drawn
+        model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin)
+        continuous = _continuous_joints(model, origin)
+        self.geared = geared_joints(model, edges)
         self.frame_note = frames.note
+        off_chain = [lj for lj in self.locked if lj.reason != "asked"]
+        self.lock_note = None if not off_chain else (
+            f"{len(off_chain)} joint(s) not on the chain {frames.root} -> {tool_frame} locked: "
+            + ", ".join(f"{lj.name} = {lj.value:.6g}" for lj in off_chain[:12])
+            + (" ..." if len(off_chain) > 12 else "") + " (--lock JOINT=VALUE sets them, rad or m)"
+        )  # fmt: skip
         self.package_path = package_path if package_path is not None else PackagePath()
         self.model = model
         self.data = model.createData()

@@ -422,7 +422,7 @@ LAYERS = (
     ("limits", "files", "urdf_rules"),
     ("description",),
     ("_checks", "tables", "_urdf_checks"),
-    ("model",),
+    ("model", "chain"),
     ("kinematics",),
     ("robots", "workspace", "lint"),
     ("motion",),

@@ -133,6 +133,17 @@ def _parse_sets(items: Sequence[str] | None) -> dict[str, float]:
     return overrides
 
 
+def _parse_locks(items: Sequence[str] | None) -> dict[str, float]:
+    """``--lock JOINT=VALUE`` items (SI, as --set): each value through :func:`_number`."""
+    locks: dict[str, float] = {}
+    for item in items or ():
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise InvalidInputError(f"--lock {item[:80]!r} must have the form JOINT=VALUE (e.g. lower_j1=0.5)")
+        locks[key.strip()] = _number(f"--lock {key.strip()[:80]}", value)
+    return locks
+
+
 _MAX_NAME = 4096
 """Longest --robot name or folder path (the system's PATH_MAX)."""
 
@@ -150,10 +161,12 @@ def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
         from ..limits import check_input_file
 
         check_input_file(args.urdf, "URDF")
+    locks = _parse_locks(getattr(args, "lock", None))
     robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf, tool=args.tool, base=args.base,
-                       package_path=args.package_path or ())  # fmt: skip
-    if robot.frame_note is not None:  # the tool chosen without a tool0: said once
-        print(f"info: {robot.frame_note}", file=sys.stderr)
+                       package_path=args.package_path or (), lock=locks)  # fmt: skip
+    for note in (robot.frame_note, robot.lock_note):  # the tool chosen without a tool0, another arm locked
+        if note is not None:
+            print(f"info: {note}", file=sys.stderr)
     if units is not None:  # what each joint value measures, read from the model (any joint order)
         units.q = robot.joint_kinds
     return robot
@@ -288,6 +301,9 @@ def _add_frame_options(g: Any) -> None:
                    "else the chain's last link)")  # fmt: skip
     g.add_argument("--base", metavar="FRAME", help="the frame poses are expressed in (a link; default: base "
                    "if present, else the root link)")  # fmt: skip
+    g.add_argument("--lock", action="append", metavar="JOINT=VALUE",
+                   help="fix a joint at a value [rad or m, SI as --set]; joints not on the chain from the root to "
+                   "the tool (another arm) are locked at 0 unless given; repeatable")  # fmt: skip
     g.add_argument("--package-path", action="append", metavar="DIR",
                    help="a folder holding ROS packages (folders with package.xml), for $(find pkg) and "
                    "package://pkg/ in --urdf; repeatable; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are "

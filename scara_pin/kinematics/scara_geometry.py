@@ -185,30 +185,37 @@ class ScaraGeometry:
     def _read(cls, robot: Robot, wrist: bool) -> ScaraGeometry:
         model = robot.model
         data = model.createData()
-        names = tuple(model.names[j] for j in range(1, model.njoints))
+        # the joints of q (nv = 1); geared (<mimic>) joints, nv = 0, follow one of them
+        actuated = [j for j in range(1, model.njoints) if model.joints[j].nv > 0]
+        geared = [j for j in range(1, model.njoints) if model.joints[j].nv == 0]
+        names = tuple(model.names[j] for j in actuated)
         n = 4 if wrist else 3
-        if model.njoints - 1 != n:
-            raise NotScaraError(f"a SCARA has {n} joints; this model has {model.njoints - 1}: {', '.join(names)}")
+        if len(actuated) != n:
+            raise NotScaraError(f"a SCARA has {n} joints; this model has {len(actuated)}: {', '.join(names)}")
         for j in range(2, model.njoints):
             if model.parents[j] != j - 1:
                 raise NotScaraError(f"joint {model.names[j]} does not follow {model.names[j - 1]}: not a serial chain")
         tool_parent = model.frames[robot.tool_id].parentJoint
         if tool_parent != model.njoints - 1:
-            raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint {names[-1]}")
+            raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint "
+                                f"{model.names[model.njoints - 1]}")  # fmt: skip
         q0 = pin.neutral(model)  # q = 0 (a continuous joint's (cos, sin) = (1, 0))
         pin.computeJointJacobians(model, data, q0)
         pin.updateFramePlacements(model, data)
         oMb = data.oMf[robot.base_id]
         Rbo = oMb.rotation.T
+        bMt = oMb.actInv(data.oMf[robot.tool_id])
+        if geared:
+            _check_geared(robot, data, geared, actuated, oMb, bMt.translation, wrist)
         revolute: list[int] = []
         prismatic: list[int] = []
         signs = [0.0] * 4
         points: dict[int, np.ndarray] = {}
         worst = 0.0
-        for j in range(1, model.njoints):
+        for i, j in enumerate(actuated):
             jm = model.joints[j]
             name = model.names[j]
-            continuous = jm.nq == 2 and jm.nv == 1 and robot.continuous[j - 1]
+            continuous = jm.nq == 2 and jm.nv == 1 and robot.continuous[i]
             if (jm.nq != 1 and not continuous) or jm.nv != 1:
                 raise NotScaraError(f"joint {name} ({jm.shortname()}) has nq = {jm.nq}, nv = {jm.nv}; "
                                     "a SCARA's joints are single-DOF revolute or prismatic")  # fmt: skip
@@ -227,13 +234,12 @@ class ScaraGeometry:
                     f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
                 )
             worst = max(worst, tilt)
-            signs[j - 1] = 1.0 if axis[2] > 0 else -1.0
-            kind.append(j - 1)
-            points[j - 1] = oMb.actInv(data.oMi[j]).translation
+            signs[i] = 1.0 if axis[2] > 0 else -1.0
+            kind.append(i)
+            points[i] = oMb.actInv(data.oMi[j]).translation
         if len(revolute) != n - 1 or len(prismatic) != 1:
             kinds = ", ".join(f"{n} ({'revolute' if i in revolute else 'prismatic'})" for i, n in enumerate(names))
             raise NotScaraError(f"a SCARA has {n - 1} revolute joints and 1 prismatic joint; this model has {kinds}")
-        bMt = oMb.actInv(data.oMf[robot.tool_id])
         if not wrist:  # the virtual wrist: index 3, on the tool point, continuous, +z
             revolute.append(3)
             points[3] = bMt.translation
@@ -263,9 +269,9 @@ class ScaraGeometry:
             yaw0=math.atan2(R0[1, 0], R0[0, 0]),
             R0=R0,
             # continuous joints have no limits; others: the model's limits
-            lower=tuple(-math.inf if cont[i] else float(model.lowerPositionLimit[model.joints[i + 1].idx_q])
+            lower=tuple(-math.inf if cont[i] else float(model.lowerPositionLimit[model.joints[actuated[i]].idx_q])
                         for i in range(4)),
-            upper=tuple(math.inf if cont[i] else float(model.upperPositionLimit[model.joints[i + 1].idx_q])
+            upper=tuple(math.inf if cont[i] else float(model.upperPositionLimit[model.joints[actuated[i]].idx_q])
                         for i in range(4)),
             continuous=cont,
             tilt=worst,
@@ -300,6 +306,49 @@ class ScaraGeometry:
         r_max = arm.l12 if reaches(0.0) else max(arm.radius(g_lo), arm.radius(g_hi))
         r_min = arm.d12 if reaches(math.pi) else min(arm.radius(g_lo), arm.radius(g_hi))
         return r_min, r_max
+
+
+GEARED_AXIS_TOL = 1e-9
+"""[m] the largest plan-view distance of the tool point from a geared joint's vertical axis (it then turns the
+tool about its own point: the position stays the SCARA's)."""
+
+
+def _check_geared(robot: Robot, data: pin.Data, geared: list[int], actuated: list[int], oMb: pin.SE3,
+                  tool: np.ndarray, wrist: bool) -> None:  # fmt: skip
+    """Refuse (NotScaraError) geared joints the closed form cannot take.
+
+    A geared joint (URDF ``<mimic>``) is taken when it only turns the tool about the tool point: a revolute
+    joint whose axis is vertical and passes through the tool point, with no revolute joint of q after it
+    (so that the tool point stays on its axis). Then the tool's position is that of the SCARA without it,
+    and its yaw follows (q1, q2 and the joint it is geared to): a 3-joint SCARA, whose yaw is not chosen. A
+    4-joint SCARA chooses its yaw: a geared joint turning the tool would change it; refused.
+    """
+    model = robot.model
+    for j in geared:
+        name = model.names[j]
+        follows = next(model.names[a] for a in actuated if model.joints[a].idx_q == model.joints[j].idx_q)
+        if wrist:
+            raise NotScaraError(f"joint {name} is geared to {follows} (<mimic>) and turns the tool: a 4-joint SCARA "
+                                "chooses its tool's yaw with its own wrist; the closed form takes no geared joint "
+                                "there (only numeric IK applies)")  # fmt: skip
+        jd = model.joints[j].createData()  # the joint's own motion subspace, in its frame (its inner joint's)
+        model.joints[j].calc(jd, pin.neutral(model))
+        S = np.asarray(jd.S).reshape(6)
+        if np.linalg.norm(S[:3]) > 1e-12 or abs(np.linalg.norm(S[3:]) - 1) > 1e-12:
+            raise NotScaraError(f"joint {name} (geared to {follows} by <mimic>) is not a revolute joint: the "
+                                "closed form takes geared joints that turn the tool about its point")  # fmt: skip
+        bMj = oMb.actInv(data.oMi[j])
+        axis = bMj.rotation @ S[3:]
+        tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
+        off = math.hypot(*(tool[:2] - bMj.translation[:2]))
+        later = [model.names[a] for a in actuated if a > j and model.joints[a].shortname().startswith("JointModelR")]
+        if tilt > EXACT_TILT or off > GEARED_AXIS_TOL or later:
+            why = (f"its axis is {math.degrees(tilt):.6g} deg from vertical" if tilt > EXACT_TILT else
+                   f"joint {later[0]} turns after it" if later else
+                   f"the tool point is {off:.6g} m from its axis")  # fmt: skip
+            raise NotScaraError(f"joint {name} is geared to {follows} (<mimic>) and moves the tool point ({why}): "
+                                "the closed form takes geared joints that only turn the tool about its point "
+                                "(only numeric IK applies)")  # fmt: skip
 
 
 def branch_of(geo: ScaraGeometry, q: ArrayLike) -> str:
