@@ -17,7 +17,7 @@ Lock values are SI (rad, m), as the rest of the robot's description (the CLI's `
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,7 +26,18 @@ import pinocchio as pin
 from .errors import ParameterError, UrdfError
 from .urdf_rules import JointEdge
 
-__all__ = ["GearedJoint", "LockedJoint", "geared_joints", "reduce_to_chain"]
+__all__ = [
+    "AXIS_TOL",
+    "LEVEL_PROBES",
+    "GearedJoint",
+    "JointAxis",
+    "LockedJoint",
+    "flange_pitch",
+    "geared_joints",
+    "joint_axes",
+    "palletizer_layout",
+    "reduce_to_chain",
+]
 
 
 @dataclass(frozen=True)
@@ -200,3 +211,78 @@ def reduce_to_chain(
         raise UrdfError(f"{origin}: locking {', '.join(model.names[j] for j in ids)} failed in Pinocchio: {exc}") \
             from None  # fmt: skip
     return reduced, tuple(LockedJoint(model.names[j], values[j], reasons[j]) for j in ids)
+
+
+@dataclass(frozen=True)
+class JointAxis:
+    """A joint of q as the model places it at q = 0, in the base frame.
+
+    Attributes:
+        name: its URDF name; ``index``: its index in q.
+        kind: ``"revolute"``, ``"prismatic"``, or ``"other"`` (neither: a screw, say).
+        axis: its unit axis (revolute) or direction (prismatic) in the base frame.
+        point: its joint frame's origin in the base frame [m].
+        tilt: the angle between the axis and the base z axis, either way [rad] (0: vertical, pi/2: horizontal).
+    """
+
+    name: str
+    index: int
+    kind: str
+    axis: np.ndarray
+    point: np.ndarray
+    tilt: float
+
+
+def joint_axes(model: pin.Model, base_id: int) -> tuple[JointAxis, ...]:
+    """The joints of q at q = 0 (their columns of Pinocchio's joint Jacobian, in the base frame's axes).
+
+    Args:
+        model: the robot's model (geared joints, nv = 0, are skipped: they are not in q).
+        base_id: the id of the base frame.
+    """
+    data = model.createData()
+    pin.computeJointJacobians(model, data, pin.neutral(model))
+    pin.updateFramePlacements(model, data)
+    oMb = data.oMf[base_id]
+    Rbo = oMb.rotation.T
+    out: list[JointAxis] = []
+    for j in range(1, model.njoints):
+        jm = model.joints[j]
+        if jm.nv == 0:
+            continue
+        col = pin.getJointJacobian(model, data, j, pin.LOCAL_WORLD_ALIGNED)[:, jm.idx_v]
+        lin, ang = Rbo @ col[:3], Rbo @ col[3:]
+        if np.linalg.norm(lin) < 1e-12 and abs(np.linalg.norm(ang) - 1) < 1e-12:
+            kind, axis = "revolute", ang
+        elif np.linalg.norm(ang) < 1e-12 and abs(np.linalg.norm(lin) - 1) < 1e-12:
+            kind, axis = "prismatic", lin
+        else:
+            kind, axis = "other", ang
+        tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
+        out.append(JointAxis(model.names[j], len(out), kind, axis, oMb.actInv(data.oMi[j]).translation.copy(), tilt))
+    return tuple(out)
+
+
+AXIS_TOL = 1e-9
+"""[rad] an axis this close to the base z axis is vertical; this close to the base plane, horizontal."""
+
+
+def palletizer_layout(axes: Sequence[JointAxis]) -> bool:
+    """Four revolute joints: a vertical waist, two parallel horizontal arm joints, a vertical flange (at q = 0)."""
+    if len(axes) != 4 or any(a.kind != "revolute" for a in axes):
+        return False
+    vertical = [a.tilt <= AXIS_TOL for a in axes]
+    horizontal = [abs(a.tilt - math.pi / 2) <= AXIS_TOL for a in axes]
+    parallel = float(np.linalg.norm(np.cross(axes[1].axis, axes[2].axis))) <= AXIS_TOL
+    return vertical[0] and horizontal[1] and horizontal[2] and parallel and vertical[3]
+
+
+LEVEL_PROBES = ((0.3, 0.4, -0.5, 0.2), (-0.6, -0.3, 0.7, 1.1))
+"""[rad] configurations at which a palletizer's flange must stay level (besides q = 0)."""
+
+
+def flange_pitch(tool_placement: Callable[[np.ndarray], pin.SE3], q: Sequence[float]) -> float:
+    """The angle between the tool's z axis at ``q`` and at q = 0 [rad] (0 for a flange kept level)."""
+    z0 = tool_placement(np.zeros(len(q))).rotation[:, 2]
+    z = tool_placement(np.asarray(q, dtype=float)).rotation[:, 2]
+    return math.atan2(float(np.linalg.norm(np.cross(z0, z))), float(z0 @ z))

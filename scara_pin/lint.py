@@ -24,7 +24,9 @@ Findings (``code``: severity):
   ``velocity-implausible`` (revolute outside 0.05..50 rad/s, prismatic outside 0.05..10 m/s; a
   deg/s reading is offered), ``axis-flipped`` (a revolute axis along base -z: handled, q turns
   clockwise), ``axis-tilted`` (more than 1e-2 rad from vertical, angle in degrees: the closed-form IK
-  refuses; only numeric IK applies), ``closed-form-refused`` (the closed form's own reason),
+  refuses; only numeric IK applies), ``not-a-scara`` (an arm of another layout: an R-R-R arm, or a
+  palletizer's layout without its levelling parallelogram; what it is and what applies), ``wrist-tilted``
+  (the wrist axis alone, up to 0.1 rad: refined on the model), ``closed-form-refused`` (the closed form's own reason),
   ``prismatic-position`` (not third in the chain, e.g. a lifting column first: supported),
   ``near-parallel`` (axes 1e-6 .. 1e-2 rad from vertical, e.g. pi written as 3.14: the tilt and the tool
   position error the closed form would make without refinement, measured on sampled configurations;
@@ -32,8 +34,9 @@ Findings (``code``: severity):
   ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an ``rpy`` value such as
   3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle error times the
   distance from that joint to the tool at q = 0; ``info`` below 1 micrometre);
-- ``info``: ``joints`` (types and order), ``no-wrist`` (3 joints), ``axis-near-parallel`` (per joint, its
-  tilt up to 1e-2 rad), ``axis-down`` (a quill whose q grows downward: the usual
+- ``info``: ``joints`` (types and order), ``geared`` (a ``<mimic>`` joint: not in q), ``locked`` (joints off
+  the chain root -> tool, fixed), ``palletizer`` (recognised: its closed form applies), ``no-wrist`` (3 joints),
+  ``axis-near-parallel`` (per joint, its tilt up to 1e-2 rad), ``axis-down`` (a quill whose q grows downward: the usual
   convention), ``zero-pose-direction`` (the arm points along +y or elsewhere than +x at q = 0: handled
   by the zero offsets), ``zero-pose-bent``, ``tool-frame`` (no ``tool0``: the chain's last link is used).
 
@@ -59,7 +62,7 @@ import numpy as np
 
 from ._checks import number_text
 from ._urdf_checks import xacro_leftovers
-from .kinematics.scara import NEAR_PARALLEL_TOL  # beyond it an axis is tilted: the closed form refuses it
+from .kinematics.scara_geometry import NEAR_PARALLEL_TOL, WRIST_TILT_MAX  # beyond: tilted (the wrist: up to the max)
 from .urdf_rules import JointEdge, choose_frames, joint_problem
 
 __all__ = [
@@ -515,7 +518,7 @@ class _Checker:
             self.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic), or 3 without a "
                        f"wrist (2 revolute, 1 prismatic); this file has {len(movable)}: "
                        f"{listing or 'none'}")  # fmt: skip
-        elif len(movable) == 3:
+        elif len(movable) == 3 and sorted(j.type == "prismatic" for j in movable) == [False, False, True]:
             self.add(Severity.INFO, "no-wrist", "3 movable joints: a SCARA without a wrist (2 revolute, 1 prismatic); "
                      "fk takes 3 joint values and ik a tool point X Y Z (the tool's yaw follows the arm)")  # fmt: skip
         velocities: list[float] = []
@@ -615,12 +618,27 @@ class _Checker:
         revolute: list[tuple[_Joint, np.ndarray]] = []
         prismatic_at = [i for i, j in enumerate(self.chain) if j.type == "prismatic"]
         self.axes: dict[str, tuple[float, float, float]] = {}
+        tilts = {}
+        for j in self.chain:
+            axis = (bMo @ j.world)[:3, :3] @ (np.asarray(j.axis) / np.linalg.norm(j.axis))
+            self.axes[j.name] = (float(axis[0]), float(axis[1]), float(axis[2]))
+            tilts[j.name] = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
+        # the wrist alone may tilt further (scara_geometry's rule): the last of 4, revolute, the others near-vertical
+        wrist_only = len(self.chain) == 4 and self.chain[-1].type != "prismatic" and all(
+            tilts[j.name] <= NEAR_PARALLEL_TOL for j in self.chain[:-1])  # fmt: skip
         for j in self.chain:
             M = bMo @ j.world
-            axis = M[:3, :3] @ (np.asarray(j.axis) / np.linalg.norm(j.axis))
-            self.axes[j.name] = (float(axis[0]), float(axis[1]), float(axis[2]))
-            tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
-            if tilt > NEAR_PARALLEL_TOL:
+            axis = np.asarray(self.axes[j.name])
+            tilt = tilts[j.name]
+            wrist = wrist_only and j is self.chain[-1]
+            if NEAR_PARALLEL_TOL < tilt <= WRIST_TILT_MAX and wrist:  # the closed form's rule (scara_geometry)
+                self.add(Severity.WARNING, "wrist-tilted",
+                         f"joint {j.name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
+                         f"axis: the wrist alone tilts (at most {WRIST_TILT_MAX:g} rad): the tool's roll/pitch follow "
+                         f"{j.name}, and a tool point off its axis moves up and down as it turns; nothing that carries "
+                         "the wrist point depends on it: the closed form's solutions are refined on the model, the "
+                         f"workspace is that of {j.name}'s axis at the tool's height", j.line, j.name)  # fmt: skip
+            elif tilt > NEAR_PARALLEL_TOL:
                 self.add(Severity.WARNING, "axis-tilted",
                          f"joint {j.name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
                          f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the closed-form IK refuses it; only numeric IK "
@@ -688,7 +706,7 @@ class _Checker:
     # ------------------------------------------------------------------------------------- loading
     def load(self) -> None:
         from .errors import UrdfError
-        from .kinematics.kinds import kinematics_for
+        from .kinematics.kinds import kinematics_for, what_arm
         from .kinematics.scara import NotScaraError
         from .model import Robot
 
@@ -702,12 +720,21 @@ class _Checker:
             return
         finally:
             logging.getLogger("scara_pin").removeFilter(quiet)
+        if robot.kind == "palletizer":  # its horizontal arm joints are its own: not a SCARA's tilted axes
+            self.findings = [f for f in self.findings if f.code != "axis-tilted"]
         try:
             kinematics = robot.kinematics
-        except NotScaraError as exc:
-            if not any(f.code == "axis-tilted" for f in self.findings):
+        except UrdfError as exc:  # NotScaraError, NotPalletizerError: the kind's own reason
+            what = what_arm(robot) if isinstance(exc, NotScaraError) else None
+            if what is not None:  # an arm of another shape: what it is and what applies
+                self.add(Severity.WARNING, "not-a-scara", what[0].upper() + what[1:])
+            elif not any(f.code == "axis-tilted" for f in self.findings):
                 self.add(Severity.WARNING, "closed-form-refused",
                          f"the closed-form IK refuses it: {exc}; only numeric IK applies")
+            return
+        if robot.kind == "palletizer":
+            self.add(Severity.INFO, "palletizer", "a palletizer (a waist, two parallel horizontal arm joints, the "
+                     "flange kept level by <mimic> joints): the palletizer's closed form applies")  # fmt: skip
             return
         self.near_parallel(robot, kinematics)
 

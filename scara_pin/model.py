@@ -33,7 +33,7 @@ from .urdf_rules import choose_frames, read_tree
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
-    from .chain import GearedJoint, LockedJoint
+    from .chain import GearedJoint, JointAxis, LockedJoint
     from .description.packages import PackagePath
     from .kinematics.results import BatchIKResult, IKResult
 
@@ -125,7 +125,8 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
         raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
     # urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state):
     # its rules are checked first, in Python, so that it only sees documents it accepts.
-    leftover = xacro_leftovers(root)  # the rule `scara-pin check` applies (xacro-not-expanded / xacro-ignored)
+    # the rule `scara-pin check` applies (xacro-not-expanded / xacro-ignored); the text search spares a walk
+    leftover = xacro_leftovers(root) if "xacro" in urdf or "$" in urdf else None
     if leftover is not None:
         if leftover[0]:
             raise UrdfError(f"{origin}: {leftover[1]}")
@@ -190,7 +191,8 @@ class Robot:
         name: the robot's name.
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
-        kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file counts as a SCARA).
+        kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file is a palletizer when it has
+            the palletizer's layout and its flange stays level, :func:`_urdf_kind`; else it counts as a SCARA).
         continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
         dof: the number of joint values in q, 4 or 3 (a SCARA without a wrist; :data:`JOINT_COUNTS`).
         base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
@@ -280,7 +282,6 @@ class Robot:
         self.urdf = urdf
         self.name = model.name
         self.parameters = parameters
-        self.kind = parameters.kind if parameters is not None else "scara"
         self.base_frame = base_frame
         self.tool_frame = tool_frame
         self.base_id = model.getFrameId(base_frame, pin.FrameType.BODY)
@@ -318,6 +319,7 @@ class Robot:
         if type(self).task_jacobian is _ROBOT_TASK_JACOBIAN:
             self.task_jacobian = self._per_call[1]  # type: ignore[method-assign,assignment]
         self._kinematics_factory = kinematics
+        self.kind = parameters.kind if parameters is not None else _urdf_kind(self)
         if self.has_continuous:
             # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
             iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
@@ -481,6 +483,13 @@ class Robot:
         return tuple("length" if jm.shortname().startswith("JointModelP") else "angle" for jm in actuated)
 
     @cached_property
+    def axes(self) -> tuple[JointAxis, ...]:
+        """The joints of q at q = 0 in the base frame: kind, axis, point (:func:`scara_pin.chain.joint_axes`)."""
+        from .chain import joint_axes
+
+        return joint_axes(self.model, self.base_id)
+
+    @cached_property
     def joint_names(self) -> tuple[str, ...]:
         """The URDF names of the joints of q, in q order (mimic joints are not in q)."""
         return tuple(self.model.names[j] for j in range(1, self.model.njoints) if self.model.joints[j].nv > 0)
@@ -596,6 +605,22 @@ class Robot:
             names = ", ".join(f.name for f in self.model.frames)
             raise InvalidInputError(f"no frame named {frame!r}; frames: {names}")
         return int(self.model.getFrameId(frame))
+
+
+def _urdf_kind(robot: Robot) -> str:
+    """``"palletizer"`` for a palletizer's layout whose flange stays level, else ``"scara"``.
+
+    The layout (:func:`scara_pin.chain.palletizer_layout`): a vertical waist, two parallel horizontal arm
+    joints, a vertical flange. Level: the tool's z axis keeps its direction at
+    :data:`~scara_pin.chain.LEVEL_PROBES` (the levelling parallelogram, modelled by ``<mimic>`` joints).
+    Whether the palletizer's closed form then fits the model is its kinematics' check (FK at sampled q).
+    """
+    from .chain import AXIS_TOL, LEVEL_PROBES, flange_pitch, palletizer_layout
+
+    if robot.dof != 4 or not palletizer_layout(robot.axes):
+        return "scara"
+    level = all(flange_pitch(robot.tool_placement, q) <= AXIS_TOL for q in LEVEL_PROBES)
+    return "palletizer" if level else "scara"
 
 
 _ROBOT_TOOL_PLACEMENT = Robot.tool_placement

@@ -164,8 +164,6 @@ def cmd_ik(args: argparse.Namespace) -> int:
     target = _read_pose(args.target, units, dof=robot.dof)
     near = _near(robot, args.near, units) if args.near else None
     numeric = args.numeric
-    if numeric:
-        _needs_wrist(robot, "ik --numeric")
     if robot.kind == "palletizer":
         if args.branch in ("left", "right"):
             raise InvalidInputError(f"--branch {args.branch} is a SCARA branch; a palletizer's are up and down")
@@ -173,12 +171,12 @@ def cmd_ik(args: argparse.Namespace) -> int:
         raise InvalidInputError(f"--branch {args.branch} is a palletizer branch; a SCARA's are left and right")
     if args.all_turns and (numeric or near is not None):
         raise InvalidInputError("--all-turns lists every closed-form solution: not with --numeric or --near")
-    if not numeric and robot.kind == "scara":
-        from ..kinematics.scara import NotScaraError
+    if not numeric:
+        from ..errors import UrdfError
 
         try:
-            _ = robot.kinematics  # extracted on first use: refused here if the model is not SCARA-like
-        except NotScaraError as exc:
+            _ = robot.kinematics  # extracted on first use: refused here if the model is not its kind's
+        except UrdfError as exc:  # NotScaraError, NotPalletizerError
             log.warning("closed-form IK refused this robot (%s); using the numeric IK", exc)
             numeric = True
     if numeric and args.branch != "all":  # the numeric IK lands where its seed leads: no branch to choose
@@ -234,8 +232,8 @@ def cmd_ik(args: argparse.Namespace) -> int:
 
 
 def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
-    from ..kinematics.numeric import solve_numeric
-    from ..kinematics.scara import NotScaraError
+    from ..errors import UrdfError
+    from ..kinematics.numeric import elbow_sign, solve_numeric
 
     res = solve_numeric(robot, target, q0=near)
     if not res.success:
@@ -243,8 +241,8 @@ def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) 
                 f"{res.iterations} iterations from {res.starts} starts)", [], [])  # fmt: skip
     try:
         branch = robot.branch_of(res.q)
-    except NotScaraError:
-        branch = "unknown"
+    except UrdfError:  # no closed form for this arm: its elbow's side (elbow+ / elbow-)
+        branch = elbow_sign(robot, res.q)
     return "OK", f"converged in {res.iterations} iterations (residual {res.residual:.3g})", [res.q], [branch]
 
 

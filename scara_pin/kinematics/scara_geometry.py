@@ -48,6 +48,7 @@ __all__ = [
     "BRANCHES",
     "EXACT_TILT",
     "NEAR_PARALLEL_TOL",
+    "WRIST_TILT_MAX",
     "YAW_POSE_TOL",
     "IKStatus",
     "NotScaraError",
@@ -62,6 +63,9 @@ NEAR_PARALLEL_TOL = 1e-2
 """[rad] the largest angle between a joint axis and the base z axis for a SCARA: beyond EXACT_TILT the
 axes are near-parallel (pi written as 3.14 in an rpy) and the closed form's solutions are refined on the
 model (:mod:`scara_pin.kinematics.polish`)."""
+WRIST_TILT_MAX = 0.1
+"""[rad] the largest tilt of the wrist axis alone (the last joint of a 4-joint SCARA; the others within
+NEAR_PARALLEL_TOL): a modelling or mounting error such as a vendor file's 1 deg, refined on the model."""
 EXACT_TILT = 1e-12
 """[rad] a model whose axes tilt less than this is solved by the closed form alone (no refinement)."""
 BRANCHES = ("right", "left")
@@ -107,7 +111,12 @@ class ScaraGeometry:
         continuous: per joint in q order, whether it is continuous (no limits).
         arm: the planar two-link arm (l1, l2).
         tilt: the largest angle between a joint axis of the model and the base z axis [rad] (0 for the
-            ideal geometry; up to NEAR_PARALLEL_TOL: the closed form seeds a refinement on the model).
+            ideal geometry; up to NEAR_PARALLEL_TOL: the closed form seeds a refinement on the model; up to
+            WRIST_TILT_MAX when only the wrist tilts further).
+        wrist_tilt: the wrist axis' own tilt [rad]. Beyond NEAR_PARALLEL_TOL (a wrist-only tilt) the joints
+            that carry the wrist point are still (near-)vertical: the wrist point's region does not depend on
+            the wrist; the tool's roll/pitch (and an offset tool point's height) do, and the solutions are
+            refined on the model.
     """
 
     revolute: tuple[int, int, int]
@@ -125,6 +134,7 @@ class ScaraGeometry:
     upper: tuple[float, ...]
     continuous: tuple[bool, ...] = (False, False, False, False)
     tilt: float = 0.0
+    wrist_tilt: float = 0.0
     l1: float = field(init=False)
     l2: float = field(init=False)
     beta1: float = field(init=False)
@@ -200,10 +210,8 @@ class ScaraGeometry:
             raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint "
                                 f"{model.names[model.njoints - 1]}")  # fmt: skip
         q0 = pin.neutral(model)  # q = 0 (a continuous joint's (cos, sin) = (1, 0))
-        pin.computeJointJacobians(model, data, q0)
-        pin.updateFramePlacements(model, data)
+        pin.framesForwardKinematics(model, data, q0)
         oMb = data.oMf[robot.base_id]
-        Rbo = oMb.rotation.T
         bMt = oMb.actInv(data.oMf[robot.tool_id])
         if geared:
             _check_geared(robot, data, geared, actuated, oMb, bMt.translation, wrist)
@@ -211,32 +219,30 @@ class ScaraGeometry:
         prismatic: list[int] = []
         signs = [0.0] * 4
         points: dict[int, np.ndarray] = {}
-        worst = 0.0
-        for i, j in enumerate(actuated):
-            jm = model.joints[j]
-            name = model.names[j]
-            continuous = jm.nq == 2 and jm.nv == 1 and robot.continuous[i]
-            if (jm.nq != 1 and not continuous) or jm.nv != 1:
-                raise NotScaraError(f"joint {name} ({jm.shortname()}) has nq = {jm.nq}, nv = {jm.nv}; "
-                                    "a SCARA's joints are single-DOF revolute or prismatic")  # fmt: skip
-            col = pin.getJointJacobian(model, data, j, pin.LOCAL_WORLD_ALIGNED)[:, jm.idx_v]
-            lin, ang = Rbo @ col[:3], Rbo @ col[3:]
-            if np.linalg.norm(lin) < 1e-12 and abs(np.linalg.norm(ang) - 1) < 1e-12:
-                axis, kind = ang, revolute
-            elif np.linalg.norm(ang) < 1e-12 and abs(np.linalg.norm(lin) - 1) < 1e-12:
-                axis, kind = lin, prismatic
-            else:
-                raise NotScaraError(f"joint {name} ({jm.shortname()}) is neither revolute nor prismatic")
-            tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
-            if tilt > NEAR_PARALLEL_TOL:
+        worst = wrist_tilt = 0.0
+        wrist_axis = np.array([0.0, 0.0, 1.0])
+        for ja in robot.axes:
+            i, name, axis = ja.index, ja.name, ja.axis
+            if ja.kind == "other":
+                raise NotScaraError(f"joint {name} ({model.joints[actuated[i]].shortname()}) is neither revolute "
+                                    "nor prismatic")  # fmt: skip
+            kind = revolute if ja.kind == "revolute" else prismatic
+            tilt = ja.tilt
+            # the wrist (the last joint, revolute, of a 4-joint SCARA) may tilt further: it moves nothing that
+            # carries the wrist point, so only the tool's own attitude (and an offset tool point) depends on it
+            is_wrist = wrist and i == n - 1 and kind is revolute
+            if tilt > NEAR_PARALLEL_TOL and not (is_wrist and tilt <= WRIST_TILT_MAX):
+                limit = f"{WRIST_TILT_MAX:g} rad for the wrist, " if is_wrist else ""
                 raise NotScaraError(
                     f"joint {name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
-                    f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
+                    f"axis (more than {limit}{NEAR_PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
                 )
             worst = max(worst, tilt)
+            if is_wrist:
+                wrist_tilt, wrist_axis = tilt, axis
             signs[i] = 1.0 if axis[2] > 0 else -1.0
             kind.append(i)
-            points[i] = oMb.actInv(data.oMi[j]).translation
+            points[i] = ja.point
         if len(revolute) != n - 1 or len(prismatic) != 1:
             kinds = ", ".join(f"{n} ({'revolute' if i in revolute else 'prismatic'})" for i, n in enumerate(names))
             raise NotScaraError(f"a SCARA has {n - 1} revolute joints and 1 prismatic joint; this model has {kinds}")
@@ -244,6 +250,9 @@ class ScaraGeometry:
             revolute.append(3)
             points[3] = bMt.translation
             signs[3] = 1.0
+        else:  # the wrist point: the foot of the tool point on the wrist axis (arm 2 carries it, the wrist does not)
+            w = revolute[2]
+            points[w] = points[w] + wrist_axis * float((bMt.translation - points[w]) @ wrist_axis)
         ra, rb, rc = revolute
         a1, a2, a4 = points[ra][:2], points[rb][:2], points[rc][:2]
         u1, u2, t = a2 - a1, a4 - a2, bMt.translation[:2] - a4
@@ -275,6 +284,7 @@ class ScaraGeometry:
                         for i in range(4)),
             continuous=cont,
             tilt=worst,
+            wrist_tilt=wrist_tilt,
         )  # fmt: skip
 
     # ---------------------------------------------------------------------------------------- derived
