@@ -62,6 +62,7 @@ import numpy as np
 
 from ._checks import number_text
 from ._urdf_checks import xacro_leftovers
+from .description.xacro_sources import SourceMap
 from .kinematics.scara_geometry import NEAR_PARALLEL_TOL, WRIST_TILT_MAX  # beyond: tilted (the wrist: up to the max)
 from .urdf_rules import JointEdge, choose_frames, joint_problem
 
@@ -125,8 +126,12 @@ class Finding:
         severity: info, warning or error.
         code: a stable identifier (see the module docstring).
         message: one sentence with the numbers.
-        line: the line in the file, when the finding belongs to an element.
+        line: the line in the file, when the finding belongs to an element (in ``file`` when given).
         joint: the joint concerned, if any.
+        file: a xacro file's findings: the file where the element was written (the checked file, a file it
+            includes, the file of the macro that made it); None: the checked file itself.
+        expanded_line: a xacro file's findings: the line in the expanded document; with ``line`` None, the
+            element was made by xacro and this is all there is to point at.
     """
 
     severity: Severity
@@ -134,11 +139,13 @@ class Finding:
     message: str
     line: int | None = None
     joint: str | None = None
+    file: str | None = None
+    expanded_line: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {"severity": self.severity.value, "code": self.code, "message": self.message, "line": self.line,
-                "joint": self.joint}  # fmt: skip
+                "joint": self.joint, "file": self.file, "expanded_line": self.expanded_line}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -151,11 +158,13 @@ class JointInfo:
     parent: str
     child: str
     axis: tuple[float, float, float] | None = None
+    file: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
+        """JSON-ready (``file``: as :class:`Finding`'s)."""
         return {"name": self.name, "type": self.type, "line": self.line, "parent": self.parent,
-                "child": self.child, "axis": list(self.axis) if self.axis is not None else None}  # fmt: skip
+                "child": self.child, "axis": list(self.axis) if self.axis is not None else None,
+                "file": self.file}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -221,7 +230,12 @@ class CheckReport:
         """One line per finding (``file:line: severity: message [code]``), then the status line."""
         out = []
         for f in self.findings:
-            where = f"{self.source}:{f.line}" if f.line is not None else self.source
+            if f.line is not None:
+                where = f"{f.file or self.source}:{f.line}"
+            elif f.expanded_line is not None:
+                where = f"{self.source} (line {f.expanded_line} of the expanded document)"
+            else:
+                where = self.source
             out.append(f"{where}: {f.severity.value}: {f.message} [{f.code}]")
         out.append(f"{self.source}: {self.status.value}")
         return "\n".join(out)
@@ -293,6 +307,7 @@ class _Checker:
         self.base_asked = base
         self.lock = dict(lock or {})
         self.load_kwargs = load_kwargs or {}
+        self.sources: SourceMap | None = None  # a xacro file's: where each expanded line was written
         self.findings: list[Finding] = []
         self.joints: dict[str, _Joint] = {}
         self.chain: list[_Joint] = []
@@ -301,7 +316,29 @@ class _Checker:
     def add(
         self, severity: Severity, code: str, message: str, line: int | None = None, joint: str | None = None
     ) -> None:
-        self.findings.append(Finding(severity, code, message, line, joint))
+        if self.sources is None:
+            self.findings.append(Finding(severity, code, message, line, joint))
+            return
+        where = self.sources.where(line)  # the file and line where the element was written
+        self.findings.append(Finding(severity, code, message, where[1] if where else None, joint,
+                                     self._shown(where[0]) if where else None, line))  # fmt: skip
+
+    def at(self, line: int | None) -> str:
+        """``line 12`` in a message; for a xacro file, the file and line where the element was written."""
+        where = self.sources.where(line) if self.sources is not None else None
+        if where is not None:
+            return f"{self._shown(where[0])}:{where[1]}"
+        return f"line {line}" if self.sources is None else f"line {line} of the expanded document"
+
+    def _shown(self, path: Path, top: Path | None = None) -> str:
+        """A source file's name as the report shows it: the checked file as given, others beside it."""
+        import os
+
+        top = top or (self.sources.top if self.sources is not None else Path(self.source).resolve())
+        if path == top:
+            return self.source
+        rel = os.path.relpath(path, top.parent)
+        return str(Path(self.source).parent / rel) if not rel.startswith("..") else str(path)
 
     def error(self, code: str, message: str, line: int | None = None, joint: str | None = None) -> None:
         self.add(Severity.ERROR, code, message, line, joint)
@@ -369,7 +406,7 @@ class _Checker:
             if not name:
                 self.error("missing-name", "a <link> has no name", lines.get(el))
             elif name in links:
-                self.error("duplicate-name", f"link {name!r} is defined twice (first at line {links[name]})",
+                self.error("duplicate-name", f"link {name!r} is defined twice (first at {self.at(links[name])})",
                            lines.get(el))  # fmt: skip
             else:
                 links[name] = lines.get(el)
@@ -381,7 +418,7 @@ class _Checker:
                 continue
             if name in self.joints:
                 first = self.joints[name].line
-                self.error("duplicate-name", f"joint {name!r} is defined twice (first at line {first})",
+                self.error("duplicate-name", f"joint {name!r} is defined twice (first at {self.at(first)})",
                            line, name)  # fmt: skip
                 continue
             if kind not in _KNOWN:
@@ -432,7 +469,7 @@ class _Checker:
             raise _Unusable
         roots = [name for name in links if name not in parent_of]
         if len(roots) != 1:
-            shown = ", ".join(f"{r} (line {links[r]})" for r in roots) or "none (a cycle)"
+            shown = ", ".join(f"{r} ({self.at(links[r])})" for r in roots) or "none (a cycle)"
             self.error("disconnected", f"the tree must have one root link; this file has {len(roots)}: {shown}")
             raise _Unusable
         children: dict[str, list[_Joint]] = {}
@@ -499,7 +536,7 @@ class _Checker:
                 self.add(Severity.INFO, "geared", f"joint {j.name} follows {src} (<mimic>): {j.name} = {m:.9g} * {src} "
                          f"+ {c:.9g} {unit}; not a degree of freedom (not in q), reported beside it", j.line, j.name)
         self.chain = movable
-        listing = ", ".join(f"{j.name} ({j.type}, line {j.line})" for j in movable[:12])
+        listing = ", ".join(f"{j.name} ({j.type}, {self.at(j.line)})" for j in movable[:12])
         if len(movable) > 12:
             listing += f", ... ({len(movable) - 12} more)"
         self.add(Severity.INFO, "joints", f"{len(movable)} movable joints in chain order: {listing or 'none'}")
@@ -768,8 +805,11 @@ class _Checker:
             pass
         joints = tuple(
             JointInfo(j.name, j.type, j.line, j.parent, j.child, getattr(self, "axes", {}).get(j.name))
+            if self.sources is None else
+            JointInfo(j.name, j.type, where[1] if (where := self.sources.where(j.line)) else None, j.parent, j.child,
+                      getattr(self, "axes", {}).get(j.name), self._shown(where[0]) if where else None)
             for j in self.chain
-        )
+        )  # fmt: skip
         return CheckReport(self.source, tuple(self.findings), joints, self.tool, getattr(self, "base", None))
 
 
@@ -797,13 +837,18 @@ def check_urdf_file(
     path: str | Path, *, tool: str | None = None, base: str | None = None, package_dirs: Sequence[str | Path] = (),
     lock: Mapping[str, float] | None = None,
 ) -> CheckReport:
-    """Lint a URDF file, or a xacro file (``.xacro``: expanded first, the lines are the expanded text's).
+    """Lint a URDF file, or a xacro file (``.xacro``: expanded first, as the loader does).
+
+    A xacro file's findings point at the file and line where their element was written (the file itself,
+    a file it includes, a macro's definition: ``Finding.file``, ``Finding.line``), with its line in the
+    expanded document (``Finding.expanded_line``); an element that xacro made has only the latter.
 
     An unreadable file gives an ``unreadable`` error finding, a xacro that cannot be expanded (a missing
     package, say) a ``xacro-failed`` one: status unusable. Other arguments as :func:`check_urdf`; packages
     are looked for as the loader does (:mod:`scara_pin.description.packages`).
     """
     from .description.packages import PackagePath, read_robot_file
+    from .description.xacro_sources import expand_with_sources
     from .errors import InvalidInputError, UrdfError
     from .limits import check_input_file
 
@@ -812,11 +857,19 @@ def check_urdf_file(
         check_input_file(path, "URDF")
     except InvalidInputError as exc:
         return CheckReport(str(path), (Finding(Severity.ERROR, "unreadable", f"cannot be read ({exc})"),))
+    sources = None
     try:
         packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
-        text = read_robot_file(path, packages)
+        if path.name.endswith(".xacro"):  # the loader's text, and where each element was written
+            text, sources = expand_with_sources(path, packages)
+        else:
+            text = read_robot_file(path, packages)
     except UrdfError as exc:
         code = "xacro-failed" if path.name.endswith(".xacro") and path.is_file() else "unreadable"
-        reason = str(exc).removeprefix(f"{path}: ")
-        return CheckReport(str(path), (Finding(Severity.ERROR, code, reason),))
-    return _Checker(text, str(path), tool, base, {"package_path": packages}, lock).run()
+        reason = getattr(exc, "reason", str(exc)).removeprefix(f"{path}: ")
+        file, line = getattr(exc, "file", None), getattr(exc, "line", None)  # where xacro failed, when known
+        shown = None if file is None else _Checker("", str(path))._shown(Path(file), path.resolve())
+        return CheckReport(str(path), (Finding(Severity.ERROR, code, reason, line, None, shown),))
+    checker = _Checker(text, str(path), tool, base, {"package_path": packages}, lock)
+    checker.sources = sources
+    return checker.run()

@@ -371,7 +371,16 @@ class Robot:
 
         path = Path(path)
         packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
-        return cls(read_robot_file(path, packages), origin=str(path), package_path=packages, **kwargs)
+        try:
+            text = read_robot_file(path, packages)
+        except UrdfError:
+            if not path.name.endswith(".xacro"):
+                raise
+            from .description.xacro_sources import expand_with_sources
+
+            expand_with_sources(path, packages)  # fails again, saying where in which file (XacroSourceError)
+            raise
+        return cls(text, origin=str(path), package_path=packages, **kwargs)
 
     # ----------------------------------------------------------------- geometry (lazy)
     @cached_property
