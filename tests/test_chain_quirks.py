@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from quirks import assert_pose, run, texts
 
 from scara_pin import load_robot
-from scara_pin.cli import main
 from scara_pin.errors import ParameterError, UrdfError
 from scara_pin.lint import CheckStatus, check_urdf_file
 
@@ -30,18 +30,6 @@ MIMIC = QUIRKS / "mimic_wrist_scara.urdf"
 TWO_ARM = QUIRKS / "two_arm_scara.urdf"
 STRAY = QUIRKS / "stray_xacro_property.urdf"
 TOL = 1e-9  # [m, rad] the bar for exact kinematics
-
-
-def texts(values: object) -> list[str]:
-    """Numbers as a user types them (repr of a Python float: round-trips exactly)."""
-    return [repr(float(v)) for v in values]  # type: ignore[attr-defined]
-
-
-def run(capsys: pytest.CaptureFixture[str], argv: list[str]) -> tuple[int, str, str]:
-    rc = main(argv)
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
 
 
 def wrapped(a: float) -> float:
@@ -54,11 +42,6 @@ def pin_pose(model: pin.Model, frame: str, q_full: np.ndarray) -> np.ndarray:
     pin.framesForwardKinematics(model, data, q_full)
     M = data.oMf[model.getFrameId(frame)]
     return np.array([*M.translation, math.atan2(M.rotation[1, 0], M.rotation[0, 0])])
-
-
-def assert_pose(got: np.ndarray, expected: np.ndarray, tol: float = 1e-12) -> None:
-    np.testing.assert_allclose(got[:3], expected[:3], rtol=0, atol=tol)
-    assert abs(wrapped(got[3] - expected[3])) <= tol
 
 
 # ------------------------------------------------------------------------------------------ the geared wrist

@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from quirks import assert_pose, run, texts
 
 from scara_pin import load_robot
-from scara_pin.cli import main
 from scara_pin.errors import InvalidInputError, UrdfError
 from scara_pin.lint import check_urdf_file
 from scara_pin.workspace import workspace
@@ -30,17 +30,6 @@ RRR = QUIRKS / "rrr_arm.urdf"
 PALLETIZER = QUIRKS / "palletizer_without_mimic.urdf"
 TOL = 1e-9  # [m, rad] the bar for exact kinematics
 TAU = 0.0174533  # [rad] the tilt written in the tilted fixture (rpy roll of J4's origin)
-
-
-def texts(values: object) -> list[str]:
-    return [repr(float(v)) for v in values]  # type: ignore[attr-defined]
-
-
-def run(capsys: pytest.CaptureFixture[str], argv: list[str]) -> tuple[int, str, str]:
-    rc = main(argv)
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return rc, out, err
 
 
 def T(xyz: tuple[float, float, float] = (0.0, 0.0, 0.0), R: np.ndarray | None = None) -> np.ndarray:
@@ -75,11 +64,6 @@ def pin_tool(text: str, q: np.ndarray, frame: str = "tool0") -> np.ndarray:
     data = model.createData()
     pin.framesForwardKinematics(model, data, q)
     return data.oMf[model.getFrameId(frame)].homogeneous
-
-
-def assert_pose(got: np.ndarray, expected: np.ndarray, tol: float = 1e-12) -> None:
-    np.testing.assert_allclose(got[:3], expected[:3], rtol=0, atol=tol)
-    assert abs(math.remainder(got[3] - expected[3], 2 * math.pi)) <= tol
 
 
 def sample(limits: tuple[tuple[float, float], ...], rng: np.random.Generator) -> np.ndarray:
@@ -258,3 +242,44 @@ def test_a_palletizer_without_its_parallelogram_says_why_and_what_it_lacks(
         for s in res.solutions:
             assert_pose(levelled.tool_pose(s.q), target, TOL)
         assert min(float(np.abs(s.q - q).max()) for s in res.solutions) <= TOL
+
+
+# ------------------------------------------------------------------------------------------ the listing
+def test_the_workspace_listing_leaves_out_sub_micrometre_arcs(capsys: pytest.CaptureFixture[str]) -> None:
+    """pi written as 3.14159 shifts the elbow's limits by 2.65e-6 rad: two boundary arcs 0.26 um long, which
+    printed as 'a..a deg'. The text leaves them out and says so; --json keeps every arc (the loops close)."""
+    path = Path(__file__).resolve().parent / "data" / "near_parallel" / "scara_rpy_3_14159.urdf"
+    rc, out, _ = run(capsys, ["workspace", "--urdf", str(path), "--json"])
+    arcs = json.loads(out)["workspace"]["arcs"]
+    lengths = [a["radius"] * abs(a["end_angle"] - a["start_angle"]) for a in arcs]
+    short = [i for i, length in enumerate(lengths) if length < 1e-6]
+    assert rc == 0 and len(short) == 2 and all(length > 1e-4 for i, length in enumerate(lengths) if i not in short)
+    rc, out, _ = run(capsys, ["workspace", "--urdf", str(path)])
+    rows = [line.split() for line in out.splitlines() if line.startswith("  ") and line.split()[0].isdigit()]
+    assert [int(r[0]) for r in rows] == [i for i in range(len(arcs)) if i not in short]
+    for r in rows:  # 'start.. end deg': the two printed angles differ
+        text = " ".join(r)
+        start, end = text.split("..")[0].split()[-1], text.split("..")[1].split()[0]
+        assert start != end, text
+    assert f"({len(short)} arc(s) shorter than 1 um not listed: {', '.join(map(str, short))};" in out
+
+
+def test_a_stray_property_fixture_is_an_ordinary_scara() -> None:
+    """The stray-xacro fixture's kinematics: FK as Pinocchio's model of the file, IK back to a sampled q."""
+    stray = QUIRKS / "stray_xacro_property.urdf"
+    robot = load_robot(urdf=stray)
+    text = stray.read_text()
+    limits = ((-2.0, 2.0), (-2.4, 2.4), (0.0, 0.12), (-6.0, 6.0))
+    rng = np.random.default_rng(65)
+    for _ in range(40):
+        q = sample(limits, rng)
+        M = (T((0, 0, 0.2)) @ T(R=Rz(q[0])) @ T((0.25, 0, 0)) @ T(R=Rz(q[1])) @ T((0.2, 0, 0)) @ T((0, 0, -q[2]))
+             @ T((0, 0, -0.04)) @ T(R=Rz(q[3])))  # fmt: skip
+        np.testing.assert_allclose(pin_tool(text, q), M, rtol=0, atol=1e-12)
+        target = pose(M)
+        res = robot.ik(target)
+        assert res.success, res.message
+        for sol in res.solutions:
+            assert_pose(robot.tool_pose(sol.q), target, TOL)
+            assert all(lo - 1e-12 <= v <= hi + 1e-12 for v, (lo, hi) in zip(sol.q, limits))
+        assert min(sol.distance(q) for sol in res.solutions) <= TOL

@@ -122,26 +122,21 @@ def integer_type(name: str, low: int, high: int) -> Callable[[str], int]:
     return parse
 
 
-def _parse_sets(items: Sequence[str] | None) -> dict[str, float]:
-    """``--set KEY=VALUE`` items; each value goes through :func:`_number` (never to xacro as text)."""
+def _parse_sets(items: Sequence[str] | None, option: str = "--set", form: str = "key=value (e.g. l1=0.25)"
+                ) -> dict[str, float]:  # fmt: skip
+    """``--set KEY=VALUE`` items (or ``option``'s); each value through :func:`_number` (never to xacro as text)."""
     overrides: dict[str, float] = {}
     for item in items or ():
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise InvalidInputError(f"--set {item[:80]!r} must have the form key=value (e.g. l1=0.25)")
-        overrides[key.strip()] = _number(f"--set {key.strip()[:80]}", value)
+            raise InvalidInputError(f"{option} {item[:80]!r} must have the form {form}")
+        overrides[key.strip()] = _number(f"{option} {key.strip()[:80]}", value)
     return overrides
 
 
 def _parse_locks(items: Sequence[str] | None) -> dict[str, float]:
-    """``--lock JOINT=VALUE`` items (SI, as --set): each value through :func:`_number`."""
-    locks: dict[str, float] = {}
-    for item in items or ():
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise InvalidInputError(f"--lock {item[:80]!r} must have the form JOINT=VALUE (e.g. lower_j1=0.5)")
-        locks[key.strip()] = _number(f"--lock {key.strip()[:80]}", value)
-    return locks
+    """``--lock JOINT=VALUE`` items (SI, as --set)."""
+    return _parse_sets(items, "--lock", "JOINT=VALUE (e.g. lower_j1=0.5)")
 
 
 _MAX_NAME = 4096
