@@ -31,9 +31,10 @@ Findings (``code``: severity):
   ``near-parallel`` (axes 1e-6 .. 1e-2 rad from vertical, e.g. pi written as 3.14: the tilt and the tool
   position error the closed form would make without refinement, measured on sampled configurations;
   the toolkit refines its solutions on the model; ``info`` below 1 micrometre),
-  ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an ``rpy`` value such as
-  3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle error times the
-  distance from that joint to the tool at q = 0; ``info`` below 1 micrometre);
+  ``mesh-missing`` (a visual's mesh that cannot be found or is refused, as the viewer resolves it: the
+  viewer draws a box), ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an
+  ``rpy`` value such as 3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle
+  error times the distance from that joint to the tool at q = 0; ``info`` below 1 micrometre);
 - ``info``: ``joints`` (types and order), ``geared`` (a ``<mimic>`` joint: not in q), ``locked`` (joints off
   the chain root -> tool, fixed), ``palletizer`` (recognised: its closed form applies), ``no-wrist`` (3 joints),
   ``axis-near-parallel`` (per joint, its tilt up to 1e-2 rad), ``axis-down`` (a quill whose q grows downward: the usual
@@ -308,6 +309,7 @@ class _Checker:
         self.lock = dict(lock or {})
         self.load_kwargs = load_kwargs or {}
         self.sources: SourceMap | None = None  # a xacro file's: where each expanded line was written
+        self.meshes: list[tuple[str, str, int | None]] = []  # (link, filename, line) of each visual mesh
         self.findings: list[Finding] = []
         self.joints: dict[str, _Joint] = {}
         self.chain: list[_Joint] = []
@@ -411,6 +413,9 @@ class _Checker:
             else:
                 links[name] = lines.get(el)
             self._inertial(el, name or "?", lines.get(el))
+            for visual in el.findall("visual"):  # the viewer's meshes: checked in meshes()
+                for mesh in visual.findall("geometry/mesh"):
+                    self.meshes.append((name or "?", mesh.get("filename", ""), lines.get(mesh)))
         for el in root.findall("joint"):
             name, kind, line = el.get("name"), el.get("type"), lines.get(el)
             if not name:
@@ -775,6 +780,30 @@ class _Checker:
             return
         self.near_parallel(robot, kinematics)
 
+    def mesh_files(self) -> None:
+        """``mesh-missing``: a visual's mesh the viewer cannot find or may not read (it draws a box instead).
+
+        Found by the viewer's own resolver (:func:`scara_pin.description.mesh_paths.mesh_file`), for a file
+        (``check_urdf_file``: the package folders known); one finding per file name, naming its links.
+        """
+        from .description.mesh_paths import MeshProblem, mesh_file
+
+        packages = self.load_kwargs.get("package_path")
+        if packages is None:  # URDF text without a file: nowhere to look relative names up
+            return
+        links: dict[str, list[str]] = {}
+        first: dict[str, int | None] = {}
+        for link, filename, line in self.meshes:
+            links.setdefault(filename, []).append(link)
+            first.setdefault(filename, line)
+        for filename, names in links.items():
+            try:
+                mesh_file(filename, packages)
+            except MeshProblem as exc:
+                shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+                self.add(Severity.WARNING, "mesh-missing",
+                         f"{exc}: the viewer draws link {shown} as a placeholder box", first[filename])
+
     def near_parallel(self, robot: Any, kinematics: Any) -> None:
         """The ``near-parallel`` finding: the axes' tilt, and the error of the closed form without refinement."""
         from .kinematics.polish import unrefined_error
@@ -801,6 +830,7 @@ class _Checker:
             self.geometry()
             if not any(f.severity is Severity.ERROR for f in self.findings):
                 self.load()
+            self.mesh_files()
         except _Unusable:
             pass
         joints = tuple(

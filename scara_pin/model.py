@@ -267,7 +267,14 @@ class Robot:
         edges = {j.name: j for j in joints}
         # one arm of a multi-arm tree (or with --lock): the other joints fixed, the whole robot still drawn
         model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin)
-        continuous = _continuous_joints(model, origin)
+        try:
+            continuous = _continuous_joints(model, origin)
+        except UrdfError as exc:
+            if not self.locked:
+                raise
+            names = ", ".join(lj.name for lj in self.locked[:12]) + (" ..." if len(self.locked) > 12 else "")
+            raise UrdfError(f"{exc}, once {names} locked (not on the chain {frames.root} -> {tool_frame}, or "
+                            "--lock): --tool picks the link that ends an arm") from None  # fmt: skip
         self.geared = geared_joints(model, edges)
         self.frame_note = frames.note
         off_chain = [lj for lj in self.locked if lj.reason != "asked"]

@@ -283,3 +283,27 @@ def test_a_stray_property_fixture_is_an_ordinary_scara() -> None:
             assert_pose(robot.tool_pose(sol.q), target, TOL)
             assert all(lo - 1e-12 <= v <= hi + 1e-12 for v, (lo, hi) in zip(sol.q, limits))
         assert min(sol.distance(q) for sol in res.solutions) <= TOL
+
+
+# ------------------------------------------------------------------------------------------ missing meshes
+def test_check_reports_the_meshes_the_viewer_cannot_find(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """The quirky package with two of its four meshes written: check names the other two, as view warns."""
+    import shutil
+
+    import trimesh
+
+    package = Path(__file__).resolve().parent / "data" / "packages" / "quirky_scara_description"
+    ws = tmp_path / "ws"
+    shutil.copytree(package, ws / package.name)
+    (ws / package.name / "meshes").mkdir()
+    for name in ("base_link.STL", "arm1.STL"):  # hand.STL and arm2.STL are not written
+        trimesh.creation.box(extents=(10.0, 10.0, 10.0)).export(ws / package.name / "meshes" / name, file_type="stl")
+    xacro = ws / package.name / "urdf" / "quirky_scara.urdf.xacro"
+    report = check_urdf_file(xacro)
+    found = report.find("mesh-missing")
+    assert sorted(f.message.split("'")[1].rsplit("/", 1)[1] for f in found) == ["arm2.STL", "hand.STL"]
+    assert all("does not exist" in f.message and f.line is not None for f in found)
+    assert report.exit_code == 4
+    rc, _, err = run(capsys, ["view", "--urdf", str(xacro), "--html", str(tmp_path / "v.html")])
+    warned = sorted(w for w in ("arm2.STL", "hand.STL", "arm1.STL", "base_link.STL") if w in err)
+    assert rc == 0 and warned == ["arm2.STL", "hand.STL"]  # the viewer warns of the same two

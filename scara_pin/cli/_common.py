@@ -208,8 +208,11 @@ def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
 def _needs_wrist(robot: Robot, what: str) -> None:
     """Refuse (exit 2) a command or option that supports 4-joint robots only, for a 3-joint SCARA."""
     if robot.dof != 4:
+        kinds = sorted(a.kind for a in robot.axes)
+        arm = "a SCARA without a wrist" if kinds == ["prismatic", "revolute", "revolute"] else " and ".join(
+            f"{kinds.count(k)} {k}" for k in sorted(set(kinds)))  # fmt: skip
         raise InvalidInputError(f"{what} supports 4-joint robots only; {robot.name!r} has {robot.dof} joints "
-                                "(a SCARA without a wrist)")  # fmt: skip
+                                f"({arm})")  # fmt: skip
 
 
 def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]:

@@ -114,12 +114,16 @@ def _tagging_parser(top: Path, table: list[tuple[Path, int]], failed: list[int])
     def parse(inp: Any, filename: str | None = None) -> Any:
         if inp is None and filename is not None:  # an include: read as xacro does (relative to its root_dir)
             path = Path(os.path.join(xacro.root_dir, filename))
+            reader = getattr(xacro, "open", open)  # the loader's bounded reader when it installs one
             try:
-                text = path.read_text(encoding="utf-8")
+                with reader(str(path)) as handle:
+                    text = handle.read()
             except OSError:
                 return original(inp, filename)  # xacro's own error (optional includes handle it)
             except UnicodeDecodeError:
                 raise UrdfError(f"{path}: not UTF-8 text") from None
+            if isinstance(text, bytes):
+                text = text.decode("utf-8")
             return _tagged(text, path.resolve(), table)
         if isinstance(inp, str):
             return _tagged(inp, top, table)

@@ -31,23 +31,19 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..description.mesh_paths import MeshProblem, resolve_mesh
 from ..description.placeholders import PLACEHOLDER_SIZE
 
 if TYPE_CHECKING:
-    from ..description.packages import PackagePath
     from ..model import Robot
 
-__all__ = ["MAX_MESH_BYTES", "VisualMesh", "resolve_mesh", "visual_meshes"]
+__all__ = ["MAX_MESH_BYTES", "MeshProblem", "VisualMesh", "resolve_mesh", "visual_meshes"]
 
 log = logging.getLogger(__name__)
 
 MAX_MESH_BYTES = 200 * 1024 * 1024
 """[bytes] a mesh file larger than this is not read (a placeholder is drawn)."""
 _FORMATS = {".stl": "stl", ".dae": "dae", ".obj": "obj"}
-
-
-class MeshProblem(Exception):
-    """Why a mesh is not drawn (the message names the file); reported as a warning, never raised to users."""
 
 
 @dataclass(frozen=True)
@@ -69,47 +65,6 @@ class VisualMesh:
     path: Path
     vertices: np.ndarray
     faces: np.ndarray
-
-
-def _inside(path: Path, folder: Path) -> bool:
-    return path == folder or folder in path.parents
-
-
-def resolve_mesh(filename: str, packages: PackagePath) -> Path:
-    """The file a URDF mesh name refers to, within the allowed folders (see the module docstring).
-
-    Raises:
-        MeshProblem: a network or unknown scheme, a missing package, a path out of the allowed folders.
-    """
-    from ..errors import UrdfError
-
-    scheme, sep, rest = filename.partition("://")
-    if not sep:
-        scheme, rest = "", filename
-    if scheme == "package":
-        package, _, relative = rest.partition("/")
-        try:
-            folder = packages.find(package)
-        except UrdfError as exc:
-            raise MeshProblem(f"mesh {filename!r}: {exc}") from None
-        path = (folder / relative).resolve()
-        if not _inside(path, folder):
-            raise MeshProblem(f"mesh {filename!r} leaves its package folder {folder}: not read")
-        return path
-    if scheme not in ("", "file"):
-        raise MeshProblem(f"mesh {filename!r}: the {scheme}:// scheme is not supported (no file is fetched "
-                          "from the network): not read")  # fmt: skip
-    raw = Path(rest)
-    if not raw.is_absolute():
-        if packages.origin_dir is None:
-            raise MeshProblem(f"mesh {filename!r} is relative but the robot has no file to resolve it from")
-        raw = packages.origin_dir / raw
-    path = raw.resolve()
-    roots = packages.roots()
-    if not any(_inside(path, root) for root in roots):
-        raise MeshProblem(f"mesh {filename!r} is outside the package folders and the robot file's folder "
-                          f"({', '.join(str(r) for r in roots) or 'none'}): not read")  # fmt: skip
-    return path
 
 
 def _scale(text: str | None, filename: str) -> np.ndarray:
