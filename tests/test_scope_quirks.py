@@ -228,6 +228,8 @@ def test_a_palletizer_without_its_parallelogram_says_why_and_what_it_lacks(
     assert rc == 0 and "not recognised as a palletizer" in err
     (sol,) = json.loads(out)["solutions"]
     assert np.abs(np.array(sol["q"]) - q).max() <= TOL and sol["branch"] == "elbow+"
+    assert all(lo <= v <= hi for v, (lo, hi) in zip(sol["q"], PAL_LIMITS))
+    assert_pose(pose(palletizer_fk(np.array(sol["q"]))), target, TOL)
     assert check_urdf_file(PALLETIZER).find("not-a-scara")
     # with what the message says it lacks, the file is a palletizer and its closed form applies
     path = tmp_path / "levelled.urdf"
