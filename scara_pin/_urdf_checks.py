@@ -143,3 +143,58 @@ def check_urdf_tree(root: ET.Element, origin: str) -> None:
         shown = ", ".join(roots[:5]) + (" ..." if len(roots) > 5 else "")
         raise UrdfError(f"{origin}: not a valid URDF: {len(roots)} root links ({shown or 'none: a cycle'}); "
                         "a URDF tree has exactly one root link")  # fmt: skip
+
+
+_XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro", "http://wiki.ros.org/xacro")
+_INERT_XACRO = frozenset(("property", "arg"))
+"""xacro declarations that change nothing in a document that never substitutes them (no ``${``, ``$(``)."""
+
+
+def _xacro_name(tag: str) -> str | None:
+    """``property`` for ``xacro:property`` (a parser without namespaces) or ``{ns}property``; else None."""
+    if tag.startswith("xacro:"):
+        return tag[6:]
+    if tag.startswith("{"):
+        ns, _, local = tag[1:].partition("}")
+        if ns in _XACRO_NAMESPACES:
+            return local
+    return None
+
+
+def xacro_leftovers(root: ET.Element) -> tuple[bool, str, ET.Element] | None:
+    """Xacro in a document read as URDF: the rule the loader and ``scara-pin check`` share.
+
+    A URDF file (not named ``.xacro``) is read as written, never expanded. xacro left in it is
+
+    - harmless when it is only declarations (``<xacro:property>``, ``<xacro:arg>``) that the document never
+      substitutes (no ``${...}`` nor ``$(...)`` in any attribute): they are ignored, with a warning;
+    - an error otherwise (a macro call, ``<xacro:if>``, an include, a substitution): read as written, the
+      file would be a different robot (or no robot), so it must be expanded first.
+
+    Returns:
+        None when the document holds no xacro, else ``(blocking, message, first element concerned)``.
+    """
+    found: list[tuple[str, ET.Element]] = []
+    substituted: ET.Element | None = None
+    for el in root.iter():
+        name = _xacro_name(el.tag) if isinstance(el.tag, str) else None
+        if name is not None:
+            found.append((name, el))
+        elif substituted is None and any("${" in v or "$(" in v for v in el.attrib.values()):
+            substituted = el
+    if not found and substituted is None:
+        return None
+    counts: dict[str, int] = {}
+    for name, _ in found:
+        counts[name] = counts.get(name, 0) + 1
+    listing = ", ".join(f"{n} <xacro:{k}>" for k, n in counts.items())
+    if substituted is not None:
+        attr, value = next((a, v) for a, v in substituted.attrib.items() if "${" in v or "$(" in v)
+        return True, (f"<{substituted.tag}> {attr}={value[:60]!r} is a xacro substitution: this is a xacro document; "
+                      "expand it first (name it .xacro, or run xacro)"), substituted  # fmt: skip
+    if set(counts) <= _INERT_XACRO:
+        return False, (f"{listing} declared but never substituted (no ${{...}} in the document): ignored, the "
+                       "file is read as plain URDF"), found[0][1]  # fmt: skip
+    name, el = next((n, e) for n, e in found if n not in _INERT_XACRO)
+    return True, (f"<xacro:{name}> found ({listing}): this is a xacro document; expand it first (name it .xacro, "
+                  "or run xacro)"), el  # fmt: skip

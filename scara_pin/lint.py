@@ -15,25 +15,31 @@ Findings (``code``: severity):
   ``not-loadable`` (Pinocchio or :class:`~scara_pin.model.Robot` refuses it; the reason is quoted),
   ``frame-missing`` (``--tool`` / ``--base`` names no link), ``xacro-failed`` (a ``.xacro`` file that
   cannot be expanded: a missing package, say), ``unreadable``;
-- ``warning`` (usable, but check it): ``continuous-joint`` (Pinocchio gives it nq = 2, cos/sin),
+- ``warning`` (usable, but check it): ``xacro-ignored`` (a URDF holding only ``<xacro:property>`` /
+  ``<xacro:arg>`` declarations it never substitutes: the loaders ignore them; any other xacro is
+  ``xacro-not-expanded``, the same rule as the loaders'), ``continuous-joint`` (Pinocchio gives it nq = 2, cos/sin),
   ``velocity-zero``, ``velocity-placeholder`` (100, 1000, 10000, or one value on every joint),
   ``limits-implausible`` (revolute limits beyond +/-4 pi: degrees?; strokes beyond 5 m: millimetres?),
   ``length-implausible`` (an origin offset beyond 10 m: millimetres?),
   ``velocity-implausible`` (revolute outside 0.05..50 rad/s, prismatic outside 0.05..10 m/s; a
   deg/s reading is offered), ``axis-flipped`` (a revolute axis along base -z: handled, q turns
   clockwise), ``axis-tilted`` (more than 1e-2 rad from vertical, angle in degrees: the closed-form IK
-  refuses; only numeric IK applies), ``closed-form-refused`` (the closed form's own reason),
+  refuses; only numeric IK applies), ``not-a-scara`` (an arm of another layout: an R-R-R arm, or a
+  palletizer's layout without its levelling parallelogram; what it is and what applies), ``wrist-tilted``
+  (the wrist axis alone, up to 0.1 rad: refined on the model), ``closed-form-refused`` (the closed form's own reason),
   ``prismatic-position`` (not third in the chain, e.g. a lifting column first: supported),
   ``near-parallel`` (axes 1e-6 .. 1e-2 rad from vertical, e.g. pi written as 3.14: the tilt and the tool
   position error the closed form would make without refinement, measured on sampled configurations;
   the toolkit refines its solutions on the model; ``info`` below 1 micrometre, and ``info`` when no
   ``rpy-approximate`` warning explains the tilt: deliberate tilts, e.g. a calibrated robot's, are handled exactly),
-  ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an ``rpy`` value such as
-  3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle error times the
-  distance from that joint to the tool at q = 0; ``info`` below 1 micrometre; a value written with 15
-  significant digits or more is deliberate, e.g. a calibrated origin, never reported);
-- ``info``: ``joints`` (types and order), ``no-wrist`` (3 joints), ``axis-near-parallel`` (per joint, its
-  tilt up to 1e-2 rad), ``axis-down`` (a quill whose q grows downward: the usual
+  ``mesh-missing`` (a visual's mesh that cannot be found or is refused, as the viewer resolves it: the
+  viewer draws a box), ``zero-pose-folded`` (the elbow folded back at q = 0), ``rpy-approximate`` (an
+  ``rpy`` value such as 3.14 or 1.5708 close to a multiple of pi/2, with the position error it causes: angle
+  error times the distance from that joint to the tool at q = 0; ``info`` below 1 micrometre; a value written
+  with 15 significant digits or more is deliberate, e.g. a calibrated origin, never reported);
+- ``info``: ``joints`` (types and order), ``geared`` (a ``<mimic>`` joint: not in q), ``locked`` (joints off
+  the chain root -> tool, fixed), ``palletizer`` (recognised: its closed form applies), ``no-wrist`` (3 joints),
+  ``axis-near-parallel`` (per joint, its tilt up to 1e-2 rad), ``axis-down`` (a quill whose q grows downward: the usual
   convention), ``zero-pose-direction`` (the arm points along +y or elsewhere than +x at q = 0: handled
   by the zero offsets), ``zero-pose-bent``, ``tool-frame`` (no ``tool0``: the chain's last link is used).
 
@@ -47,8 +53,9 @@ Status: ``unusable`` if any error (exit code 2), else ``warnings`` if any warnin
 from __future__ import annotations
 
 import enum
+import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -57,7 +64,9 @@ from xml.etree.ElementTree import Element, TreeBuilder
 import numpy as np
 
 from ._checks import number_text
-from .kinematics.scara import NEAR_PARALLEL_TOL  # beyond it an axis is tilted: the closed form refuses it
+from ._urdf_checks import xacro_leftovers
+from .description.xacro_sources import SourceMap
+from .kinematics.scara_geometry import NEAR_PARALLEL_TOL, WRIST_TILT_MAX  # beyond: tilted (the wrist: up to the max)
 from .urdf_rules import JointEdge, choose_frames, joint_problem
 
 __all__ = [
@@ -123,8 +132,12 @@ class Finding:
         severity: info, warning or error.
         code: a stable identifier (see the module docstring).
         message: one sentence with the numbers.
-        line: the line in the file, when the finding belongs to an element.
+        line: the line in the file, when the finding belongs to an element (in ``file`` when given).
         joint: the joint concerned, if any.
+        file: a xacro file's findings: the file where the element was written (the checked file, a file it
+            includes, the file of the macro that made it); None: the checked file itself.
+        expanded_line: a xacro file's findings: the line in the expanded document; with ``line`` None, the
+            element was made by xacro and this is all there is to point at.
     """
 
     severity: Severity
@@ -132,11 +145,13 @@ class Finding:
     message: str
     line: int | None = None
     joint: str | None = None
+    file: str | None = None
+    expanded_line: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {"severity": self.severity.value, "code": self.code, "message": self.message, "line": self.line,
-                "joint": self.joint}  # fmt: skip
+                "joint": self.joint, "file": self.file, "expanded_line": self.expanded_line}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -149,11 +164,13 @@ class JointInfo:
     parent: str
     child: str
     axis: tuple[float, float, float] | None = None
+    file: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
+        """JSON-ready (``file``: as :class:`Finding`'s)."""
         return {"name": self.name, "type": self.type, "line": self.line, "parent": self.parent,
-                "child": self.child, "axis": list(self.axis) if self.axis is not None else None}  # fmt: skip
+                "child": self.child, "axis": list(self.axis) if self.axis is not None else None,
+                "file": self.file}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -219,13 +236,25 @@ class CheckReport:
         """One line per finding (``file:line: severity: message [code]``), then the status line."""
         out = []
         for f in self.findings:
-            where = f"{self.source}:{f.line}" if f.line is not None else self.source
+            if f.line is not None:
+                where = f"{f.file or self.source}:{f.line}"
+            elif f.expanded_line is not None:
+                where = f"{self.source} (line {f.expanded_line} of the expanded document)"
+            else:
+                where = self.source
             out.append(f"{where}: {f.severity.value}: {f.message} [{f.code}]")
         out.append(f"{self.source}: {self.status.value}")
         return "\n".join(out)
 
 
 # ----------------------------------------------------------------------------------------------- parsing
+class _Quiet(logging.Filter):
+    """Drops every record (the loader's warnings while ``check`` loads the file: they are findings)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return False
+
+
 class _Unusable(Exception):
     """Internal: stop the checks (the findings so far say why)."""
 
@@ -277,16 +306,21 @@ class _Joint:
     limit: dict[str, str] | None = None
     limit_line: int | None = None
     world: np.ndarray = field(default_factory=lambda: np.eye(4))  # joint frame at q = 0 in the root
+    mimic: tuple[str, float, float] | None = None  # (joint followed, multiplier, offset)
 
 
 class _Checker:
     def __init__(self, text: str, source: str, tool: str | None = None, base: str | None = None,
-                 load_kwargs: dict[str, Any] | None = None) -> None:  # fmt: skip
+                 load_kwargs: dict[str, Any] | None = None, lock: Mapping[str, float] | None = None
+                 ) -> None:  # fmt: skip
         self.text = text
         self.source = source
         self.tool_asked = tool
         self.base_asked = base
+        self.lock = dict(lock or {})
         self.load_kwargs = load_kwargs or {}
+        self.sources: SourceMap | None = None  # a xacro file's: where each expanded line was written
+        self.meshes: list[tuple[str, str, int | None]] = []  # (link, filename, line) of each visual mesh
         self.findings: list[Finding] = []
         self.joints: dict[str, _Joint] = {}
         self.chain: list[_Joint] = []
@@ -295,7 +329,29 @@ class _Checker:
     def add(
         self, severity: Severity, code: str, message: str, line: int | None = None, joint: str | None = None
     ) -> None:
-        self.findings.append(Finding(severity, code, message, line, joint))
+        if self.sources is None:
+            self.findings.append(Finding(severity, code, message, line, joint))
+            return
+        where = self.sources.where(line)  # the file and line where the element was written
+        self.findings.append(Finding(severity, code, message, where[1] if where else None, joint,
+                                     self._shown(where[0]) if where else None, line))  # fmt: skip
+
+    def at(self, line: int | None) -> str:
+        """``line 12`` in a message; for a xacro file, the file and line where the element was written."""
+        where = self.sources.where(line) if self.sources is not None else None
+        if where is not None:
+            return f"{self._shown(where[0])}:{where[1]}"
+        return f"line {line}" if self.sources is None else f"line {line} of the expanded document"
+
+    def _shown(self, path: Path, top: Path | None = None) -> str:
+        """A source file's name as the report shows it: the checked file as given, others beside it."""
+        import os
+
+        top = top or (self.sources.top if self.sources is not None else Path(self.source).resolve())
+        if path == top:
+            return self.source
+        rel = os.path.relpath(path, top.parent)
+        return str(Path(self.source).parent / rel) if not rel.startswith("..") else str(path)
 
     def error(self, code: str, message: str, line: int | None = None, joint: str | None = None) -> None:
         self.add(Severity.ERROR, code, message, line, joint)
@@ -350,22 +406,27 @@ class _Checker:
         if size > MAX_CHECK_ELEMENTS:
             self.error("too-large", f"{size} links and joints, above the cap of {MAX_CHECK_ELEMENTS:,}")
             raise _Unusable
-        xacro = next((el for el in root.iter() if el.tag.startswith("xacro:")), None)
-        if xacro is not None:
-            self.error("xacro-not-expanded", f"<{xacro.tag}> found: this is a xacro file; expand it with xacro first",
-                       lines.get(xacro))  # fmt: skip
-            raise _Unusable
+        leftover = xacro_leftovers(root)  # the loader's rule (scara_pin._urdf_checks)
+        if leftover is not None:
+            blocking, message, where = leftover
+            if blocking:
+                self.error("xacro-not-expanded", message, lines.get(where))
+                raise _Unusable
+            self.add(Severity.WARNING, "xacro-ignored", message, lines.get(where))
         links: dict[str, int | None] = {}
         for el in root.findall("link"):
             name = el.get("name")
             if not name:
                 self.error("missing-name", "a <link> has no name", lines.get(el))
             elif name in links:
-                self.error("duplicate-name", f"link {name!r} is defined twice (first at line {links[name]})",
+                self.error("duplicate-name", f"link {name!r} is defined twice (first at {self.at(links[name])})",
                            lines.get(el))  # fmt: skip
             else:
                 links[name] = lines.get(el)
             self._inertial(el, name or "?", lines.get(el))
+            for visual in el.findall("visual"):  # the viewer's meshes: checked in meshes()
+                for mesh in visual.findall("geometry/mesh"):
+                    self.meshes.append((name or "?", mesh.get("filename", ""), lines.get(mesh)))
         for el in root.findall("joint"):
             name, kind, line = el.get("name"), el.get("type"), lines.get(el)
             if not name:
@@ -373,7 +434,7 @@ class _Checker:
                 continue
             if name in self.joints:
                 first = self.joints[name].line
-                self.error("duplicate-name", f"joint {name!r} is defined twice (first at line {first})",
+                self.error("duplicate-name", f"joint {name!r} is defined twice (first at {self.at(first)})",
                            line, name)  # fmt: skip
                 continue
             if kind not in _KNOWN:
@@ -405,6 +466,10 @@ class _Checker:
                     self.error(problem[0], problem[1], line, name)
             if limit is not None:
                 j.limit, j.limit_line = dict(limit.attrib), lines.get(limit)
+            mimic = el.find("mimic")
+            if mimic is not None and kind in _MOVABLE:
+                m, c = (number_text(mimic.get(a, d)) for a, d in (("multiplier", "1"), ("offset", "0")))
+                j.mimic = (mimic.get("joint", ""), m, c)
             self.joints[name] = j
         if any(f.severity is Severity.ERROR for f in self.findings):
             raise _Unusable
@@ -420,7 +485,7 @@ class _Checker:
             raise _Unusable
         roots = [name for name in links if name not in parent_of]
         if len(roots) != 1:
-            shown = ", ".join(f"{r} (line {links[r]})" for r in roots) or "none (a cycle)"
+            shown = ", ".join(f"{r} ({self.at(links[r])})" for r in roots) or "none (a cycle)"
             self.error("disconnected", f"the tree must have one root link; this file has {len(roots)}: {shown}")
             raise _Unusable
         children: dict[str, list[_Joint]] = {}
@@ -452,26 +517,63 @@ class _Checker:
         self.children = children
 
     # ------------------------------------------------------------------------------------- joints
+    def frames(self) -> None:
+        """The tool and base frames the loader takes (the same function, scara_pin.urdf_rules.choose_frames)."""
+        from .errors import UrdfError
+
+        try:
+            self.chosen = choose_frames(list(self.links), [JointEdge(j.name, j.type, j.parent, j.child)
+                                                           for j in self.joints.values()],
+                                        tool=self.tool_asked, base=self.base_asked, origin=self.source)  # fmt: skip
+        except UrdfError as exc:
+            self.error("frame-missing", str(exc).removeprefix(f"{self.source}: "))
+            raise _Unusable from None
+
     def joint_rules(self) -> None:
-        movable = [j for j in self.order if j.type in _MOVABLE]
+        # the chain: the movable joints between the root and the tool, as the loader keeps them
+        # (scara_pin.chain): geared (<mimic>) joints follow another, joints off the chain are locked
+        on_path: set[str] = set()
+        link = self.chosen.tool
+        while link in self.parent_of:
+            on_path.add(self.parent_of[link].name)
+            link = self.parent_of[link].parent
+        everything = [j for j in self.order if j.type in _MOVABLE]
+        movable = [j for j in everything if j.mimic is None and j.name in on_path and j.name not in self.lock]
+        off_chain = [j for j in everything if j.mimic is None and j.name not in on_path and j.name not in self.lock]
+        if off_chain:
+            shown = ", ".join(j.name for j in off_chain[:12]) + (" ..." if len(off_chain) > 12 else "")
+            self.add(Severity.INFO, "locked", f"{len(off_chain)} movable joint(s) not on the chain {self.root} -> "
+                     f"{self.chosen.tool} are locked (at 0, or the nearest limit; --lock JOINT=VALUE sets them): "
+                     f"{shown}")  # fmt: skip
+        for j in everything:
+            if j.mimic is not None:
+                src, m, c = j.mimic
+                unit = "m" if j.type == "prismatic" else "rad"
+                self.add(Severity.INFO, "geared", f"joint {j.name} follows {src} (<mimic>): {j.name} = {m:.9g} * {src} "
+                         f"+ {c:.9g} {unit}; not a degree of freedom (not in q), reported beside it", j.line, j.name)
         self.chain = movable
-        listing = ", ".join(f"{j.name} ({j.type}, line {j.line})" for j in movable[:12])
+        listing = ", ".join(f"{j.name} ({j.type}, {self.at(j.line)})" for j in movable[:12])
         if len(movable) > 12:
             listing += f", ... ({len(movable) - 12} more)"
         self.add(Severity.INFO, "joints", f"{len(movable)} movable joints in chain order: {listing or 'none'}")
         from .description import JOINT_COUNTS  # the loader's rule
 
-        if len(movable) not in JOINT_COUNTS:
+        if len(movable) not in JOINT_COUNTS and off_chain:
+            # not one arm among others: where the tree branches off the chain (a joint hung on the wrong link)
+            free = [j for j in everything if j.mimic is None and j.name not in self.lock]
+            for a, b in zip(free, free[1:]):
+                if not self._is_ancestor(a, b):
+                    self.error("not-serial", f"joint {b.name} is not downstream of {a.name}: not a serial chain (the "
+                               f"chain {self.root} -> {self.chosen.tool} has {len(movable)} movable joints; --tool "
+                               "picks an arm's last link)", b.line, b.name)  # fmt: skip
+                    break
+        elif len(movable) not in JOINT_COUNTS:
             self.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic), or 3 without a "
                        f"wrist (2 revolute, 1 prismatic); this file has {len(movable)}: "
                        f"{listing or 'none'}")  # fmt: skip
-        elif len(movable) == 3:
+        elif len(movable) == 3 and sorted(j.type == "prismatic" for j in movable) == [False, False, True]:
             self.add(Severity.INFO, "no-wrist", "3 movable joints: a SCARA without a wrist (2 revolute, 1 prismatic); "
                      "fk takes 3 joint values and ik a tool point X Y Z (the tool's yaw follows the arm)")  # fmt: skip
-        for a, b in zip(movable, movable[1:]):
-            if not self._is_ancestor(a, b):
-                self.error("not-serial", f"joint {b.name} is not downstream of {a.name}: not a serial chain",
-                           b.line, b.name)  # fmt: skip
         velocities: list[float] = []
         first_limit_line = next((j.limit_line for j in movable if j.limit is not None), None)
         for j in movable:
@@ -557,16 +659,7 @@ class _Checker:
 
     # ------------------------------------------------------------------------------------- geometry
     def geometry(self) -> None:
-        from .errors import UrdfError
-
-        # the frames the loader takes: the same function (scara_pin.urdf_rules.choose_frames)
-        try:
-            frames = choose_frames(list(self.links), [JointEdge(j.name, j.type, j.parent, j.child)
-                                                      for j in self.joints.values()],
-                                   tool=self.tool_asked, base=self.base_asked, origin=self.source)  # fmt: skip
-        except UrdfError as exc:
-            self.error("frame-missing", str(exc).removeprefix(f"{self.source}: "))
-            raise _Unusable from None
+        frames = self.chosen
         base = frames.base
         self.base = base
         bMo = np.linalg.inv(self.link_world[base])
@@ -578,12 +671,27 @@ class _Checker:
         revolute: list[tuple[_Joint, np.ndarray]] = []
         prismatic_at = [i for i, j in enumerate(self.chain) if j.type == "prismatic"]
         self.axes: dict[str, tuple[float, float, float]] = {}
+        tilts = {}
+        for j in self.chain:
+            axis = (bMo @ j.world)[:3, :3] @ (np.asarray(j.axis) / np.linalg.norm(j.axis))
+            self.axes[j.name] = (float(axis[0]), float(axis[1]), float(axis[2]))
+            tilts[j.name] = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
+        # the wrist alone may tilt further (scara_geometry's rule): the last of 4, revolute, the others near-vertical
+        wrist_only = len(self.chain) == 4 and self.chain[-1].type != "prismatic" and all(
+            tilts[j.name] <= NEAR_PARALLEL_TOL for j in self.chain[:-1])  # fmt: skip
         for j in self.chain:
             M = bMo @ j.world
-            axis = M[:3, :3] @ (np.asarray(j.axis) / np.linalg.norm(j.axis))
-            self.axes[j.name] = (float(axis[0]), float(axis[1]), float(axis[2]))
-            tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
-            if tilt > NEAR_PARALLEL_TOL:
+            axis = np.asarray(self.axes[j.name])
+            tilt = tilts[j.name]
+            wrist = wrist_only and j is self.chain[-1]
+            if NEAR_PARALLEL_TOL < tilt <= WRIST_TILT_MAX and wrist:  # the closed form's rule (scara_geometry)
+                self.add(Severity.WARNING, "wrist-tilted",
+                         f"joint {j.name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
+                         f"axis: the wrist alone tilts (at most {WRIST_TILT_MAX:g} rad): the tool's roll/pitch follow "
+                         f"{j.name}, and a tool point off its axis moves up and down as it turns; nothing that carries "
+                         "the wrist point depends on it: the closed form's solutions are refined on the model, the "
+                         f"workspace is that of {j.name}'s axis at the tool's height", j.line, j.name)  # fmt: skip
+            elif tilt > NEAR_PARALLEL_TOL:
                 self.add(Severity.WARNING, "axis-tilted",
                          f"joint {j.name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
                          f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the closed-form IK refuses it; only numeric IK "
@@ -651,24 +759,61 @@ class _Checker:
     # ------------------------------------------------------------------------------------- loading
     def load(self) -> None:
         from .errors import UrdfError
-        from .kinematics.kinds import kinematics_for
+        from .kinematics.kinds import kinematics_for, what_arm
         from .kinematics.scara import NotScaraError
         from .model import Robot
 
+        quiet = _Quiet()  # the loader's warnings are findings here already (xacro-ignored): not logged twice
+        logging.getLogger("scara_pin").addFilter(quiet)
         try:
             robot = Robot(self.text, origin=self.source, tool_frame=self.tool_asked, base_frame=self.base_asked,
-                          kinematics=kinematics_for, **self.load_kwargs)  # the frames: the same choose_frames
+                          kinematics=kinematics_for, lock=self.lock, **self.load_kwargs)  # the same choose_frames
         except UrdfError as exc:
             self.error("not-loadable", f"the toolkit cannot load it: {exc}")
             return
+        finally:
+            logging.getLogger("scara_pin").removeFilter(quiet)
+        if robot.kind == "palletizer":  # its horizontal arm joints are its own: not a SCARA's tilted axes
+            self.findings = [f for f in self.findings if f.code != "axis-tilted"]
         try:
             kinematics = robot.kinematics
-        except NotScaraError as exc:
-            if not any(f.code == "axis-tilted" for f in self.findings):
+        except UrdfError as exc:  # NotScaraError, NotPalletizerError: the kind's own reason
+            what = what_arm(robot) if isinstance(exc, NotScaraError) else None
+            if what is not None:  # an arm of another shape: what it is and what applies
+                self.add(Severity.WARNING, "not-a-scara", what[0].upper() + what[1:])
+            elif not any(f.code == "axis-tilted" for f in self.findings):
                 self.add(Severity.WARNING, "closed-form-refused",
                          f"the closed-form IK refuses it: {exc}; only numeric IK applies")
             return
+        if robot.kind == "palletizer":
+            self.add(Severity.INFO, "palletizer", "a palletizer (a waist, two parallel horizontal arm joints, the "
+                     "flange kept level by <mimic> joints): the palletizer's closed form applies")  # fmt: skip
+            return
         self.near_parallel(robot, kinematics)
+
+    def mesh_files(self) -> None:
+        """``mesh-missing``: a visual's mesh the viewer cannot find or may not read (it draws a box instead).
+
+        Found by the viewer's own resolver (:func:`scara_pin.description.mesh_paths.mesh_file`), for a file
+        (``check_urdf_file``: the package folders known); one finding per file name, naming its links.
+        """
+        from .description.mesh_paths import MeshProblem, mesh_file
+
+        packages = self.load_kwargs.get("package_path")
+        if packages is None:  # URDF text without a file: nowhere to look relative names up
+            return
+        links: dict[str, list[str]] = {}
+        first: dict[str, int | None] = {}
+        for link, filename, line in self.meshes:
+            links.setdefault(filename, []).append(link)
+            first.setdefault(filename, line)
+        for filename, names in links.items():
+            try:
+                mesh_file(filename, packages)
+            except MeshProblem as exc:
+                shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+                self.add(Severity.WARNING, "mesh-missing",
+                         f"{exc}: the viewer draws link {shown} as a placeholder box", first[filename])
 
     def near_parallel(self, robot: Any, kinematics: Any) -> None:
         """The ``near-parallel`` finding: the axes' tilt, and the error of the closed form without refinement."""
@@ -694,21 +839,27 @@ class _Checker:
     def run(self) -> CheckReport:
         try:
             self.structure()
+            self.frames()
             self.joint_rules()
             self.geometry()
             if not any(f.severity is Severity.ERROR for f in self.findings):
                 self.load()
+            self.mesh_files()
         except _Unusable:
             pass
         joints = tuple(
             JointInfo(j.name, j.type, j.line, j.parent, j.child, getattr(self, "axes", {}).get(j.name))
+            if self.sources is None else
+            JointInfo(j.name, j.type, where[1] if (where := self.sources.where(j.line)) else None, j.parent, j.child,
+                      getattr(self, "axes", {}).get(j.name), self._shown(where[0]) if where else None)
             for j in self.chain
-        )
+        )  # fmt: skip
         return CheckReport(self.source, tuple(self.findings), joints, self.tool, getattr(self, "base", None))
 
 
 def check_urdf(
-    text: str, *, origin: str = "URDF", tool: str | None = None, base: str | None = None
+    text: str, *, origin: str = "URDF", tool: str | None = None, base: str | None = None,
+    lock: Mapping[str, float] | None = None,
 ) -> CheckReport:
     """Lint URDF text.
 
@@ -718,23 +869,30 @@ def check_urdf(
         tool: the tool frame asked for (``--tool``); default as the loader picks it
             (:func:`scara_pin.urdf_rules.choose_frames`).
         base: the base frame asked for (``--base``); likewise.
+        lock: joints locked at a value (``--lock``, [rad, m]), as the loader takes them (:mod:`scara_pin.chain`).
 
     Returns:
         The report; its ``status`` and ``exit_code`` give the verdict. Never raises for bad input.
     """
-    return _Checker(text, origin, tool, base).run()
+    return _Checker(text, origin, tool, base, lock=lock).run()
 
 
 def check_urdf_file(
-    path: str | Path, *, tool: str | None = None, base: str | None = None, package_dirs: Sequence[str | Path] = ()
+    path: str | Path, *, tool: str | None = None, base: str | None = None, package_dirs: Sequence[str | Path] = (),
+    lock: Mapping[str, float] | None = None,
 ) -> CheckReport:
-    """Lint a URDF file, or a xacro file (``.xacro``: expanded first, the lines are the expanded text's).
+    """Lint a URDF file, or a xacro file (``.xacro``: expanded first, as the loader does).
+
+    A xacro file's findings point at the file and line where their element was written (the file itself,
+    a file it includes, a macro's definition: ``Finding.file``, ``Finding.line``), with its line in the
+    expanded document (``Finding.expanded_line``); an element that xacro made has only the latter.
 
     An unreadable file gives an ``unreadable`` error finding, a xacro that cannot be expanded (a missing
     package, say) a ``xacro-failed`` one: status unusable. Other arguments as :func:`check_urdf`; packages
     are looked for as the loader does (:mod:`scara_pin.description.packages`).
     """
     from .description.packages import PackagePath, read_robot_file
+    from .description.xacro_sources import expand_with_sources
     from .errors import InvalidInputError, UrdfError
     from .limits import check_input_file
 
@@ -743,11 +901,19 @@ def check_urdf_file(
         check_input_file(path, "URDF")
     except InvalidInputError as exc:
         return CheckReport(str(path), (Finding(Severity.ERROR, "unreadable", f"cannot be read ({exc})"),))
+    sources = None
     try:
         packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
-        text = read_robot_file(path, packages)
+        if path.name.endswith(".xacro"):  # the loader's text, and where each element was written
+            text, sources = expand_with_sources(path, packages)
+        else:
+            text = read_robot_file(path, packages)
     except UrdfError as exc:
         code = "xacro-failed" if path.name.endswith(".xacro") and path.is_file() else "unreadable"
-        reason = str(exc).removeprefix(f"{path}: ")
-        return CheckReport(str(path), (Finding(Severity.ERROR, code, reason),))
-    return _Checker(text, str(path), tool, base, {"package_path": packages}).run()
+        reason = getattr(exc, "reason", str(exc)).removeprefix(f"{path}: ")
+        file, line = getattr(exc, "file", None), getattr(exc, "line", None)  # where xacro failed, when known
+        shown = None if file is None else _Checker("", str(path))._shown(Path(file), path.resolve())
+        return CheckReport(str(path), (Finding(Severity.ERROR, code, reason, line, None, shown),))
+    checker = _Checker(text, str(path), tool, base, {"package_path": packages}, lock)
+    checker.sources = sources
+    return checker.run()

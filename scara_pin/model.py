@@ -3,10 +3,12 @@
 Conventions (used by every command of the package):
 
 - ``q`` holds the four joint values in URDF joint order, SI units ([rad], and [m] for the quill).
-  Passive ``<mimic>`` joints (the palletizer's levelling joints) are loaded as Pinocchio mimic joints:
-  they follow their joint and are not in ``q``. A URDF ``continuous`` joint (Pinocchio: nq = 2, its
-  (cos q, sin q)) is one angle in ``q`` too: no position limit (any finite q), IK solutions presented in
-  [-pi, pi]; :meth:`Robot.to_pinocchio_q` / :meth:`Robot.from_pinocchio_q` convert for raw Pinocchio calls.
+  Passive ``<mimic>`` joints (the palletizer's levelling joints, a wrist geared to the shoulder) are loaded
+  as Pinocchio mimic joints: they follow their joint and are not in ``q`` (``Robot.geared``). Joints off the
+  chain from the root to the tool (another arm) are locked (``Robot.locked``, :mod:`scara_pin.chain`).
+  A URDF ``continuous`` joint (Pinocchio: nq = 2, its (cos q, sin q)) is one angle in ``q`` too: no position
+  limit (any finite q), IK solutions presented in [-pi, pi]; :meth:`Robot.to_pinocchio_q` /
+  :meth:`Robot.from_pinocchio_q` convert for raw Pinocchio calls.
 - Poses are of ``tool0`` in the robot's ``base`` frame (the controller's reference frame). The yaw is
   ``atan2(R[1, 0], R[0, 0])`` of that rotation: the heading of tool0's x axis in the base plane.
 - Pinocchio's world frame (``universe``) is the root link (``base_link``); Jacobians named after
@@ -16,6 +18,7 @@ Conventions (used by every command of the package):
 from __future__ import annotations
 
 import enum
+import logging
 import math
 from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
@@ -32,6 +35,7 @@ from .urdf_rules import choose_frames, read_tree
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
+    from .chain import GearedJoint, JointAxis, LockedJoint
     from .description.packages import PackagePath
     from .kinematics.results import BatchIKResult, IKResult
 
@@ -112,7 +116,7 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
     """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
     import xml.etree.ElementTree as ET
 
-    from ._urdf_checks import check_urdf_tree
+    from ._urdf_checks import check_urdf_tree, xacro_leftovers
 
     try:
         root = ET.fromstring(urdf)
@@ -123,6 +127,12 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
         raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
     # urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state):
     # its rules are checked first, in Python, so that it only sees documents it accepts.
+    # the rule `scara-pin check` applies (xacro-not-expanded / xacro-ignored); the text search spares a walk
+    leftover = xacro_leftovers(root) if "xacro" in urdf or "$" in urdf else None
+    if leftover is not None:
+        if leftover[0]:
+            raise UrdfError(f"{origin}: {leftover[1]}")
+        logging.getLogger("scara_pin").warning("%s: %s", origin, leftover[1])
     check_urdf_tree(root, origin)
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
     mimic = root.find("joint/mimic") is not None
@@ -183,11 +193,15 @@ class Robot:
         name: the robot's name.
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
-        kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file counts as a SCARA).
+        kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file is a palletizer when it has
+            the palletizer's layout and its flange stays level, :func:`_urdf_kind`; else it counts as a SCARA).
         continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
         dof: the number of joint values in q, 4 or 3 (a SCARA without a wrist; :data:`JOINT_COUNTS`).
         base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
         frame_note: the notice when the tool frame was chosen by default without a ``tool0`` (else None).
+        geared: the joints that follow another (URDF ``<mimic>``; not in q): :class:`scara_pin.chain.GearedJoint`.
+        locked: the joints fixed at a value (another arm's, or asked for): :class:`scara_pin.chain.LockedJoint`;
+            ``lock_note``: the notice naming those locked without being asked for (else None).
         package_path: where ``package://`` names (meshes) are looked for (see
             :mod:`scara_pin.description.packages`).
     """
@@ -205,6 +219,9 @@ class Robot:
     base_frame: str
     tool_frame: str
     frame_note: str | None
+    geared: tuple[GearedJoint, ...]
+    locked: tuple[LockedJoint, ...]
+    lock_note: str | None
     package_path: PackagePath
 
     def __init__(
@@ -218,6 +235,7 @@ class Robot:
         origin: str = "URDF",
         package_path: PackagePath | None = None,
         kinematics: KinematicsFactory | None = None,
+        lock: Mapping[str, float] | None = None,
     ) -> None:
         """Load URDF text.
 
@@ -233,27 +251,46 @@ class Robot:
             package_path: where ``package://`` names are looked for (meshes); default: none.
             kinematics: builds the robot's kinematics object from the loaded robot (its kind's; see
                 :func:`scara_pin.kinematics.kinds.kinematics_for`, which :func:`scara_pin.load_robot` passes).
+            lock: joints to fix, with their values [rad, m] (:mod:`scara_pin.chain`); joints that are not on
+                the chain from the root to the tool (another arm) are locked anyway, at 0 by default.
 
         Raises:
             UrdfError: unreadable, invalid or disconnected URDF, not a 4-joint robot, an unusable joint
                 (inverted limits, zero axis: :func:`scara_pin.urdf_rules.joint_problem`), or a frame
                 asked for that is not a link of the file.
         """
+        from .chain import geared_joints, reduce_to_chain
         from .description.packages import PackagePath
 
         model = _parse_urdf(urdf, origin)
         links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
-        continuous = _continuous_joints(model, origin)
         frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
         base_frame, tool_frame = frames.base, frames.tool
+        edges = {j.name: j for j in joints}
+        # one arm of a multi-arm tree (or with --lock): the other joints fixed, the whole robot still drawn
+        model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin)
+        try:
+            continuous = _continuous_joints(model, origin)
+        except UrdfError as exc:
+            if not self.locked:
+                raise
+            names = ", ".join(lj.name for lj in self.locked[:12]) + (" ..." if len(self.locked) > 12 else "")
+            raise UrdfError(f"{exc}, once {names} locked (not on the chain {frames.root} -> {tool_frame}, or "
+                            "--lock): --tool picks the link that ends an arm") from None  # fmt: skip
+        self.geared = geared_joints(model, edges)
         self.frame_note = frames.note
+        off_chain = [lj for lj in self.locked if lj.reason != "asked"]
+        self.lock_note = None if not off_chain else (
+            f"{len(off_chain)} joint(s) not on the chain {frames.root} -> {tool_frame} locked: "
+            + ", ".join(f"{lj.name} = {lj.value:.6g}" for lj in off_chain[:12])
+            + (" ..." if len(off_chain) > 12 else "") + " (--lock JOINT=VALUE sets them, rad or m)"
+        )  # fmt: skip
         self.package_path = package_path if package_path is not None else PackagePath()
         self.model = model
         self.data = model.createData()
         self.urdf = urdf
         self.name = model.name
         self.parameters = parameters
-        self.kind = parameters.kind if parameters is not None else "scara"
         self.base_frame = base_frame
         self.tool_frame = tool_frame
         self.base_id = model.getFrameId(base_frame, pin.FrameType.BODY)
@@ -291,6 +328,7 @@ class Robot:
         if type(self).task_jacobian is _ROBOT_TASK_JACOBIAN:
             self.task_jacobian = self._per_call[1]  # type: ignore[method-assign,assignment]
         self._kinematics_factory = kinematics
+        self.kind = parameters.kind if parameters is not None else _urdf_kind(self)
         if self.has_continuous:
             # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
             iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
@@ -342,7 +380,16 @@ class Robot:
 
         path = Path(path)
         packages = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
-        return cls(read_robot_file(path, packages), origin=str(path), package_path=packages, **kwargs)
+        try:
+            text = read_robot_file(path, packages)
+        except UrdfError:
+            if not path.name.endswith(".xacro"):
+                raise
+            from .description.xacro_sources import expand_with_sources
+
+            expand_with_sources(path, packages)  # fails again, saying where in which file (XacroSourceError)
+            raise
+        return cls(text, origin=str(path), package_path=packages, **kwargs)
 
     # ----------------------------------------------------------------- geometry (lazy)
     @cached_property
@@ -452,6 +499,13 @@ class Robot:
         """
         actuated = [jm for jm in self.model.joints[1:] if jm.nv > 0]
         return tuple("length" if jm.shortname().startswith("JointModelP") else "angle" for jm in actuated)
+
+    @cached_property
+    def axes(self) -> tuple[JointAxis, ...]:
+        """The joints of q at q = 0 in the base frame: kind, axis, point (:func:`scara_pin.chain.joint_axes`)."""
+        from .chain import joint_axes
+
+        return joint_axes(self.model, self.base_id)
 
     @cached_property
     def joint_names(self) -> tuple[str, ...]:
@@ -569,6 +623,22 @@ class Robot:
             names = ", ".join(f.name for f in self.model.frames)
             raise InvalidInputError(f"no frame named {frame!r}; frames: {names}")
         return int(self.model.getFrameId(frame))
+
+
+def _urdf_kind(robot: Robot) -> str:
+    """``"palletizer"`` for a palletizer's layout whose flange stays level, else ``"scara"``.
+
+    The layout (:func:`scara_pin.chain.palletizer_layout`): a vertical waist, two parallel horizontal arm
+    joints, a vertical flange. Level: the tool's z axis keeps its direction at
+    :data:`~scara_pin.chain.LEVEL_PROBES` (the levelling parallelogram, modelled by ``<mimic>`` joints).
+    Whether the palletizer's closed form then fits the model is its kinematics' check (FK at sampled q).
+    """
+    from .chain import AXIS_TOL, LEVEL_PROBES, flange_pitch, palletizer_layout
+
+    if robot.dof != 4 or not palletizer_layout(robot.axes):
+        return "scara"
+    level = all(flange_pitch(robot.tool_placement, q) <= AXIS_TOL for q in LEVEL_PROBES)
+    return "palletizer" if level else "scara"
 
 
 _ROBOT_TOOL_PLACEMENT = Robot.tool_placement

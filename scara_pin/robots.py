@@ -48,6 +48,7 @@ def load_robot(
     tool: str | None = None,
     base: str | None = None,
     package_path: Sequence[str | Path] = (),
+    lock: Mapping[str, float] | None = None,
 ) -> Robot:
     """Load a robot with the kinematics of its kind: a configured one (name or folder) or a URDF / xacro file.
 
@@ -59,11 +60,16 @@ def load_robot(
             ``robot.frame_note`` says so).
         base: the base frame poses are expressed in (a link); default ``base`` if present, else the root.
         package_path: folders holding ROS-style packages, for ``$(find pkg)`` and ``package://pkg/``.
+        lock: joints to fix at a value [rad, m] (:mod:`scara_pin.chain`). Joints not on the chain from the
+            root to ``tool`` (the other arm of a two-arm robot) are locked anyway, at 0 unless given here;
+            ``robot.locked`` lists them all.
 
     Raises:
         UrdfError: (exit code 2) among others a ``tool`` or ``base`` that is not a link of the robot.
     """
     kwargs: dict[str, Any] = {"tool_frame": tool, "base_frame": base, "kinematics": kinematics_for}
+    if lock:
+        kwargs["lock"] = dict(lock)
     if urdf is not None:
         if overrides:
             raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file")

@@ -25,12 +25,18 @@ MOVABLE = ("revolute", "continuous", "prismatic")
 
 @dataclass(frozen=True)
 class JointEdge:
-    """A URDF joint as the tree sees it: name, type, parent link, child link."""
+    """A URDF joint as the tree sees it: name, type, parent link, child link; its limits and mimic as written.
+
+    ``lower``/``upper``: the position limits (None when absent); ``mimic``: the joint it follows, if any.
+    """
 
     name: str
     type: str
     parent: str
     child: str
+    lower: float | None = None
+    upper: float | None = None
+    mimic: str | None = None
 
 
 @dataclass(frozen=True)
@@ -42,11 +48,13 @@ class FrameChoice:
         tool: the tool frame (a link).
         note: when the tool was chosen by default without a ``tool0``: the one-line notice saying which
             link is the tool (the CLI prints it as ``info:``); else None.
+        root: the root link of the tree.
     """
 
     base: str
     tool: str
     note: str | None = None
+    root: str = ""
 
 
 def _dfs(links: Sequence[str], joints: Sequence[JointEdge]) -> tuple[str, list[JointEdge], dict[str, list[JointEdge]]]:
@@ -130,7 +138,7 @@ def choose_frames(
                 tool = level[0]
                 level = [j.child for link in level for j in children.get(link, [])]
             note = f"no tool0 frame: {tool} (the chain's last link) is taken as the tool; --tool FRAME picks another"
-    return FrameChoice(base=base, tool=tool, note=note)
+    return FrameChoice(base=base, tool=tool, note=note, root=root)
 
 
 def joint_problem(
@@ -185,17 +193,18 @@ def read_tree(urdf: str, origin: str) -> tuple[list[str], list[JointEdge]]:
     for el in root.findall("joint"):
         name, kind = el.get("name", ""), el.get("type", "")
         parent, child = el.find("parent"), el.find("child")
+        axis_el, limit, mimic = el.find("axis"), el.find("limit"), el.find("mimic")
+        lo = _float(limit.get("lower")) if limit is not None else None
+        hi = _float(limit.get("upper")) if limit is not None else None
         joints.append(JointEdge(name, kind, parent.get("link", "") if parent is not None else "",
-                                child.get("link", "") if child is not None else ""))  # fmt: skip
-        if kind not in MOVABLE or el.find("mimic") is not None:  # a mimic joint follows another: not in q
+                                child.get("link", "") if child is not None else "", lo, hi,
+                                None if mimic is None else mimic.get("joint", "")))  # fmt: skip
+        if kind not in MOVABLE or mimic is not None:  # a mimic joint follows another: not in q
             continue
-        axis_el, limit = el.find("axis"), el.find("limit")
         try:
             axis = [float(v) for v in (axis_el.get("xyz", "1 0 0") if axis_el is not None else "1 0 0").split()]
         except ValueError:
             axis = [math.nan]
-        lo = _float(limit.get("lower")) if limit is not None else None
-        hi = _float(limit.get("upper")) if limit is not None else None
         problem = joint_problem(name, kind, axis, lo, hi)
         if problem is not None:
             raise UrdfError(f"{origin}: {problem[1]} [{problem[0]}]")

@@ -440,18 +440,20 @@ def test_hand_urdf_ik_round_trip(name: str, hand_robots: dict[str, Robot]) -> No
 
 
 # ============================================================================== refused models
-@pytest.mark.parametrize("joint", ["j1", "j2", "j3", "j4"])
-def test_tilted_axis_is_not_a_scara(joint: str) -> None:
-    """A joint frame tilted by 0.02 rad (roll), beyond the near-parallel 1e-2 rad (refined up to there:
-    tests/test_near_parallel.py): the first joint whose axis is off vertical is named, with its angle."""
-    robot = robot_from_urdf(yk400xe_y({joint: "0.02 0 0"}), origin="tilted")
+@pytest.mark.parametrize(("joint", "tilt"), [("j1", 0.02), ("j2", 0.02), ("j3", 0.02), ("j4", 0.12)])
+def test_tilted_axis_is_not_a_scara(joint: str, tilt: float) -> None:
+    """A joint frame tilted (roll) beyond the near-parallel 1e-2 rad (refined up to there:
+    tests/test_near_parallel.py), or the wrist alone beyond WRIST_TILT_MAX (0.1 rad; a wrist-only tilt up to
+    there is refined: tests/test_chain_quirks.py): the first joint whose axis is off vertical is named, with its
+    angle."""
+    robot = robot_from_urdf(yk400xe_y({joint: f"{tilt!r} 0 0"}), origin="tilted")
     with pytest.raises(NotScaraError) as info:
         _ = robot.kinematics.geometry
     msg = str(info.value)
     assert re.search(rf"\b{joint}\b", msg), msg
     assert not any(re.search(rf"\b{j}\b", msg) for j in ("j1", "j2", "j3", "j4") if j != joint), msg
-    # the angle: 0.02 rad, accepted in degrees or radians
-    assert mentions(msg, math.degrees(0.02), 1e-6) or mentions(msg, 0.02, 1e-9), msg
+    # the angle, accepted in degrees or radians
+    assert mentions(msg, math.degrees(tilt), 1e-6) or mentions(msg, tilt, 1e-9), msg
 
 
 def test_tilt_below_one_microradian_is_accepted() -> None:

@@ -422,7 +422,7 @@ LAYERS = (
     ("limits", "files", "urdf_rules"),
     ("description",),
     ("_checks", "tables", "_urdf_checks"),
-    ("model",),
+    ("model", "chain"),
     ("kinematics",),
     ("calibration",),  # beside kinematics: imports description, model, kinematics; nothing lower imports it
     ("robots", "workspace", "lint"),

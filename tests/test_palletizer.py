@@ -179,7 +179,8 @@ def test_urdf_is_a_tree_with_two_mimic_joints(robot: Robot) -> None:
 
 def test_golden_palletizer_urdf_loads_with_the_same_fk(robot: Robot, rng: np.random.Generator) -> None:
     from_file = load_urdf(GOLDEN)
-    assert from_file.model.nq == 4 and from_file.kind == "scara"  # a URDF file has no yaml: kind unknown
+    # a URDF file has no yaml: its kind is read from the model (a palletizer's layout, the flange kept level)
+    assert from_file.model.nq == 4 and from_file.kind == "palletizer"
     for q in rng.uniform(-3, 3, size=(50, 4)):
         assert np.abs(from_file.tool_placement(q).homogeneous - robot.tool_placement(q).homogeneous).max() <= FK_TOL
 

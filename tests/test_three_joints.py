@@ -155,10 +155,9 @@ def test_cli_ik_xyz_both_branches_and_yaw_refused(capsys: pytest.CaptureFixture[
 
 @pytest.mark.parametrize(
     "argv",
-    [["validate-ik"], ["ik", "--numeric", "0.3", "0.2", "0.2"], ["jog", "--from", "0", "0", "0", "0", "--direction",
-                                                                  "1", "0", "0"],
+    [["validate-ik"], ["jog", "--from", "0", "0", "0", "0", "--direction", "1", "0", "0"],
      ["traj", "--from", "0", "0", "0", "--to", "1", "0.5", "0.1", "--linear"], ["cycle"]],
-    ids=["validate-ik", "ik-numeric", "jog", "traj-linear", "cycle"],
+    ids=["validate-ik", "jog", "traj-linear", "cycle"],
 )  # fmt: skip
 def test_cli_commands_without_3_joint_support_refuse(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
     rc, _, err = run(capsys, [argv[0], "--urdf", str(RRP), *argv[1:]])

@@ -134,15 +134,21 @@ def _jerk(args: argparse.Namespace) -> list[float] | None:
     return values * 4 if len(values) == 1 else values
 
 
-def _parse_sets(items: Sequence[str] | None) -> dict[str, float]:
-    """``--set KEY=VALUE`` items; each value goes through :func:`_number` (never to xacro as text)."""
+def _parse_sets(items: Sequence[str] | None, option: str = "--set", form: str = "key=value (e.g. l1=0.25)"
+                ) -> dict[str, float]:  # fmt: skip
+    """``--set KEY=VALUE`` items (or ``option``'s); each value through :func:`_number` (never to xacro as text)."""
     overrides: dict[str, float] = {}
     for item in items or ():
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise InvalidInputError(f"--set {item[:80]!r} must have the form key=value (e.g. l1=0.25)")
-        overrides[key.strip()] = _number(f"--set {key.strip()[:80]}", value)
+            raise InvalidInputError(f"{option} {item[:80]!r} must have the form {form}")
+        overrides[key.strip()] = _number(f"{option} {key.strip()[:80]}", value)
     return overrides
+
+
+def _parse_locks(items: Sequence[str] | None) -> dict[str, float]:
+    """``--lock JOINT=VALUE`` items (SI, as --set)."""
+    return _parse_sets(items, "--lock", "JOINT=VALUE (e.g. lower_j1=0.5)")
 
 
 _MAX_NAME = 4096
@@ -162,10 +168,12 @@ def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
         from ..limits import check_input_file
 
         check_input_file(args.urdf, "URDF")
+    locks = _parse_locks(getattr(args, "lock", None))
     robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf, tool=args.tool, base=args.base,
-                       package_path=args.package_path or ())  # fmt: skip
-    if robot.frame_note is not None:  # the tool chosen without a tool0: said once
-        print(f"info: {robot.frame_note}", file=sys.stderr)
+                       package_path=args.package_path or (), lock=locks)  # fmt: skip
+    for note in (robot.frame_note, robot.lock_note):  # the tool chosen without a tool0, another arm locked
+        if note is not None:
+            print(f"info: {note}", file=sys.stderr)
     if units is not None:  # what each joint value measures, read from the model (any joint order)
         units.q = robot.joint_kinds
     return robot
@@ -212,8 +220,11 @@ def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
 def _needs_wrist(robot: Robot, what: str) -> None:
     """Refuse (exit 2) a command or option that supports 4-joint robots only, for a 3-joint SCARA."""
     if robot.dof != 4:
+        kinds = sorted(a.kind for a in robot.axes)
+        arm = "a SCARA without a wrist" if kinds == ["prismatic", "revolute", "revolute"] else " and ".join(
+            f"{kinds.count(k)} {k}" for k in sorted(set(kinds)))  # fmt: skip
         raise InvalidInputError(f"{what} supports 4-joint robots only; {robot.name!r} has {robot.dof} joints "
-                                "(a SCARA without a wrist)")  # fmt: skip
+                                f"({arm})")  # fmt: skip
 
 
 def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]:
@@ -300,6 +311,9 @@ def _add_frame_options(g: Any) -> None:
                    "else the chain's last link)")  # fmt: skip
     g.add_argument("--base", metavar="FRAME", help="the frame poses are expressed in (a link; default: base "
                    "if present, else the root link)")  # fmt: skip
+    g.add_argument("--lock", action="append", metavar="JOINT=VALUE",
+                   help="fix a joint at a value [rad or m, SI as --set]; joints not on the chain from the root to "
+                   "the tool (another arm) are locked at 0 unless given; repeatable")  # fmt: skip
     g.add_argument("--package-path", action="append", metavar="DIR",
                    help="a folder holding ROS packages (folders with package.xml), for $(find pkg) and "
                    "package://pkg/ in --urdf; repeatable; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are "

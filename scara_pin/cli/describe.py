@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
 from ..files import check_output_path
-from ._common import _add_frame_options, _add_robot_options, _parse_sets, write_atomic
+from ._common import _add_frame_options, _add_robot_options, _parse_locks, _parse_sets, write_atomic
 
 if TYPE_CHECKING:
 
@@ -55,7 +55,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable."""
     from ..lint import check_urdf_file
 
-    report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or ())
+    report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or (),
+                             lock=_parse_locks(args.lock))
     print(report.to_json() if args.json else report.format_text())
     return int(report.exit_code)
 

@@ -65,12 +65,16 @@ def cmd_fk(args: argparse.Namespace) -> int:
             "reference": robot.base_frame,
             "units": _SI_UNITS,
         }
+        if robot.geared:
+            out["geared"] = _geared(robot, q)
         print(json.dumps(out))
         return 0
     print(f"robot     {robot.name}: {robot.tool_frame} in {robot.base_frame}")
     print(f"q         {_fmt(q_out)}  [{', '.join(units.names(units.q))}]")
     print(f"position  {_fmt(pos)}  [{units.length_name}]")
     print(f"yaw       {yaw: .9g}  [{units.angle_name}]")
+    if robot.geared:
+        print(f"geared    {_geared_text(robot, q, units)}")
     print("matrix")
     for row in matrix:
         print("          " + _fmt(row))
@@ -125,6 +129,28 @@ def _solutions_json(q_list: Sequence[ArrayLike], branches: Sequence[str], units:
     return [{"q": _scaled(q, scale), "branch": b} for q, b in zip(q_list, branches)]
 
 
+def _geared(robot: Robot, q: ArrayLike) -> dict[str, float]:
+    """The values of the geared (``<mimic>``) joints at ``q`` [rad, m]; a warning for any outside its own limits."""
+    out = {}
+    for g in robot.geared:
+        out[g.name] = value = g.value(q)  # type: ignore[arg-type]
+        if g.outside_limits(value):
+            log.warning("geared joint %s = %.9g is outside its own URDF limits [%.9g, %.9g] (%s)", g.name, value,
+                        g.lower, g.upper, g.describe())  # fmt: skip
+    return out
+
+
+def _geared_text(robot: Robot, q: ArrayLike, units: Units) -> str:
+    """``wrist = 1.3 rad (= 1 * arm1 + 1)``, per geared joint, in the user's units."""
+    values = _geared(robot, q)
+    parts = []
+    for g in robot.geared:
+        scale, unit = (units.angle, units.angle_name) if g.kind == "angle" else (units.length, units.length_name)
+        parts.append(f"{g.name} = {values[g.name] * scale:.9g} {unit} ({g.multiplier:.9g} * {g.source_name} + "
+                     f"{g.offset * scale:.9g})")  # fmt: skip
+    return "; ".join(parts)
+
+
 def cmd_ik(args: argparse.Namespace) -> int:
     """Inverse kinematics: every joint solution for a tool pose (closed form, or numeric)."""
     units = Units(args.deg, args.mm)
@@ -138,8 +164,6 @@ def cmd_ik(args: argparse.Namespace) -> int:
     target = _read_pose(args.target, units, dof=robot.dof)
     near = _near(robot, args.near, units) if args.near else None
     numeric = args.numeric
-    if numeric:
-        _needs_wrist(robot, "ik --numeric")
     if robot.kind == "palletizer":
         if args.branch in ("left", "right"):
             raise InvalidInputError(f"--branch {args.branch} is a SCARA branch; a palletizer's are up and down")
@@ -147,12 +171,12 @@ def cmd_ik(args: argparse.Namespace) -> int:
         raise InvalidInputError(f"--branch {args.branch} is a palletizer branch; a SCARA's are left and right")
     if args.all_turns and (numeric or near is not None):
         raise InvalidInputError("--all-turns lists every closed-form solution: not with --numeric or --near")
-    if not numeric and robot.kind == "scara":
-        from ..kinematics.scara import NotScaraError
+    if not numeric:
+        from ..errors import UrdfError
 
         try:
-            _ = robot.kinematics  # extracted on first use: refused here if the model is not SCARA-like
-        except NotScaraError as exc:
+            _ = robot.kinematics  # extracted on first use: refused here if the model is not its kind's
+        except UrdfError as exc:  # NotScaraError, NotPalletizerError
             log.warning("closed-form IK refused this robot (%s); using the numeric IK", exc)
             numeric = True
     if numeric and args.branch != "all":  # the numeric IK lands where its seed leads: no branch to choose
@@ -183,6 +207,9 @@ def cmd_ik(args: argparse.Namespace) -> int:
         solutions = _solutions_json(qs, branches, si)
         for sol, t in zip(solutions, turns):
             sol["turns"] = t
+        if robot.geared:  # the joints that follow (not degrees of freedom): their values at each solution
+            for sol, q in zip(solutions, qs):
+                sol["geared"] = _geared(robot, q)
         print(json.dumps({"robot": robot.name, "target": dict(zip(("x", "y", "z", "yaw"), map(float, target))),
                           "solutions": solutions, "status": status, "message": message,
                           "method": "numeric" if numeric else "closed-form", "units": _SI_UNITS}))  # fmt: skip
@@ -199,12 +226,14 @@ def cmd_ik(args: argparse.Namespace) -> int:
             extra = "  turns " + " ".join(f"{n}:{'any' if t is None else t}" for n, t in zip(_Q_NAMES, turns[i])
                                           if t != [0, 0])  # fmt: skip
         print(f"{b:<9} {_fmt(_scaled(q, units.scale(units.q)))}{extra}")
+        if robot.geared:
+            print(f"  geared  {_geared_text(robot, q, units)}")
     return 0
 
 
 def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
-    from ..kinematics.numeric import solve_numeric
-    from ..kinematics.scara import NotScaraError
+    from ..errors import UrdfError
+    from ..kinematics.numeric import elbow_sign, solve_numeric
 
     res = solve_numeric(robot, target, q0=near)
     if not res.success:
@@ -212,8 +241,8 @@ def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) 
                 f"{res.iterations} iterations from {res.starts} starts)", [], [])  # fmt: skip
     try:
         branch = robot.branch_of(res.q)
-    except NotScaraError:
-        branch = "unknown"
+    except UrdfError:  # no closed form for this arm: its elbow's side (elbow+ / elbow-)
+        branch = elbow_sign(robot, res.q)
     return "OK", f"converged in {res.iterations} iterations (residual {res.residual:.3g})", [res.q], [branch]
 
 

@@ -16,6 +16,11 @@ if TYPE_CHECKING:
     from ..model import Robot
 
 
+LISTED_ARC_MIN = 1e-6
+"""[m] boundary arcs shorter than this (a limit just past another, by microradians: a 3.14 in an rpy) are not
+listed in the text (their angles would print as one number); --json keeps every arc, the loops close."""
+
+
 def cmd_workspace(args: argparse.Namespace) -> int:
     """The exact reachable region (arcs, area, radii), a ray query to its edge, and a picture."""
     from ..workspace.scara import plot_workspace, workspace
@@ -65,11 +70,19 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         print(f"area      {ws.area * L * L:.9g} {units.length_name}^2")
         print(f"radius    {ws.r_min * L:.9g} .. {ws.r_max * L:.9g} {units.length_name} (from the J1 axis)")
         print(f"z         {z0 * L:.9g} .. {z1 * L:.9g} {units.length_name} (J3 stroke)")
+        if ws.note is not None:
+            print(f"note      {ws.note}")
         print(f"boundary  {len(ws.loops)} loop(s) of {len(ws.arcs)} arcs (centre, radius, start..end angle, limit):")
+        short = [i for i, arc in enumerate(ws.arcs) if arc.radius * abs(arc.sweep) < LISTED_ARC_MIN]
         for i, arc in enumerate(ws.arcs):
+            if i in short:
+                continue
             cx, cy = (v * L for v in arc.center)
             print(f"  {i:>2}  ({cx: .6g}, {cy: .6g})  r {arc.radius * L:.6g}  "
                   f"{math.degrees(arc.start):8.3f}..{math.degrees(arc.end):8.3f} deg  {arc.description}")  # fmt: skip
+        if short:
+            print(f"  ({len(short)} arc(s) shorter than {LISTED_ARC_MIN * 1e6:g} um not listed: "
+                  f"{', '.join(map(str, short))}; real corners of the region, kept in --json)")  # fmt: skip
     if args.plot:
         print(f"wrote     {args.plot}")
     return 0

@@ -1,5 +1,7 @@
 """Numeric inverse kinematics with Pinocchio: damped least squares on the 4-D task (x, y, z, yaw).
 
+A 3-joint arm (a SCARA without a wrist, an R-R-R arm) solves (x, y, z) of its tool point the same way.
+
 It is the independent check of the closed form (:mod:`scara_pin.kinematics.scara`) and the fallback for robots the
 closed form refuses. Each iteration solves
 
@@ -35,7 +37,7 @@ if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..model import Robot
 
-__all__ = ["NumericIKOptions", "NumericIKReason", "NumericIKResult", "solve_numeric"]
+__all__ = ["NumericIKOptions", "NumericIKReason", "NumericIKResult", "elbow_index", "elbow_sign", "solve_numeric"]
 
 _TWO_PI = 2.0 * math.pi
 _PI = math.pi
@@ -139,19 +141,24 @@ def solve_numeric(
         NumericIKResult with the best q found; ``success`` tells whether it reaches the target.
     """
     opts = options or _DEFAULTS
-    if robot.dof != 4:
-        raise InvalidInputError(f"the numeric IK solves 4 joints (x, y, z, yaw); robot {robot.name!r} has {robot.dof}")
+    n = robot.dof
+    if n not in (3, 4):
+        raise InvalidInputError(f"the numeric IK solves 4 joints (x, y, z, yaw) or 3 (x, y, z); robot {robot.name!r} "
+                                f"has {n}")  # fmt: skip
     tgt = np.asarray(target, dtype=float)
-    if tgt.shape != (4,) or not np.isfinite(tgt).all():
-        raise ParameterError("target", tgt.tolist(), "must be 4 finite numbers (x, y, z, yaw)")
+    if tgt.shape != (n,) or not np.isfinite(tgt).all():
+        what = "4 finite numbers (x, y, z, yaw)" if n == 4 else "3 finite numbers (x, y, z): 3 joints choose no yaw"
+        raise ParameterError("target", tgt.tolist(), f"must be {what}")
     lo = np.asarray(robot.limits.lower)
     hi = np.asarray(robot.limits.upper)
     # the actuated joints in q order (mimic joints, nv = 0, follow others and are not in q)
     actuated = [jm for jm in robot.model.joints[1:] if jm.nv > 0]
     revolute = [jm.shortname().startswith("JointModelR") for jm in actuated]
-    turning = [i for i in range(4) if revolute[i]]
-    elbow = turning[1] if len(turning) >= 2 else None
+    elbow = elbow_index(robot)
     start = (lo + hi) / 2 if q0 is None else robot.check_q(q0)
+    if n == 3:  # a 3-joint arm: the task (x, y, z) padded with a free 4th coordinate (see _Task)
+        lo, hi, start, tgt = np.append(lo, -1.0), np.append(hi, 1.0), np.append(start, 0.0), np.append(tgt, 0.0)
+        revolute = [*revolute, False]
     if elbow is not None and abs(math.sin(start[elbow])) < 1e-3:
         # a stretched or folded start has a rank-deficient Jacobian: step off the singularity; the
         # default start goes half-way to the upper limit (a well-conditioned elbow: fewer restarts),
@@ -180,14 +187,46 @@ def solve_numeric(
         if res < best_res:
             best_q, best_res = q, res
         if res <= opts.tol:
-            return NumericIKResult(best_q, True, total, best_res, NumericIKReason.CONVERGED, starts)
+            return NumericIKResult(best_q[:n].copy(), True, total, best_res, NumericIKReason.CONVERGED, starts)
         if starts == 1 and elbow is not None:  # next: the mirrored elbow of where this start ended
             mirrored = q.copy()
             mirrored[elbow] = -mirrored[elbow] if abs(mirrored[elbow]) > 1e-3 else (hi[elbow] - lo[elbow]) / 4
             candidates.append(mirrored)
         if starts >= 2 + opts.restarts:
             break
-    return NumericIKResult(best_q, False, total, best_res, NumericIKReason.MAX_ITERATIONS, starts)
+    return NumericIKResult(best_q[:n].copy(), False, total, best_res, NumericIKReason.MAX_ITERATIONS, starts)
+
+
+ELBOW_PARALLEL = 0.02
+"""[rad] two revolute axes within this angle make the shoulder and elbow of an arm (near-parallel included)."""
+
+
+def elbow_index(robot: Robot) -> int | None:
+    """The index in q of the elbow, or None when the arm has none.
+
+    The elbow is the second of the first two revolute joints (in q order) with parallel axes at q = 0: a
+    SCARA's J2 (J1 and J2 vertical), an articulated or palletizer arm's third joint (after the waist, the
+    shoulder and elbow about parallel horizontal axes). Without such a pair, the second revolute joint.
+    """
+    turning = [a for a in robot.axes if a.kind == "revolute"]
+    for k, b in enumerate(turning):
+        for a in turning[:k]:
+            if float(np.linalg.norm(np.cross(a.axis, b.axis))) <= math.sin(ELBOW_PARALLEL):
+                return b.index
+    return turning[1].index if len(turning) >= 2 else None
+
+
+def elbow_sign(robot: Robot, q: ArrayLike) -> str:
+    """The branch of a numeric solution, for any arm: ``elbow+`` / ``elbow-``, the sign of sin(q_elbow).
+
+    The elbow as :func:`elbow_index` finds it; ``elbow 0`` when it is stretched or folded (|sin| < 1e-12) or
+    the arm has no elbow.
+    """
+    e = elbow_index(robot)
+    if e is None:
+        return "elbow 0"
+    s = math.sin(float(np.asarray(q, dtype=float)[e]))
+    return "elbow 0" if abs(s) < 1e-12 else ("elbow+" if s > 0 else "elbow-")
 
 
 class _Task:
@@ -203,9 +242,12 @@ class _Task:
     def __init__(self, robot: Robot, target: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: list[bool],
                  opts: NumericIKOptions) -> None:  # fmt: skip
         self.robot = robot
+        # a 3-joint arm: q and the task carry a 4th coordinate that nothing moves (error 0, Jacobian row and
+        # column of the identity, limits [-1, 1]): the 4 x 4 steps solve (x, y, z) and leave it at 0
+        self.three = robot.dof == 3
         # continuous joints (Pinocchio's q holds their cos, sin): through the robot's public methods, which
         # convert q; the joint values themselves stay angles, wrapped into [-pi, pi] by the projection
-        plain = not getattr(robot, "has_continuous", False)
+        plain = not getattr(robot, "has_continuous", False) and not self.three
         self.model = getattr(robot, "_base_model", None) if plain else None
         self.data = getattr(robot, "_base_data", None) if plain else None
         self.tool = robot.tool_id
@@ -220,6 +262,10 @@ class _Task:
     def error(self, q: np.ndarray) -> tuple[list[float], float]:
         """Return e = target - (x, y, z, yaw) at q (yaw wrapped to [-pi, pi)) and |e|."""
         model = self.model
+        if self.three:
+            p = self.robot.tool_placement(q[:3]).translation
+            e = [self.x - p[0], self.y - p[1], self.z - p[2], 0.0]
+            return e, math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
         if model is None:  # a Robot without the re-rooted model: its public methods
             e = _error(self.robot, q, self.target).tolist()
             return e, math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3])
@@ -232,6 +278,10 @@ class _Task:
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """Return the 4 x 4 task Jacobian (rows x, y, z, yaw) at q, in base axes."""
+        if self.three:
+            J = np.eye(4)
+            J[:3, :3] = np.asarray(self.robot.task_jacobian(q[:3]), dtype=float)[:3]
+            return J
         if self.model is None:
             return np.asarray(self.robot.task_jacobian(q), dtype=float)
         return _jac(self.model, self.data, q, self.tool, _LWA).take(_TASK_ROWS, 0)

@@ -48,6 +48,7 @@ __all__ = [
     "BRANCHES",
     "EXACT_TILT",
     "NEAR_PARALLEL_TOL",
+    "WRIST_TILT_MAX",
     "YAW_POSE_TOL",
     "IKStatus",
     "NotScaraError",
@@ -62,6 +63,9 @@ NEAR_PARALLEL_TOL = 1e-2
 """[rad] the largest angle between a joint axis and the base z axis for a SCARA: beyond EXACT_TILT the
 axes are near-parallel (pi written as 3.14 in an rpy) and the closed form's solutions are refined on the
 model (:mod:`scara_pin.kinematics.polish`)."""
+WRIST_TILT_MAX = 0.1
+"""[rad] the largest tilt of the wrist axis alone (the last joint of a 4-joint SCARA; the others within
+NEAR_PARALLEL_TOL): a modelling or mounting error such as a vendor file's 1 deg, refined on the model."""
 EXACT_TILT = 1e-12
 """[rad] a model whose axes tilt less than this is solved by the closed form alone (no refinement)."""
 BRANCHES = ("right", "left")
@@ -107,7 +111,12 @@ class ScaraGeometry:
         continuous: per joint in q order, whether it is continuous (no limits).
         arm: the planar two-link arm (l1, l2).
         tilt: the largest angle between a joint axis of the model and the base z axis [rad] (0 for the
-            ideal geometry; up to NEAR_PARALLEL_TOL: the closed form seeds a refinement on the model).
+            ideal geometry; up to NEAR_PARALLEL_TOL: the closed form seeds a refinement on the model; up to
+            WRIST_TILT_MAX when only the wrist tilts further).
+        wrist_tilt: the wrist axis' own tilt [rad]. Beyond NEAR_PARALLEL_TOL (a wrist-only tilt) the joints
+            that carry the wrist point are still (near-)vertical: the wrist point's region does not depend on
+            the wrist; the tool's roll/pitch (and an offset tool point's height) do, and the solutions are
+            refined on the model.
     """
 
     revolute: tuple[int, int, int]
@@ -125,6 +134,7 @@ class ScaraGeometry:
     upper: tuple[float, ...]
     continuous: tuple[bool, ...] = (False, False, False, False)
     tilt: float = 0.0
+    wrist_tilt: float = 0.0
     l1: float = field(init=False)
     l2: float = field(init=False)
     beta1: float = field(init=False)
@@ -185,59 +195,64 @@ class ScaraGeometry:
     def _read(cls, robot: Robot, wrist: bool) -> ScaraGeometry:
         model = robot.model
         data = model.createData()
-        names = tuple(model.names[j] for j in range(1, model.njoints))
+        # the joints of q (nv = 1); geared (<mimic>) joints, nv = 0, follow one of them
+        actuated = [j for j in range(1, model.njoints) if model.joints[j].nv > 0]
+        geared = [j for j in range(1, model.njoints) if model.joints[j].nv == 0]
+        names = tuple(model.names[j] for j in actuated)
         n = 4 if wrist else 3
-        if model.njoints - 1 != n:
-            raise NotScaraError(f"a SCARA has {n} joints; this model has {model.njoints - 1}: {', '.join(names)}")
+        if len(actuated) != n:
+            raise NotScaraError(f"a SCARA has {n} joints; this model has {len(actuated)}: {', '.join(names)}")
         for j in range(2, model.njoints):
             if model.parents[j] != j - 1:
                 raise NotScaraError(f"joint {model.names[j]} does not follow {model.names[j - 1]}: not a serial chain")
         tool_parent = model.frames[robot.tool_id].parentJoint
         if tool_parent != model.njoints - 1:
-            raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint {names[-1]}")
+            raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint "
+                                f"{model.names[model.njoints - 1]}")  # fmt: skip
         q0 = pin.neutral(model)  # q = 0 (a continuous joint's (cos, sin) = (1, 0))
-        pin.computeJointJacobians(model, data, q0)
-        pin.updateFramePlacements(model, data)
+        pin.framesForwardKinematics(model, data, q0)
         oMb = data.oMf[robot.base_id]
-        Rbo = oMb.rotation.T
+        bMt = oMb.actInv(data.oMf[robot.tool_id])
+        if geared:
+            _check_geared(robot, data, geared, actuated, oMb, bMt.translation, wrist)
         revolute: list[int] = []
         prismatic: list[int] = []
         signs = [0.0] * 4
         points: dict[int, np.ndarray] = {}
-        worst = 0.0
-        for j in range(1, model.njoints):
-            jm = model.joints[j]
-            name = model.names[j]
-            continuous = jm.nq == 2 and jm.nv == 1 and robot.continuous[j - 1]
-            if (jm.nq != 1 and not continuous) or jm.nv != 1:
-                raise NotScaraError(f"joint {name} ({jm.shortname()}) has nq = {jm.nq}, nv = {jm.nv}; "
-                                    "a SCARA's joints are single-DOF revolute or prismatic")  # fmt: skip
-            col = pin.getJointJacobian(model, data, j, pin.LOCAL_WORLD_ALIGNED)[:, jm.idx_v]
-            lin, ang = Rbo @ col[:3], Rbo @ col[3:]
-            if np.linalg.norm(lin) < 1e-12 and abs(np.linalg.norm(ang) - 1) < 1e-12:
-                axis, kind = ang, revolute
-            elif np.linalg.norm(ang) < 1e-12 and abs(np.linalg.norm(lin) - 1) < 1e-12:
-                axis, kind = lin, prismatic
-            else:
-                raise NotScaraError(f"joint {name} ({jm.shortname()}) is neither revolute nor prismatic")
-            tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
-            if tilt > NEAR_PARALLEL_TOL:
+        worst = wrist_tilt = 0.0
+        wrist_axis = np.array([0.0, 0.0, 1.0])
+        for ja in robot.axes:
+            i, name, axis = ja.index, ja.name, ja.axis
+            if ja.kind == "other":
+                raise NotScaraError(f"joint {name} ({model.joints[actuated[i]].shortname()}) is neither revolute "
+                                    "nor prismatic")  # fmt: skip
+            kind = revolute if ja.kind == "revolute" else prismatic
+            tilt = ja.tilt
+            # the wrist (the last joint, revolute, of a 4-joint SCARA) may tilt further: it moves nothing that
+            # carries the wrist point, so only the tool's own attitude (and an offset tool point) depends on it
+            is_wrist = wrist and i == n - 1 and kind is revolute
+            if tilt > NEAR_PARALLEL_TOL and not (is_wrist and tilt <= WRIST_TILT_MAX):
+                limit = f"{WRIST_TILT_MAX:g} rad for the wrist, " if is_wrist else ""
                 raise NotScaraError(
                     f"joint {name}'s axis is {math.degrees(tilt):.6g} deg ({tilt:.3g} rad) away from the base z "
-                    f"axis (more than {NEAR_PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
+                    f"axis (more than {limit}{NEAR_PARALLEL_TOL:g} rad): the axes of a SCARA are parallel and vertical"
                 )
             worst = max(worst, tilt)
-            signs[j - 1] = 1.0 if axis[2] > 0 else -1.0
-            kind.append(j - 1)
-            points[j - 1] = oMb.actInv(data.oMi[j]).translation
+            if is_wrist:
+                wrist_tilt, wrist_axis = tilt, axis
+            signs[i] = 1.0 if axis[2] > 0 else -1.0
+            kind.append(i)
+            points[i] = ja.point
         if len(revolute) != n - 1 or len(prismatic) != 1:
             kinds = ", ".join(f"{n} ({'revolute' if i in revolute else 'prismatic'})" for i, n in enumerate(names))
             raise NotScaraError(f"a SCARA has {n - 1} revolute joints and 1 prismatic joint; this model has {kinds}")
-        bMt = oMb.actInv(data.oMf[robot.tool_id])
         if not wrist:  # the virtual wrist: index 3, on the tool point, continuous, +z
             revolute.append(3)
             points[3] = bMt.translation
             signs[3] = 1.0
+        else:  # the wrist point: the foot of the tool point on the wrist axis (arm 2 carries it, the wrist does not)
+            w = revolute[2]
+            points[w] = points[w] + wrist_axis * float((bMt.translation - points[w]) @ wrist_axis)
         ra, rb, rc = revolute
         a1, a2, a4 = points[ra][:2], points[rb][:2], points[rc][:2]
         u1, u2, t = a2 - a1, a4 - a2, bMt.translation[:2] - a4
@@ -263,12 +278,13 @@ class ScaraGeometry:
             yaw0=math.atan2(R0[1, 0], R0[0, 0]),
             R0=R0,
             # continuous joints have no limits; others: the model's limits
-            lower=tuple(-math.inf if cont[i] else float(model.lowerPositionLimit[model.joints[i + 1].idx_q])
+            lower=tuple(-math.inf if cont[i] else float(model.lowerPositionLimit[model.joints[actuated[i]].idx_q])
                         for i in range(4)),
-            upper=tuple(math.inf if cont[i] else float(model.upperPositionLimit[model.joints[i + 1].idx_q])
+            upper=tuple(math.inf if cont[i] else float(model.upperPositionLimit[model.joints[actuated[i]].idx_q])
                         for i in range(4)),
             continuous=cont,
             tilt=worst,
+            wrist_tilt=wrist_tilt,
         )  # fmt: skip
 
     # ---------------------------------------------------------------------------------------- derived
@@ -300,6 +316,49 @@ class ScaraGeometry:
         r_max = arm.l12 if reaches(0.0) else max(arm.radius(g_lo), arm.radius(g_hi))
         r_min = arm.d12 if reaches(math.pi) else min(arm.radius(g_lo), arm.radius(g_hi))
         return r_min, r_max
+
+
+GEARED_AXIS_TOL = 1e-9
+"""[m] the largest plan-view distance of the tool point from a geared joint's vertical axis (it then turns the
+tool about its own point: the position stays the SCARA's)."""
+
+
+def _check_geared(robot: Robot, data: pin.Data, geared: list[int], actuated: list[int], oMb: pin.SE3,
+                  tool: np.ndarray, wrist: bool) -> None:  # fmt: skip
+    """Refuse (NotScaraError) geared joints the closed form cannot take.
+
+    A geared joint (URDF ``<mimic>``) is taken when it only turns the tool about the tool point: a revolute
+    joint whose axis is vertical and passes through the tool point, with no revolute joint of q after it
+    (so that the tool point stays on its axis). Then the tool's position is that of the SCARA without it,
+    and its yaw follows (q1, q2 and the joint it is geared to): a 3-joint SCARA, whose yaw is not chosen. A
+    4-joint SCARA chooses its yaw: a geared joint turning the tool would change it; refused.
+    """
+    model = robot.model
+    for j in geared:
+        name = model.names[j]
+        follows = next(model.names[a] for a in actuated if model.joints[a].idx_q == model.joints[j].idx_q)
+        if wrist:
+            raise NotScaraError(f"joint {name} is geared to {follows} (<mimic>) and turns the tool: a 4-joint SCARA "
+                                "chooses its tool's yaw with its own wrist; the closed form takes no geared joint "
+                                "there (only numeric IK applies)")  # fmt: skip
+        jd = model.joints[j].createData()  # the joint's own motion subspace, in its frame (its inner joint's)
+        model.joints[j].calc(jd, pin.neutral(model))
+        S = np.asarray(jd.S).reshape(6)
+        if np.linalg.norm(S[:3]) > 1e-12 or abs(np.linalg.norm(S[3:]) - 1) > 1e-12:
+            raise NotScaraError(f"joint {name} (geared to {follows} by <mimic>) is not a revolute joint: the "
+                                "closed form takes geared joints that turn the tool about its point")  # fmt: skip
+        bMj = oMb.actInv(data.oMi[j])
+        axis = bMj.rotation @ S[3:]
+        tilt = math.atan2(math.hypot(axis[0], axis[1]), abs(axis[2]))
+        off = math.hypot(*(tool[:2] - bMj.translation[:2]))
+        later = [model.names[a] for a in actuated if a > j and model.joints[a].shortname().startswith("JointModelR")]
+        if tilt > EXACT_TILT or off > GEARED_AXIS_TOL or later:
+            why = (f"its axis is {math.degrees(tilt):.6g} deg from vertical" if tilt > EXACT_TILT else
+                   f"joint {later[0]} turns after it" if later else
+                   f"the tool point is {off:.6g} m from its axis")  # fmt: skip
+            raise NotScaraError(f"joint {name} is geared to {follows} (<mimic>) and moves the tool point ({why}): "
+                                "the closed form takes geared joints that only turn the tool about its point "
+                                "(only numeric IK applies)")  # fmt: skip
 
 
 def branch_of(geo: ScaraGeometry, q: ArrayLike) -> str:

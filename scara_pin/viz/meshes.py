@@ -56,6 +56,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import number_text
+from ..description.mesh_paths import MeshProblem, mesh_file, resolve_mesh
 from ..description.placeholders import PLACEHOLDER_SIZE
 from ..errors import InvalidInputError
 from ..limits import (
@@ -70,13 +71,13 @@ from ..limits import (
 from ..signals import raise_pending
 
 if TYPE_CHECKING:
-    from ..description.packages import PackagePath
     from ..model import Robot
 
 __all__ = [
     "LARGE_RATIO",
     "MAX_MESH_BYTES",
     "MAX_MESH_COORDINATE",
+    "MeshProblem",
     "SMALL_RATIO",
     "MeshGeometry",
     "VisualMesh",
@@ -99,10 +100,6 @@ _FORMATS = {".stl": "stl", ".dae": "dae", ".zae": "dae", ".obj": "obj"}
 _ZIP, _GZIP = b"PK\x03\x04", b"\x1f\x8b"
 _SHOWN_LINKS = 3
 """Links named in one warning (a mesh named by many visuals is one warning)."""
-
-
-class MeshProblem(Exception):
-    """Why a mesh is not drawn (the message names the file); reported as a warning, never raised to users."""
 
 
 @dataclass(frozen=True)
@@ -166,47 +163,6 @@ class VisualMesh:
     def faces(self) -> np.ndarray:
         """(M, 3) vertex indices of the triangles."""
         return self.geometry.faces
-
-
-def _inside(path: Path, folder: Path) -> bool:
-    return path == folder or folder in path.parents
-
-
-def resolve_mesh(filename: str, packages: PackagePath) -> Path:
-    """The file a URDF mesh name refers to, within the allowed folders (see the module docstring).
-
-    Raises:
-        MeshProblem: a network or unknown scheme, a missing package, a path out of the allowed folders.
-    """
-    from ..errors import UrdfError
-
-    scheme, sep, rest = filename.partition("://")
-    if not sep:
-        scheme, rest = "", filename
-    if scheme == "package":
-        package, _, relative = rest.partition("/")
-        try:
-            folder = packages.find(package)
-        except UrdfError as exc:
-            raise MeshProblem(f"mesh {filename!r}: {exc}") from None
-        path = (folder / relative).resolve()
-        if not _inside(path, folder):
-            raise MeshProblem(f"mesh {filename!r} leaves its package folder {folder}: not read")
-        return path
-    if scheme not in ("", "file"):
-        raise MeshProblem(f"mesh {filename!r}: the {scheme}:// scheme is not supported (no file is fetched "
-                          "from the network): not read")  # fmt: skip
-    raw = Path(rest)
-    if not raw.is_absolute():
-        if packages.origin_dir is None:
-            raise MeshProblem(f"mesh {filename!r} is relative but the robot has no file to resolve it from")
-        raw = packages.origin_dir / raw
-    path = raw.resolve()
-    roots = packages.roots()
-    if not any(_inside(path, root) for root in roots):
-        raise MeshProblem(f"mesh {filename!r} is outside the package folders and the robot file's folder "
-                          f"({', '.join(str(r) for r in roots) or 'none'}): not read")  # fmt: skip
-    return path
 
 
 def _scale(text: str | None, filename: str) -> tuple[float, float, float]:
@@ -449,7 +405,7 @@ def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
             if not filename:
                 raise MeshProblem(f"a <mesh> of link {link} has no filename")
             scale = _scale(mesh.get("scale"), filename)
-            path = resolve_mesh(filename, robot.package_path)
+            path = mesh_file(filename, robot.package_path)  # the rule `check` applies too
             if path not in read:
                 try:
                     read[path] = budget.load(path, filename)

@@ -90,6 +90,7 @@ def joint_nodes(robot: Robot, root: str) -> tuple[JointNode, ...]:
     # index in Pinocchio's q -> index in the user's q, for the actuated joints (nv = 1)
     actuated = [j for j in range(1, model.njoints) if model.joints[j].nv == 1]
     user_index = {model.joints[j].idx_q: i for i, j in enumerate(actuated)}
+    geared = {g.name: g for g in robot.geared}  # read once, by the robot (scara_pin.chain)
 
     def li_mi(q: np.ndarray) -> list[pin.SE3]:
         pin.forwardKinematics(model, data, robot.to_pinocchio_q(q))
@@ -101,9 +102,9 @@ def joint_nodes(robot: Robot, root: str) -> tuple[JointNode, ...]:
         jm = model.joints[j]
         if jm.nv == 1:
             source, multiplier, offset = user_index[jm.idx_q], 1.0, 0.0
-        else:  # a mimic joint follows the joint that owns its configuration index
-            mimic = jm.extract()
-            source, multiplier, offset = user_index[jm.idx_q], float(mimic.scaling), float(mimic.offset)
+        else:  # a geared (mimic) joint follows the joint that owns its configuration index
+            g = geared[model.names[j]]
+            source, multiplier, offset = g.source, g.multiplier, g.offset
         step = np.zeros(robot.dof)
         step[source] = 1.0
         # the joint's own motion over a unit step of its source: exp(axis * multiplier)

@@ -66,7 +66,7 @@ import numpy as np
 
 from ..errors import InvalidInputError, ParameterError
 from ..kinematics.planar2r import LIMIT_TOL
-from ..kinematics.scara import ScaraGeometry
+from ..kinematics.scara import NEAR_PARALLEL_TOL, ScaraGeometry
 from .arcs import SIDE_OFFSET, ArmBox, JointRange, Role, box_region
 
 if TYPE_CHECKING:
@@ -246,6 +246,7 @@ class Workspace:
         z_range: (z_min, z_max) of the tool from the J3 stroke [m].
         offset: translation of the region from the wrist region: (0, 0), or R(yaw - yaw0) t with ``yaw``.
         yaw: the fixed tool yaw the region is for, or None (wrist axis point) [rad].
+        note: what a wrist-only tilt changes (:func:`wrist_tilt_note`), else None.
     """
 
     geometry: ScaraGeometry
@@ -257,6 +258,7 @@ class Workspace:
     z_range: tuple[float, float]
     offset: tuple[float, float] = (0.0, 0.0)
     yaw: float | None = None
+    note: str | None = None
     _box: ArmBox = field(init=False, repr=False, compare=False)
     _z_limits: tuple[Limit, Limit] = field(init=False, repr=False, compare=False)
     _arc_arrays: tuple[np.ndarray, ...] = field(init=False, repr=False, compare=False)
@@ -473,6 +475,7 @@ class Workspace:
             "z_range": list(self.z_range),
             "arcs": [a.to_dict() for a in self.arcs],
             "loops": [list(loop) for loop in self.loops],
+            "note": self.note,
         }
 
 
@@ -528,6 +531,9 @@ def workspace(
     offset = (0.0, 0.0)
     if yaw is not None and not math.isfinite(yaw):
         raise ParameterError("yaw", yaw, "must be a finite number", "rad")
+    note = wrist_tilt_note(geo)
+    if yaw is not None and note is not None and math.hypot(*geo.tool) > TOOL_ON_AXIS:
+        raise InvalidInputError(f"no fixed-yaw region of the tool point: {note}")
     if yaw is not None and math.hypot(*geo.tool) > 0.0:
         rc = geo.revolute[2]
         if not geo.upper[rc] - geo.lower[rc] >= _TWO_PI:
@@ -547,7 +553,34 @@ def workspace(
     r_min, r_max = (box.arm.d12, box.arm.l12) if box.second.full else geo.radius_range()
     ip = geo.prismatic
     zs = sorted((geo.z0 + geo.signs[ip] * geo.lower[ip], geo.z0 + geo.signs[ip] * geo.upper[ip]))
-    return Workspace(geo, tuple(arcs), region.loops, region.area, r_min, r_max, (zs[0], zs[1]), offset, yaw)
+    return Workspace(geo, tuple(arcs), region.loops, region.area, r_min, r_max, (zs[0], zs[1]), offset, yaw, note)
+
+
+TOOL_ON_AXIS = 1e-9
+"""[m] a tool point this close to the wrist axis (plan view) lies on it."""
+
+
+def wrist_tilt_note(geo: ScaraGeometry) -> str | None:
+    """What a wrist-only tilt (beyond NEAR_PARALLEL_TOL) changes in the workspace; None without one.
+
+    The joints that carry the wrist point are (near-)vertical, so the region of the point of the wrist axis at
+    the tool's height does not depend on the wrist: it is the region computed. A tool point on that axis has
+    this region exactly; off it by d, it circles the axis in a plane tilted by the wrist's tilt tau (its height
+    varies by +/- d sin tau as the wrist turns), so no fixed-yaw region of it is given.
+    """
+    tau = geo.wrist_tilt
+    if tau <= NEAR_PARALLEL_TOL:
+        return None
+    name = geo.names[geo.revolute[2]]
+    d = math.hypot(*geo.tool)
+    head = (f"{name}'s axis is {math.degrees(tau):.3g} deg ({tau:.3g} rad) from vertical (the wrist alone): the "
+            f"region is that of the point of {name}'s axis at the tool's height, which {name} does not "
+            "move")  # fmt: skip
+    if d <= TOOL_ON_AXIS:
+        return f"{head}; the tool point lies on that axis: it is the tool point's region ({name} only tilts the tool)"
+    return (f"{head}; the tool point is {d:.4g} m off that axis and circles it in a plane tilted by "
+            f"{math.degrees(tau):.3g} deg (its height varies by +/-{d * math.sin(tau) * 1000:.3g} mm as {name} turns): "
+            "a fixed-yaw region of the tool point is not given")  # fmt: skip
 
 
 def _deg(v: float) -> str:
