@@ -7,7 +7,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= build
 
-.PHONY: demo test browser bench bench-ik lint clean
+.PHONY: demo test browser bench bench-ik lint docs clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -55,5 +55,10 @@ lint: $(VENV)/.installed-test
 	$(BIN)/ruff check scara_pin tests benchmarks
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
+# the documentation site from docs/ and the docstrings, into site/; a warning fails the build
+docs: $(VENV)/.installed
+	$(BIN)/python -m pip install -q -e '.[docs]'
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
 clean:
-	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(RTB_VENV) $(OUT) .pytest_cache site

@@ -145,7 +145,7 @@ def test_fk_random_poses_against_closed_form(robot: str, capsys: pytest.CaptureF
     ],
 )
 def test_fk_units(flags: list[str], argv_q: list[str], q_si: list[float], capsys: pytest.CaptureFixture[str]) -> None:
-    # --deg/--mm scale the inputs; JSON is always SI (README: "JSON output")
+    # --deg/--mm scale the inputs; JSON is always SI (docs/cli.md: "--json output is always SI")
     data = fk_json(capsys, ["fk", "--json", *flags, "--", *argv_q])
     pos, yaw, M = closed_form_pose("default", np.array(q_si))
     assert data["units"] == {"length": "m", "angle": "rad"}

@@ -119,7 +119,7 @@ def register(sub: Any) -> None:
     p = sub.add_parser("cycle", help="the standard SCARA cycle (up 25, across 305, down, back): time, legs, limits")
     g = p.add_argument_group("the cycle (lengths in m, or mm with --mm)")
     g.add_argument("--from", dest="from_pose", nargs=4, metavar="P",
-                   help="start pose X Y Z YAW (default: where the robot reaches the cycle best, see README)")
+                   help="start pose X Y Z YAW (default: where the robot reaches the cycle best, see docs/motion.md)")
     g.add_argument("--direction", nargs=2, metavar="D", help="traverse direction DX DY (with --from; default 1 0)")
     g.add_argument("--span", default="0.305", metavar="L", help="horizontal stroke (default 0.305 m)")
     g.add_argument("--rise", default="0.025", metavar="H", help="vertical stroke (default 0.025 m)")

@@ -54,7 +54,7 @@ def cmd_fk(args: argparse.Namespace) -> int:
     yaw = float(pose[3]) * units.angle
     matrix = M.homogeneous.copy()
     matrix[:3, 3] *= units.length
-    if args.json:  # always SI (README: "JSON output")
+    if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         out = {
             "robot": robot.name,
             "q": q.tolist(),
@@ -96,7 +96,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         rows = ["vx", "vy", "vz", "wx", "wy", "wz"]
         row_kinds = ("length",) * 3 + ("angle",) * 3
     w = robot.manipulability(q)
-    if args.json:  # always SI (README: "JSON output")
+    if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         out = {
             "robot": robot.name,
             "q": q.tolist(),
@@ -178,7 +178,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
     scale = units.scale(_POSE_KINDS)
     tgt = dict(zip(("x", "y", "z", "yaw"), _scaled(target, scale)))
     code = 0 if status == "OK" else 3
-    if args.json:  # always SI (README: "JSON output")
+    if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         si = Units(False, False)
         solutions = _solutions_json(qs, branches, si)
         for sol, t in zip(solutions, turns):

@@ -640,8 +640,8 @@ def standard_cycle(
         options: TOPP-RA grid and verification options.
 
     Raises:
-        ParameterError, InvalidInputError: bad input (exit 2); InfeasibleError (PathError, TimingError): the
-        robot cannot do it (exit 3).
+        ParameterError: bad input (exit 2); so is InvalidInputError.
+        InfeasibleError: the robot cannot do it (PathError, TimingError; exit 3).
     """
     span = _nonneg("span", span, strict=True)
     rise = _nonneg("rise", rise, strict=True)
