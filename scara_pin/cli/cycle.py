@@ -17,7 +17,9 @@ from ._common import (
     _add_units,
     _load,
     _needs_wrist,
+    _num,
     _number,
+    _read_pose,
 )
 
 if TYPE_CHECKING:
@@ -32,7 +34,7 @@ def _payload(args: argparse.Namespace, units: Units) -> Any:
         raise ParameterError("--payload", mass, "must be >= 0", "kg")
     com: tuple[float, ...] = (0.0, 0.0, 0.0)
     if args.payload_com is not None:
-        com = tuple(_number(f"--payload-com {n}", v) / units.length for n, v in zip("XYZ", args.payload_com))
+        com = tuple(units.value(f"--payload-com {n}", v, "length") for n, v in zip("XYZ", args.payload_com))
     return Payload(mass, com)  # type: ignore[arg-type]
 
 
@@ -49,23 +51,23 @@ def _jerk(args: argparse.Namespace) -> list[float] | None:
 
 def cmd_cycle(args: argparse.Namespace) -> int:
     """The standard cycle: up, across, down and back, time-optimal under the robot's limits."""
-    from ..motion.cycle import limits_dict, standard_cycle
+    from ..motion.cycle import STANDARD_RISE, STANDARD_SPAN, limits_dict, standard_cycle
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
-    units = Units(args.deg, args.mm)
-    L = units.length
+    units = Units.from_args(args)
     robot = _load(args, units)
     _needs_wrist(robot, "cycle")
     if not (math.isfinite(args.rate) and args.rate > 0):
         raise ParameterError("--rate", args.rate, "must be a finite number > 0", "Hz")
-    span = _number("--span", args.span) / L
-    rise = _number("--rise", args.rise) / L
-    blend = 0.0 if args.no_blend else (None if args.arch is None else _number("--arch", args.arch) / L)
+    # defaults in SI; a typed value in the user's units (the units rule)
+    span = STANDARD_SPAN if args.span is None else units.value("--span", args.span, "length")
+    rise = STANDARD_RISE if args.rise is None else units.value("--rise", args.rise, "length")
+    blend = 0.0 if args.no_blend else (None if args.arch is None else units.value("--arch", args.arch, "length"))
     if args.no_blend and args.arch is not None:
         raise InvalidInputError("--arch and --no-blend exclude each other")
     start = None
     if args.from_pose is not None:
-        start = [_number(n, t) / s for n, t, s in zip(("x", "y", "z", "yaw"), args.from_pose, (L, L, L, units.angle))]
+        start = _read_pose(args.from_pose, units, "--from")
     direction = None if args.direction is None else [_number("--direction", d) for d in args.direction]
     _acceleration(robot, args.acceleration, units)  # a URDF file has none: given, or refused
     limits = robot.limits
@@ -101,11 +103,11 @@ def cmd_cycle(args: argparse.Namespace) -> int:
         return 0
     print(f"robot       {robot.name}: standard cycle, payload {move.payload.mass:g} kg"
           + (f", jerk limit {move.jerk}" if move.jerk else ""))  # fmt: skip
-    print(f"cycle time  {result.cycle_time:.6g} s (up {result.rise * L:g}, across {result.span * L:g}, down and back "
-          f"[{units.length_name}]; blend {result.blend * L:g} {units.length_name})")  # fmt: skip
-    a, b = result.start, result.end
-    print(f"placement   from ({a[0] * L:.6g}, {a[1] * L:.6g}, {a[2] * L:.6g}) to ({b[0] * L:.6g}, {b[1] * L:.6g}, "
-          f"{b[2] * L:.6g}) {units.length_name}: {result.placement}")  # fmt: skip
+    n = units.length_name
+    print(f"cycle time  {_num(result.cycle_time, 6)} s (up {units.num(result.rise, 'length')}, across "
+          f"{units.num(result.span, 'length')}, down and back [{n}]; blend {units.num(result.blend, 'length')} {n})")
+    print(f"placement   from {units.fmt(result.start[:3], 'length')} to {units.fmt(result.end[:3], 'length')} {n}: "
+          f"{result.placement}")  # fmt: skip
     for leg in move.legs:
         print(f"  {'out ' if leg.move == 0 else 'back'} {leg.name:<11} {leg.duration:9.6f} s   "
               f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit")  # fmt: skip
@@ -121,8 +123,8 @@ def register(sub: Any) -> None:
     g.add_argument("--from", dest="from_pose", nargs=4, metavar="P",
                    help="start pose X Y Z YAW (default: where the robot reaches the cycle best, see docs/motion.md)")
     g.add_argument("--direction", nargs=2, metavar="D", help="traverse direction DX DY (with --from; default 1 0)")
-    g.add_argument("--span", default="0.305", metavar="L", help="horizontal stroke (default 0.305 m)")
-    g.add_argument("--rise", default="0.025", metavar="H", help="vertical stroke (default 0.025 m)")
+    g.add_argument("--span", metavar="L", help="horizontal stroke (default 0.305 m)")
+    g.add_argument("--rise", metavar="H", help="vertical stroke (default 0.025 m)")
     g.add_argument("--arch", metavar="B",
                    help="blend distance at each corner, along each line (default: the whole rise)")
     g.add_argument("--no-blend", action="store_true", help="stop at the corners (three straight lines)")

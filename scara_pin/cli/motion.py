@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import check_output_path
 from ._common import (
+    _POSE_KINDS,
     Units,
     _acceleration,
     _add_acceleration,
@@ -21,6 +22,7 @@ from ._common import (
     _joint_arg,
     _load,
     _needs_wrist,
+    _num,
     _number,
     _read_pose,
     log,
@@ -48,10 +50,11 @@ def cmd_traj(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..motion import trajectory as tr
+    from ..motion.cycle import STANDARD_RISE
     from ..motion.plan import MotionRequest, plan_motion
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     _check_outputs(args, (args.out, args.setpoints, args.plot))
     robot = _load(args, units)
     for flag in ("linear", "arch", "plot", "payload"):
@@ -77,6 +80,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     if args.tool_speed is not None:
         if not args.tool_speed > 0:
             raise ParameterError("--tool-speed", args.tool_speed, "must be > 0")
+        units.guard(("--tool-speed",), (f"{args.tool_speed:g}",), ("length",))
         tool_speed = args.tool_speed / units.length
     if args.arch and not args.linear and robot.kind == "scara":
         if args.via:
@@ -88,8 +92,9 @@ def cmd_traj(args: argparse.Namespace) -> int:
         start_pose=None if pose_from is None else np.array(pose_from),
         end_pose=None if pose_to is None else np.array(pose_to), vias=tuple(vias), duration=args.duration,
         linear=args.linear, arch=args.arch, tool_speed=tool_speed, torque=args.torque, payload=_payload(args, units),
-        rise=_number("--rise", args.rise) / units.length if args.arch else None,
-        blend=None if args.blend is None or not args.arch else _number("--blend", args.blend) / units.length,
+        rise=None if not args.arch else STANDARD_RISE if args.rise is None else units.value("--rise", args.rise,
+                                                                                            "length"),
+        blend=None if args.blend is None or not args.arch else units.value("--blend", args.blend, "length"),
     )
     if args.plot and robot.kind != "scara" and not args.arch:
         raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
@@ -119,7 +124,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
             motor = tr.MotorUnits.from_drive(
                 [_number("--gear", g) for g in args.gear],
                 [_number("--steps-per-rev", v) for v in args.steps_per_rev],
-                _number("--screw-lead", args.screw_lead) / units.length,
+                units.value("--screw-lead", args.screw_lead, "length"),
                 prismatic=robot.joint_kinds.index("length"),
             )
         delays = [_number("--delays", d) for d in args.delays] if args.delays else None
@@ -150,9 +155,10 @@ def cmd_traj(args: argparse.Namespace) -> int:
         return 0
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
     print(f"robot     {robot.name}: {method}", file=text)
-    print(f"duration  {traj.duration:.9g} s", file=text)
-    print(f"from      {_fmt(traj.q_start)}  [SI]", file=text)
-    print(f"to        {_fmt(traj.q_end)}  [SI]", file=text)
+    q_units = ", ".join(units.names(units.q))
+    print(f"duration  {_num(traj.duration)} s", file=text)
+    print(f"from      {units.fmt(traj.q_start, units.q)}  [{q_units}]", file=text)
+    print(f"to        {units.fmt(traj.q_end, units.q)}  [{q_units}]", file=text)
     print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} "
           "(exact for joint-line laws, else sampled)", file=text)  # fmt: skip
     for kind, where in outputs.items():
@@ -185,7 +191,7 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any) -> int:
         print(json.dumps(summary))
         return 0
     print(f"robot     {robot.name}: {Method.ARCH.value}")
-    print(f"duration  {traj.duration:.9g} s")
+    print(f"duration  {_num(traj.duration)} s")
     for leg in move.legs:
         print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit")
     for kind, where in outputs.items():
@@ -197,7 +203,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge."""
     from ..motion.jog import jog_to_edge
 
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     _check_outputs(args, (args.out, args.plot))
     robot = _load(args, units)
     if robot.kind != "scara":
@@ -208,7 +214,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
     if len(direction) not in (2, 3):
         raise ParameterError("--direction", " ".join(args.direction), "must be DX DY or DX DY DZ")
-    margin = _number("--margin", args.margin) / units.length
+    margin = 0.0 if args.margin is None else units.value("--margin", args.margin, "length")
     jog = jog_to_edge(robot, q0, direction, margin=margin)
     traj = jog.trajectory
     if args.out:
@@ -223,14 +229,12 @@ def cmd_jog(args: argparse.Namespace) -> int:
                           "q_end": traj.q_end.tolist(), "limit_ratio": jog.ratio,
                           "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
         return 0
-    L = units.length
     text = sys.stderr if "-" in (args.out, args.plot) else sys.stdout  # stdout carries a file
     print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}", file=text)
     print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
-    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)",
-          file=text)  # fmt: skip
-    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]",
-          file=text)  # fmt: skip
+    print(f"travel    {units.num(jog.distance, 'length')} {units.length_name} in {_num(traj.duration, 6)} s (at rest "
+          "at both ends)", file=text)  # fmt: skip
+    print(f"end pose  {units.fmt(jog.end_pose, _POSE_KINDS)}  [{', '.join(units.names(_POSE_KINDS))}]", file=text)
     print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)", file=text)
     for what in (args.out, args.plot):
         if what:
@@ -260,7 +264,8 @@ def register(sub: Any) -> None:
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")
     g = p.add_argument_group("arch (jump) move between --from-pose and --to-pose")
     g.add_argument("--arch", action="store_true", help="lift, traverse, descend, corners blended (time-optimal)")
-    g.add_argument("--rise", default="0.025", metavar="H", help="traverse height above the higher pose (0.025 m)")
+    g.add_argument("--rise", metavar="H", help="traverse height above the higher pose [m, or mm with --mm] "
+                   "(default 0.025 m)")  # fmt: skip
     g.add_argument("--blend", metavar="B", help="blend distance at each corner (default: as large as allowed)")
     _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
@@ -281,7 +286,7 @@ def register(sub: Any) -> None:
     p = sub.add_parser("jog", help="jog to the edge: straight tool move ending at rest on the workspace edge")
     p.add_argument("--from", dest="from_q", nargs=4, metavar="Q", required=True, help="current configuration")
     p.add_argument("--direction", nargs="+", metavar="D", required=True, help="DX DY (plan) or DX DY DZ")
-    p.add_argument("--margin", default="0", metavar="M", help="stop this far before the edge [m or mm] (default 0)")
+    p.add_argument("--margin", metavar="M", help="stop this far before the edge [m, or mm with --mm] (default 0)")
     p.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip
     _add_acceleration(p)

@@ -22,7 +22,7 @@ def cmd_view(args: argparse.Namespace) -> int:
 
     from ..viz import meshcat as viz
 
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     if args.html:  # refused before any work
         check_output_path(args.html)
     robot = _load(args, units)
