@@ -96,11 +96,9 @@ def cmd_traj(args: argparse.Namespace) -> int:
                                                                                             "length"),
         blend=None if args.blend is None or not args.arch else units.value("--blend", args.blend, "length"),
     )
-    if args.plot and robot.kind != "scara" and not args.arch:
-        raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     plan = plan_motion(robot, request)
     if plan.arch is not None:
-        return _print_arch(args, plan.robot, plan.arch)
+        return _print_arch(args, plan.robot, plan.arch, units, tool_speed)
     robot, traj, method = plan.robot, plan.trajectory, plan.method.value
     from ..motion.timing import limit_ratios
 
@@ -135,7 +133,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot)
+        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=method, torque=args.torque,
+                        tool_speed=tool_speed)  # fmt: skip
         outputs["plot"] = args.plot
     summary = {
         "robot": robot.name,
@@ -166,7 +165,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_arch(args: argparse.Namespace, robot: Any, move: Any) -> int:
+def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, tool_speed: float | None) -> int:
     """``traj --arch``: write and print the arch (jump) move (lift, traverse, descend, blended corners)."""
     from ..motion.plan import Method
 
@@ -175,10 +174,11 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any) -> int:
     if args.out:
         traj.save(args.out, rate=args.rate)
         outputs["trajectory"] = str(args.out)
-    if args.plot:
-        from ..viz.cycle import plot_cycle
+    if args.plot:  # the robot carries the payload: the torques are the loaded arm's
+        from ..viz.plots import plot_trajectory
 
-        plot_cycle(robot, move, args.plot, title=f"{robot.name}: arch move {traj.duration:.4g} s")
+        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=Method.ARCH.value, torque=args.torque,
+                        tool_speed=tool_speed)  # fmt: skip
         outputs["plot"] = args.plot
     if args.json:
         summary = {"robot": robot.name, "method": Method.ARCH.value,
@@ -222,7 +222,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot)
+        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law="jog to the edge, straight line")
     if args.json:
         print(json.dumps({"robot": robot.name, "hit": jog.hit.to_dict(), "start_pose": jog.start_pose.tolist(),
                           "end_pose": jog.end_pose.tolist(), "distance": jog.distance, "duration": traj.duration,
@@ -272,7 +272,8 @@ def register(sub: Any) -> None:
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out and --json (default 1000)")  # fmt: skip
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
-    g.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time with limits, and the tool path")
+    g.add_argument("--plot", metavar="PNG", help="each joint's q, qd, qdd (and torque with --torque) against "
+                   "time with its limits, in the units of --mm/--deg; the tool path and speed (.png, .svg, .pdf)")
     g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
     g.add_argument("--setpoint-rate", type=number_type("--setpoint-rate"), metavar="HZ",
                    help="setpoint rate (default: --rate)")  # fmt: skip

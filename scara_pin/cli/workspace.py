@@ -46,7 +46,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         raise InvalidInputError("--z/--dz go with --ray")
     if args.plot:
         ray = None if hit is None else (start[:2], direction[:2])
-        plot_workspace(ws, args.plot, ray=ray)
+        plot_workspace(ws, args.plot, ray=ray, units=units.display, robot_name=robot.name)
     if args.json:
         out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}}
         if hit is not None:
@@ -90,7 +90,7 @@ def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) 
         raise InvalidInputError("--ray/--z/--dz are SCARA-only for now; a palletizer gets its arm-plane envelope")
     env = arm_plane_envelope(robot.kinematics.geometry)
     if args.plot:
-        plot_envelope(env, args.plot)
+        plot_envelope(env, args.plot, units=units.display, robot_name=robot.name)
     if args.json:
         out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"},
                                "envelope": env.to_dict()}  # fmt: skip
