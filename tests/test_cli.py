@@ -7,6 +7,7 @@ with the documented numbers: default (S4) l1 = l2 = 0.2 m, z0 = -0.05 m; s1 l1 =
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import os
@@ -569,3 +570,23 @@ def test_console_script_error_and_version() -> None:
     proc = subprocess.run([script, "--version"], capture_output=True, text=True, timeout=TIMEOUT)
     assert proc.returncode == 0
     assert proc.stdout.startswith("scara-pin ")
+
+
+def test_parser_of_one_command_is_the_full_parsers() -> None:
+    """main() builds only the command it runs (start-up): that parser is, option for option, the full one's."""
+    from scara_pin.cli import build_parser
+
+    def options(parser: argparse.ArgumentParser) -> list[tuple]:
+        return [(a.dest, tuple(a.option_strings), a.nargs, a.default, a.required,
+                 getattr(a.type, "__qualname__", a.type), a.help) for a in parser._actions]  # fmt: skip
+
+    full = build_parser()
+    commands = full._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+    assert len(commands) >= 13
+    for name, sub in commands.items():
+        one = build_parser(name)._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+        assert list(one) == [name]
+        assert options(one[name]) == options(sub), name
+        assert one[name].get_default("func") is sub.get_default("func")
+    everything = build_parser("no-such-command")._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+    assert list(everything) == list(commands)  # argparse then names the choices

@@ -28,6 +28,7 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from types import FrameType
+from typing import Any
 
 from ..errors import ScaraError
 from . import cycle, describe, kinematics, motion, teach, view, workspace
@@ -36,8 +37,15 @@ from ._common import _Parser, _UsageError, log
 __all__ = ["build_parser", "main"]
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``scara-pin``."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of ``scara-pin``.
+
+    Args:
+        command: build only this command's parser (what :func:`main` does once it knows the command:
+            building every command's options costs more than the rest of a ``scara-pin fk`` run above
+            ``import pinocchio``); a name that is no command builds them all, for argparse's message.
+            None: every command.
+    """
     from .. import __version__
 
     parser = _Parser(
@@ -49,10 +57,48 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"scara-pin {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-
+    target: Any = sub if command is None else _OneCommand(sub, command)
     for module in (describe, kinematics, motion, cycle, workspace, view, teach):
-        module.register(sub)
+        module.register(target)
+    if command is not None and not target.found:
+        return build_parser(None)
     return parser
+
+
+def _command_of(argv: Sequence[str]) -> str | None:
+    """The command named in ``argv``: its first word that is not an option (the top level's take no value)."""
+    return next((a for a in argv if not a.startswith("-")), None)
+
+
+class _Ignored:
+    """Takes a command's option declarations and keeps none (the command is not the one being run)."""
+
+    def add_argument(self, *args: Any, **kwargs: Any) -> None:  # noqa: D102
+        return None
+
+    def add_argument_group(self, *args: Any, **kwargs: Any) -> _Ignored:  # noqa: D102
+        return self
+
+    def add_mutually_exclusive_group(self, *args: Any, **kwargs: Any) -> _Ignored:  # noqa: D102
+        return self
+
+    def set_defaults(self, **kwargs: Any) -> None:  # noqa: D102
+        return None
+
+
+class _OneCommand:
+    """The subparsers, as the commands' ``register`` functions see them, when one command will run."""
+
+    def __init__(self, sub: Any, command: str) -> None:
+        self._sub = sub
+        self._command = command
+        self.found = False
+
+    def add_parser(self, name: str, **kwargs: Any) -> Any:  # noqa: D102
+        if name != self._command:
+            return _Ignored()
+        self.found = True
+        return self._sub.add_parser(name, **kwargs)
 
 
 class _Terminated(KeyboardInterrupt):
@@ -87,7 +133,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     handler.setFormatter(_Formatter())
     log.addHandler(handler)
     try:
-        parser = build_parser()
+        parser = build_parser(_command_of(sys.argv[1:] if argv is None else argv))
         try:
             args = parser.parse_args(argv)
         except _UsageError as exc:
