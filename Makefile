@@ -7,7 +7,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= build
 
-.PHONY: demo test browser bench bench-ik bench-calibration lint clean
+.PHONY: demo test browser bench bench-ik bench-calibration lint docs clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -27,7 +27,7 @@ demo: $(VENV)/.installed
 	$(BIN)/scara-pin fk 0.1 0.2 0.05 0.3
 	$(BIN)/scara-pin jacobian 0.1 0.2 0.05 0.3
 	$(BIN)/scara-pin ik 0.3 0.1 -0.1 0.5
-	$(BIN)/scara-pin traj --robot s1 --deg --from 0 0 0 0 --to 90 60 0.05 -180 --duration 5 \
+	$(BIN)/scara-pin traj --robot s1 --deg --mm --from 0 0 0 0 --to 90 60 50 -180 --duration 5 \
 	    --out $(OUT)/s1_traj.csv --plot $(OUT)/s1_traj.png
 	$(BIN)/scara-pin view --robot s1 --traj $(OUT)/s1_traj.csv --workspace --html $(OUT)/s1_traj.html
 	$(BIN)/scara-pin workspace --plot $(OUT)/workspace.png
@@ -62,5 +62,10 @@ lint: $(VENV)/.installed-test
 	$(BIN)/ruff check scara_pin tests benchmarks
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
+# the documentation site from docs/ and the docstrings, into site/; a warning fails the build
+docs: $(VENV)/.installed
+	$(BIN)/python -m pip install -q -e '.[docs]'
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
 clean:
-	rm -rf $(VENV) $(RTB_VENV) $(FIGAROH_VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(RTB_VENV) $(FIGAROH_VENV) $(OUT) .pytest_cache site

@@ -12,7 +12,7 @@ One place for the caps and the checks, used by the command line and the library 
 - :func:`text_lines` streams a text file line by line, each line at most :data:`MAX_LINE_CHARS`
   characters, bad UTF-8 and NUL bytes refused with the line number.
 
-The caps are module constants (documented in the README, "Limits"); they are generous for a robot cell
+The caps are module constants (documented in docs/cli.md, "Resource limits"); they are generous for a robot cell
 and small enough that one command never needs more than a few GB of memory.
 """
 

@@ -31,6 +31,7 @@ import pinocchio as pin
 from ._checks import MAGNITUDE_MAX
 from .description import JOINT_COUNTS, JointLimits, RobotParameters, generate_urdf, load_parameters
 from .errors import InvalidInputError, ParameterError, UrdfError
+from .units import HUMAN, format_number
 from .urdf_rules import choose_frames, read_tree
 
 if TYPE_CHECKING:
@@ -409,6 +410,62 @@ class Robot:
         from .description.placeholders import placeholder_urdf
 
         return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
+
+    # ----------------------------------------------------------------- a summary for people (repr, notebooks)
+    def summary(self) -> tuple[str, list[list[str]]]:
+        """The robot at a glance: a headline and one row per joint, in degrees and millimetres.
+
+        Returns:
+            (headline, rows): the headline names the robot, its kind, its frames and where the tool is at
+            q = 0; each row is ``[#, joint, type, lower, upper, velocity, acceleration, effort]`` (text, units
+            included; ``continuous`` joints have no position limits, URDF files no acceleration limits).
+        """
+        human = HUMAN
+        kinds = self.joint_kinds
+        rows = []
+        for i, name in enumerate(self.joint_names):
+            kind = kinds[i]
+            unit = human.name(kind)
+            sc = human.scale(kind)
+
+            def cell(v: float, per: str = "", sc: float = sc, unit: str = unit) -> str:
+                return f"{format_number(v * sc, 3)} {unit}{per}" if math.isfinite(v) else "unknown"
+
+            lim = self.limits
+            kind_name = "continuous" if self.continuous[i] else ("prismatic" if kind == "length" else "revolute")
+            lower = "-" if self.continuous[i] else cell(lim.lower[i])
+            upper = "-" if self.continuous[i] else cell(lim.upper[i])
+            effort = f"{format_number(lim.effort[i], 3)} {'N' if kind == 'length' else 'N·m'}"
+            rows.append([str(i + 1), name, kind_name, lower, upper, cell(lim.velocity[i], "/s"),
+                         cell(lim.acceleration[i], "/s²"), effort])  # fmt: skip
+        try:
+            x, y, z, yaw = self.tool_pose(np.zeros(self.dof)).tolist()
+            at_zero = (f"; {self.tool_frame} at q = 0: ({human.format(x, 'length')}, {human.format(y, 'length')}, "
+                       f"{human.format(z, 'length')}) mm, yaw {human.format(yaw, 'angle')} deg")  # fmt: skip
+        except (ValueError, TypeError, ParameterError):  # a model whose tool pose cannot be read at q = 0
+            at_zero = ""
+        head = (f"Robot {self.name!r}: {self.kind}, {self.dof} joints, {self.tool_frame} in {self.base_frame}"
+                f"{at_zero}")  # fmt: skip
+        return head, rows
+
+    def __repr__(self) -> str:
+        head, rows = self.summary()
+        table = [["#", "joint", "type", "lower", "upper", "velocity", "acceleration", "effort"], *rows]
+        widths = [max(len(r[c]) for r in table) for c in range(len(table[0]))]
+        lines = ["  ".join(v.rjust(w) if c >= 3 else v.ljust(w) for c, (v, w) in enumerate(zip(r, widths))).rstrip()
+                 for r in table]  # fmt: skip
+        return "\n".join([head, *("  " + line for line in lines)])
+
+    def _repr_html_(self) -> str:
+        """The summary as an HTML table (Jupyter shows it for a robot at the end of a cell)."""
+        from html import escape
+
+        head, rows = self.summary()
+        cols = ["#", "joint", "type", "lower", "upper", "velocity", "acceleration", "effort"]
+        th = "".join(f"<th>{c}</th>" for c in cols)
+        body = "".join("<tr>" + "".join(f"<td>{escape(v)}</td>" for v in r) + "</tr>" for r in rows)
+        return (f"<div class='scara-pin-robot'><p><b>{escape(head)}</b></p><table><thead><tr>{th}</tr></thead>"
+                f"<tbody>{body}</tbody></table></div>")  # fmt: skip
 
     # ----------------------------------------------------------------- inverse kinematics (delegated)
     @property

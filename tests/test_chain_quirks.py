@@ -103,9 +103,13 @@ def test_geared_values_are_reported_by_ik_and_fk(capsys: pytest.CaptureFixture[s
     rc, out, err = run(capsys, ["ik", "--urdf", str(MIMIC), *xyz])
     assert rc == 0 and "refused" not in err and out.count("geared  wrist_joint = ") == 2
     assert "wrist_joint = 1.3 rad (1 * arm1 + 1)" in out  # the sampled q's branch: 0.3 + 1
-    rc, out, _ = run(capsys, ["fk", "--urdf", str(MIMIC), "0.3", "-0.5", "0.1", "--deg"])
-    geared = math.degrees(math.radians(0.3) + 1.0)  # --deg: q1 = 0.3 deg, the offset 1 rad in degrees too
-    assert rc == 0 and f"wrist_joint = {geared:.9g} deg (1 * arm1 + {math.degrees(1.0):.9g})" in out
+    rc, out, _ = run(capsys, ["fk", "--urdf", str(MIMIC), "0.3", "-0.5", "0.1", "--units", "deg,m"])
+    geared = math.degrees(math.radians(0.3) + 1.0)  # deg: q1 = 0.3 deg, the offset 1 rad in degrees too
+
+    def shown(v: float) -> str:  # the text's resolution in degrees: 1e-7, trailing zeros dropped
+        return f"{v:.7f}".rstrip("0").rstrip(".")
+
+    assert rc == 0 and f"wrist_joint = {shown(geared)} deg (1 * arm1 + {shown(math.degrees(1.0))})" in out, out
 
 
 def test_check_counts_the_free_joints_and_names_the_geared_one() -> None:
@@ -262,7 +266,7 @@ def test_a_stray_xacro_property_is_one_rule_for_check_and_the_loaders(
     (f,) = report.find("xacro-ignored")
     assert f.line == 4 and "1 <xacro:property>" in f.message
     rc, out, err = run(capsys, ["fk", "--urdf", str(STRAY), "0", "0", "0", "0"])
-    assert rc == 0 and "xacro:property" in err and "position  [ 0.45,  0,  0.16]" in out
+    assert rc == 0 and "xacro:property" in err and "position  [0.45, 0, 0.16]" in out
     # a substitution or a macro: a xacro document read as URDF would be another robot: both refuse it
     for old, new in (('xyz="0.25 0 0"', 'xyz="${0.25} 0 0"'),
                      ("<link name=\"tool0\"/>", '<xacro:if value="1"><link name="tool0"/></xacro:if>')):  # fmt: skip

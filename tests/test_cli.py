@@ -141,12 +141,14 @@ def test_fk_random_poses_against_closed_form(robot: str, capsys: pytest.CaptureF
     [
         (["--deg", "--mm"], ["90", "0", "10", "0"], [math.pi / 2, 0.0, 0.010, 0.0]),
         (["--deg", "--mm"], ["30", "-45", "25.5", "100"], [*map(math.radians, (30, -45)), 0.0255, math.radians(100)]),
-        (["--deg"], ["30", "-45", "0.0255", "100"], [*map(math.radians, (30, -45)), 0.0255, math.radians(100)]),
-        (["--mm"], ["0.5", "-0.8", "25.5", "1.7"], [0.5, -0.8, 0.0255, 1.7]),
+        (["--units", "deg,m"], ["30", "-45", "0.0255", "100"],
+         [*map(math.radians, (30, -45)), 0.0255, math.radians(100)]),
+        (["--units", "mm,rad"], ["0.5", "-0.8", "25.5", "1.7"], [0.5, -0.8, 0.0255, 1.7]),
+        (["--units", "mm"], ["0.5", "-0.8", "25.5", "1.7"], [0.5, -0.8, 0.0255, 1.7]),
     ],
 )
 def test_fk_units(flags: list[str], argv_q: list[str], q_si: list[float], capsys: pytest.CaptureFixture[str]) -> None:
-    # --deg/--mm scale the inputs; JSON is always SI (README: "JSON output")
+    # --deg/--mm scale the inputs; JSON is always SI (docs/cli.md: "--json output is always SI")
     data = fk_json(capsys, ["fk", "--json", *flags, "--", *argv_q])
     pos, yaw, M = closed_form_pose("default", np.array(q_si))
     assert data["units"] == {"length": "m", "angle": "rad"}
@@ -258,8 +260,9 @@ def test_jacobian_text_output(capsys: pytest.CaptureFixture[str]) -> None:
     rc, out, err = run(capsys, ["jacobian", "0", "1.0", "0", "0"])
     assert rc == 0 and err == ""
     rows = {line.split()[0]: line.split()[1:] for line in out.splitlines() if line.split()}
-    assert [float(v) for v in rows["z"]] == [0.0, 0.0, -1.0, 0.0]
-    assert [float(v) for v in rows["yaw"]] == [1.0, 1.0, 0.0, 1.0]
+    assert rows["z"][0] == "[m]" and rows["yaw"][0] == "[rad]"  # each row names its unit
+    assert [float(v) for v in rows["z"][1:]] == [0.0, 0.0, -1.0, 0.0]
+    assert [float(v) for v in rows["yaw"][1:]] == [1.0, 1.0, 0.0, 1.0]
 
 
 # ------------------------------------------------------------------------------------ errors and codes

@@ -28,8 +28,8 @@ def read_csv(path: Path) -> tuple[list[str], np.ndarray]:
 
 def test_s1_quintic_from_the_command_line(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     out_csv, png = tmp_path / "s1.csv", tmp_path / "s1.png"
-    rc, out, err = run(capsys, ["traj", "--robot", "s1", "--deg", "--from", "0", "0", "0", "0",
-                                "--to", "90", "60", "0.05", "-180", "--duration", "5",
+    rc, out, err = run(capsys, ["traj", "--robot", "s1", "--deg", "--mm", "--from", "0", "0", "0", "0",
+                                "--to", "90", "60", "50", "-180", "--duration", "5",
                                 "--out", str(out_csv), "--plot", str(png), "--rate", "1000"])  # fmt: skip
     assert rc == 0, err
     header, data = read_csv(out_csv)

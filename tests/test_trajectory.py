@@ -540,11 +540,11 @@ def test_plot_writes_a_png(tmp_path: Path, robot_s1: Robot) -> None:
     from scara_pin.viz.plots import plot_trajectory
 
     tr = quintic(S1_Q0, S1_Q1, S1_T)
-    out = plot_trajectory(tr, tmp_path / "s1.png", robot=robot_s1, samples=300)
-    data = out.read_bytes()
+    plot_trajectory(tr, tmp_path / "s1.png", robot=robot_s1, samples=300)
+    data = (tmp_path / "s1.png").read_bytes()
     assert len(data) > 10_000 and data[:8] == b"\x89PNG\r\n\x1a\n"
-    bare = plot_trajectory(tr, tmp_path / "bare.png", samples=50)
-    assert bare.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    plot_trajectory(tr, tmp_path / "bare.png", samples=50)
+    assert (tmp_path / "bare.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(InvalidInputError):
         plot_trajectory(tr, tmp_path / "missing" / "x.png")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bare.png", "s1.png"]

@@ -15,6 +15,7 @@ from .._checks import NUMBER_TEXT
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_text_atomic
 from ..limits import MAX_NUMBER
+from ..units import DisplayUnits, format_number, format_vector
 
 if TYPE_CHECKING:
     import numpy as np
@@ -44,14 +45,39 @@ class _Parser(argparse.ArgumentParser):
 
 
 class Units:
-    """Scale factors from SI to the units the user asked for (``--deg``, ``--mm``)."""
+    """The units of the numbers the user types and reads: ``--mm --deg``, ``--units LENGTH,ANGLE``, or SI.
 
-    def __init__(self, deg: bool, mm: bool) -> None:
-        self.angle = 180.0 / math.pi if deg else 1.0
-        self.length = 1000.0 if mm else 1.0
-        self.angle_name = "deg" if deg else "rad"
-        self.length_name = "mm" if mm else "m"
+    The units rule (docs/units.md): typed numbers are SI (m, rad) unless the command line says otherwise;
+    ``--mm --deg`` (or ``--units mm,deg``) switches both; ``--units`` names each kind explicitly (``m,deg``,
+    ``mm,rad``, ``deg``: the kind left out stays SI). One flag alone, ``--deg`` or ``--mm``, is refused
+    (exit 2) as soon as the command reads a typed value of the OTHER kind, which would silently stay SI:
+    ``fk --deg 90 0 10 0`` would read q3 = 10 as metres. Text output uses the same units; JSON stays SI.
+
+    Attributes:
+        display: the units of the text (:class:`scara_pin.units.DisplayUnits`).
+        alone: ``"--deg"`` or ``"--mm"`` when that flag was given without the other (the rule applies).
+        q: what each joint value measures (``"angle"``/``"length"``); :func:`_load` sets the robot's own.
+    """
+
+    def __init__(self, deg: bool = False, mm: bool = False, *, spec: str | None = None) -> None:
+        if spec is not None:
+            if deg or mm:
+                raise InvalidInputError("give either --units or --deg/--mm, not both")
+            self.display = DisplayUnits.parse(spec)
+            self.alone: str | None = None
+        else:
+            self.display = DisplayUnits("mm" if mm else "m", "deg" if deg else "rad")
+            self.alone = "--deg" if deg and not mm else "--mm" if mm and not deg else None
+        self.angle = self.display.scale("angle")
+        self.length = self.display.scale("length")
+        self.angle_name = self.display.angle
+        self.length_name = self.display.length
         self.q: tuple[str, ...] = _Q_KINDS  # what each joint value measures; _load sets the robot's own
+
+    @classmethod
+    def from_args(cls, args: argparse.Namespace) -> Units:
+        """The units of a parsed command line (its ``--deg``, ``--mm`` and ``--units``, those it has)."""
+        return cls(getattr(args, "deg", False), getattr(args, "mm", False), spec=getattr(args, "units", None))
 
     def scale(self, kinds: Sequence[str]) -> list[float]:
         """Multipliers from SI for a sequence of quantity kinds ("angle" / "length")."""
@@ -60,6 +86,39 @@ class Units:
     def names(self, kinds: Sequence[str]) -> list[str]:
         """Unit names for a sequence of quantity kinds."""
         return [self.angle_name if k == "angle" else self.length_name for k in kinds]
+
+    def guard(self, names: Sequence[str], texts: Sequence[str], kinds: Sequence[str]) -> None:
+        """Refuse a typed value of the kind a lone ``--deg`` / ``--mm`` leaves in SI (the units rule).
+
+        Raises:
+            InvalidInputError: ``--deg`` alone and a length typed, or ``--mm`` alone and an angle typed.
+        """
+        if self.alone is None:
+            return
+        other = "length" if self.alone == "--deg" else "angle"
+        for name, text, kind in zip(names, texts, kinds):
+            if kind == other:
+                shown = text.strip()[:40]
+                if other == "length":
+                    raise InvalidInputError(f"--deg without --mm: {name} = {shown} is a length and would be read "
+                                            "in metres; add --mm to type millimetres (or --units deg,m to keep "
+                                            "metres)")  # fmt: skip
+                raise InvalidInputError(f"--mm without --deg: {name} = {shown} is an angle and would be read in "
+                                        "radians; add --deg to type degrees (or --units mm,rad to keep "
+                                        "radians)")  # fmt: skip
+
+    def value(self, name: str, text: str, kind: str) -> float:
+        """One typed value of a kind ("length" / "angle"), in SI, after the units rule."""
+        self.guard((name,), (text,), (kind,))
+        return _number(name, text) / (self.angle if kind == "angle" else self.length)
+
+    def fmt(self, values: ArrayLike, kinds: str | Sequence[str], width: int = 0) -> str:
+        """SI values as ``[a, b, c]`` in the user's units, rounded to the unit's resolution (scara_pin.units)."""
+        return self.display.format_vector(values, kinds, width)  # type: ignore[arg-type]
+
+    def num(self, value: float, kind: str) -> str:
+        """One SI value in the user's units, rounded to the unit's resolution (no unit name)."""
+        return self.display.format(value, kind)
 
 
 _INTEGER_TEXT = re.compile(r"[+-]?\d+", re.ASCII)
@@ -198,6 +257,7 @@ def _acceleration(robot: Robot, texts: Sequence[str] | None, units: Units) -> No
     if texts:
         if len(texts) != len(units.q):
             raise ParameterError("--acceleration", " ".join(texts), f"must be {len(units.q)} values, one per joint")
+        units.guard([f"--acceleration {n}" for n in _Q_NAMES], texts, units.q)
         acc = [_number(f"--acceleration {n}", t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
         for name, value in zip(_Q_NAMES, acc):
             if not value > 0:
@@ -232,6 +292,7 @@ def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]
     prefix = f"{what} " if what else ""
     if len(texts) != len(units.q):  # never truncated by the zip below
         raise ParameterError(what or "q", " ".join(texts), f"must be {len(units.q)} joint values (got {len(texts)})")
+    units.guard([prefix + n for n in _Q_NAMES], texts, units.q)
     return [_number(prefix + n, t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
 
 
@@ -244,8 +305,14 @@ def _check_limits(robot: Robot, q: np.ndarray, strict: bool) -> None:
         log.warning("%s (computed anyway; --strict refuses)", item)
 
 
-def _fmt(values: ArrayLike) -> str:
-    return "[" + ", ".join(f"{v: .9g}" for v in values) + "]"
+def _fmt(values: ArrayLike, decimals: int = 9) -> str:
+    """Plain numbers (no unit: directions, SI values labelled ``[SI]``) as ``[a, b, c]``, to ``decimals`` decimals."""
+    return format_vector(values, decimals)  # type: ignore[arg-type]
+
+
+def _num(value: float, decimals: int = 9) -> str:
+    """One plain number to ``decimals`` decimals (scara_pin.units.format_number: no -0, no 1e-17)."""
+    return format_number(value, decimals)
 
 
 def _scaled(values: ArrayLike, scale: Sequence[float]) -> list[float]:
@@ -262,6 +329,7 @@ def _read_pose(texts: Sequence[str], units: Units, what: str = "target", dof: in
             raise ParameterError(what, " ".join(texts), f"must be 3 values X Y Z (got {len(texts)})")
     elif len(texts) != 4:
         raise ParameterError(what, " ".join(texts), f"must be 4 values X Y Z YAW (got {len(texts)})")
+    units.guard([f"{what} {n}" for n in ("x", "y", "z", "yaw")], texts, _POSE_KINDS)
     return [_number(n, t) / sc for n, t, sc in zip(("x", "y", "z", "yaw"), texts, units.scale(_POSE_KINDS))]
 
 
@@ -282,12 +350,17 @@ def _add_units(
     p: argparse.ArgumentParser, *, deg: bool = True, mm: bool = True, json_help: str | None = "print one JSON object",
     inputs: bool = False,
 ) -> None:
-    """The shared unit and output switches: --deg, --mm (human units) and --json."""
-    scope = " (inputs)" if inputs else ""
+    """The shared unit and output switches: --deg, --mm, --units (human units; the units rule) and --json."""
+    scope = " (inputs and text)" if inputs else ""
     if deg:
-        p.add_argument("--deg", action="store_true", help=f"angles in degrees{scope}")
+        p.add_argument("--deg", action="store_true", help=f"angles in degrees{scope}; with a length typed, give "
+                       "--mm too (or --units)")  # fmt: skip
     if mm:
-        p.add_argument("--mm", action="store_true", help=f"lengths in millimetres{scope}")
+        p.add_argument("--mm", action="store_true", help=f"lengths in millimetres{scope}; with an angle typed, give "
+                       "--deg too (or --units)")  # fmt: skip
+    kinds = "LENGTH,ANGLE" if deg else "LENGTH"
+    p.add_argument("--units", metavar=kinds, help="units of typed and printed values, named explicitly: m or mm, "
+                   "rad or deg (e.g. mm,deg or m,deg); a kind left out stays SI; not with --deg/--mm")  # fmt: skip
     if json_help is not None:
         p.add_argument("--json", action="store_true", help=json_help)
 

@@ -17,7 +17,9 @@ from ._common import (
     _jerk,
     _load,
     _needs_wrist,
+    _num,
     _number,
+    _read_pose,
     number_type,
 )
 from ._points import add_points_options, use_points
@@ -34,16 +36,16 @@ def _payload(args: argparse.Namespace, units: Units) -> Any:
         raise ParameterError("--payload", mass, "must be >= 0", "kg")
     com: tuple[float, ...] = (0.0, 0.0, 0.0)
     if args.payload_com is not None:
-        com = tuple(_number(f"--payload-com {n}", v) / units.length for n, v in zip("XYZ", args.payload_com))
+        com = tuple(units.value(f"--payload-com {n}", v, "length") for n, v in zip("XYZ", args.payload_com))
     return Payload(mass, com)  # type: ignore[arg-type]
 
 
 def cmd_cycle(args: argparse.Namespace) -> int:
     """The standard cycle: up, across, down and back, time-optimal under the robot's limits."""
-    from ..motion.cycle import STANDARD_CLEARANCE, CyclePath, limits_dict, standard_cycle
+    from ..motion.cycle import STANDARD_CLEARANCE, STANDARD_RISE, STANDARD_SPAN, CyclePath, limits_dict, standard_cycle
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     L = units.length
     path = CyclePath(args.path)
     if path is CyclePath.JUMP:
@@ -59,17 +61,18 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     use_points(args, robot, units, "cycle")  # --points FILE --from-point P1 --to-point P2: --from, --direction, --span
     if not args.rate > 0:  # parsed by the one number grammar (number_type): finite, ASCII digits
         raise ParameterError("--rate", args.rate, "must be > 0", "Hz")
-    span = _number("--span", args.span) / L
-    rise = _number("--rise", args.rise) / L
-    blend = 0.0 if args.no_blend else (None if args.arch is None else _number("--arch", args.arch) / L)
+    # defaults in SI; a typed value in the user's units (the units rule)
+    span = STANDARD_SPAN if args.span is None else units.value("--span", args.span, "length")
+    rise = STANDARD_RISE if args.rise is None else units.value("--rise", args.rise, "length")
+    blend = 0.0 if args.no_blend else (None if args.arch is None else units.value("--arch", args.arch, "length"))
     if args.no_blend and args.arch is not None:
         raise InvalidInputError("--arch and --no-blend exclude each other")
-    radius = STANDARD_CLEARANCE if args.clearance_radius is None else _number("--clearance-radius",
-                                                                              args.clearance_radius) / L
-    ceiling = None if args.max_height is None else _number("--max-height", args.max_height) / L
+    radius = (STANDARD_CLEARANCE if args.clearance_radius is None
+              else units.value("--clearance-radius", args.clearance_radius, "length"))  # fmt: skip
+    ceiling = None if args.max_height is None else units.value("--max-height", args.max_height, "length")
     start = None
     if args.from_pose is not None:
-        start = [_number(n, t) / s for n, t, s in zip(("x", "y", "z", "yaw"), args.from_pose, (L, L, L, units.angle))]
+        start = _read_pose(args.from_pose, units, "--from")
     direction = None if args.direction is None else [_number("--direction", d) for d in args.direction]
     _acceleration(robot, args.acceleration, units)  # a URDF file has none: given, or refused
     limits = robot.limits
@@ -125,15 +128,15 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             else "straight-leg arch (lines and blends, TOPP-RA timing)")  # fmt: skip
     print(f"robot       {robot.name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
           + (f", jerk limit {list(move.jerk)}" if move.jerk else ""))  # fmt: skip
-    print(f"cycle time  {result.cycle_time:.6g} s (up {result.rise * L:g}, across {result.span * L:g}, down and back "
-          f"[{Ln}]" + (f"; clearance radius {radius * L:g} {Ln})" if path is CyclePath.JUMP
-                       else f"; blend {result.blend * L:g} {Ln})"))  # fmt: skip
+    print(f"cycle time  {_num(result.cycle_time, 6)} s (up {units.num(result.rise, 'length')}, across "
+          f"{units.num(result.span, 'length')}, down and back [{Ln}]"
+          + (f"; clearance radius {units.num(radius, 'length')} {Ln})" if path is CyclePath.JUMP
+             else f"; blend {units.num(result.blend, 'length')} {Ln})"))  # fmt: skip
     if bound is not None:
-        print(f"bound       {bound.duration:.6g} s ({bound.reason}): no cycle under these limits is faster; this "
+        print(f"bound       {_num(bound.duration, 6)} s ({bound.reason}): no cycle under these limits is faster; this "
               f"one is {100 * (result.gap or 0.0):.1f} % above it")  # fmt: skip
-    a, b = result.start, result.end
-    print(f"placement   from ({a[0] * L:.6g}, {a[1] * L:.6g}, {a[2] * L:.6g}) to ({b[0] * L:.6g}, {b[1] * L:.6g}, "
-          f"{b[2] * L:.6g}) {Ln}: {result.placement}")  # fmt: skip
+    print(f"placement   from {units.fmt(result.start[:3], 'length')} to {units.fmt(result.end[:3], 'length')} {Ln}: "
+          f"{result.placement}")  # fmt: skip
     if path is CyclePath.JUMP:
         jm = move
         print(f"arch        up to {(jm.z_top + jm.peak) * L:.6g} {Ln} ({jm.peak * L:.3g} above the clearance height), "  # type: ignore[union-attr]
@@ -175,10 +178,10 @@ def register(sub: Any) -> None:
     p = sub.add_parser("cycle", help="the standard SCARA cycle (up 25, across 305, down, back): time, legs, limits")
     g = p.add_argument_group("the cycle (lengths in m, or mm with --mm)")
     g.add_argument("--from", dest="from_pose", nargs=4, metavar="P",
-                   help="start pose X Y Z YAW (default: where the robot reaches the cycle best, see README)")
+                   help="start pose X Y Z YAW (default: where the robot reaches the cycle best, see docs/motion.md)")
     g.add_argument("--direction", nargs=2, metavar="D", help="traverse direction DX DY (with --from; default 1 0)")
-    g.add_argument("--span", default="0.305", metavar="L", help="horizontal stroke (default 0.305 m)")
-    g.add_argument("--rise", default="0.025", metavar="H", help="vertical stroke (default 0.025 m)")
+    g.add_argument("--span", metavar="L", help="horizontal stroke (default 0.305 m)")
+    g.add_argument("--rise", metavar="H", help="vertical stroke (default 0.025 m)")
     g.add_argument("--path", choices=("jump", "lines"), default="jump",
                    help="jump: time-optimal, joint path free (default); lines: the straight-leg arch (slower)")
     g.add_argument("--clearance-radius", metavar="R",

@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..units import decimals_for
 from ._common import (
     _POSE_KINDS,
     _Q_NAMES,
@@ -17,9 +18,9 @@ from ._common import (
     _add_robot_options,
     _add_units,
     _check_limits,
-    _fmt,
     _load,
     _needs_wrist,
+    _num,
     _q_values,
     _read_pose,
     _read_q,
@@ -41,7 +42,7 @@ _SI_UNITS = {"length": "m", "angle": "rad"}
 
 def cmd_fk(args: argparse.Namespace) -> int:
     """Forward kinematics: the pose of tool0 in the base frame."""
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     robot = _load(args, units)
     q = _read_q(args, units)
     _check_limits(robot, q, args.strict)
@@ -49,12 +50,7 @@ def cmd_fk(args: argparse.Namespace) -> int:
     from ..model import pose_from_placement
 
     pose = pose_from_placement(M)
-    q_out = _scaled(q, units.scale(units.q))
-    pos = [float(v) * units.length for v in pose[:3]]
-    yaw = float(pose[3]) * units.angle
-    matrix = M.homogeneous.copy()
-    matrix[:3, 3] *= units.length
-    if args.json:  # always SI (README: "JSON output")
+    if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         out = {
             "robot": robot.name,
             "q": q.tolist(),
@@ -70,14 +66,18 @@ def cmd_fk(args: argparse.Namespace) -> int:
         print(json.dumps(out))
         return 0
     print(f"robot     {robot.name}: {robot.tool_frame} in {robot.base_frame}")
-    print(f"q         {_fmt(q_out)}  [{', '.join(units.names(units.q))}]")
-    print(f"position  {_fmt(pos)}  [{units.length_name}]")
-    print(f"yaw       {yaw: .9g}  [{units.angle_name}]")
+    print(f"q         {units.fmt(q, units.q)}  [{', '.join(units.names(units.q))}]")
+    print(f"position  {units.fmt(pose[:3], 'length')}  [{units.length_name}]")
+    print(f"yaw       {units.num(pose[3], 'angle')}  [{units.angle_name}]")
     if robot.geared:
         print(f"geared    {_geared_text(robot, q, units)}")
-    print("matrix")
-    for row in matrix:
-        print("          " + _fmt(row))
+    # the rotation (no unit) to 1e-9 and the translation in the user's length unit, in aligned columns
+    H = M.homogeneous
+    cells = [[_num(v) for v in row[:3]] + [units.num(row[3], "length")] for row in H[:3]] + [[_num(v) for v in H[3]]]
+    width = max(len(c) for row in cells for c in row)
+    print(f"matrix    (rotation [-], translation [{units.length_name}])")
+    for row in cells:
+        print("          [" + ", ".join(c.rjust(width) for c in row) + "]")
     return 0
 
 
@@ -85,7 +85,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     """The task Jacobian d(x, y, z, yaw)/dq, or Pinocchio's 6 x 4 frame Jacobian."""
     import numpy as np
 
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     robot = _load(args, units)
     q = _read_q(args, units)
     _check_limits(robot, q, args.strict)
@@ -100,7 +100,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         rows = ["vx", "vy", "vz", "wx", "wy", "wz"]
         row_kinds = ("length",) * 3 + ("angle",) * 3
     w = robot.manipulability(q)
-    if args.json:  # always SI (README: "JSON output")
+    if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         out = {
             "robot": robot.name,
             "q": q.tolist(),
@@ -113,14 +113,17 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         }
         print(json.dumps(out))
         return 0
-    # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j)
-    J = J * np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
+    # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j), printed to 1e-9 SI in that unit
+    ratio = np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
+    cells = [[_num(v, decimals_for(r)) for v, r in zip(row, rrow)] for row, rrow in zip(J * ratio, ratio)]
+    width = max(16, *(len(c) + 2 for row in cells for c in row))
     print(f"robot     {robot.name}: {args.reference} Jacobian of {args.frame or robot.tool_frame}")
-    print(f"q         {_fmt(_scaled(q, units.scale(units.q)))}  [{', '.join(units.names(units.q))}]")
-    print("          " + "".join(f"{f'd/dq{i + 1}':>16}" for i in range(robot.dof)))
-    for name, row in zip(rows, J):
-        print(f"{name:<10}" + "".join(f"{v:16.9g}" for v in row))
-    print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {w:.9g}")
+    print(f"q         {units.fmt(q, units.q)}  [{', '.join(units.names(units.q))}]")
+    heads = [f"d/dq{i + 1} [/{u}]" for i, u in enumerate(units.names(units.q))]
+    print("          " + "".join(h.rjust(width) for h in heads))
+    for name, unit, row in zip(rows, units.names(row_kinds), cells):
+        print(f"{f'{name} [{unit}]':<10}" + "".join(c.rjust(width) for c in row))
+    print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {_num(w)}")
     return 0
 
 
@@ -145,15 +148,15 @@ def _geared_text(robot: Robot, q: ArrayLike, units: Units) -> str:
     values = _geared(robot, q)
     parts = []
     for g in robot.geared:
-        scale, unit = (units.angle, units.angle_name) if g.kind == "angle" else (units.length, units.length_name)
-        parts.append(f"{g.name} = {values[g.name] * scale:.9g} {unit} ({g.multiplier:.9g} * {g.source_name} + "
-                     f"{g.offset * scale:.9g})")  # fmt: skip
+        unit = units.angle_name if g.kind == "angle" else units.length_name
+        parts.append(f"{g.name} = {units.num(values[g.name], g.kind)} {unit} ({_num(g.multiplier)} * {g.source_name} "
+                     f"+ {units.num(g.offset, g.kind)})")  # fmt: skip
     return "; ".join(parts)
 
 
 def cmd_ik(args: argparse.Namespace) -> int:
     """Inverse kinematics: every joint solution for a tool pose (closed form, or numeric)."""
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     robot = _load(args, units)
     if args.input:
         if args.numeric:
@@ -199,10 +202,8 @@ def cmd_ik(args: argparse.Namespace) -> int:
             message = f"no {args.branch} solution ({len(result.solutions)} of the other branch)"
         qs, branches = [s.q for s in sols], [s.branch for s in sols]
         turns = [[list(t) if t is not None else None for t in s.turns] for s in sols]
-    scale = units.scale(_POSE_KINDS)
-    tgt = dict(zip(("x", "y", "z", "yaw"), _scaled(target, scale)))
     code = 0 if status == "OK" else 3
-    if args.json:  # always SI (README: "JSON output")
+    if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         si = Units(False, False)
         solutions = _solutions_json(qs, branches, si)
         for sol, t in zip(solutions, turns):
@@ -218,14 +219,15 @@ def cmd_ik(args: argparse.Namespace) -> int:
         raise InfeasibleError(f"{status}: {message}")
     method = "numeric" if numeric else "closed-form"
     print(f"robot     {robot.name}: {method} IK of {robot.tool_frame} in {robot.base_frame}")
-    print(f"target    {_fmt(list(tgt.values()))}  [{', '.join(units.names(_POSE_KINDS[: len(tgt)]))}]")
+    kinds = _POSE_KINDS[: len(target)]
+    print(f"target    {units.fmt(target, kinds)}  [{', '.join(units.names(kinds))}]")
     print(f"units     q = [{', '.join(units.names(units.q))}]")
     for i, (q, b) in enumerate(zip(qs, branches)):
         extra = ""
         if turns and not args.all_turns and any(t is None or t != [0, 0] for t in turns[i]):
             extra = "  turns " + " ".join(f"{n}:{'any' if t is None else t}" for n, t in zip(_Q_NAMES, turns[i])
                                           if t != [0, 0])  # fmt: skip
-        print(f"{b:<9} {_fmt(_scaled(q, units.scale(units.q)))}{extra}")
+        print(f"{b:<9} {units.fmt(q, units.q)}{extra}")
         if robot.geared:
             print(f"  geared  {_geared_text(robot, q, units)}")
     return 0

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import check_output_path
 from ._common import (
+    _POSE_KINDS,
     Units,
     _acceleration,
     _add_acceleration,
@@ -22,6 +23,7 @@ from ._common import (
     _joint_arg,
     _load,
     _needs_wrist,
+    _num,
     _number,
     _read_pose,
     log,
@@ -52,7 +54,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     from ..motion.plan import MotionRequest, plan_motion
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     _check_outputs(args, (args.out, args.setpoints, args.plot))
     robot = _load(args, units)
     use_points(args, robot, units, "traj")  # --points FILE --through P1 .. Pn: their q as --from, --via, --to
@@ -79,6 +81,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     if args.tool_speed is not None:
         if not args.tool_speed > 0:
             raise ParameterError("--tool-speed", args.tool_speed, "must be > 0")
+        units.guard(("--tool-speed",), (f"{args.tool_speed:g}",), ("length",))
         tool_speed = args.tool_speed / units.length
     _arch_options(args)
     if args.arch and not args.linear:
@@ -86,7 +89,6 @@ def cmd_traj(args: argparse.Namespace) -> int:
             raise InvalidInputError("--arch takes no --via (one arch between two poses)")
         if args.duration is not None:
             raise InvalidInputError("--arch is time-optimal: --duration does not apply")
-    L = units.length
     jerk = _jerk(args)
     if jerk is not None and robot.dof != 4:
         raise InvalidInputError("--jerk-limit needs a 4-joint robot for now")
@@ -95,19 +97,17 @@ def cmd_traj(args: argparse.Namespace) -> int:
         start_pose=None if pose_from is None else np.array(pose_from),
         end_pose=None if pose_to is None else np.array(pose_to), vias=tuple(vias), duration=args.duration,
         linear=args.linear, arch=args.arch, tool_speed=tool_speed, torque=args.torque, payload=_payload(args, units),
-        rise=None if args.rise is None else _number("--rise", args.rise) / L,
-        blend=None if args.blend is None else _number("--blend", args.blend) / L,
+        rise=None if args.rise is None else units.value("--rise", args.rise, "length"),
+        blend=None if args.blend is None else units.value("--blend", args.blend, "length"),
         jerk=None if jerk is None else tuple(jerk),
         path=args.path or "jump",
-        clearance_radius=None if args.clearance_radius is None else _number("--clearance-radius",
-                                                                             args.clearance_radius) / L,
-        max_height=None if args.max_height is None else _number("--max-height", args.max_height) / L,
+        clearance_radius=None if args.clearance_radius is None else units.value("--clearance-radius",
+                                                                                 args.clearance_radius, "length"),
+        max_height=None if args.max_height is None else units.value("--max-height", args.max_height, "length"),
     )
-    if args.plot and robot.kind != "scara" and not args.arch:
-        raise InvalidInputError(f"traj --plot is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     plan = plan_motion(robot, request)
     if plan.arch is not None:
-        return _print_arch(args, plan.robot, plan.arch, units, plan.method)
+        return _print_arch(args, plan.robot, plan.arch, units, plan.method, tool_speed)
     robot, traj, method = plan.robot, plan.trajectory, plan.method.value
     from ..motion.timing import limit_ratios
 
@@ -129,7 +129,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot)
+        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=method, torque=args.torque,
+                        tool_speed=tool_speed)  # fmt: skip
         outputs["plot"] = args.plot
     summary = {
         "robot": robot.name,
@@ -149,9 +150,10 @@ def cmd_traj(args: argparse.Namespace) -> int:
         return 0
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
     print(f"robot     {robot.name}: {method}", file=text)
-    print(f"duration  {traj.duration:.9g} s", file=text)
-    print(f"from      {_fmt(traj.q_start)}  [SI]", file=text)
-    print(f"to        {_fmt(traj.q_end)}  [SI]", file=text)
+    q_units = ", ".join(units.names(units.q))
+    print(f"duration  {_num(traj.duration)} s", file=text)
+    print(f"from      {units.fmt(traj.q_start, units.q)}  [{q_units}]", file=text)
+    print(f"to        {units.fmt(traj.q_end, units.q)}  [{q_units}]", file=text)
     print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} "
           "(exact for joint-line laws, else sampled)", file=text)  # fmt: skip
     for kind, where in outputs.items():
@@ -199,7 +201,7 @@ def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Uni
         motor = tr.MotorUnits.from_drive(
             [_number("--gear", g) for g in args.gear],
             [_number("--steps-per-rev", v) for v in args.steps_per_rev],
-            _number("--screw-lead", args.screw_lead) / units.length,
+            units.value("--screw-lead", args.screw_lead, "length"),
             prismatic=robot.joint_kinds.index("length"),
         )
     delays = [_number("--delays", d) for d in args.delays] if args.delays else None
@@ -208,7 +210,8 @@ def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Uni
     write_atomic(Path(args.setpoints), sp.csv_text())
 
 
-def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any) -> int:
+def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any,
+                tool_speed: float | None) -> int:
     """``traj --arch``: write and print the arch move (the jump, or the straight-leg arch with ``--path lines``)."""
     from ..motion.plan import Method
 
@@ -221,10 +224,11 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
     if args.setpoints:
         _write_setpoints(args, robot, traj, units)
         outputs["setpoints"] = args.setpoints
-    if args.plot:
-        from ..viz.cycle import plot_cycle
+    if args.plot:  # the robot carries the payload: the torques are the loaded arm's
+        from ..viz.plots import plot_trajectory
 
-        plot_cycle(robot, move, args.plot, title=f"{robot.name}: {method.value}, {traj.duration:.4g} s")
+        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=method.value, torque=args.torque,
+                        tool_speed=tool_speed)  # fmt: skip
         outputs["plot"] = args.plot
     faster = None if jump else _jump_time(robot, move, args, units)
     if args.json:
@@ -245,20 +249,20 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
         return 0
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
     print(f"robot     {robot.name}: {method.value}", file=text)
-    print(f"duration  {traj.duration:.9g} s", file=text)
+    print(f"duration  {_num(traj.duration)} s", file=text)
     if jump:
-        b, L, Ln = move.lower_bound, units.length, units.length_name
-        print(f"bound     {b.duration:.6g} s ({b.reason}): no move under these limits is faster; this one is "
+        b, Ln = move.lower_bound, units.length_name
+        print(f"bound     {_num(b.duration, 6)} s ({b.reason}): no move under these limits is faster; this one is "
               f"{100 * move.gap:.1f} % above it", file=text)  # fmt: skip
-        print(f"arch      up to {(move.z_top + move.peak) * L:.6g} {Ln}, {move.bulge * L:.3g} {Ln} off the straight "
-              f"line in plan view; solved in {move.stats.seconds:.3g} s", file=text)  # fmt: skip
+        print(f"arch      up to {units.num(move.z_top + move.peak, 'length')} {Ln}, {units.num(move.bulge, 'length')} "
+              f"{Ln} off the straight line in plan view; solved in {move.stats.seconds:.3g} s", file=text)  # fmt: skip
     for leg in move.legs:
         binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in getattr(leg, "binding", ()))
         print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
               + (f"; binding: {binding}" if binding else ""), file=text)  # fmt: skip
     if not jump:
         print("note      the straight-leg arch is slower than the jump (--path jump, the default)"
-              + (f", which takes {faster:.6g} s" if faster is not None else ""), file=text)  # fmt: skip
+              + (f", which takes {_num(faster, 6)} s" if faster is not None else ""), file=text)  # fmt: skip
     for kind, where in outputs.items():
         print(f"wrote     {kind}: {where}", file=text)
     return 0
@@ -285,7 +289,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge."""
     from ..motion.jog import jog_to_edge
 
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     _check_outputs(args, (args.out, args.plot))
     robot = _load(args, units)
     if robot.kind != "scara":
@@ -296,7 +300,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
     if len(direction) not in (2, 3):
         raise ParameterError("--direction", " ".join(args.direction), "must be DX DY or DX DY DZ")
-    margin = _number("--margin", args.margin) / units.length
+    margin = 0.0 if args.margin is None else units.value("--margin", args.margin, "length")
     jog = jog_to_edge(robot, q0, direction, margin=margin)
     traj = jog.trajectory
     if args.out:
@@ -304,21 +308,19 @@ def cmd_jog(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot)
+        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law="jog to the edge, straight line")
     if args.json:
         print(json.dumps({"robot": robot.name, "hit": jog.hit.to_dict(), "start_pose": jog.start_pose.tolist(),
                           "end_pose": jog.end_pose.tolist(), "distance": jog.distance, "duration": traj.duration,
                           "q_end": traj.q_end.tolist(), "limit_ratio": jog.ratio,
                           "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
         return 0
-    L = units.length
     text = sys.stderr if "-" in (args.out, args.plot) else sys.stdout  # stdout carries a file
     print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}", file=text)
     print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
-    print(f"travel    {jog.distance * L:.9g} {units.length_name} in {traj.duration:.6g} s (at rest at both ends)",
-          file=text)  # fmt: skip
-    print(f"end pose  {_fmt([*(v * L for v in jog.end_pose[:3]), jog.end_pose[3]])}  [{units.length_name}, rad]",
-          file=text)  # fmt: skip
+    print(f"travel    {units.num(jog.distance, 'length')} {units.length_name} in {_num(traj.duration, 6)} s (at rest "
+          "at both ends)", file=text)  # fmt: skip
+    print(f"end pose  {units.fmt(jog.end_pose, _POSE_KINDS)}  [{', '.join(units.names(_POSE_KINDS))}]", file=text)
     print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)", file=text)
     for what in (args.out, args.plot):
         if what:
@@ -354,7 +356,8 @@ def register(sub: Any) -> None:
     g.add_argument("--path", choices=("jump", "lines"),
                    help="jump (default) or lines: the straight-leg arch, lift, traverse, descend, corners blended "
                    "(slower)")
-    g.add_argument("--rise", metavar="H", help="clearance above the higher pose (default 0.025 m)")
+    g.add_argument("--rise", metavar="H", help="clearance above the higher pose [m, or mm with --mm] "
+                   "(default 0.025 m)")  # fmt: skip
     g.add_argument("--clearance-radius", metavar="R",
                    help="jump: within R of an end (horizontally) the tool may be lower (default 0.005 m)")
     g.add_argument("--max-height", metavar="Z", help="a ceiling for the tool's z (base frame)")
@@ -364,7 +367,8 @@ def register(sub: Any) -> None:
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out and --json (default 1000)")  # fmt: skip
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
-    g.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time with limits, and the tool path")
+    g.add_argument("--plot", metavar="PNG", help="each joint's q, qd, qdd (and torque with --torque) against "
+                   "time with its limits, in the units of --mm/--deg; the tool path and speed (.png, .svg, .pdf)")
     g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
     g.add_argument("--setpoint-rate", type=number_type("--setpoint-rate"), metavar="HZ",
                    help="setpoint rate (default: --rate)")  # fmt: skip
@@ -379,7 +383,7 @@ def register(sub: Any) -> None:
     p = sub.add_parser("jog", help="jog to the edge: straight tool move ending at rest on the workspace edge")
     p.add_argument("--from", dest="from_q", nargs=4, metavar="Q", required=True, help="current configuration")
     p.add_argument("--direction", nargs="+", metavar="D", required=True, help="DX DY (plan) or DX DY DZ")
-    p.add_argument("--margin", default="0", metavar="M", help="stop this far before the edge [m or mm] (default 0)")
+    p.add_argument("--margin", metavar="M", help="stop this far before the edge [m, or mm with --mm] (default 0)")
     p.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip
     _add_acceleration(p)

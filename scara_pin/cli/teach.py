@@ -14,7 +14,7 @@ def cmd_teach(args: argparse.Namespace) -> int:
     """Serve the teach pendant page until Ctrl-C."""
     from ..viz.teach import TeachServer
 
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     robot = _load(args, units)
     q = _q_values(args.q, units) if args.q else None
     server = TeachServer(robot, port=args.port, q=q, points_file=args.points, controls=args.controls)

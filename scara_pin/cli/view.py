@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from typing import TYPE_CHECKING, Any
 
@@ -23,7 +22,7 @@ def cmd_view(args: argparse.Namespace) -> int:
 
     from ..viz import meshcat as viz
 
-    units = Units(args.deg, args.mm)
+    units = Units.from_args(args)
     if args.html:  # refused before any work
         check_output_path(args.html)
     robot = _load(args, units)
@@ -44,14 +43,10 @@ def cmd_view(args: argparse.Namespace) -> int:
     elif args.traj:
         times, qs = viz.read_trajectory_csv(args.traj, robot.dof)
     polylines = None
-    if args.workspace:
-        from ..workspace import Workspace, workspace_of
+    if args.workspace:  # a palletizer: the arm-plane envelope at the waist limits, and its sweep
+        from ..viz.inline import workspace_polylines
 
-        ws = workspace_of(robot)
-        if not isinstance(ws, Workspace):  # a palletizer: the arm-plane envelope at the waist limits, and its sweep
-            polylines = ws.wireframe()
-        else:
-            polylines = [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
+        polylines = workspace_polylines(robot)
     if args.html:
         viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines,
                         title=f"scara-pin: {robot.name}")  # fmt: skip

@@ -9,7 +9,11 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
 from ..files import check_output_path
+from ..units import decimals_for, format_number
 from ._common import Units, _add_robot_options, _add_units, _fmt, _load, _number
+
+_TABLE_RESOLUTION = 1e-6
+"""The arc table of ``workspace`` prints centres and radii to 1 um (a summary; --json gives every bit)."""
 
 if TYPE_CHECKING:
 
@@ -25,7 +29,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     """The exact reachable region (arcs, area, radii), a ray query to its edge, and a picture."""
     from ..workspace.scara import plot_workspace, workspace
 
-    units = Units(False, args.mm)
+    units = Units.from_args(args)
     L = units.length
     if args.plot:  # refused before any work
         check_output_path(args.plot)
@@ -35,19 +39,19 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     ws = workspace(robot)
     hit = None
     if args.ray:
-        start = [_number(n, t) / L for n, t in zip(("x", "y"), args.ray[:2])]
+        start = [units.value(n, t, "length") for n, t in zip(("x", "y"), args.ray[:2])]
         direction = [_number(n, t) for n, t in zip(("dx", "dy"), args.ray[2:])]
         if (args.z is None) != (args.dz is None):
             raise InvalidInputError("--z and --dz go together (a 3-D ray also meets the J3 stroke)")
         if args.z is not None:
-            start.append(_number("--z", args.z) / L)
+            start.append(units.value("--z", args.z, "length"))
             direction.append(_number("--dz", args.dz))
         hit = ws.ray(start, direction)
     elif args.z is not None or args.dz is not None:
         raise InvalidInputError("--z/--dz go with --ray")
     if args.plot:
         ray = None if hit is None else (start[:2], direction[:2])
-        plot_workspace(ws, args.plot, ray=ray)
+        plot_workspace(ws, args.plot, ray=ray, units=units.display, robot_name=robot.name)
     if args.json:
         out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}}
         if hit is not None:
@@ -58,28 +62,31 @@ def cmd_workspace(args: argparse.Namespace) -> int:
             out["plot"] = args.plot
         print(json.dumps(out))
         return 0
+    n = units.length_name
     if hit is not None:
-        origin = _fmt([v * L for v in start])
-        print(f"robot     {robot.name}: ray from {origin} [{units.length_name}] along {_fmt(direction)}")
-        print(f"edge      {_fmt([v * L for v in hit.point])} [{units.length_name}]")
-        print(f"distance  {hit.distance * L:.9g} {units.length_name}")
+        print(f"robot     {robot.name}: ray from {units.fmt(start, 'length')} [{n}] along {_fmt(direction)}")
+        print(f"edge      {units.fmt(hit.point, 'length')} [{n}]")
+        print(f"distance  {units.num(hit.distance, 'length')} {n}")
         print(f"stopped by {hit.description} [{hit.limit.value}]")
     else:
         z0, z1 = ws.z_range
         print(f"robot     {robot.name}: reachable region of the wrist axis (= tool point without tool offset)")
-        print(f"area      {ws.area * L * L:.9g} {units.length_name}^2")
-        print(f"radius    {ws.r_min * L:.9g} .. {ws.r_max * L:.9g} {units.length_name} (from the J1 axis)")
-        print(f"z         {z0 * L:.9g} .. {z1 * L:.9g} {units.length_name} (J3 stroke)")
+        print(f"area      {units.num(ws.area, 'area')} {n}^2")
+        print(f"radius    {units.num(ws.r_min, 'length')} .. {units.num(ws.r_max, 'length')} {n} (from the J1 axis)")
+        print(f"z         {units.num(z0, 'length')} .. {units.num(z1, 'length')} {n} (J3 stroke)")
         if ws.note is not None:
             print(f"note      {ws.note}")
-        print(f"boundary  {len(ws.loops)} loop(s) of {len(ws.arcs)} arcs (centre, radius, start..end angle, limit):")
+        # the arc table to 1 um and 0.001 deg (--json gives every bit)
+        d = decimals_for(L, _TABLE_RESOLUTION)
+        print(f"boundary  {len(ws.loops)} loop(s) of {len(ws.arcs)} arcs (centre, radius [{n}], start..end angle "
+              "[deg], limit):")  # fmt: skip
         short = [i for i, arc in enumerate(ws.arcs) if arc.radius * abs(arc.sweep) < LISTED_ARC_MIN]
         for i, arc in enumerate(ws.arcs):
             if i in short:
                 continue
-            cx, cy = (v * L for v in arc.center)
-            print(f"  {i:>2}  ({cx: .6g}, {cy: .6g})  r {arc.radius * L:.6g}  "
-                  f"{math.degrees(arc.start):8.3f}..{math.degrees(arc.end):8.3f} deg  {arc.description}")  # fmt: skip
+            cx, cy, r = (format_number(v * L, d) for v in (*arc.center, arc.radius))
+            a0, a1 = (format_number(math.degrees(v), 3) for v in (arc.start, arc.end))
+            print(f"  {i:>2}  ({cx:>11}, {cy:>11})  r {r:>11}  {a0:>8} .. {a1:<8}  {arc.description}")
         if short:
             print(f"  ({len(short)} arc(s) shorter than {LISTED_ARC_MIN * 1e6:g} um not listed: "
                   f"{', '.join(map(str, short))}; real corners of the region, kept in --json)")  # fmt: skip
@@ -96,7 +103,7 @@ def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) 
         raise InvalidInputError("--ray/--z/--dz are SCARA-only for now; a palletizer gets its arm-plane envelope")
     env = arm_plane_envelope(robot.kinematics.geometry)
     if args.plot:
-        plot_envelope(env, args.plot)
+        plot_envelope(env, args.plot, units=units.display, robot_name=robot.name)
     if args.json:
         out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"},
                                "envelope": env.to_dict()}  # fmt: skip
@@ -104,15 +111,15 @@ def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) 
             out["plot"] = args.plot
         print(json.dumps(out))
         return 0
-    L, name = units.length, units.length_name
+    name = units.length_name
     print(f"robot     {robot.name}: reach envelope of {robot.tool_frame} in the arm plane (r from the waist axis, z)")
-    print(f"area      {env.area * L * L:.9g} {name}^2")
-    print(f"r range   [{env.r_range[0] * L:.9g}, {env.r_range[1] * L:.9g}] {name}")
-    print(f"z range   [{env.z_range[0] * L:.9g}, {env.z_range[1] * L:.9g}] {name}")
+    print(f"area      {units.num(env.area, 'area')} {name}^2")
+    print(f"r range   {units.fmt(env.r_range, 'length')} {name}")
+    print(f"z range   {units.fmt(env.z_range, 'length')} {name}")
     print(f"arcs      {len(env.arcs)} (centre, radius [{name}], phi from the vertical [rad])")
     for a in env.arcs:
-        print(f"  {a.limit:<13} centre {_fmt([v * L for v in a.center])} radius {a.radius * L:.9g} "
-              f"phi [{a.start:.9g}, {a.start + a.sweep:.9g}]")  # fmt: skip
+        print(f"  {a.limit:<13} centre {units.fmt(a.center, 'length')} radius {units.num(a.radius, 'length')} "
+              f"phi {_fmt([a.start, a.start + a.sweep])}")  # fmt: skip
     if args.plot:
         print(f"wrote     {args.plot}")
     return 0

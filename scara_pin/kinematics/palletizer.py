@@ -440,4 +440,4 @@ def solve_batch(
         status[i] = int(res.status)
         best_q[i] = np.nan if best is None else best.q
         sign[i] = 0 if best is None else (1 if best.branch == "up" else -1)
-    return BatchIKResult(best_q, status, sign)
+    return BatchIKResult(best_q, status, sign, PalletizerIKStatus, BRANCHES)

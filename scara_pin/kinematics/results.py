@@ -21,7 +21,7 @@ from ..errors import InvalidInputError, NoSolutionError
 if TYPE_CHECKING:
     from .._typing import ArrayLike
 
-__all__ = ["MAX_SOLUTIONS", "BatchIKResult", "IKResult", "IKSolution", "joint_distance", "result_of"]
+__all__ = ["MAX_SOLUTIONS", "BatchBranch", "BatchIKResult", "IKResult", "IKSolution", "joint_distance", "result_of"]
 
 MAX_SOLUTIONS = 100_000
 """The most solutions :meth:`IKResult.expand` lists (``ik --all-turns``); beyond it: InvalidInputError."""
@@ -180,19 +180,80 @@ def result_of(
     return result.expand(lower, upper) if all_turns else result
 
 
+class BatchBranch(enum.IntEnum):
+    """The codes of :attr:`BatchIKResult.branch`: which elbow branch a row's solution is on.
+
+    ``FIRST`` is the kind's first branch (SCARA ``right``, palletizer ``up``), ``SECOND`` its second (SCARA
+    ``left``, palletizer ``down``); ``NONE`` marks a row without a solution.
+    """
+
+    FIRST = 1
+    SECOND = -1
+    NONE = 0
+
+
 @dataclass(frozen=True)
 class BatchIKResult:
     """One solution per target: the requested branch, or the nearest branch, at the turns nearest the reference.
 
+    The arrays stay plain integers (vectorised code compares them at numpy speed); the kind's enums name
+    them: ``result.statuses()`` gives each row's status member (``IKStatus.OUT_OF_REACH``, ...),
+    ``result.branch_labels()`` each row's branch name, ``result.counts()`` the number of rows per status, and
+    ``result.ok`` the rows solved. ``BatchBranch`` names the branch codes.
+
     Attributes:
         q: (N, 4) joint values; NaN rows where there is no solution.
-        status: (N,) status codes as integers (0 = OK; the kind's status enum names them).
-        branch: (N,) +1 for the first branch (SCARA right, palletizer up), -1 for the second, 0 where none.
+        status: (N,) status codes as integers: 0 = OK, else the value of the kind's status enum
+            (``status_enum``: :class:`~scara_pin.kinematics.scara_geometry.IKStatus` for a SCARA).
+        branch: (N,) :class:`BatchBranch` codes: +1 the first branch (SCARA right, palletizer up), -1 the
+            second, 0 where there is no solution.
+        status_enum: the kind's status enum (None: the codes are not named).
+        branches: the kind's branch names, first and second (``("right", "left")``, ``("up", "down")``).
     """
 
     q: np.ndarray
     status: np.ndarray
     branch: np.ndarray
+    status_enum: type[enum.IntEnum] | None = None
+    branches: tuple[str, str] = ("right", "left")
+
+    def __len__(self) -> int:
+        return len(self.status)
+
+    @property
+    def ok(self) -> np.ndarray:
+        """(N,) booleans: the rows with a solution."""
+        return np.asarray(self.status == 0)
+
+    def statuses(self) -> list[enum.IntEnum]:
+        """Each row's status as the kind's enum member (``IKStatus.OK``, ``IKStatus.OUT_OF_REACH``, ...).
+
+        Raises:
+            InvalidInputError: the result does not know its kind's enum (``status_enum`` is None).
+        """
+        if self.status_enum is None:
+            raise InvalidInputError("this batch result does not name its status codes (status_enum is None)")
+        members = {int(m): m for m in self.status_enum}
+        return [members[int(c)] for c in self.status.tolist()]
+
+    def branch_labels(self) -> list[str]:
+        """Each row's branch name (``"right"``/``"left"``, ``"up"``/``"down"``), ``""`` where no solution."""
+        names = {1: self.branches[0], -1: self.branches[1], 0: ""}
+        return [names[int(b)] for b in self.branch.tolist()]
+
+    def counts(self) -> dict[str, int]:
+        """The number of rows per status name (``{"OK": 998, "OUT_OF_REACH": 2}``), most frequent first."""
+        codes, n = np.unique(self.status, return_counts=True)
+        named = {int(m): m.name for m in self.status_enum} if self.status_enum is not None else {}
+        pairs = sorted(((named.get(int(c), str(int(c))), int(k)) for c, k in zip(codes, n)), key=lambda p: -p[1])
+        return dict(pairs)
+
+    def __repr__(self) -> str:
+        solved = int(np.count_nonzero(self.branch))
+        first = int(np.count_nonzero(self.branch == BatchBranch.FIRST))
+        counts = ", ".join(f"{k} {v}" for k, v in self.counts().items())
+        return (f"BatchIKResult({len(self)} targets: {counts}; branches {self.branches[0]} {first}, "
+                f"{self.branches[1]} {solved - first})")  # fmt: skip
 
 
 def nearest_q(res: IKResult, reference: ArrayLike | None, weights: ArrayLike | None, branch: str,

@@ -117,7 +117,7 @@ class Scara3Kinematics(ScaraKinematics):
         ref4 = self._ref4(reference)
         if branch != "nearest":
             res = solve_batch(self.geometry, T4, branch=branch, reference=ref4)
-            out = BatchIKResult(res.q[:, :3].copy(), res.status, res.branch)
+            out = BatchIKResult(res.q[:, :3].copy(), res.status, res.branch, res.status_enum, res.branches)
         else:  # each branch, then the nearer one in the 3 joints (the virtual wrist's turn counts for nothing)
             ref3 = np.zeros(3) if ref4 is None else (ref4[:3] if ref4.ndim == 1 else ref4[:, :3])
             right = solve_batch(self.geometry, T4, branch="right", reference=ref4)
@@ -127,7 +127,7 @@ class Scara3Kinematics(ScaraKinematics):
             take = d_l < d_r
             status = np.where(take | ((right.status != 0) & (left.status == 0)), left.status, right.status)
             q = np.where(take[:, None], left.q[:, :3], right.q[:, :3])
-            out = BatchIKResult(q, status, np.where(take, left.branch, right.branch))
+            out = BatchIKResult(q, status, np.where(take, left.branch, right.branch), right.status_enum, right.branches)
         if self.robot is None:
             return out
         return polish_batch(self.robot, self.geometry, T, out, row_solver(self, T, reference, branch))

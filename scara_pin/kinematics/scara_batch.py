@@ -67,14 +67,14 @@ def solve_batch(
     status = np.empty(n, dtype=np.int64)
     sign = np.empty(n, dtype=np.int64)
     if n == 0:
-        return BatchIKResult(q, status, sign)
+        return BatchIKResult(q, status, sign, IKStatus, BRANCHES)
     const = ref.ndim == 1
     work = _BatchWork(geo, min(n, _BATCH_ROWS), branch, ref.tolist() if const else None)
     for start in range(0, n, _BATCH_ROWS):
         stop = min(start + _BATCH_ROWS, n)
         refs = ref if const else ref[start:stop]
         work.block(T[start:stop], refs, q[start:stop], status[start:stop], sign[start:stop])
-    return BatchIKResult(q, status, sign)
+    return BatchIKResult(q, status, sign, IKStatus, BRANCHES)
 
 
 class _BatchWork:

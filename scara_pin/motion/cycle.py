@@ -632,8 +632,8 @@ def standard_cycle(
         jump_options: the jump's grid and solver options (JUMP).
 
     Raises:
-        ParameterError, InvalidInputError: bad input (exit 2); InfeasibleError (PathError, TimingError,
-        JumpError): the robot cannot do it (exit 3).
+        ParameterError: bad input (exit 2); so is InvalidInputError.
+        InfeasibleError: the robot cannot do it (PathError, TimingError, JumpError; exit 3).
     """
     path = CyclePath(path)
     span = _nonneg("span", span, strict=True)

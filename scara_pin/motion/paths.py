@@ -119,13 +119,16 @@ class GeometricPath(abc.ABC):
         """[0, 1] (toppra's interface)."""
         return np.array([0.0, 1.0])
 
-    def eval(self, s: np.ndarray) -> np.ndarray:  # noqa: D102 - toppra's interface
+    def eval(self, s: np.ndarray) -> np.ndarray:
+        """q(s) at the path parameters ``s`` (toppra's interface): ``path(s, 0)``."""
         return self(s, 0)
 
-    def evald(self, s: np.ndarray) -> np.ndarray:  # noqa: D102
+    def evald(self, s: np.ndarray) -> np.ndarray:
+        """dq/ds at ``s`` (toppra's interface): ``path(s, 1)``."""
         return self(s, 1)
 
-    def evaldd(self, s: np.ndarray) -> np.ndarray:  # noqa: D102
+    def evaldd(self, s: np.ndarray) -> np.ndarray:
+        """d2q/ds2 at ``s`` (toppra's interface): ``path(s, 2)``."""
         return self(s, 2)
 
 

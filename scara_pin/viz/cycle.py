@@ -6,15 +6,16 @@ Object-oriented matplotlib (a Figure on the Agg canvas, no pyplot, no global sta
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..description import JOINT_NAMES
-from ..files import save_figure
+from .plots import finish
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from ..description import JointLimits
     from ..model import Robot
     from ..motion.cycle import ArchMove
@@ -31,14 +32,14 @@ _LEG_COLORS = {"lift": "tab:gray", "blend up": "tab:purple", "traverse": "tab:bl
 def plot_cycle(
     robot: Robot,
     move: ArchMove | JumpMove,
-    path: str | os.PathLike[str],
+    path: str | os.PathLike[str] | None = None,
     *,
     limits: JointLimits | None = None,
     title: str | None = None,
     rate: float = 2000.0,
     dpi: int = 110,
-) -> Path:
-    """Write a PNG of an arch move or cycle: the tool path, and the joint rates against their limits.
+) -> Figure:
+    """An arch move or cycle: the tool path, and the joint rates against their limits (written given a path).
 
     Side view (horizontal progress vs z) and plan view (x, y) with the legs coloured (blends in purple);
     for a jump, its clearance: the height z_top (dashed) outside the circles of radius R around the two poses
@@ -99,7 +100,7 @@ def plot_cycle(
     ax.set_xlabel("t [s]")
     if title:
         fig.suptitle(title)
-    return save_figure(fig, path, dpi=dpi)
+    return finish(fig, path, dpi)
 
 
 def _jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:

@@ -28,12 +28,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..kinematics.palletizer import PalletizerGeometry
+from ..units import SI, DisplayUnits, decimals_for, format_number
 from .arcs import ArmBox, JointRange, Role, box_region, green
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["ArmPlaneEnvelope", "EnvelopeArc", "arm_plane_envelope", "plot_envelope", "reachable"]
 
@@ -165,10 +169,24 @@ def arm_plane_envelope(geo: PalletizerGeometry) -> ArmPlaneEnvelope:
                             (float(pts[:, 1].min()), float(pts[:, 1].max())), geo)  # fmt: skip
 
 
-def plot_envelope(env: ArmPlaneEnvelope, path: str, q: np.ndarray | None = None) -> None:
-    """Draw the envelope to a PNG: arcs coloured by their limit, and the arm at ``q`` (default mid-range)."""
+def plot_envelope(env: ArmPlaneEnvelope, path: str | None = None, q: np.ndarray | None = None, *,
+                  units: DisplayUnits = SI, robot_name: str | None = None, dpi: int = 120) -> Figure:  # fmt: skip
+    """The envelope in the arm plane: arcs coloured by their limit, and the arm at ``q`` (default mid-range).
+
+    Args:
+        env: the envelope.
+        path: write the figure here (PNG, SVG or PDF by the ending; atomically); None: only return it.
+        q: the configuration the arm is drawn at [rad].
+        units: the length unit of the axes (``DisplayUnits("mm")`` for millimetres).
+        robot_name: named in the title.
+        dpi: resolution of a written PNG.
+
+    Returns:
+        the matplotlib Figure.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+    from matplotlib.ticker import FuncFormatter
 
     colours = {"joint2_lower": "tab:green", "joint2_upper": "tab:olive", "joint3_lower": "tab:red",
                "joint3_upper": "tab:orange", "stretched": "tab:blue", "folded": "tab:purple"}  # fmt: skip
@@ -191,11 +209,19 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str, q: np.ndarray | None = None)
     ax.plot(chain[:, 0], chain[:, 1], "k-o", ms=3, lw=1.5, label="arm (mid-range)")
     ax.axhline(0.0, color="grey", lw=0.8)
     ax.set_aspect("equal")
-    ax.set_xlabel("r: from the waist axis [m]")
-    ax.set_ylabel("z: above the floor [m]")
-    ax.set_title(f"palletizer: tool0 in the arm plane, area {env.area:.5g} m$^2$")
+    # drawn in metres; the ticks read in the unit chosen (m or mm: a power of ten keeps them round)
+    L, n = units.scale("length"), units.name("length")
+    ticks = FuncFormatter(lambda v, _: f"{v * L:.6g}")
+    ax.xaxis.set_major_formatter(ticks)
+    ax.yaxis.set_major_formatter(ticks)
+    ax.set_xlabel(f"r: from the waist axis [{n}]")
+    ax.set_ylabel(f"z: above the floor [{n}]")
+    area = format_number(env.area * L * L, decimals_for(L * L, 1e-6))  # to 1 mm^2
+    ax.set_title(f"{robot_name or 'palletizer'}: tool0 in the arm plane, area {area} {n}$^2$")
     ax.legend(loc="best", fontsize=8)
     ax.grid(True, alpha=0.3)
-    from ..files import save_figure  # written atomically: never through a symlink, never a device
+    if path is not None:
+        from ..files import save_figure  # written atomically: never through a symlink, never a device
 
-    save_figure(fig, path, dpi=120, bbox_inches="tight")
+        save_figure(fig, path, dpi=dpi, bbox_inches="tight")
+    return fig

@@ -67,9 +67,12 @@ import numpy as np
 from ..errors import InvalidInputError, ParameterError
 from ..kinematics.planar2r import LIMIT_TOL
 from ..kinematics.scara import NEAR_PARALLEL_TOL, ScaraGeometry
+from ..units import SI, DisplayUnits, decimals_for, format_number
 from .arcs import SIDE_OFFSET, ArmBox, JointRange, Role, box_region
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from .._typing import ArrayLike
     from ..model import Robot
 
@@ -612,28 +615,40 @@ def _labels(geo: ScaraGeometry) -> dict[Role, tuple[tuple[Limit, str], int]]:
 # ------------------------------------------------------------------------------------------ picture
 def plot_workspace(
     ws: Workspace,
-    path: str,
+    path: str | None = None,
     q: Sequence[float] | None = None,
     ray: tuple[Sequence[float], Sequence[float]] | None = None,
-) -> None:
-    """Draw the region to a PNG: filled, arcs coloured by their limit, the arm at ``q``, a ray and its hit.
+    *,
+    units: DisplayUnits = SI,
+    robot_name: str | None = None,
+    dpi: int = 120,
+) -> Figure:
+    """The region in plan view: filled, arcs coloured by their limit, the arm at ``q``, a ray and its hit.
 
     Args:
         ws: the workspace.
-        path: output file (.png).
+        path: write the figure here (PNG, SVG or PDF by the ending; atomically); None: only return it.
         q: a joint configuration (q order) to draw the arm at; default the limits' midpoints (finite ones).
-        ray: (start, direction) of a ray to draw with its edge point.
+        ray: (start, direction) of a ray to draw with its edge point [m].
+        units: the length unit of the axes (``DisplayUnits("mm")`` for millimetres).
+        robot_name: named in the title.
+        dpi: resolution of a written PNG.
+
+    Returns:
+        the matplotlib Figure.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path as MPath
+    from matplotlib.ticker import FuncFormatter
 
     colours = {Limit.OUTER: "tab:blue", Limit.FOLDED: "tab:purple", Limit.J1_LOWER: "tab:red",
                Limit.J1_UPPER: "tab:orange", Limit.J2_LOWER: "tab:green", Limit.J2_UPPER: "tab:olive"}  # fmt: skip
     fig = Figure(figsize=(7, 7))  # object-oriented: no pyplot, no global backend or figure state
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
+    L, n = units.scale("length"), units.name("length")
     verts: list[np.ndarray] = []
     codes: list[int] = []
     for loop in ws.loops:
@@ -671,16 +686,25 @@ def plot_workspace(
         start, direction = ray
         hit = ws.ray(start[:2], direction[:2])
         ax.plot([start[0], hit.point[0]], [start[1], hit.point[1]], "--", color="crimson", lw=1.5,
-                label=f"ray: {hit.distance:.4g} m to {hit.limit.value}")  # fmt: skip
+                label=f"ray: {hit.distance * L:.4g} {n} to {hit.limit.value}")  # fmt: skip
         ax.plot(*hit.point[:2], "x", color="crimson", ms=10, mew=2)
         ax.plot(start[0], start[1], "o", color="crimson", ms=5)
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.grid(alpha=0.3)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(f"workspace: area {ws.area:.5g} m$^2$, r in [{ws.r_min:.4g}, {ws.r_max:.4g}] m")
+    # drawn in metres; the ticks read in the unit chosen (m or mm: a power of ten keeps them round)
+    ticks = FuncFormatter(lambda v, _: f"{v * L:.6g}")
+    ax.xaxis.set_major_formatter(ticks)
+    ax.yaxis.set_major_formatter(ticks)
+    ax.set_xlabel(f"x [{n}] (base frame)")
+    ax.set_ylabel(f"y [{n}]")
+    head = f"{robot_name}: " if robot_name else ""
+    area = format_number(ws.area * L * L, decimals_for(L * L, 1e-6))  # to 1 mm^2 and 1 um
+    radii = ", ".join(format_number(r * L, decimals_for(L, 1e-6)) for r in (ws.r_min, ws.r_max))
+    ax.set_title(f"{head}reachable region of the wrist axis\narea {area} {n}$^2$, r in [{radii}] {n}")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=7, framealpha=0.8)
-    from ..files import save_figure  # written atomically: never through a symlink, never a device
+    if path is not None:
+        from ..files import save_figure  # written atomically: never through a symlink, never a device
 
-    save_figure(fig, path, dpi=120, bbox_inches="tight")
+        save_figure(fig, path, dpi=dpi, bbox_inches="tight")
+    return fig
