@@ -124,8 +124,9 @@ def cmd_cycle(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
         return 0
     Ln = units.length_name
+    timing = "jerk-limited time-optimal timing" if move.jerk else "TOPP-RA timing"
     what = ("jump (time-optimal, joint path free)" if path is CyclePath.JUMP
-            else "straight-leg arch (lines and blends, TOPP-RA timing)")  # fmt: skip
+            else f"straight-leg arch (lines and blends, {timing})")  # fmt: skip
     print(f"robot       {robot.name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
           + (f", jerk limit {list(move.jerk)}" if move.jerk else ""))  # fmt: skip
     print(f"cycle time  {_num(result.cycle_time, 6)} s (up {units.num(result.rise, 'length')}, across "

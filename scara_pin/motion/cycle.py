@@ -47,7 +47,7 @@ import numpy as np
 
 from .._checks import _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from .jerk import jerk_limited
+from .jerk import time_optimal_jerk
 from .jump import STANDARD_CLEARANCE, STANDARD_RISE, JumpMove, JumpOptions, Leg, LowerBound, jump_move, lower_bound
 from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
 from .payload import Payload, with_payload
@@ -140,6 +140,9 @@ class BlendSegment(CartesianSegment):
 
     def pose_derivatives(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # noqa: D102
         return self._at(s, 1), self._at(s, 2)
+
+    def pose_third_derivative(self, s: np.ndarray) -> np.ndarray:  # noqa: D102
+        return self._at(s, 3)
 
 
 @dataclass(frozen=True, eq=False)
@@ -453,18 +456,19 @@ def arch_move(
         path = arch_path(robot, P[k], P[k + 1], rise=rise, blend=blend, start=q, branch=branch)
         paths.append(path)
         q, branch = path.q_end, path.branch
-    pieces: list[Motion] = []
-    # the blends' curvature changes fast: 128 verified points per grid segment (besides 1 kHz) keep the
-    # acceleration between verified points within 1e-6 of its limit (16 left 2.9e-5 at 400 kHz; 128 leave 8e-7)
-    options = options if options is not None else TimingOptions(check_subdivisions=128)
-    for path in paths:
-        res = parameterize(loaded, path, torque=torque, limits=limits, options=options, tool_speed=tool_speed)
-        pieces.extend(p for p in res.trajectory.pieces if isinstance(p, Motion))
-    traj = Trajectory(tuple(pieces))
     jv = None
-    if jerk is not None:
-        traj, _ = jerk_limited(loaded, traj, jerk, torque=torque, limits=limits, options=options)
+    if jerk is not None:  # the jerk-limited timing of the same paths (its own start: no TOPP-RA profile needed)
+        traj = time_optimal_jerk(loaded, paths, jerk, torque=torque, limits=limits).trajectory
         jv = tuple(float(v) for v in np.broadcast_to(np.asarray(jerk, dtype=float), (4,)))
+    else:
+        pieces: list[Motion] = []
+        # the blends' curvature changes fast: 128 verified points per grid segment (besides 1 kHz) keep the
+        # acceleration between verified points within 1e-6 of its limit (16 left 2.9e-5 at 400 kHz; 128: 8e-7)
+        options = options if options is not None else TimingOptions(check_subdivisions=128)
+        for path in paths:
+            res = parameterize(loaded, path, torque=torque, limits=limits, options=options, tool_speed=tool_speed)
+            pieces.extend(p for p in res.trajectory.pieces if isinstance(p, Motion))
+        traj = Trajectory(tuple(pieces))
     legs, ratios = _legs(loaded, traj, paths, lim, None if jv is None else np.array(jv))
     return ArchMove(traj, tuple(paths), legs, ratios, payload, jv)
 

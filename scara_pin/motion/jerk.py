@@ -1,43 +1,44 @@
 """Jerk-limited TIME-OPTIMAL timing of a path: joint velocity, acceleration, jerk (and torque) limits, each local.
 
-The law is found by direct collocation in time, solved by IPOPT (casadi); the path ``q(s)`` is followed
-exactly (only the time law ``s(t)`` is computed). With N intervals of equal length h = T / N and a
-constant path jerk ``c_k`` on each, ``s(t)`` is a C2 piecewise cubic, integrated exactly:
+The path ``q(s)`` is followed exactly; only the time law ``s(t)`` is computed, by direct collocation in
+time solved by IPOPT (casadi). The law has N intervals of free lengths h_k and a constant path jerk
+``c_k`` on each: s(t) is a C2 piecewise cubic, integrated exactly from node to node,
 
     s_{k+1} = s_k + h sd_k + h^2 sdd_k / 2 + h^3 c_k / 6,   sd_{k+1} = sd_k + h sdd_k + h^2 c_k / 2,
     sdd_{k+1} = sdd_k + h c_k,        rest at both ends: (s, sd, sdd) = (0, 0, 0) and (1, 0, 0).
 
-Minimise T subject to, at sigma = 0, 1/2, 1 of every interval (the jerk at both sides of every node),
+**The points are fixed in s.** The node values s_k are GIVEN (a node on each knot of the path, where
+q''' jumps), and so is one point m_k inside each interval, reached at a free time u_k h_k
+(``m_k = s_k + tau sd_k + tau^2 sdd_k / 2 + tau^3 c_k / 6``, tau = u_k h_k). The path derivatives q',
+q'', q''' (both sides of the knots) and the torque coefficients are evaluated ONCE, exactly, at those
+points; the unknowns are the times and the states there. Minimise T = sum h_k subject to, at every node
+and every inner point,
 
     |q'(s) sd| <= vmax,   |q'(s) sdd + q''(s) sd^2| <= amax,
-    |q'(s) c + 3 q''(s) sd sdd + q'''(s) sd^3| <= jmax,   |a(s) sdd + b(s) sd^2 + g(s)| <= tau_max
+    |q'(s) c + 3 q''(s) sd sdd + q'''(s) sd^3| <= jmax (at a node: the jerk of both intervals),
+    |a(s) sdd + b(s) sd^2 + g(s)| <= tau_max
 
 (torques as in :mod:`~scara_pin.motion.timing`: ``g = rnea(q, 0, 0)``, ``a = rnea(q, 0, q') - g``,
 ``b = rnea(q, q', q'') - g``). Each limit binds where it binds: there is no global slow-down. Working in
-time avoids the rest-to-rest singularity of the s-domain (sd = 0 at both ends, where a jerk-limited start
-has ``sd ~ s^(2/3)``, no polynomial in s).
+time avoids the rest-to-rest singularity of the s-domain (a jerk-limited start has ``sd ~ s^(2/3)``, no
+polynomial in s); fixing the points in s makes the NLP's data exact and constant: ONE NLP per grid.
 
-**The path inside the NLP.** The path derivatives are evaluated EXACTLY (:meth:`GeometricPath.evaluate`,
-:func:`~scara_pin.motion.verify.path_third_derivative`) at the collocation points of the current iterate
-and expanded to second order in ``s - s_bar`` (q' + q'' ds + q''' ds^2 / 2, q'' + q''' ds, q''') inside a
-trust region |s - s_bar| <= delta: a sequence of NLPs, each warm-started from the last, delta halved after
-the first few, until the points stop moving (1e-9 in s). At convergence every constraint holds with the
-exact path at every collocation point.
+**Grids.** The first grid puts the nodes at equal times of a feasible double-S law (:func:`_guess`); the
+second at equal times of the first solution (the intervals then have nearly equal lengths at the
+optimum), solved warm.
 
-**Between the points** (the promise is the :mod:`~scara_pin.motion.verify` grid, 10 kHz): the exact joint
-states q, qd, qdd, qddd are computed at sigma = 0, 1/4, 1/2, 3/4 and 1- of every interval (and densely in
-the intervals that hold a knot of the path, where q''' jumps), interpolated by the quartic through them
-(errors ~ (h / T_phase)^5) at :data:`_DENSE` points per interval, and the time scale k that brings the
-worst ratio there to 1 is applied (:func:`~scara_pin.motion.verify.time_scale`): a final correction of a
-few 1e-4 at most (reported as ``correction``), never the old global slow-down.
+**Between the points** (the promise is the :mod:`~scara_pin.motion.verify` grid, 10 kHz): the exact
+joint states are evaluated on the trajectory's 10 kHz grid and on both sides of every node; where an
+interval exceeds a limit by more than 1e-3 the limits at its points are divided by the excess and the
+NLP solved again (warm); then the time scale k that brings the worst ratio there to 1 is applied
+(:func:`~scara_pin.motion.verify.time_scale`: a final correction of a few 1e-4 at most, reported as
+``correction``, never the old global slow-down) and a 2e-6 margin.
 
-**Initial guess**: the TOPP-RA profile filtered by a moving average (:class:`~scara_pin.motion.jerk_fir.FilteredLaw`).
-
-Why IPOPT through casadi: the NLP is small (4 N + 1 variables), sparse, smooth; IPOPT with casadi's exact
-Hessians converges in 20-60 iterations from the filtered profile and every step is robust to an
-infeasible start. A sequential LP (HiGHS) needs a merit function and more iterations; the s-domain SOCP
-(Clarabel) cannot represent the jerk-limited rest. casadi is imported only inside the solver (about
-0.15 s). See ``docs/jerk.md``.
+Why IPOPT through casadi: the NLP is small (5 N + 2 variables), sparse and smooth, its data constant;
+IPOPT with casadi's exact Hessians converges in 15-40 iterations from a feasible start and every step is
+robust to an infeasible one. A sequential LP (HiGHS) needs a merit function and more iterations; the
+s-domain SOCP (Clarabel) cannot represent the jerk-limited rest. casadi is imported only inside the
+solver. See ``docs/jerk.md``.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ from __future__ import annotations
 import functools
 import logging
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -54,9 +56,9 @@ import numpy as np
 from .._checks import _positive
 from ..errors import InfeasibleError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
-from .paths import CartesianPath, GeometricPath, joint_path
-from .timing import TimingError, TimingOptions, parameterize
-from .trajectory import Motion, ProfileLaw, TimeLaw, Trajectory
+from .paths import CartesianPath, GeometricPath, path_segments
+from .timing import TimingError
+from .trajectory import Motion, TimeLaw, Trajectory
 from .verify import (
     VERIFY_RATE,
     Quantity,
@@ -64,8 +66,7 @@ from .verify import (
     _limits,
     _rnea,
     jerk_vector,
-    joint_jerk,
-    path_third_derivative,
+    motion_states,
     state_ratios,
     time_scale,
 )
@@ -80,32 +81,20 @@ __all__ = ["JerkLaw", "JerkOptions", "JerkRatios", "JerkResult", "jerk_limited",
 
 logger = logging.getLogger(__name__)
 
-_SIGMA = (0.0, 0.5, 1.0)
-"""Collocation points in each interval (fractions of h)."""
-_CHECK_SIGMA = np.array([0.0, 0.25, 0.5, 0.75, 1.0 - 1e-9])
-"""Exact evaluation points of the final check in each interval (the quartic through them interpolates)."""
-_DENSE = 48
-"""Interpolated points per interval in the final check (h / 48 < 0.1 ms for h < 4.8 ms)."""
-_KNOT_DENSE = 64
-"""Exact points in an interval that holds a knot of the path (q''' jumps there: no interpolation)."""
-_FIRST_DELTA = 0.05
-"""Trust region in s of the first NLPs; halved each time after the first three."""
-_S_TOL = 1e-7
-"""Convergence: the collocation points moved less than this in s (the expansion is then exact to ~1e-14)."""
+_SIDE = 1e-9
+"""The left side of a node, as a fraction of the interval before it (the jerk switches at the node)."""
 _MARGIN = 2e-6
 """The final time margin (relative) over the checked grid."""
-_T_TOL = 1e-7
-"""Convergence also when the duration changed less than this (relative) and the exact path data are kept."""
 _ACCEPT = 1.0 + 1e-9
 """The final correction brings the worst checked ratio to 1; this small margin covers rounding."""
 _CORRECTION_MAX = 0.02
-_TIGHTEN_ROUNDS = 6
-"""NLP rounds with the limits tightened where the dense check found them exceeded."""
-_BINS = 2000
-"""Bins of s that carry the local tightening of the limits."""
+"""A final correction above 2 % means the NLP did not converge to the exact path: an error, not a slow motion."""
+_REGRIDS = 1
+"""Grids after the first: each from the last solution, denser where its jerk switches (:func:`_density`)."""
+_PROBES = 8
+"""Points inside each interval where the tightening rounds check the exact limits (besides the nodes)."""
 _TIGHT_TOL = 1e-3
 """Between-point excess left to the final uniform correction (a time scale of at most ~1e-3)."""
-"""A final correction above 2 % means the NLP did not converge to the exact path: an error, not a slow motion."""
 
 
 @dataclass(frozen=True)
@@ -114,20 +103,21 @@ class JerkOptions:
 
     Attributes:
         intervals: N, the intervals of constant path jerk (more: closer to the continuous optimum, slower
-            to plan; 40 is within about 0.3 % of the optimum on the moves tested, see ``docs/jerk.md``).
-        max_iterations: the largest number of NLPs (each warm-started) before giving up.
+            to plan; see ``docs/jerk.md`` for the figures).
+        max_iterations: the largest number of NLPs per path (two grids, then the local tightening rounds).
         ipopt_iterations: IPOPT's iteration limit per NLP.
-        check_rate: [Hz] the verification rate the duration is sized for (the samples a trajectory of the
-            implied duration would need, against :data:`~scara_pin.limits.MAX_SAMPLES`).
+        check_rate: [Hz] the verification rate (the grid the result is checked and corrected on; the
+            samples a trajectory of the implied duration would need are sized against
+            :data:`~scara_pin.limits.MAX_SAMPLES`).
     """
 
-    intervals: int = 40
-    max_iterations: int = 25
+    intervals: int = 48
+    max_iterations: int = 8
     ipopt_iterations: int = 500
     check_rate: float = VERIFY_RATE
 
     def __post_init__(self) -> None:
-        for name, low, high in (("intervals", 8, 2000), ("max_iterations", 1, 1000), ("ipopt_iterations", 10, 100000)):
+        for name, low, high in (("intervals", 8, 2000), ("max_iterations", 2, 1000), ("ipopt_iterations", 10, 100000)):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not low <= v <= high:
                 raise ParameterError(name, v, f"must be an integer in [{low}, {high}]")
@@ -236,6 +226,23 @@ class JerkLaw(TimeLaw):
         """The node times [s] (the path jerk is constant between them)."""
         return self.t.copy()
 
+    def reversed(self, knots: tuple[float, ...] | None = None) -> JerkLaw:
+        """The law run backwards on the reversed path: s_r(t) = 1 - s(T - t).
+
+        So sd_r(t) = sd(T - t), sdd_r(t) = -sdd(T - t) and the path jerk c_r(t) = c(T - t) (the intervals
+        in reverse order). On q_r(s) = q(1 - s) the joints then move as q_r(s_r(t)) = q(s(T - t)): the
+        motion in reverse, velocities and jerks negated, accelerations and torques unchanged (frictionless
+        rigid bodies: the Coriolis and centrifugal terms are quadratic in qd).
+
+        Args:
+            knots: the reversed path's own knots (1 - each of :attr:`knots` up to rounding: the nodes must
+                sit on the path's values exactly); default 1 - each.
+        """
+        t = self.duration - self.t[::-1]
+        t[0] = 0.0
+        knots = tuple(1.0 - k for k in self.knots) if knots is None else knots
+        return JerkLaw.from_jerks(t, self.c[::-1].copy(), knots)
+
 
 def _integrate(h: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     n = len(c)
@@ -283,244 +290,342 @@ def _size(path: GeometricPath, jv: np.ndarray, lim: _Limits, opts: JerkOptions) 
 # ---------------------------------------------------------------------------------------------- the NLP
 @functools.lru_cache(maxsize=8)
 def _nlp(n: int, torque: bool, dof: int, ipopt_iterations: int) -> Any:
-    """The parametric NLP (casadi/IPOPT) for n intervals: built once per shape, reused for every path.
+    """The parametric NLP (casadi/IPOPT) of n intervals: built once per shape, reused for every path.
 
-    Variables x = (H, s, p, r, c) in the reference time T_ref (parameters): H the interval length in units
-    of T_ref / n (equal on every interval), p = T_ref sd, r = T_ref^2 sdd, c = T_ref^3 sddd. Parameters:
-    the collocation points' s_bar, the path data there, the limits in reference units.
+    Variables x = (H, P, R, C, U) in a reference time T_ref: H (n) the interval lengths in units of
+    T_ref / n, P = T_ref sd and R = T_ref^2 sdd at the nodes (n + 1), C = T_ref^3 sddd on the intervals (n),
+    U (n) the fraction of each interval where its midpoint in s is reached. Parameters: the nodes' s
+    (n + 1) and the midpoints' s (n), the path data there (module docstring), the limits there (each point
+    its own, in reference units: the local tightening).
+
+    Returns:
+        (solver, constraint function g(x, p), number of equality rows, number of limit rows).
     """
     import casadi as ca
 
-    H = ca.SX.sym("H", n)
-    S, P, R, C = ca.SX.sym("s", n + 1), ca.SX.sym("p", n + 1), ca.SX.sym("r", n + 1), ca.SX.sym("c", n)
-    npt = len(_SIGMA) * n
-    cols = (6 if torque else 3) * dof
-    par = ca.SX.sym("par", npt * (1 + cols + 4 * dof))
-    s_bar = par[:npt]
-    D = ca.reshape(par[npt : npt * (1 + cols)], npt, cols)
-    L = ca.reshape(par[npt * (1 + cols) :], npt, 4 * dof)  # the limits at each point (tightened locally)
+    H, P, R, C, U = (ca.SX.sym(name, size) for name, size in (("H", n), ("P", n + 1), ("R", n + 1), ("C", n),
+                                                                ("U", n)))  # fmt: skip
+    cn, cm = (7 if torque else 4) * dof, (6 if torque else 3) * dof
+    sizes = (n + 1, n, (n + 1) * cn, n * cm, (n + 1) * 4 * dof, n * 4 * dof)
+    par = ca.SX.sym("par", sum(sizes))
+    cut = np.cumsum((0, *sizes))
+    S, M = par[cut[0] : cut[1]], par[cut[1] : cut[2]]
+    DN = ca.reshape(par[cut[2] : cut[3]], n + 1, cn)
+    DM = ca.reshape(par[cut[3] : cut[4]], n, cm)
+    LN = ca.reshape(par[cut[4] : cut[5]], n + 1, 4 * dof)
+    LM = ca.reshape(par[cut[5] : cut[6]], n, 4 * dof)
     h = H / n
-    dyn = [S[1:] - (S[:-1] + h * P[:-1] + h**2 / 2 * R[:-1] + h**3 / 6 * C),
-           P[1:] - (P[:-1] + h * R[:-1] + h**2 / 2 * C), R[1:] - (R[:-1] + h * C), H[1:] - H[:-1]]  # fmt: skip
-    pts = []
-    for k in range(n):
-        for sig in _SIGMA:
-            t = sig * h[k]
-            pts.append((S[k] + P[k] * t + R[k] * t**2 / 2 + C[k] * t**3 / 6, P[k] + R[k] * t + C[k] * t**2 / 2,
-                        R[k] + C[k] * t, C[k]))  # fmt: skip
-    sp, pp, rp, cp = (ca.vertcat(*[x[i] for x in pts]) for i in range(4))
-    ds = sp - s_bar
-    cons = []
+    tau = U * h
+    p0, r0 = P[:-1], R[:-1]
+    eq = [S[1:] - S[:-1] - (h * p0 + h**2 / 2 * r0 + h**3 / 6 * C),
+          P[1:] - (p0 + h * r0 + h**2 / 2 * C),
+          R[1:] - (r0 + h * C),
+          M - S[:-1] - (tau * p0 + tau**2 / 2 * r0 + tau**3 / 6 * C)]  # fmt: skip
+    pm, rm = p0 + tau * r0 + tau**2 / 2 * C, r0 + tau * C
+    rows: list[Any] = []
     for j in range(dof):
-        D1, D2, D3 = D[:, j], D[:, dof + j], D[:, 2 * dof + j]
-        d1 = D1 + D2 * ds + D3 * ds**2 / 2
-        d2 = D2 + D3 * ds
-        cons += [d1 * pp / L[:, j], (d1 * rp + d2 * pp**2) / L[:, dof + j],
-                 (d1 * cp + 3 * d2 * pp * rp + D3 * pp**3) / L[:, 2 * dof + j]]  # fmt: skip
+        d1, d2, d3l, d3r = (DN[:, k * dof + j] for k in range(4))
+        m1, m2, m3 = (DM[:, k * dof + j] for k in range(3))
+        v, a, jk, e = (LN[:, k * dof + j] for k in range(4))
+        vm, am, jm, em = (LM[:, k * dof + j] for k in range(4))
+        rows += [d1 * P / v, (d1 * R + d2 * P**2) / a,
+                 (d1[1:] * C + 3 * d2[1:] * P[1:] * R[1:] + d3l[1:] * P[1:] ** 3) / jk[1:],  # left of node k + 1
+                 (d1[:-1] * C + 3 * d2[:-1] * p0 * r0 + d3r[:-1] * p0**3) / jk[:-1],  # right of node k
+                 m1 * pm / vm, (m1 * rm + m2 * pm**2) / am, (m1 * C + 3 * m2 * pm * rm + m3 * pm**3) / jm]  # fmt: skip
         if torque:
-            A, B, G = D[:, 3 * dof + j], D[:, 4 * dof + j], D[:, 5 * dof + j]
-            cons.append((A * rp + B * pp**2 + G) / L[:, 3 * dof + j])
-    nlp = {"x": ca.vertcat(H, S, P, R, C), "f": ca.sum1(H) / n, "g": ca.vertcat(*dyn, *cons, pp, ds), "p": par}
-    opts: dict[str, Any] = {"ipopt.print_level": 0, "print_time": 0, "ipopt.sb": "yes", "ipopt.tol": 1e-8,
-            "ipopt.max_iter": ipopt_iterations, "ipopt.warm_start_init_point": "yes",
-            "ipopt.mu_init": 1e-3}  # fmt: skip
-    g = ca.Function("jerk_constraints", [nlp["x"], par], [nlp["g"]])
-    return ca.nlpsol("jerk_time_optimal", "ipopt", nlp, opts), g, 4 * n - 1, len(cons) * npt, npt
+            A, B, G = (DN[:, (4 + k) * dof + j] for k in range(3))
+            Am, Bm, Gm = (DM[:, (3 + k) * dof + j] for k in range(3))
+            rows += [(A * R + B * P**2 + G) / e, (Am * rm + Bm * pm**2 + Gm) / em]
+    g = ca.vertcat(*eq, *rows, pm)
+    n_eq = 4 * n
+    n_lim = int(g.numel()) - n_eq - n
+    nlp = {"x": ca.vertcat(H, P, R, C, U), "f": ca.sum1(H) / n, "g": g, "p": par}
+    opts: dict[str, Any] = {
+        "ipopt.print_level": 0, "print_time": 0, "ipopt.sb": "yes", "ipopt.tol": 1e-9,
+        "ipopt.constr_viol_tol": 1e-11, "ipopt.max_iter": ipopt_iterations, "ipopt.mu_strategy": "adaptive",
+        # MUMPS' own scaling costs more than the factorisation of this small, well-scaled system
+        "ipopt.mumps_scaling": 0, "ipopt.mumps_permuting_scaling": 0,
+        "ipopt.warm_start_init_point": "yes", "ipopt.warm_start_bound_push": 1e-9,
+        "ipopt.warm_start_mult_bound_push": 1e-9}  # fmt: skip
+    return ca.nlpsol("jerk_time_optimal", "ipopt", nlp, opts), ca.Function("g", [nlp["x"], par], [g]), n_eq, n_lim
 
 
-def _bin(s: np.ndarray | float) -> np.ndarray:
-    """The bin of s in [0, 1] (_BINS of them)."""
-    return np.clip((np.asarray(s) * _BINS).astype(int), 0, _BINS - 1)
+def _path_data(robot: Robot, path: GeometricPath, s: np.ndarray, torque: bool, Tr: float) -> np.ndarray:
+    """(n, 3 dof) q', q'', q''' at s; with ``torque`` also the RNEA coefficients a, b (in reference units) and g.
 
-
-def _path_data(robot: Robot, path: GeometricPath, s: np.ndarray, torque: bool) -> np.ndarray:
-    """(n, 3 dof) q', q'', q''' at s, and with ``torque`` the RNEA coefficients a, b, g: (n, 6 dof)."""
-    q, d1, d2 = path.evaluate(s, 2)
-    cols = [d1, d2, path_third_derivative(path, s)]
+    tau = a sdd + b sd^2 + g with ``g = rnea(q, 0, 0)``, ``a = rnea(q, 0, q') - g``,
+    ``b = rnea(q, q', q'') - g``; a and b are divided by T_ref^2 (the NLP's R and P are T_ref^2 sdd, T_ref sd).
+    """
+    q, d1, d2, d3 = path.evaluate(s, 3)
+    cols = [d1, d2, d3]
     if torque:
         zero = np.zeros_like(d1)
         g = _rnea(robot, q, zero, zero)
-        cols += [_rnea(robot, q, zero, d1) - g, _rnea(robot, q, d1, d2) - g, g]
-    return np.hstack(cols)
-
-
-def _points(x: np.ndarray, n: int) -> np.ndarray:
-    """The collocation points' s for the variables x."""
-    H, S, P, R, C = (x[:n], x[n : 2 * n + 1], x[2 * n + 1 : 3 * n + 2], x[3 * n + 2 : 4 * n + 3],
-                     x[4 * n + 3 :])  # fmt: skip
-    t = np.array(_SIGMA)[None, :] * (H[:, None] / n)
-    return (S[:-1, None] + P[:-1, None] * t + R[:-1, None] * t**2 / 2 + C[:, None] * t**3 / 6).ravel()
-
-
-class _Solver:
-    """The sequence of NLPs on one path (module docstring), warm-started, with per-point limit factors."""
-
-    def __init__(self, robot: Robot, path: GeometricPath, base: ProfileLaw, lim: _Limits, jv: np.ndarray,
-                 opts: JerkOptions, segment: int) -> None:  # fmt: skip
-        from .jerk_fir import FilteredLaw
-
-        n = opts.intervals
-        self.robot, self.path, self.lim, self.jv, self.opts, self.segment = robot, path, lim, jv, opts, segment
-        self.dof = len(lim.velocity)
-        self.torque = lim.effort is not None
-        self.solver, self.g, self.n_dyn, self.n_con, self.npt = _nlp(n, self.torque, self.dof, opts.ipopt_iterations)
-        guess = FilteredLaw(base, 0.15 * base.duration)
-        self.Tr = Tr = guess.duration
-        s0, sd0, sdd0, _ = guess.evaluate_jerk(np.linspace(0.0, 1.0, n + 1) * Tr)
-        self.x = np.concatenate([np.ones(n), s0, sd0 * Tr, sdd0 * Tr**2, np.diff(sdd0 * Tr**2) * n])
-        o = n
-        self.lbx, self.ubx = np.full(len(self.x), -np.inf), np.full(len(self.x), np.inf)
-        self.lbx[:n] = 1e-3
-        self.lbx[o : o + n + 1], self.ubx[o : o + n + 1] = 0.0, 1.0
-        self.lbx[o + n + 1 : o + 2 * n + 2] = 0.0
-        for i, value in ((o, 0.0), (o + n, 1.0), (o + n + 1, 0.0), (o + 2 * n + 1, 0.0), (o + 2 * n + 2, 0.0),
-                         (o + 3 * n + 2, 0.0)):  # fmt: skip
-            self.lbx[i] = self.ubx[i] = value
-        # nodes pinned at the path's knots (the third derivative jumps there): the node nearest the guess's
-        # crossing time; the interval length is equal within each smooth piece, free from one piece to the next
-        knots = np.unique(np.clip(path.knots(), 0.0, 1.0))[1:-1]
-        cross = np.interp(knots, s0, np.arange(n + 1)) if len(knots) else np.zeros(0)
-        nodes = np.clip(np.round(cross).astype(int), 1, n - 1)
-        if len(nodes) and ((np.diff(nodes) < 1).any() or len(nodes) > n // 4):
-            raise TimingError("JerkNLP", f"the path has {len(knots)} knots too close in time for {n} intervals "
-                              "(more intervals needed)", segment=segment)  # fmt: skip
-        for m, kn in zip(nodes, knots):
-            self.lbx[o + m] = self.ubx[o + m] = kn
-        self.knot_nodes, self.knots = nodes, knots
-        self.chain_free = np.zeros(n - 1, dtype=bool)
-        self.chain_free[nodes - 1] = True  # row k of H[k+1] - H[k]: free where node k + 1 is a knot
-        e = lim.effort if lim.effort is not None else np.ones(self.dof)
-        self.limits = np.concatenate([lim.velocity * Tr, lim.acceleration * Tr**2, jv * Tr**3, e])
-        self.warm: dict[str, Any] = {}
-        self.nlps = 0
-
-    def _feasible(self, x: np.ndarray) -> bool:
-        """True when x keeps every limit (1e-6) with the EXACT path data at its own collocation points."""
-        n = self.opts.intervals
-        s_bar = np.clip(_points(x, n), 0.0, 1.0)
-        s_eval = s_bar.copy()
-        s_eval[len(_SIGMA) * (self.knot_nodes - 1) + len(_SIGMA) - 1] = self.knots - 1e-12
-        D = _path_data(self.robot, self.path, s_eval, self.torque)
-        L = (self.limits[None, :] * self.tight[_bin(s_bar)]).ravel(order="F")
-        g = np.asarray(self.g(x, np.concatenate([s_bar, D.ravel(order="F"), L])), dtype=float).ravel()
-        return bool(np.all(np.abs(g[self.n_dyn : self.n_dyn + self.n_con]) <= 1.0 + 1e-6))
-
-    def run(self, tight: np.ndarray) -> JerkLaw:
-        """Solve with the limits multiplied by ``tight`` (_BINS, 4 dof: a factor per bin of s), until converged."""
-        n, npt, x = self.opts.intervals, self.npt, self.x
-        self.tight = tight
-        delta = _FIRST_DELTA
-        for it in range(self.opts.max_iterations):
-            s_bar = np.clip(_points(x, n), 0.0, 1.0)
-            L = (self.limits[None, :] * tight[_bin(s_bar)]).ravel(order="F")
-            s_eval = s_bar.copy()
-            s_eval[len(_SIGMA) * (self.knot_nodes - 1) + len(_SIGMA) - 1] = self.knots - 1e-12  # the left side
-            D = _path_data(self.robot, self.path, s_eval, self.torque)
-            if not np.isfinite(D).all():
-                raise TimingError("JerkNLP", "the path derivatives are not finite (a singular point)",
-                                  segment=self.segment)  # fmt: skip
-            lbg = np.concatenate([np.zeros(self.n_dyn), -np.ones(self.n_con), np.zeros(npt), np.full(npt, -delta)])
-            ubg = np.concatenate([np.zeros(self.n_dyn), np.ones(self.n_con), np.full(npt, np.inf), np.full(npt, delta)])
-            chain = slice(3 * n, 4 * n - 1)
-            lbg[chain] = np.where(self.chain_free, -np.inf, 0.0)
-            ubg[chain] = np.where(self.chain_free, np.inf, 0.0)
-            res = self.solver(x0=x, lbx=self.lbx, ubx=self.ubx, lbg=lbg, ubg=ubg,
-                              p=np.concatenate([s_bar, D.ravel(order="F"), L]), **self.warm)  # fmt: skip
-            self.nlps += 1
-            status = self.solver.stats()["return_status"]
-            if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
-                raise TimingError("JerkNLP", f"IPOPT did not converge ({status}) on NLP {self.nlps}",
-                                  segment=self.segment)  # fmt: skip
-            x_new = np.asarray(res["x"], dtype=float).ravel()
-            self.warm = {"lam_x0": res["lam_x"], "lam_g0": res["lam_g"]}
-            step = float(np.max(np.abs(_points(x_new, n) - s_bar)))
-            T_change = abs(x_new[0] - x[0]) / x[0] if it else math.inf
-            x = x_new
-            logger.debug("segment %d NLP %d: T = %.9f s, step %.3g", self.segment, self.nlps, x[0] * self.Tr, step)
-            if step < _S_TOL or (T_change < _T_TOL and self._feasible(x)):
-                break
-            if it >= 2:
-                delta = max(delta / 2.0, 1e-12)
-        else:
-            raise TimingError("JerkNLP", f"the collocation points still move after {self.opts.max_iterations} NLPs",
-                              segment=self.segment)  # fmt: skip
-        self.x = x
-        t = np.concatenate([[0.0], np.cumsum(x[:n] * self.Tr / n)])
-        return JerkLaw.from_jerks(t, x[n + 3 * n + 3 :] / self.Tr**3, tuple(self.knots.tolist()))
-
-
-def _states(motion: Motion, law: JerkLaw, t: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(q, qd, qdd, qddd) at times t, from exact values at sigma = 0, 1/4, 1/2, 3/4, 1- of each interval.
-
-    Interpolated by the quartic through them; exact where the interval holds a knot of the path.
-    """
-    t = np.clip(np.asarray(t, dtype=float), 0.0, law.duration)
-    n = len(law.c)
-    i = np.clip(np.searchsorted(law.t, t, side="right") - 1, 0, n - 1)
-    h = np.diff(law.t)
-    sig = (t - law.t[i]) / h[i]
-    knots = np.unique(np.clip(motion.path.knots(), 0.0, 1.0))[1:-1]
-    rough = np.asarray(((knots[None, :] > law.s[:-1, None] - 1e-12) & (knots[None, :] < law.s[1:, None] + 1e-12))
-                       .any(axis=1), dtype=bool)  # fmt: skip
-    exact = rough[i]
-    need = np.unique(i[~exact])
-    out = [np.empty((len(t), motion.path.dof if hasattr(motion.path, "dof") else 4)) for _ in range(4)]
-    if len(need):
-        tt = (law.t[need, None] + h[need, None] * _CHECK_SIGMA[None, :]).ravel()
-        vals = (*motion.evaluate(tt), joint_jerk(motion, tt))
-        row = np.full(n, -1)
-        row[need] = np.arange(len(need))
-        sel = np.nonzero(~exact)[0]
-        W = _lagrange(_CHECK_SIGMA, sig[sel])  # (m, 5)
-        r = row[i[sel]]
-        for o, v in zip(out, vals):
-            V = v.reshape(len(need), len(_CHECK_SIGMA), -1)
-            o[sel] = np.einsum("ms,msj->mj", W, V[r])
-    if exact.any():
-        sel = np.nonzero(exact)[0]
-        tt = t[sel]
-        for o, v in zip(out, (*motion.evaluate(tt), joint_jerk(motion, tt))):
-            o[sel] = v
-    return tuple(out)
-
-
-def _interval_ratios(motion: Motion, law: JerkLaw, lim: _Limits, jv: np.ndarray, robot: Robot) -> np.ndarray:
-    """(N, 4 dof): per interval the worst ratio of velocity, acceleration, jerk, torque of each joint."""
-    n = len(law.c)
-    sig = np.linspace(0.0, 1.0 - 1e-9, _DENSE)
-    t = (law.t[:-1, None] + np.diff(law.t)[:, None] * sig[None, :]).ravel()
-    q, qd, qdd, qddd = _states(motion, law, t)
-    r = state_ratios(robot, lim, q, qd, qdd, qddd, jv)
-    dof = q.shape[1]
-    out = np.zeros((n, 4 * dof))
-    for b, quantity in enumerate((Quantity.VELOCITY, Quantity.ACCELERATION, Quantity.JERK, Quantity.TORQUE)):
-        if quantity in r:
-            out[:, b * dof : (b + 1) * dof] = r[quantity].reshape(n, _DENSE, dof).max(axis=1)
+        cols += [(_rnea(robot, q, zero, d1) - g) / Tr**2, (_rnea(robot, q, d1, d2) - g) / Tr**2, g]
+    out = np.hstack(cols)
+    if not np.isfinite(out).all():
+        raise TimingError("JerkNLP", "the path derivatives are not finite (a singular point)")
     return out
 
 
-def _final_scale(
-    robot: Robot, motion: Motion, law: JerkLaw, lim: _Limits, jv: np.ndarray, t_start: float, rate: float
-) -> tuple[float, JerkRatios]:
-    """(k, ratios) on the trajectory's ``rate`` grid that falls in this motion, its nodes (both sides) and knots."""
+@dataclass(frozen=True, eq=False)
+class _Grid:
+    """The points of the NLP, FIXED in s: nodes S (a node on each knot of the path), midpoints M; and x0.
+
+    Attributes:
+        S: (n + 1,) the nodes' s, 0 to 1.
+        M: (n,) the midpoints' s, strictly inside their interval.
+        knot_nodes: indices of the nodes on the path's knots.
+        x0: the initial variables (from the law the grid was made from).
+    """
+
+    S: np.ndarray
+    M: np.ndarray
+    knot_nodes: np.ndarray
+    x0: np.ndarray
+
+    @classmethod
+    def from_law(cls, law: JerkLaw, knots: np.ndarray, n: int, Tr: float, segment: int,
+                 density: np.ndarray | None = None) -> _Grid:  # fmt: skip
+        """Nodes at n + 1 equal times of ``law`` (the node nearest each knot's time moved onto the knot)."""
+        T = law.duration
+        t = np.linspace(0.0, T, n + 1)
+        if density is not None:
+            C = np.concatenate([[0.0], np.cumsum(density * np.diff(law.t))])
+            t = np.interp(np.linspace(0.0, C[-1], n + 1), C, law.t)
+        s = law.evaluate(t)[0]
+        s[0], s[-1] = 0.0, 1.0
+        nodes = np.clip(np.round(np.interp(knots, s, np.arange(n + 1.0))).astype(int), 1, n - 1)
+        for i in range(1, len(nodes)):  # two knots never share a node
+            nodes[i] = max(nodes[i], nodes[i - 1] + 1)
+        if len(nodes) and nodes[-1] > n - 1:
+            raise TimingError("JerkNLP", f"the path has {len(knots)} knots: too many for {n} intervals (more "
+                              "intervals needed)", segment=segment)  # fmt: skip
+        t[nodes] = _law_times(law, knots)
+        s[nodes] = knots
+        if not (np.diff(t) > 0).all():
+            raise TimingError("JerkNLP", f"the path's knots are too close in time for {n} intervals (more "
+                              "intervals needed)", segment=segment)  # fmt: skip
+        tm = 0.5 * (t[:-1] + t[1:])
+        m, _, _, c = law.evaluate_jerk(tm)
+        _, sd, sdd, _ = law.evaluate_jerk(t)
+        if not ((m > s[:-1]) & (m < s[1:])).all():
+            raise TimingError("JerkNLP", "the initial law does not advance along the path", segment=segment)
+        x0 = np.concatenate([np.diff(t) / (Tr / n), sd * Tr, sdd * Tr**2, c * Tr**3, np.full(n, 0.5)])
+        return cls(s, m, nodes, x0)
+
+
+def _law_times(law: TimeLaw, s_target: np.ndarray) -> np.ndarray:
+    """The times a monotonic law reaches ``s_target`` (bisection, all at once)."""
+    lo, hi = np.zeros(len(s_target)), np.full(len(s_target), float(law.duration))
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        below = law.evaluate(mid)[0] < s_target
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return hi
+
+
+class _Solver:
+    """The NLP on one path (module docstring): guess, solve, re-grid, solve, tighten locally where exceeded."""
+
+    def __init__(self, robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, opts: JerkOptions,
+                 segment: int) -> None:  # fmt: skip
+        self.robot, self.path, self.lim, self.jv, self.opts, self.segment = robot, path, lim, jv, opts, segment
+        self.n = n = opts.intervals
+        self.dof = len(lim.velocity)
+        self.torque = lim.effort is not None
+        self.knots = np.unique(np.clip(path.knots(), 0.0, 1.0))[1:-1]
+        self.solver, self.g, self.n_eq, self.n_lim = _nlp(n, self.torque, self.dof, opts.ipopt_iterations)
+        guess = _guess(robot, path, lim, jv, n)
+        self.Tr = Tr = guess.duration
+        e = lim.effort if lim.effort is not None else np.ones(self.dof)
+        self.limits = np.concatenate([lim.velocity * Tr, lim.acceleration * Tr**2, jv * Tr**3, e])
+        self.tight_nodes = np.ones((n + 1, 4 * self.dof))
+        self.tight_mids = np.ones((n, 4 * self.dof))
+        self.grid = _Grid.from_law(guess, self.knots, n, Tr, segment)
+        self.warm: dict[str, Any] = {}
+        self.nlps = 0
+        o = n
+        lbx, ubx = np.full(5 * n + 2, -np.inf), np.full(5 * n + 2, np.inf)
+        lbx[:n] = 1e-4  # H
+        lbx[o : o + n + 1] = 0.0  # P >= 0
+        for i in (o, o + n, o + n + 1, o + 2 * n + 1):  # rest at both ends: P and R are 0 at nodes 0 and n
+            lbx[i] = ubx[i] = 0.0
+        lbx[4 * n + 2 :], ubx[4 * n + 2 :] = 1e-3, 1.0 - 1e-3  # U
+        self.lbx, self.ubx = lbx, ubx
+
+    def _parameters(self, grid: _Grid) -> np.ndarray:
+        """The NLP's parameters: the points' s, the exact path data there, the (tightened) limits there."""
+        S, M = grid.S, grid.M
+        DN = _path_data(self.robot, self.path, S, self.torque, self.Tr)
+        d = self.dof
+        left = DN[:, 2 * d : 3 * d].copy()  # q''' on the left of each node: differs on the knots
+        if len(grid.knot_nodes):
+            left[grid.knot_nodes] = _path_data(self.robot, self.path, self.knots - 1e-12, False, self.Tr)[:, 2 * d :]
+        DN = np.hstack([DN[:, : 2 * d], left, DN[:, 2 * d :]])
+        DM = _path_data(self.robot, self.path, M, self.torque, self.Tr)
+        LN = self.limits[None, :] * self.tight_nodes
+        LM = self.limits[None, :] * self.tight_mids
+        return np.concatenate([S, M, *(a.ravel(order="F") for a in (DN, DM, LN, LM))])
+
+    def solve(self, grid: _Grid, x0: np.ndarray) -> JerkLaw:
+        """Solve the NLP on ``grid`` from x0; the law it gives."""
+        n = self.n
+        lbg = np.concatenate([np.zeros(self.n_eq), -np.ones(self.n_lim), np.zeros(n)])
+        ubg = np.concatenate([np.zeros(self.n_eq), np.ones(self.n_lim), np.full(n, np.inf)])
+        t0 = time.perf_counter()
+        res = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=lbg, ubg=ubg, p=self._parameters(grid), **self.warm)
+        self.nlps += 1
+        stats = self.solver.stats()
+        status = stats["return_status"]
+        if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
+            raise TimingError("JerkNLP", f"IPOPT did not converge ({status}) on NLP {self.nlps}",
+                              segment=self.segment)  # fmt: skip
+        x = np.asarray(res["x"], dtype=float).ravel()
+        self.warm = {"lam_x0": res["lam_x"], "lam_g0": res["lam_g"]}
+        self.grid, self.x = grid, x
+        logger.debug("segment %d NLP %d: T = %.9f s (%d IPOPT iterations, %.3f s)", self.segment, self.nlps,
+                     float(np.sum(x[:n])) * self.Tr / n, stats["iter_count"], time.perf_counter() - t0)  # fmt: skip
+        t = np.concatenate([[0.0], np.cumsum(x[:n] * self.Tr / n)])
+        return JerkLaw.from_jerks(t, x[3 * n + 2 : 4 * n + 2] / self.Tr**3, tuple(self.knots.tolist()))
+
+    def tighten(self, over: np.ndarray) -> bool:
+        """Divide the limits at the points of each interval whose (N, 4 dof) ``over`` ratios exceed 1 + tol.
+
+        Returns False when nothing exceeds (the law is final up to the uniform correction).
+        """
+        bad = over > 1.0 + _TIGHT_TOL
+        if not bad.any():
+            return False
+        f = 1.0 / np.where(bad, over * (1.0 + _TIGHT_TOL / 2.0), 1.0)
+        self.tight_mids *= f
+        self.tight_nodes[:-1] *= f
+        self.tight_nodes[1:] *= f
+        return True
+
+
+def _guess(robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, n: int) -> JerkLaw:
+    """A feasible law on n equal intervals: a double-S in s, slowed as a whole to fit the limits.
+
+    The path jerk is +c, 0, -c, 0, -c, 0, +c over seven equal phases; the law is then slowed until every
+    limit holds at 8 points per interval (:func:`~scara_pin.motion.verify.time_scale`).
+    """
+    t = np.linspace(0.0, 1.0, n + 1)
+    pattern = np.array([1.0, 0.0, -1.0, 0.0, -1.0, 0.0, 1.0])
+    c = pattern[np.minimum((7 * (np.arange(n) + 0.5) / n).astype(int), 6)]
+    law = JerkLaw(t, c)
+    law = JerkLaw.from_jerks(t, c / law.s[-1])
+    tt = np.linspace(0.0, 1.0, 8 * n + 1)
+    k, _ = time_scale(robot, lim, *motion_states(Motion(path, law), tt), jv)
+    return law.scaled(k)
+
+
+def _check_times(law: JerkLaw, t_start: float, rate: float) -> np.ndarray:
+    """The trajectory's ``rate`` grid that falls in this motion, and both sides of every node (and knot)."""
     T = law.duration
     k0, k1 = math.ceil(t_start * rate - 1e-9), math.floor((t_start + T) * rate + 1e-9)
-    # the nodes sit on the knots: both sides of every node are both sides of every knot
-    t = np.concatenate([np.arange(k0, k1 + 1) / rate - t_start, law.t, law.t[1:] - np.diff(law.t) * 1e-9])
-    q, qd, qdd, qddd = _states(motion, law, np.clip(t, 0.0, T))
-    k, worst = time_scale(robot, lim, q, qd, qdd, qddd, jv)
-    return k, JerkRatios(worst[Quantity.VELOCITY], worst[Quantity.ACCELERATION], worst[Quantity.JERK],
-                         worst.get(Quantity.TORQUE))  # fmt: skip
+    t = np.concatenate([np.arange(k0, k1 + 1) / rate - t_start, law.t, law.t[1:] - np.diff(law.t) * _SIDE])
+    return np.clip(t, 0.0, T)
 
 
-def _lagrange(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """W (len(x), len(nodes)): the Lagrange basis of ``nodes`` at x."""
-    W = np.ones((len(x), len(nodes)))
-    for i, xi in enumerate(nodes):
-        for j, xj in enumerate(nodes):
-            if i != j:
-                W[:, i] *= (x - xj) / (xi - xj)
-    return W
+def _ratios_at(robot: Robot, motion: Motion, t: np.ndarray, lim: _Limits, jv: np.ndarray) -> np.ndarray:
+    """(len(t), 4 dof): |velocity|, |acceleration|, |jerk|, |torque| over their limits at local times t."""
+    r = state_ratios(robot, lim, *motion_states(motion, t), jv)
+    d = len(lim.velocity)
+    out = np.zeros((len(t), 4 * d))
+    for b, quantity in enumerate((Quantity.VELOCITY, Quantity.ACCELERATION, Quantity.JERK, Quantity.TORQUE)):
+        if quantity in r:
+            out[:, b * d : (b + 1) * d] = r[quantity]
+    return out
+
+
+def _interval_worst(law: JerkLaw, t: np.ndarray, ratios: np.ndarray) -> np.ndarray:
+    """(N, 4 dof): the worst ratio in each interval of the law (the left side of a node counts in the left one)."""
+    n = len(law.c)
+    i = np.clip(np.searchsorted(law.t, t, side="right") - 1, 0, n - 1)
+    out = np.zeros((n, ratios.shape[1]))
+    np.maximum.at(out, i, ratios)
+    return out
+
+
+def _time_path(
+    robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, opts: JerkOptions, segment: int
+) -> tuple[JerkLaw, int]:
+    """(law, NLPs) of one path before the final correction (module docstring)."""
+    solver = _Solver(robot, path, lim, jv, opts, segment)
+    law = solver.solve(solver.grid, solver.grid.x0)
+    for _ in range(_REGRIDS):
+        grid = _Grid.from_law(law, solver.knots, solver.n, solver.Tr, segment, _density(law))
+        law = solver.solve(grid, grid.x0)
+    for _ in range(opts.max_iterations - 1 - _REGRIDS):
+        t = _probe_times(law)
+        try:
+            r = _ratios_at(robot, Motion(path, law), t, lim, jv)
+        except InfeasibleError as exc:
+            raise TimingError("VerificationFailed", str(exc), segment=segment) from None
+        if not solver.tighten(_interval_worst(law, t, r)):
+            break
+        law = solver.solve(solver.grid, solver.x)
+    return law, solver.nlps
+
+
+def _finish(
+    robot: Robot, path: GeometricPath, law: JerkLaw, lim: _Limits, jv: np.ndarray, t_start: float, rate: float,
+    segment: int, k: float | None = None,
+) -> tuple[Motion, JerkRatios, float]:
+    """(motion, ratios, k): ``law`` k times slower, its worst ratio on the ``rate`` grid and the nodes 1 - 2e-6.
+
+    The time scale brings the worst ratio on the final grid to 1, with a margin of 2e-6 in time (4e-6 of
+    the accelerations): the limits then hold at ANY time, not only on the checked grid (an 8 kHz grid found
+    1.1e-6 of excess between the 10 kHz samples without it); again if the shifted grid needs it. A given
+    ``k`` (the scale of the same law reversed) is tried first.
+    """
+    if k is not None:
+        law = law.scaled(k)
+    for _ in range(8):
+        t = _check_times(law, t_start, rate)
+        step, worst = time_scale(robot, lim, *motion_states(Motion(path, law), t), jv)
+        if step <= _ACCEPT and k is not None:
+            break
+        law = law.scaled(step * (1.0 + _MARGIN))
+        k = (1.0 if k is None else k) * step * (1.0 + _MARGIN)
+    else:  # pragma: no cover - time scaling is exact
+        raise TimingError("VerificationFailed", f"the time scale does not settle ({step:.12g})", segment=segment)
+    if k is None or not k <= 1.0 + _CORRECTION_MAX:  # None: cannot happen (the loop sets it)
+        raise TimingError("JerkNLP", f"the solution exceeds a limit by {(k or 0.0) - 1:.3g} (time scale) between its "
+                          "points: more intervals needed", segment=segment)  # fmt: skip
+    ratios = JerkRatios(worst[Quantity.VELOCITY], worst[Quantity.ACCELERATION], worst[Quantity.JERK],
+                        worst.get(Quantity.TORQUE))  # fmt: skip
+    return Motion(path, law), ratios, k
+
+
+def _reverses(a: GeometricPath, b: GeometricPath) -> bool:
+    """True when b(s) = a(1 - s) (to 1e-9 rad or m, q and q', at the knots and 17 points): a run backwards."""
+    ka, kb = np.unique(np.clip(a.knots(), 0.0, 1.0)), np.unique(np.clip(b.knots(), 0.0, 1.0))
+    if len(ka) != len(kb) or np.abs(kb - (1.0 - ka[::-1])).max() > 1e-9:
+        return False
+    s = np.unique(np.concatenate([np.linspace(0.0, 1.0, 17), kb]))
+    qa, da = a.evaluate(1.0 - s, 1)
+    qb, db = b.evaluate(s, 1)
+    return bool(np.abs(qb - qa).max() <= 1e-9 and np.abs(db + da).max() <= 1e-9 * max(1.0, np.abs(da).max()))
+
+
+def _density(law: JerkLaw) -> np.ndarray:
+    """Per interval of ``law``, the node density of the next grid (per unit time): more where the jerk switches.
+
+    1 + (|c_k - c_{k-1}| + |c_{k+1} - c_k|) / (2 median |c|): the piecewise-constant jerk approximates a
+    switch inside an interval to first order in its length, a smooth law to second order.
+    """
+    dc = np.abs(np.diff(law.c))
+    scale = max(float(np.median(np.abs(law.c))), 1e-300)
+    return 1.0 + (np.concatenate([[0.0], dc]) + np.concatenate([dc, [0.0]])) / (2.0 * scale)
+
+
+def _probe_times(law: JerkLaw) -> np.ndarray:
+    """Both sides of every node and :data:`_PROBES` points inside every interval (the tightening's check)."""
+    h = np.diff(law.t)
+    sig = (np.arange(_PROBES) + 0.5) / _PROBES
+    return np.concatenate([law.t, law.t[1:] - h * _SIDE, (law.t[:-1, None] + h[:, None] * sig[None, :]).ravel()])
 
 
 # ---------------------------------------------------------------------------------------------- public
@@ -531,7 +636,7 @@ class JerkResult:
     Attributes:
         trajectory: one motion (a :class:`JerkLaw`) per path segment.
         ratios: worst limit ratios over the final check.
-        correction: the final time scale k >= ... (1 + a few 1e-4 at most): the duration is k times the NLP's.
+        correction: the largest final time scale (1 + a few 1e-4 at most): a duration is k times the NLP's.
         nlps: the number of NLPs solved (all segments).
         options: the options used.
     """
@@ -551,7 +656,6 @@ def time_optimal_jerk(
     torque: bool = False,
     limits: JointLimits | None = None,
     options: JerkOptions | None = None,
-    timing_options: TimingOptions | None = None,
 ) -> JerkResult:
     """The minimum-time, rest-to-rest motion along ``path`` under joint velocity, acceleration, jerk (torque) limits.
 
@@ -564,72 +668,47 @@ def time_optimal_jerk(
         torque: also keep the effort limits (RNEA, gravity included).
         limits: joint limits instead of ``robot.limits``.
         options: the NLP's options.
-        timing_options: TOPP-RA's options (the initial guess).
 
     Raises:
         ParameterError: a limit is NaN, zero, negative or not finite.
         InvalidInputError: the jerk limit implies a duration whose verified samples exceed the cap.
-        TimingError: the NLP did not converge (IPOPT's status), or TOPP-RA failed on the path.
+        TimingError: the NLP did not converge (IPOPT's status), or the path is singular.
+        InfeasibleError: the static load alone reaches an effort limit somewhere on the path.
     """
+    return _time_paths(robot, path_segments(robot, path), jerk, torque, limits, options)
+
+
+def _time_paths(
+    robot: Robot, paths: Sequence[GeometricPath], jerk: float | ArrayLike, torque: bool, limits: JointLimits | None,
+    options: JerkOptions | None,
+) -> JerkResult:
+    """Each path timed by :func:`_time_path`, one after the other (each rest to rest), sized first."""
     opts = JerkOptions() if options is None else options
-    if isinstance(path, CartesianPath):
-        paths: tuple[GeometricPath, ...] = path.segments
-    elif isinstance(path, GeometricPath):
-        paths = (path,)
-    else:
-        paths = (joint_path(robot, path),)
     lim = _limits(robot, limits, None, torque)
     jv = jerk_vector(jerk, len(lim.velocity))
     for p in paths:
         _size(p, jv, lim, opts)
-    base = parameterize(robot, path if not isinstance(path, (list, tuple, np.ndarray)) else paths[0], torque=torque,
-                        limits=limits, options=timing_options)  # fmt: skip
-    return _time_motions(robot, [m for m in base.trajectory.pieces if isinstance(m, Motion)], lim, jv, opts)
-
-
-def _time_motions(
-    robot: Robot, motions: Sequence[Motion], lim: _Limits, jv: np.ndarray, opts: JerkOptions
-) -> JerkResult:
-    """Each motion's path timed by the NLP, tightened locally where it exceeds a limit between its points."""
     out: list[Motion] = []
     ratios: list[JerkRatios] = []
+    laws: list[JerkLaw] = []  # before the final correction
+    scales: list[float] = []
     k_max, nlps, t_start = 1.0, 0, 0.0
-    for segment, m in enumerate(motions):
-        if not isinstance(m.law, ProfileLaw):
-            raise ParameterError("trajectory", type(m.law).__name__, "must be made of TOPP-RA motions (ProfileLaw)")
-        solver = _Solver(robot, m.path, m.law, lim, jv, opts, segment)
-        tight = np.ones((_BINS, 4 * solver.dof))
-        for _ in range(_TIGHTEN_ROUNDS):
-            law = solver.run(tight)
-            try:
-                over = _interval_ratios(Motion(m.path, law), law, lim, jv, robot)
-            except InfeasibleError as exc:
-                raise TimingError("VerificationFailed", str(exc), segment=segment) from None
-            if over.max() <= 1.0 + _TIGHT_TOL:
-                break
-            # the limits where an interval exceeded them (the bins of s it covers), divided by the excess: the
-            # tightening stays at that place of the path while the intervals move over it
-            for i in np.nonzero(over.max(axis=1) > 1.0 + _TIGHT_TOL)[0].tolist():
-                bins = np.arange(int(_bin(law.s[i])), int(_bin(law.s[i + 1])) + 1)
-                tight[bins] = tight[bins] / np.maximum(over[i], 1.0) / (1.0 + _TIGHT_TOL / 2)
-        k = 1.0
-        for _ in range(8):  # the time scale that brings the worst ratio on the final grid into [1 - 1e-7, 1 + 1e-9]
-            k_step, r = _final_scale(robot, Motion(m.path, law), law, lim, jv, t_start, opts.check_rate)
-            if 1.0 - 1e-7 <= k_step <= _ACCEPT:
-                break
-            law = law.scaled(k_step * (1.0 + 1e-12))
-            k *= k_step * (1.0 + 1e-12)
-        # a margin of 2e-6 in time (4e-6 of the accelerations): the limits then hold at ANY time, not only on
-        # the checked grid (an 8 kHz grid found 1.1e-6 of excess between the 10 kHz samples without it)
-        law = law.scaled(1.0 + _MARGIN)
-        k *= 1.0 + _MARGIN
-        _, r = _final_scale(robot, Motion(m.path, law), law, lim, jv, t_start, opts.check_rate)
-        if not k <= 1.0 + _CORRECTION_MAX:
-            raise TimingError("JerkNLP", f"the solution exceeds a limit by {k - 1:.3g} (time scale) between its "
-                              "collocation points: more intervals needed", segment=segment)  # fmt: skip
-        out.append(Motion(m.path, law))
+    for segment, p in enumerate(paths):
+        # a path that runs an earlier one backwards (the return move of a cycle) takes its law reversed in
+        # time: the limits are symmetric and the rigid-body torque is unchanged when qd changes sign (see
+        # :meth:`JerkLaw.reversed`), so it is feasible and optimal; it is checked on its own grid all the same
+        back = next((j for j in range(segment) if _reverses(paths[j], p)), None)
+        if back is None:
+            law, used, k0 = *_time_path(robot, p, lim, jv, opts, segment), None
+        else:
+            knots = tuple(np.unique(np.clip(p.knots(), 0.0, 1.0))[1:-1].tolist())
+            law, used, k0 = laws[back].reversed(knots), 0, scales[back]
+        motion, r, k = _finish(robot, p, law, lim, jv, t_start, opts.check_rate, segment, k0)
+        laws.append(law)
+        scales.append(k)
+        out.append(motion)
         ratios.append(r)
-        k_max, nlps, t_start = max(k_max, float(k)), nlps + solver.nlps, t_start + law.duration
+        k_max, nlps, t_start = max(k_max, k), nlps + used, t_start + motion.duration
     tops = [r.torque for r in ratios if r.torque is not None]
     worst = JerkRatios(max(r.velocity for r in ratios), max(r.acceleration for r in ratios),
                        max(r.jerk for r in ratios), max(tops) if tops else None)  # fmt: skip
@@ -643,39 +722,20 @@ def jerk_limited(
     *,
     torque: bool = False,
     limits: JointLimits | None = None,
-    options: TimingOptions | None = None,
+    options: JerkOptions | None = None,
 ) -> tuple[Trajectory, JerkRatios]:
-    """Each TOPP-RA motion of ``trajectory`` re-timed time-optimally under a joint jerk limit (module docstring).
-
-    Args:
-        robot: the robot (its model for the torques: carry the payload in it, see
-            :func:`~scara_pin.motion.payload.with_payload`).
-        trajectory: motions timed by :func:`~scara_pin.motion.timing.parameterize` (ProfileLaw each): their
-            paths, and their profiles as the initial guess.
-        jerk: joint jerk limit [rad/s^3 or m/s^3]: one number for all joints or one per joint.
-        torque: also keep the effort limits.
-        limits: joint limits instead of ``robot.limits``.
-        options: unused by the solver (kept for the callers' signature); see :func:`time_optimal_jerk`.
+    """The paths of ``trajectory``'s motions (any timing), each re-timed by :func:`time_optimal_jerk`.
 
     Returns:
         The trajectory and its worst limit ratios over the final check.
 
     Raises:
-        ParameterError: a jerk limit is not finite and > 0, or a motion is not a TOPP-RA profile.
-        InvalidInputError: the jerk limit implies more verified samples than the cap.
-        TimingError: the NLP did not converge.
+        ParameterError: a piece is not a motion (samples have no path); as :func:`time_optimal_jerk`.
     """
-    del options
-    lim = _limits(robot, limits, None, torque)
-    jv = jerk_vector(jerk, len(lim.velocity))
-    motions = []
+    paths = []
     for piece in trajectory.pieces:
         if not isinstance(piece, Motion):
-            raise ParameterError("trajectory", type(piece).__name__, "must be made of TOPP-RA motions (ProfileLaw)")
-        motions.append(piece)
-    opts = JerkOptions()
-    for m in motions:
-        _size(m.path, jv, lim, opts)
-    res = _time_motions(robot, motions, lim, jv, opts)
+            raise ParameterError("trajectory", type(piece).__name__, "must be made of motions (a path each)")
+        paths.append(piece.path)
+    res = _time_paths(robot, paths, jerk, torque, limits, options)
     return res.trajectory, res.ratios
-

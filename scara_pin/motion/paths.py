@@ -46,6 +46,8 @@ __all__ = [
     "cartesian_path",
     "joint_path",
     "joint_pose",
+    "path_segments",
+    "third_by_differences",
 ]
 
 SINGULAR_TOL = 1e-6
@@ -102,7 +104,11 @@ class GeometricPath(abc.ABC):
 
     @abc.abstractmethod
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
-        """(q, q', q'') at the path parameters ``s`` (1-D array), each (n, 4); up to ``order`` only."""
+        """(q, q', q'', q''') at the path parameters ``s`` (1-D array), each (n, 4); up to ``order`` only.
+
+        Every path of this package gives ``order`` 3 (exactly, or by :func:`third_by_differences` where
+        it has no closed form); a path of another origin may stop at 2.
+        """
 
     def knots(self) -> np.ndarray:
         """Parameters where the path is only piecewise smooth (a timing grid should include them)."""
@@ -150,7 +156,8 @@ class JointLine(GeometricPath):
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
         s = np.asarray(s, dtype=float).reshape(-1, 1)
         dq = self.q1 - self.q0
-        out = [self.q0 + s * dq, np.broadcast_to(dq, (s.shape[0], len(dq))).copy(), np.zeros((s.shape[0], len(dq)))]
+        zero = np.zeros((s.shape[0], len(dq)))
+        out = [self.q0 + s * dq, np.broadcast_to(dq, (s.shape[0], len(dq))).copy(), zero, zero.copy()]
         return tuple(out[: order + 1])
 
 
@@ -229,6 +236,24 @@ def joint_path(robot: Robot, waypoints: Sequence[ArrayLike] | np.ndarray) -> Joi
     return path
 
 
+def path_segments(
+    robot: Robot,
+    path: GeometricPath | CartesianPath | Sequence[GeometricPath | CartesianPath] | Sequence[ArrayLike] | np.ndarray,
+) -> tuple[GeometricPath, ...]:
+    """The paths a timing takes one by one, each rest to rest.
+
+    A Cartesian path's segments (the tool stops where the line turns), a path itself, a sequence of those
+    (one after the other), or the joint path through (m, 4) waypoints (:func:`joint_path`).
+    """
+    if isinstance(path, CartesianPath):
+        return path.segments
+    if isinstance(path, GeometricPath):
+        return (path,)
+    if isinstance(path, Sequence) and path and all(isinstance(p, (GeometricPath, CartesianPath)) for p in path):
+        return tuple(seg for p in path for seg in path_segments(robot, p))  # type: ignore[arg-type]
+    return (joint_path(robot, path),)  # type: ignore[arg-type]
+
+
 def _check_joint_limits(robot: Robot, path: GeometricPath, n: int = 2001) -> None:
     """Raise :class:`PathError` where a path leaves the position limits (dense grid, then bisection)."""
     lo = np.array(robot.limits.lower) - 1e-10
@@ -260,8 +285,40 @@ def _singular(J: np.ndarray) -> bool:
     return False
 
 
+_FD_STEP = 1e-4
+"""Finite-difference step of q''' relative to the width of the smooth piece of the path."""
+
+
+def third_by_differences(path: GeometricPath, s: np.ndarray) -> np.ndarray:
+    """q'''(s), (n, dof), by finite differences of the exact q'' (a path without a closed form of q''').
+
+    The differences are central, of step h = 1e-4 of the width of the smooth piece (between knots);
+    second-order one-sided within h of a knot, so a difference never straddles a knot.
+    """
+    s = np.asarray(s, dtype=float).ravel()
+    knots = np.unique(np.clip(path.knots(), 0.0, 1.0))
+    i = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, len(knots) - 2)
+    lo, hi = knots[i], knots[i + 1]
+    h = _FD_STEP * (hi - lo)
+    left = s - h < lo
+    right = s + h > hi
+    # offsets (in units of h) of the three points: centred (-1, 0, 1), forward (0, 1, 2), backward (-2, -1, 0)
+    base = np.where(left, s, np.where(right, s - 2 * h, s - h))
+    n = len(s)
+    d2 = path.evaluate(np.concatenate([base, base + h, base + 2 * h]), 2)[2]
+    f0, f1, f2 = d2[:n], d2[n : 2 * n], d2[2 * n :]
+    central = (f2 - f0) / 2.0
+    forward = (-3.0 * f0 + 4.0 * f1 - f2) / 2.0
+    backward = (f0 - 4.0 * f1 + 3.0 * f2) / 2.0
+    out = np.where(left[:, None], forward, np.where(right[:, None], backward, central))
+    return out / h[:, None]
+
+
 class _Kinematics:
-    """Task Jacobian J = d(x, y, z, yaw)/dq and its derivative along a direction, on private Pinocchio data."""
+    """Task Jacobian J = d(x, y, z, yaw)/dq and its derivative along a direction, on private Pinocchio data.
+
+    :meth:`derivatives` gives the exact q', q'', q''' along a tool curve (CasADi, built on first use).
+    """
 
     def __init__(self, robot: Robot) -> None:
         self.model = robot.model
@@ -271,6 +328,52 @@ class _Kinematics:
         self.to_pin = robot.to_pinocchio_q if getattr(robot, "has_continuous", False) else None
         pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
         self.Rbo = self.data.oMf[robot.base_id].rotation.T.copy()  # base axes from world axes
+        self.robot = robot
+        self._derivatives: Any = None
+
+    @property
+    def exact_derivatives(self) -> bool:
+        """True when :meth:`derivatives` applies: 4 joints, every axis exactly vertical (yaw linear in q)."""
+        geo = self.robot.kinematics.geometry
+        return self.robot.dof == 4 and geo.tilt == 0.0 and geo.wrist_tilt == 0.0
+
+    def derivatives(self, q: np.ndarray, p1: np.ndarray, p2: np.ndarray, p3: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(q', q'', q''') (n, 4) where the pose x(q) = (p(q), yaw(q)) follows a curve with derivatives p1, p2, p3.
+
+        Differentiating x(q(s)) = pose(s) three times (J = dx/dq; D2, D3 the second and third directional
+        derivatives of x; the yaw, yaw0 plus the signed revolute angles, is linear in q):
+
+            J q' = p1,   J q'' = p2 - D2[q', q'],   J q''' = p3 - 3 D2[q', q''] - D3[q', q', q'],
+
+        p(q) the tool position of :func:`~scara_pin.motion.symbolic.symbolic_model` (the Pinocchio model
+        in CasADi: exact derivatives), all the points in one call. Only when :attr:`exact_derivatives`.
+        """
+        if self._derivatives is None:
+            self._derivatives = self._build_derivatives()
+        out = self._derivatives(q.T, p1.T, p2.T, p3.T)
+        return tuple(np.asarray(v, dtype=float).reshape(4, len(q)).T for v in out)
+
+    def _build_derivatives(self) -> Any:
+        import casadi as ca
+
+        from .symbolic import symbolic_model
+
+        geo = self.robot.kinematics.geometry
+        q, a, b = ca.SX.sym("q", 4), ca.SX.sym("a", 4), ca.SX.sym("b", 4)
+        p = symbolic_model(self.robot).tool_position(q)
+        yaw_row = np.zeros(4)
+        for i in geo.revolute:
+            yaw_row[i] = geo.signs[i]
+        J = ca.vertcat(ca.jacobian(p, q), ca.DM(yaw_row).T)
+        # D2, D3 as functions of independent directions (q' depends on q: it must not be differentiated)
+        d2 = ca.Function("d2", [q, a, b], [ca.vertcat(ca.jtimes(ca.jtimes(p, q, a), q, b), 0)])
+        d3 = ca.Function("d3", [q, a], [ca.vertcat(ca.jtimes(ca.jtimes(ca.jtimes(p, q, a), q, a), q, a), 0)])
+        p1, p2, p3 = ca.SX.sym("p1", 4), ca.SX.sym("p2", 4), ca.SX.sym("p3", 4)
+        Jinv = ca.inv(J)  # one factorisation for the three solves
+        q1 = Jinv @ p1
+        q2 = Jinv @ (p2 - d2(q, q1, q1))
+        q3 = Jinv @ (p3 - 3 * d2(q, q1, q2) - d3(q, q1))
+        return ca.Function("path_derivatives", [q, p1, p2, p3], [q1, q2, q3])
 
     def _task(self, J6: np.ndarray) -> np.ndarray:
         out = np.empty((4, J6.shape[1]))
@@ -335,8 +438,17 @@ class CartesianSegment(GeometricPath):
         n = np.asarray(s).size
         return np.broadcast_to(self.delta, (n, 4)), np.zeros((n, 4))
 
+    def pose_third_derivative(self, s: np.ndarray) -> np.ndarray:
+        """The third derivative of the pose at s, (n, 4): zero on a line."""
+        return np.zeros((np.asarray(s).size, 4))
+
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
-        """(q, q', q'') at s: ``q' = J^-1 pose'``, ``q'' = J^-1 (pose'' - (dJ/ds) q')`` (J the task Jacobian)."""
+        """(q, q', q'', q''') at s: ``q' = J^-1 pose'``, ``q'' = J^-1 (pose'' - (dJ/ds) q')`` (J the task Jacobian).
+
+        All the derivatives at once by :meth:`_Kinematics.derivatives` (exact, CasADi); on a robot whose
+        axes are not exactly vertical, q' and q'' by Pinocchio's Jacobian and its time variation and q''' by
+        :func:`third_by_differences`.
+        """
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
         idx = np.clip(np.searchsorted(self.s_ref, s, side="right") - 1, 0, len(self.s_ref) - 1)
         res = solve_batch(self.robot.kinematics.geometry, self.poses(s), branch=self.branch, reference=self.q_ref[idx])
@@ -347,6 +459,18 @@ class CartesianSegment(GeometricPath):
         q = res.q
         if order == 0:
             return (q,)
+        if self._kin.exact_derivatives:
+            p1, p2 = self.pose_derivatives(s)
+            d = self._kin.derivatives(q, np.asarray(p1, dtype=float), np.asarray(p2, dtype=float),
+                                      self.pose_third_derivative(s))  # fmt: skip
+            bad = ~np.isfinite(np.hstack(d)).all(axis=1)
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise PathError("the task Jacobian is singular (stretched or folded arm)", s=s[k],
+                                pose=self.poses(s[k])[0], q=q[k])  # fmt: skip
+            return (q, *d)[: order + 1]
+        if order >= 3:
+            return (*self.evaluate(s, 2), third_by_differences(self, s))
         n = len(s)
         d1, d2 = self.pose_derivatives(s)
         J = np.empty((n, 4, 4))

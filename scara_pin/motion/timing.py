@@ -48,6 +48,7 @@ import numpy as np
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
+from .paths import path_segments
 from .trajectory import (
     CartesianPath,
     GeometricPath,
@@ -57,7 +58,6 @@ from .trajectory import (
     ProfileLaw,
     Trajectory,
     _positive,
-    joint_path,
 )
 from .verify import Quantity, _Limits, _limits, _rnea, _tool_rows, time_scale, verify
 
@@ -231,12 +231,7 @@ def parameterize(
     """
     opts = TimingOptions() if options is None else options
     lim = _limits(robot, limits, tool_speed, torque)
-    if isinstance(path, CartesianPath):
-        paths: tuple[GeometricPath, ...] = path.segments
-    elif isinstance(path, GeometricPath):
-        paths = (path,)
-    else:
-        paths = (joint_path(robot, path),)
+    paths = path_segments(robot, path)
     motions: list[Motion] = []
     t_toppra, ratios, npts, t_start = 0.0, [], 0, 0.0
     for k, p in enumerate(paths):

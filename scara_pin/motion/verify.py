@@ -54,7 +54,7 @@ from .._checks import _limit_vector, _positive
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
-from .paths import GeometricPath, JointLine, JointSpline
+from .paths import GeometricPath, JointLine, third_by_differences
 from .payload import Payload, with_payload
 from .trajectory import Motion, Trajectory
 
@@ -74,6 +74,7 @@ __all__ = [
     "Worst",
     "jerk_vector",
     "joint_jerk",
+    "motion_states",
     "path_third_derivative",
     "state_ratios",
     "time_scale",
@@ -93,8 +94,6 @@ PIECE_POINTS = 65
 """Points checked inside every piece, however short (besides the rate grid)."""
 _CHUNK = 50_000
 """Samples evaluated at once (bounds the memory of a long trajectory at a high rate)."""
-_FD_STEP = 1e-4
-"""Finite-difference step of q''' relative to the width of the smooth piece of the path."""
 _LEFT = 1.0 - 1e-9
 """Fraction of an interval where its left limit at the next breakpoint is checked."""
 
@@ -347,33 +346,14 @@ def time_scale(
 
 # ---------------------------------------------------------------------------------------------- jerk
 def path_third_derivative(path: GeometricPath, s: np.ndarray) -> np.ndarray:
-    """q'''(s), (n, dof): exact for joint lines (0) and splines; else finite differences of the exact q''.
+    """q'''(s), (n, dof): the path's own (``path.evaluate(s, 3)``, exact for the paths of this package).
 
-    The differences are central, of step h = 1e-4 of the width of the smooth piece (between knots);
-    second-order one-sided within h of a knot, so a difference never straddles a knot.
+    A path of another origin that stops at order 2: finite differences of its exact q''
+    (:func:`~scara_pin.motion.paths.third_by_differences`).
     """
     s = np.asarray(s, dtype=float).ravel()
-    if isinstance(path, JointLine):
-        return np.zeros((len(s), len(path.q0)))
-    if isinstance(path, JointSpline):
-        return np.asarray(path._spline(s, 3), dtype=float)
-    knots = np.unique(np.clip(path.knots(), 0.0, 1.0))
-    i = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, len(knots) - 2)
-    lo, hi = knots[i], knots[i + 1]
-    h = _FD_STEP * (hi - lo)
-    left = s - h < lo
-    right = s + h > hi
-    # offsets (in units of h) of the three points: centred (-1, 0, 1), forward (0, 1, 2), backward (-2, -1, 0)
-    base = np.where(left, s, np.where(right, s - 2 * h, s - h))
-    pts = np.concatenate([base, base + h, base + 2 * h])
-    n = len(s)
-    _, _, d2 = path.evaluate(pts, 2)
-    f0, f1, f2 = d2[:n], d2[n : 2 * n], d2[2 * n :]
-    central = (f2 - f0) / 2.0
-    forward = (-3.0 * f0 + 4.0 * f1 - f2) / 2.0
-    backward = (f0 - 4.0 * f1 + 3.0 * f2) / 2.0
-    out = np.where(left[:, None], forward, np.where(right[:, None], backward, central))
-    return out / h[:, None]
+    out = path.evaluate(s, 3)
+    return out[3] if len(out) > 3 else third_by_differences(path, s)
 
 
 def has_jerk(piece: object) -> bool:
@@ -388,15 +368,26 @@ def joint_jerk(motion: Motion, tau: np.ndarray) -> np.ndarray:
     its breakpoints (a TOPP-RA profile's jerk is unbounded AT its grid points, which this does not show:
     the third differences of :func:`verify` do).
     """
+    return motion_states(motion, tau)[3]
+
+
+def motion_states(motion: Motion, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(q, qd, qdd, qddd), each (n, dof), of a motion at local times ``tau``, from one evaluation of its path.
+
+    qd = q' sd, qdd = q' sdd + q'' sd^2, qddd = q' sddd + 3 q'' sd sdd + q''' sd^3, the path jerk sddd as
+    in :func:`joint_jerk`.
+    """
     law = motion.law
     if has_jerk(motion):
         s, sd, sdd, sddd = law.evaluate_jerk(tau)  # type: ignore[attr-defined]
     else:
         s, sd, sdd = law.evaluate(tau)
         sddd = np.zeros_like(s)
-    _, d1, d2 = motion.path.evaluate(s, 2)
-    d3 = path_third_derivative(motion.path, s)
-    return d1 * sddd[:, None] + 3.0 * d2 * (sd * sdd)[:, None] + d3 * (sd**3)[:, None]
+    out = motion.path.evaluate(s, 3)
+    d3 = out[3] if len(out) > 3 else third_by_differences(motion.path, s)
+    q, d1, d2 = out[:3]
+    v, a = sd[:, None], sdd[:, None]
+    return q, d1 * v, d1 * a + d2 * v**2, d1 * sddd[:, None] + 3.0 * d2 * v * a + d3 * v**3
 
 
 def trajectory_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
