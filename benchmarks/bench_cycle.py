@@ -20,9 +20,9 @@ enforced. Cycle = out and back (the back move of every planner here is the rever
     between its points is optimistic: fine for a minimum). Gap = ours / reference - 1.
 (b) **Against the straight-leg arch** (``standard_cycle(path="lines")``: lines and blended corners, TOPP-RA,
     the jerk-limited law of motion/jerk.py), same limits, payload 0 / 1 / 2 kg.
-(c) **Planning time**: ``scara-pin cycle`` (and with ``--jerk-limit 2000``) against
-    ``python -c "import toppra, scara_pin"``, 5 runs each alternating, medians of wall time and the ratio
-    (targets 1.5 and 2).
+(c) **Planning time**: ``scara-pin cycle`` (and with ``--jerk-limit 2000``; and the straight-leg arch with
+    ``--path lines --jerk-limit 2000`` at the issue's placement) against ``python -c "import toppra,
+    scara_pin"``, 5 runs each alternating, medians of wall time and the ratio (targets 1.5 and 2).
 """
 
 from __future__ import annotations
@@ -246,11 +246,14 @@ def against_lines() -> None:
             print(f"{name:<9}{mass:6.1f}kg  " + "".join(f"{x:<15}" for x in row))
 
 
-def planning_time(runs: int = 5) -> None:
+def planning_time(runs: int = 5, label: str = "(c)") -> None:
     exe = str(Path(sys.executable).with_name("scara-pin"))
+    lines = [exe, "cycle", "--path", "lines", "--jerk-limit", "2000", "--from", "0.2608695652173913", "-0.1525",
+             "-0.0875", "0", "--direction", "0", "1"]  # the straight-leg arch, jerk-limited (motion/jerk.py)
     commands = {"import toppra, scara_pin": [sys.executable, "-c", "import toppra, scara_pin"],
                 "scara-pin cycle": [exe, "cycle"], "scara-pin cycle --jerk-limit 2000": [exe, "cycle", "--jerk-limit",
-                                                                                        "2000"]}  # fmt: skip
+                                                                                        "2000"],
+                "cycle --path lines --jerk-limit 2000 (issue's --from)": lines}  # fmt: skip
     walls: dict[str, list[float]] = {k: [] for k in commands}
     for _ in range(runs):
         for key, argv in commands.items():
@@ -258,9 +261,9 @@ def planning_time(runs: int = 5) -> None:
             subprocess.run(argv, check=True, capture_output=True)
             walls[key].append(time.perf_counter() - t0)
     base = statistics.median(walls["import toppra, scara_pin"])
-    print(f"(c) planning time, wall, median of {runs} (alternating)")
+    print(f"{label} planning time, wall, median of {runs} (alternating)")
     for key, w in walls.items():
-        print(f"  {key:<36}{statistics.median(w):7.3f} s   ratio {statistics.median(w) / base:5.2f}")
+        print(f"  {key:<56}{statistics.median(w):7.3f} s   ratio {statistics.median(w) / base:5.2f}")
 
 
 def main() -> int:

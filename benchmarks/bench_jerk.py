@@ -15,15 +15,14 @@ Run with the project's interpreter (``.venv/bin/python benchmarks/bench_jerk.py 
 (b) **Discretisation**: ours with 24 to 96 intervals on the standard-cycle arch (duration, compute time).
 (c) **Simpler plans** on the standard-cycle arch: the three straight lines with a stop at each corner
     (jerk-limited, same limits), the old filter method.
-(d) **Planning time**: ``scara-pin cycle --path lines --jerk-limit 2000`` at the issue's placement against
-    ``python -c "import toppra, scara_pin"``, 5 runs each alternating, medians of wall time and the ratio
-    (target 2).
+(d) **Planning time** (benchmarks/bench_cycle.py's clock): ``scara-pin cycle --path lines --jerk-limit 2000``
+    at the issue's placement, and the other cycle commands, against ``python -c "import toppra, scara_pin"``,
+    5 runs each alternating, medians of wall time and the ratio (target 2 with a jerk limit).
 """
 
 from __future__ import annotations
 
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -140,31 +139,15 @@ def simpler_plans() -> None:
     print(f"  {blended:.6f}   {corners:.6f}   {old.duration:.6f}")
 
 
-def planning_time(runs: int = 5) -> None:
-    exe = str(Path(sys.executable).with_name("scara-pin"))
-    start = [str(v) for v in ISSUE_FROM]
-    commands = {"import toppra, scara_pin": [sys.executable, "-c", "import toppra, scara_pin"],
-                "cycle --path lines --jerk-limit 2000": [exe, "cycle", "--path", "lines", "--jerk-limit", "2000",
-                                                         "--from", *start, "--direction", "0", "1"]}  # fmt: skip
-    walls: dict[str, list[float]] = {k: [] for k in commands}
-    for _ in range(runs):
-        for key, argv in commands.items():
-            t0 = time.perf_counter()
-            subprocess.run(argv, check=True, capture_output=True)
-            walls[key].append(time.perf_counter() - t0)
-    base = statistics.median(walls["import toppra, scara_pin"])
-    print(f"(d) planning time, wall, median of {runs} (alternating)")
-    for key, w in walls.items():
-        print(f"  {key:<40}{statistics.median(w):7.3f} s   ratio {statistics.median(w) / base:5.2f}")
-
-
 def main() -> int:
     quick = "--quick" in sys.argv
     optimality(quick)
     discretisation()
     simpler_plans()
     if not quick:
-        planning_time()
+        from bench_cycle import planning_time  # the one clock of the cycle commands (benchmarks/bench_cycle.py)
+
+        planning_time(label="(d)")
     return 0
 
 

@@ -320,7 +320,7 @@ def test_an_angle_of_exactly_pi_is_listed_once(robot: Robot, q: list[float]) -> 
 def test_inverse_dynamics_equals_the_twin(robot: Robot, twin: Robot) -> None:
     """timing's RNEA converts q: torques of the continuous robot = its revolute twin's (1e-9 N m / N),
     both given the same off-axis link masses (the fixture has none)."""
-    from scara_pin.motion.timing import _rnea
+    from scara_pin.motion.verify import _rnea
 
     inertial = ('<link name="{0}"><inertial><origin xyz="0.1 0.03 0"/><mass value="{1}"/>'
                 '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial></link>')  # fmt: skip

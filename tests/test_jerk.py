@@ -10,6 +10,8 @@ from the samples.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -92,6 +94,48 @@ def test_verify_torque_with_payload_against_an_appended_body(robot):
     ratio = np.abs(tau) / np.array(robot.limits.effort)
     assert v.torque.ratio >= ratio.max() - 1e-12
     assert v.torque.ratio == pytest.approx(ratio.max(), rel=1e-3)
+
+
+def test_static_overload_whatever_the_sign_of_the_motion(robot):
+    """A static load above an effort limit is infeasible: time_scale refuses it whichever way the motion pushes
+    (it used to see it only where the dynamic part had the sign of the load), and says which joint."""
+    from scara_pin.motion.verify import _limits, static_load, time_scale
+
+    q = np.array([[0.3, 0.4, 0.05, 0.0]])
+    g = static_load(robot, q)[0]
+    j = int(np.argmax(np.abs(g)))
+    assert abs(g[j]) > 1.0  # the quill carries its weight
+    effort = np.array(robot.limits.effort, dtype=float)
+    effort[j] = 0.5 * abs(g[j])
+    lim = dataclasses.replace(robot.limits, effort=tuple(effort.tolist()))
+    for sign in (1.0, -1.0):  # the dynamic part along the load, then against it
+        qdd = np.zeros((1, 4))
+        qdd[0, j] = sign * np.sign(g[j]) * 1e-3
+        with pytest.raises(InfeasibleError, match=f"static load on joint{j + 1}.*cannot even hold still"):
+            time_scale(robot, _limits(robot, lim, None, True), (q, np.zeros((1, 4)), qdd))
+
+
+def test_verify_sees_a_polynomial_piece_between_its_samples(robot):
+    """verify checks every piece's breakpoints on both sides (``Piece.breakpoints``), a polynomial piece's too:
+    an acceleration peak at a breakpoint between two 10 kHz samples is found, with the exact jerk there."""
+    from scara_pin.motion.polynomial import PolynomialPiece
+    from scara_pin.motion.trajectory import Trajectory
+
+    J, tb, t2 = 100.0, 0.01234567, 0.02  # jerk +J then -J: the acceleration J tb peaks at the breakpoint tb
+    c = np.zeros((2, 4, 4))
+    c[0, 3, 0] = J / 6.0
+    c[1, :, 0] = [J * tb**3 / 6.0, J * tb**2 / 2.0, J * tb / 2.0, -J / 6.0]
+    traj = Trajectory((PolynomialPiece(np.array([0.0, tb, tb + t2]), c),))
+    peak = J * tb
+    acc = np.array(robot.limits.acceleration, dtype=float)
+    acc[0] = peak / (1.0 + 1e-5)
+    lim = dataclasses.replace(robot.limits, acceleration=tuple(acc.tolist()))
+    grid = np.arange(0, int((tb + t2) * 1e4) + 1) / 1e4
+    assert np.max(np.abs(traj.sample(grid)[2][:, 0])) / acc[0] < 1.0 - 1e-3  # the samples alone miss it
+    v = verify(robot, traj, limits=lim, jerk=2 * J)
+    assert v.acceleration.ratio == pytest.approx(1.0 + 1e-5, rel=1e-12)
+    assert v.acceleration.time == pytest.approx(tb, abs=1e-12)
+    assert v.jerk is not None and v.jerk.ratio == pytest.approx(0.5, rel=1e-12)  # the piece's own jerk
 
 
 # --------------------------------------------------------------------------------------------- jerk-limited timing

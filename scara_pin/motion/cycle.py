@@ -537,7 +537,7 @@ def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: 
     """|value| / limit per sample and joint, per quantity."""
     q, qd, qdd = traj.sample(t)
     qddd = None if jerk is None else trajectory_jerk(traj, t)
-    return {k.value: v for k, v in state_ratios(robot, lim, q, qd, qdd, qddd, jerk).items()}
+    return {k.value: v for k, v in state_ratios(robot, lim, (q, qd, qdd, qddd), jerk).items()}
 
 
 # ---------------------------------------------------------------------------------------------- the cycle

@@ -18,8 +18,8 @@ and every inner point,
     |q'(s) c + 3 q''(s) sd sdd + q'''(s) sd^3| <= jmax (at a node: the jerk of both intervals),
     |a(s) sdd + b(s) sd^2 + g(s)| <= tau_max
 
-(torques as in :mod:`~scara_pin.motion.timing`: ``g = rnea(q, 0, 0)``, ``a = rnea(q, 0, q') - g``,
-``b = rnea(q, q', q'') - g``). Each limit binds where it binds: there is no global slow-down. Working in
+(the torque coefficients of :func:`~scara_pin.motion.verify.torque_coefficients`, as TOPP-RA's in
+:mod:`~scara_pin.motion.timing`). Each limit binds where it binds: there is no global slow-down. Working in
 time avoids the rest-to-rest singularity of the s-domain (a jerk-limited start has ``sd ~ s^(2/3)``, no
 polynomial in s); fixing the points in s makes the NLP's data exact and constant: ONE NLP per grid.
 
@@ -64,11 +64,11 @@ from .verify import (
     Quantity,
     _Limits,
     _limits,
-    _rnea,
     jerk_vector,
     motion_states,
     state_ratios,
     time_scale,
+    torque_coefficients,
 )
 
 if TYPE_CHECKING:
@@ -353,15 +353,14 @@ def _nlp(n: int, torque: bool, dof: int, ipopt_iterations: int) -> Any:
 def _path_data(robot: Robot, path: GeometricPath, s: np.ndarray, torque: bool, Tr: float) -> np.ndarray:
     """(n, 3 dof) q', q'', q''' at s; with ``torque`` also the RNEA coefficients a, b (in reference units) and g.
 
-    tau = a sdd + b sd^2 + g with ``g = rnea(q, 0, 0)``, ``a = rnea(q, 0, q') - g``,
-    ``b = rnea(q, q', q'') - g``; a and b are divided by T_ref^2 (the NLP's R and P are T_ref^2 sdd, T_ref sd).
+    tau = a sdd + b sd^2 + g (:func:`~scara_pin.motion.verify.torque_coefficients`); a and b are divided by
+    T_ref^2 (the NLP's R and P are T_ref^2 sdd and T_ref sd).
     """
     q, d1, d2, d3 = path.evaluate(s, 3)
     cols = [d1, d2, d3]
     if torque:
-        zero = np.zeros_like(d1)
-        g = _rnea(robot, q, zero, zero)
-        cols += [(_rnea(robot, q, zero, d1) - g) / Tr**2, (_rnea(robot, q, d1, d2) - g) / Tr**2, g]
+        a, b, g = torque_coefficients(robot, q, d1, d2)
+        cols += [a / Tr**2, b / Tr**2, g]
     out = np.hstack(cols)
     if not np.isfinite(out).all():
         raise TimingError("JerkNLP", "the path derivatives are not finite (a singular point)")
@@ -516,7 +515,7 @@ def _guess(robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, n: i
     law = JerkLaw(t, c)
     law = JerkLaw.from_jerks(t, c / law.s[-1])
     tt = np.linspace(0.0, 1.0, 8 * n + 1)
-    k, _ = time_scale(robot, lim, *motion_states(Motion(path, law), tt), jv)
+    k, _ = time_scale(robot, lim, motion_states(Motion(path, law), tt), jv)
     return law.scaled(k)
 
 
@@ -530,7 +529,7 @@ def _check_times(law: JerkLaw, t_start: float, rate: float) -> np.ndarray:
 
 def _ratios_at(robot: Robot, motion: Motion, t: np.ndarray, lim: _Limits, jv: np.ndarray) -> np.ndarray:
     """(len(t), 4 dof): |velocity|, |acceleration|, |jerk|, |torque| over their limits at local times t."""
-    r = state_ratios(robot, lim, *motion_states(motion, t), jv)
+    r = state_ratios(robot, lim, motion_states(motion, t), jv)
     d = len(lim.velocity)
     out = np.zeros((len(t), 4 * d))
     for b, quantity in enumerate((Quantity.VELOCITY, Quantity.ACCELERATION, Quantity.JERK, Quantity.TORQUE)):
@@ -584,7 +583,7 @@ def _finish(
         law = law.scaled(k)
     for _ in range(8):
         t = _check_times(law, t_start, rate)
-        step, worst = time_scale(robot, lim, *motion_states(Motion(path, law), t), jv)
+        step, worst = time_scale(robot, lim, motion_states(Motion(path, law), t), jv)
         if step <= _ACCEPT and k is not None:
             break
         law = law.scaled(step * (1.0 + _MARGIN))

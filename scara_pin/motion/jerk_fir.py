@@ -173,7 +173,7 @@ def _scale(
     robot: Robot, motion: Motion, t: np.ndarray, lim: _Limits, jv: np.ndarray, table: _Table | None = None
 ) -> tuple[float, JerkRatios]:
     """(k, ratios): the time scale making the worst ratio at times t exactly 1, and the ratios now."""
-    k, worst = time_scale(robot, lim, *_joint_values(motion, t, table), jv)
+    k, worst = time_scale(robot, lim, _joint_values(motion, t, table), jv)
     return k, JerkRatios(worst[Quantity.VELOCITY], worst[Quantity.ACCELERATION], worst[Quantity.JERK],
                          worst.get(Quantity.TORQUE))  # fmt: skip
 

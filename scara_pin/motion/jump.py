@@ -51,8 +51,9 @@ move in many ways) the objective's tie-breaking terms pick the calmest (:data:`_
 rounding left at B (about the solver's tolerance) is removed by the least-norm change of the controls
 that ends exactly at rest at B (the end state is linear in the controls). The result is then verified
 by independent routes (:func:`_verify`): the package's verifier (:func:`~scara_pin.motion.verify.verify`:
-Pinocchio at 10 kHz, the jerk by third differences, the torques with the payload, endpoints, rest), the
-same ratios at every breakpoint on both sides and at the polynomial extrema, and the clearance, ceiling,
+Pinocchio at 10 kHz and at every breakpoint on both sides, the exact jerk and the jerk by third
+differences, the torques with the payload, endpoints, rest), the same ratios inside every interval and at
+the polynomial extrema, and the clearance, ceiling,
 joint ranges and end poses by Pinocchio's FK; a ratio above 1 + 1e-6, a clearance missed by more than
 1e-6 m, an end missed by more than 1e-9 m is an error (:class:`JumpError`), never an output.
 
@@ -97,9 +98,10 @@ from .verify import (
     VERIFY_RATE,
     LimitViolation,
     _limits,
-    _rnea,
     jerk_vector,
     state_ratios,
+    static_load,
+    static_overload,
     verify,
 )
 
@@ -763,12 +765,9 @@ def _default_intervals(jerk: bool, tool_speed: bool) -> tuple[int, int, int]:
 def _holds_still(robot: Robot, configurations: tuple[np.ndarray, ...], effort: np.ndarray) -> None:
     """InfeasibleError if the static load (gravity, payload included) at one of them is not below an effort limit."""
     q = np.array(configurations)
-    g = _rnea(robot, q, np.zeros_like(q), np.zeros_like(q))
-    over = np.abs(g) >= effort
-    if over.any():
-        k, j = np.argwhere(over)[0]
-        raise InfeasibleError(f"the static load on {JOINT_NAMES[j]} ({abs(g[k, j]):.6g}) is not below its effort limit "
-                              f"{effort[j]:.6g}: the robot cannot even hold still at q = {np.round(q[k], 6).tolist()}")
+    bad = static_overload(static_load(robot, q), effort)
+    if bad is not None:
+        raise InfeasibleError(bad.reason(f"at q = {np.round(q[bad.index], 6).tolist()}"))
 
 
 def _one_dof(
@@ -1026,11 +1025,12 @@ class _Check:
 def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     """Verify by independent routes (module docstring); JumpError naming what fails.
 
-    1. The package's verifier (:func:`~scara_pin.motion.verify.verify`): Pinocchio at 10 kHz, the jerk by third
-       differences, the torques with the payload, the tool speed, the endpoints and the rest.
-    2. The same ratios (:func:`~scara_pin.motion.verify.state_ratios`) at every breakpoint on both sides (where
-       the velocity peaks under acceleration control and the acceleration under jerk control), inside every
-       interval and at the polynomial extrema, with the piece's exact jerk.
+    1. The package's verifier (:func:`~scara_pin.motion.verify.verify`): Pinocchio at 10 kHz and at every
+       breakpoint on both sides (where the velocity peaks under acceleration control and the acceleration
+       under jerk control), the piece's exact jerk and the jerk by third differences, the torques with the
+       payload, the tool speed, the endpoints and the rest.
+    2. The same ratios (:func:`~scara_pin.motion.verify.state_ratios`) inside every interval and at the
+       polynomial extrema.
     3. The clearance and the ceiling (Pinocchio's FK), the joint ranges, the end poses.
     """
     piece = traj.pieces[0]
@@ -1048,11 +1048,11 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     ek, es = _extrema(piece)
     grid = np.arange(math.floor(T * VERIFY_RATE + 1e-9) + 1) / VERIFY_RATE
     inner = (b[:-1, None] + dt[:, None] * (np.arange(1, 8) / 8.0)[None, :]).ravel()
-    t = np.clip(np.concatenate([grid, b, b[1:] - 1e-9 * dt, inner, b[ek] + es * dt[ek]]), 0.0, T)
+    t = np.clip(np.concatenate([grid, inner, b[ek] + es * dt[ek]]), 0.0, T)
     on_grid = np.arange(len(t)) < len(grid)
     q, qd, qdd = traj.sample(t)
-    qddd = None if prob.jerk is None else piece.jerk(t)  # (a left side b - 1e-9 dt is inside its own interval)
-    ratios = state_ratios(prob.robot, lim, q, qd, qdd, qddd, prob.jerk)
+    qddd = None if prob.jerk is None else piece.jerk(t)
+    ratios = state_ratios(prob.robot, lim, (q, qd, qdd, qddd), prob.jerk)
     table = {quantity.value: r for quantity, r in ratios.items()}
     worst: dict[str, float | None] = {name: None for name in _QUANTITIES}
     for name, value in found.ratios().items():

@@ -45,7 +45,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..description import JOINT_NAMES, JointLimits
+from ..description import JointLimits
 from ..errors import InfeasibleError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
 from .paths import path_segments
@@ -59,7 +59,16 @@ from .trajectory import (
     Trajectory,
     _positive,
 )
-from .verify import Quantity, _Limits, _limits, _rnea, _tool_rows, time_scale, verify
+from .verify import (
+    Quantity,
+    _Limits,
+    _limits,
+    _tool_rows,
+    static_overload,
+    time_scale,
+    torque_coefficients,
+    verify,
+)
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -315,10 +324,7 @@ def _time_segment(
     two_sided.append(np.tile(a, m + 1))
     g_static = None
     if lim.effort is not None:
-        zero = np.zeros_like(dq)
-        c = _rnea(robot, q, zero, zero)
-        at = _rnea(robot, q, zero, dq) - c
-        bt = _rnea(robot, q, dq, ddq) - c
+        at, bt, c = torque_coefficients(robot, q, dq, ddq)
         g_static = c
         blocks_a.append((at + tw[:, None] * bt).reshape(rows, -1))
         blocks_b.append(bt.reshape(rows, -1))
@@ -342,7 +348,7 @@ def _time_segment(
         inst.compute_parameterization(0.0, 0.0)
         data = inst.problem_data
     except Exception as exc:  # toppra raises assorted exceptions: the likely cause when there is one, else typed
-        if g_static is not None and lim.effort is not None and (np.abs(g_static) >= lim.effort).any():
+        if g_static is not None and lim.effort is not None and static_overload(g_static, lim.effort) is not None:
             raise _diagnose("Exception", robot, grid, B, q, g_static, lim, m, segment, None) from exc  # a static load
         raise TimingError("Exception", f"toppra raised {type(exc).__name__}: {exc}", segment=segment) from exc
     code = data.return_code.name
@@ -407,13 +413,9 @@ def _diagnose(
     rows = len(grid)
     S = grid[:, None] + np.append(np.diff(grid), 0.0)[:, None] * (np.arange(m + 1) / m)[None, :]
     S = S.ravel()
-    if g_static is not None and lim.effort is not None:
-        over = np.abs(g_static) >= lim.effort
-        if over.any():
-            k, j = np.argwhere(over)[0]
-            return TimingError(code, f"the static load on {JOINT_NAMES[j]} ({g_static[k, j]:.6g}) is not below its "
-                               f"effort limit {lim.effort[j]:.6g}: the robot cannot even hold still there",
-                               segment=segment, s=float(S[k]))  # fmt: skip
+    bad = None if g_static is None or lim.effort is None else static_overload(g_static, lim.effort)
+    if bad is not None:
+        return TimingError(code, bad.reason(), segment=segment, s=float(S[bad.index]))
     Bmin = B.reshape(rows, m + 1).min(axis=1)
     if Bmin.min() < 1e-12:
         k = int(np.argmin(Bmin))
@@ -475,13 +477,13 @@ def _check(
     t = _check_times(law, opts, sub, t_start)
     q, qd, qdd = motion.evaluate(t)
     try:
-        k, worst = time_scale(robot, lim, q, qd, qdd)
+        k, worst = time_scale(robot, lim, (q, qd, qdd))
     except InfeasibleError as exc:
         raise TimingError("VerificationFailed", str(exc)) from None
     if extremes is not None and len(extremes[0]):  # computed before the slow-down: qd / scale, qdd / scale^2
         e_v, e_a = extremes[0] / scale, extremes[1] / (scale * scale)
         only_va = dataclasses.replace(lim, effort=None, tool_speed=None)
-        k_e, worst_e = time_scale(robot, only_va, np.zeros_like(e_v), e_v, e_a)
+        k_e, worst_e = time_scale(robot, only_va, (np.zeros_like(e_v), e_v, e_a))
         k = max(k, k_e)
         for quantity in (Quantity.VELOCITY, Quantity.ACCELERATION):
             worst[quantity] = max(worst[quantity], worst_e[quantity])

@@ -302,6 +302,10 @@ class Piece(abc.ABC):
     def evaluate(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(q, qd, qdd), each (n, 4), at local times ``tau`` (1-D array)."""
 
+    def breakpoints(self) -> np.ndarray | None:
+        """Local times [s] where the motion is only piecewise smooth (the verifier checks both sides), or None."""
+        return None
+
 
 @dataclass(frozen=True, eq=False)
 class Motion(Piece):
@@ -327,6 +331,11 @@ class Motion(Piece):
     def scaled(self, k: float) -> Motion:
         """The same motion k times slower."""
         return Motion(self.path, self.law.scaled(k))
+
+    def breakpoints(self) -> np.ndarray | None:
+        """The law's breakpoints (where its path jerk switches), when it has them."""
+        bp = getattr(self.law, "breakpoints", None)
+        return None if bp is None else np.asarray(bp(), dtype=float)
 
 
 @dataclass(frozen=True, eq=False)

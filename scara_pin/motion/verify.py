@@ -6,18 +6,19 @@ the same formulas, so "the limits hold" means one thing everywhere. :func:`verif
 - on its own fixed-rate grid ``k / rate`` (:data:`VERIFY_RATE` = 10 kHz by default), padded with three
   samples of rest on each side;
 - at the start and end of every piece and just inside them, at :data:`PIECE_POINTS` points of every
-  piece (a piece shorter than a sample period is checked too), and at the law's breakpoints and their
-  left sides when the law has them (``law.breakpoints()``, where the path jerk switches);
+  piece (a piece shorter than a sample period is checked too), and at the piece's breakpoints and their
+  left sides when it has them (``piece.breakpoints()``: a motion's law's, where its path jerk switches; a
+  polynomial piece's own, where its acceleration or jerk switches);
 
 and forms |value| / limit per joint for
 
 - **velocity** and **acceleration** (and the closed-form maxima of a straight joint move's law,
   :meth:`~scara_pin.motion.trajectory.TimeLaw.peaks`, exact between samples);
-- **jerk**, two ways: the analytic joint jerk ``q' sddd + 3 q'' sd sdd + q''' sd^3`` of the motions whose
-  law has a jerk (``law.evaluate_jerk``), and the third differences of q on the padded grid,
-  ``(q[k+3] - 3 q[k+2] + 3 q[k+1] - q[k]) / h^3``, a B-spline-weighted mean of the true jerk over 3 h (so
-  never above its maximum): it sees every acceleration step, at the pieces' joins and at both rests,
-  whatever the law. Its rounding floor ``8 eps max|q| / h^3`` is reported and allowed on top of the
+- **jerk**, two ways: the analytic joint jerk (``q' sddd + 3 q'' sd sdd + q''' sd^3`` of the motions whose
+  law has a jerk, ``law.evaluate_jerk``; a polynomial piece's own ``jerk``), and the third differences of
+  q on the padded grid, ``(q[k+3] - 3 q[k+2] + 3 q[k+1] - q[k]) / h^3``, a B-spline-weighted mean of the
+  true jerk over 3 h (so never above its maximum): it sees every acceleration step, at the pieces' joins
+  and at both rests, whatever the law. Its rounding floor ``8 eps max|q| / h^3`` is reported and allowed on top of the
   tolerance (about 2e-6 of a 2000 m/s^3 limit at 10 kHz on a 0.3 m stroke);
 - **torque**: Pinocchio's RNEA (gravity included) on the model carrying ``payload``
   (:func:`~scara_pin.motion.payload.with_payload`);
@@ -45,7 +46,7 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple, cast
 
 import numpy as np
 import pinocchio as pin
@@ -68,8 +69,10 @@ __all__ = [
     "REST_TOL",
     "TOLERANCE",
     "VERIFY_RATE",
+    "JointStates",
     "LimitViolation",
     "Quantity",
+    "StaticOverload",
     "Verification",
     "Worst",
     "jerk_vector",
@@ -77,7 +80,10 @@ __all__ = [
     "motion_states",
     "path_third_derivative",
     "state_ratios",
+    "static_load",
+    "static_overload",
     "time_scale",
+    "torque_coefficients",
     "trajectory_jerk",
     "verify",
 ]
@@ -160,8 +166,8 @@ class Verification:
         rate: [Hz] of the verified grid.
         samples: number of verified sample times.
         velocity, acceleration: the worst joint ratios.
-        jerk: the worst analytic joint-jerk ratio (motions whose law has a jerk; None without a jerk limit
-            or when no piece has one).
+        jerk: the worst analytic joint-jerk ratio (motions whose law has a jerk, polynomial pieces; None
+            without a jerk limit or when no piece has one).
         jerk_differences: the worst third-difference jerk ratio (None without a jerk limit).
         jerk_floor: the rounding floor of the third differences, as a ratio (allowed on top of the
             tolerance; 0 without a jerk limit).
@@ -271,27 +277,31 @@ def _rnea(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarr
     return np.array([pin.rnea(model, data, q[k], v[k], a[k]) for k in range(len(q))])
 
 
+class JointStates(NamedTuple):
+    """Joint states at n samples, each (n, dof): positions, velocities, accelerations, and jerks or None."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    qddd: np.ndarray | None = None
+
+
 def state_ratios(
-    robot: Robot,
-    lim: _Limits,
-    q: np.ndarray,
-    qd: np.ndarray,
-    qdd: np.ndarray,
-    qddd: np.ndarray | None = None,
-    jerk: np.ndarray | None = None,
+    robot: Robot, lim: _Limits, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
 ) -> dict[Quantity, np.ndarray]:
     """|value| / limit per sample (rows) and joint (columns; one column for the tool speed), per quantity.
 
-    The torque needs ``lim.effort``, the tool speed ``lim.tool_speed``, the jerk ``qddd`` and ``jerk``.
+    ``states``: (q, qd, qdd) or (q, qd, qdd, qddd). The torque needs ``lim.effort``, the tool speed
+    ``lim.tool_speed``, the jerk ``qddd`` and ``jerk``.
     """
-    return _ratios(robot, lim, q, qd, qdd, qddd, jerk)[0]
+    return _ratios(robot, lim, JointStates(*states), jerk)[0]
 
 
 def _ratios(
-    robot: Robot, lim: _Limits, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, qddd: np.ndarray | None,
-    jerk: np.ndarray | None,
+    robot: Robot, lim: _Limits, states: JointStates, jerk: np.ndarray | None
 ) -> tuple[dict[Quantity, np.ndarray], np.ndarray | None]:
     """(:func:`state_ratios`, the efforts or None)."""
+    q, qd, qdd, qddd = states
     out = {Quantity.VELOCITY: np.abs(qd) / lim.velocity, Quantity.ACCELERATION: np.abs(qdd) / lim.acceleration}
     tau = None
     if lim.effort is not None:
@@ -304,26 +314,77 @@ def _ratios(
     return out, tau
 
 
+@dataclass(frozen=True)
+class StaticOverload:
+    """A configuration where the static load (gravity, payload included) alone reaches an effort limit.
+
+    No timing helps there (slowing down leaves the static load): the request is infeasible.
+
+    Attributes:
+        index: the row of the configuration in the samples given.
+        joint: the joint's index.
+        load: the static load g [N m or N] (signed).
+        limit: the effort limit [N m or N].
+    """
+
+    index: int
+    joint: int
+    load: float
+    limit: float
+
+    def reason(self, where: str = "there") -> str:
+        """The sentence, ``where`` saying where the robot is (``"there"``, ``"at q = [...]"``)."""
+        return (f"the static load on {JOINT_NAMES[self.joint]} ({self.load:.6g}) is not below its effort limit "
+                f"{self.limit:.6g}: the robot cannot even hold still {where}")  # fmt: skip
+
+
+def static_overload(g: np.ndarray, effort: np.ndarray) -> StaticOverload | None:
+    """The first row of static loads ``g`` (n, dof) with |g| >= ``effort`` on a joint, or None.
+
+    Whatever its sign: a load above the limit cannot be held, and one below it leaves room on both sides
+    (E - g > 0 and E + g > 0), which :func:`time_scale` relies on.
+    """
+    over = np.abs(g) >= effort
+    if not over.any():
+        return None
+    i, j = np.argwhere(over)[0]
+    return StaticOverload(int(i), int(j), float(g[i, j]), float(effort[j]))
+
+
+def static_load(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """g(q) (n, dof): the joint efforts that hold the robot still (RNEA at rest, gravity and payload)."""
+    zero = np.zeros_like(q)
+    return _rnea(robot, q, zero, zero)
+
+
+def torque_coefficients(robot: Robot, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(a, b, g), each (n, dof), of the joint efforts along a path: tau = a(s) sdd + b(s) sd^2 + g(s).
+
+    With q' = d1 and q'' = d2 at the points q: qd = q' sd and qdd = q' sdd + q'' sd^2 in the rigid-body
+    dynamics M qdd + C(q, qd) qd + g give ``g = rnea(q, 0, 0)`` (:func:`static_load`),
+    ``a = rnea(q, 0, q') - g`` and ``b = rnea(q, q', q'') - g`` (RNEA, gravity and payload in the model).
+    """
+    zero = np.zeros_like(d1)
+    g = static_load(robot, q)
+    return _rnea(robot, q, zero, d1) - g, _rnea(robot, q, d1, d2) - g, g
+
+
 def time_scale(
-    robot: Robot,
-    lim: _Limits,
-    q: np.ndarray,
-    qd: np.ndarray,
-    qdd: np.ndarray,
-    qddd: np.ndarray | None = None,
-    jerk: np.ndarray | None = None,
+    robot: Robot, lim: _Limits, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
 ) -> tuple[float, dict[Quantity, float]]:
     """(k, worst ratios): the time scale k that brings the worst ratio of these states to exactly 1.
 
     Slowing a motion k times divides velocities and the tool speed by k, accelerations and the dynamic
     part of the torque (``tau - g(q)``) by k^2, jerks by k^3. So k = max(r_v, sqrt(r_a), cbrt(r_j),
     r_tool, sqrt(|tau - g| / room)) with ``room = E - g`` where ``tau - g > 0``, else ``E + g``; k < 1
-    speeds up.
+    speeds up. ``states`` as in :func:`state_ratios`.
 
     Raises:
-        InfeasibleError: the static load alone reaches an effort limit (no k helps).
+        InfeasibleError: the static load alone reaches an effort limit (:func:`static_overload`: no k helps).
     """
-    r, tau = _ratios(robot, lim, q, qd, qdd, qddd, jerk)
+    states = JointStates(*states)
+    q = states.q
+    r, tau = _ratios(robot, lim, states, jerk)
     worst = {name: float(np.max(v)) if v.size else 0.0 for name, v in r.items()}
     k = max(worst[Quantity.VELOCITY], math.sqrt(worst[Quantity.ACCELERATION]))
     if Quantity.JERK in worst:
@@ -332,14 +393,12 @@ def time_scale(
         k = max(k, worst[Quantity.TOOL_SPEED])
     if tau is not None and lim.effort is not None and len(q):
         E = lim.effort
-        zero = np.zeros_like(qd)
-        g = _rnea(robot, q, zero, zero)
+        g = static_load(robot, q)
+        bad = static_overload(g, E)
+        if bad is not None:
+            raise InfeasibleError(bad.reason())
         dyn = tau - g
-        room = np.where(dyn > 0, E - g, E + g)  # |dyn / k^2 + g| <= E  <=>  k^2 >= |dyn| / room
-        if (room <= 0).any():
-            i, j = np.argwhere(room <= 0)[0]
-            raise InfeasibleError(f"the static load on {JOINT_NAMES[j]} ({g[i, j]:.6g}) is not below its effort "
-                                  f"limit {E[j]:.6g}: the robot cannot even hold still there")  # fmt: skip
+        room = np.where(dyn > 0, E - g, E + g)  # |dyn / k^2 + g| <= E  <=>  k^2 >= |dyn| / room, room > 0
         k = max(k, math.sqrt(float(np.max(np.abs(dyn) / room))))
     return k, worst
 
@@ -357,8 +416,14 @@ def path_third_derivative(path: GeometricPath, s: np.ndarray) -> np.ndarray:
 
 
 def has_jerk(piece: object) -> bool:
-    """True for a motion whose law has a path jerk (``law.evaluate_jerk``)."""
-    return isinstance(piece, Motion) and callable(getattr(piece.law, "evaluate_jerk", None))
+    """True for a piece with an analytic joint jerk.
+
+    A motion whose law has a path jerk (``law.evaluate_jerk``), or a piece with its own ``jerk(tau)``
+    (:class:`~scara_pin.motion.polynomial.PolynomialPiece`).
+    """
+    if isinstance(piece, Motion):
+        return callable(getattr(piece.law, "evaluate_jerk", None))
+    return callable(getattr(piece, "jerk", None))
 
 
 def joint_jerk(motion: Motion, tau: np.ndarray) -> np.ndarray:
@@ -368,10 +433,10 @@ def joint_jerk(motion: Motion, tau: np.ndarray) -> np.ndarray:
     its breakpoints (a TOPP-RA profile's jerk is unbounded AT its grid points, which this does not show:
     the third differences of :func:`verify` do).
     """
-    return motion_states(motion, tau)[3]
+    return cast(np.ndarray, motion_states(motion, tau).qddd)  # always given by motion_states
 
 
-def motion_states(motion: Motion, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def motion_states(motion: Motion, tau: np.ndarray) -> JointStates:
     """(q, qd, qdd, qddd), each (n, dof), of a motion at local times ``tau``, from one evaluation of its path.
 
     qd = q' sd, qdd = q' sdd + q'' sd^2, qddd = q' sddd + 3 q'' sd sdd + q''' sd^3, the path jerk sddd as
@@ -387,7 +452,7 @@ def motion_states(motion: Motion, tau: np.ndarray) -> tuple[np.ndarray, np.ndarr
     d3 = out[3] if len(out) > 3 else third_by_differences(motion.path, s)
     q, d1, d2 = out[:3]
     v, a = sd[:, None], sdd[:, None]
-    return q, d1 * v, d1 * a + d2 * v**2, d1 * sddd[:, None] + 3.0 * d2 * v * a + d3 * v**3
+    return JointStates(q, d1 * v, d1 * a + d2 * v**2, d1 * sddd[:, None] + 3.0 * d2 * v * a + d3 * v**3)
 
 
 def trajectory_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
@@ -424,15 +489,14 @@ def _exact_peaks(piece: object) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _extra_times(traj: Trajectory) -> np.ndarray:
-    """Each piece's ends and just inside them, PIECE_POINTS inside it, its law's breakpoints and their left sides."""
+    """Each piece's ends and just inside them, PIECE_POINTS inside it, its breakpoints and their left sides."""
     parts = []
     for start, piece in zip(traj.starts.tolist(), traj.pieces):
         d = piece.duration
         parts.append(start + np.linspace(0.0, d, PIECE_POINTS))
         parts.append(start + d * np.array([1e-9, _LEFT]))
-        bp = getattr(getattr(piece, "law", None), "breakpoints", None)
-        if callable(bp):
-            b = np.asarray(bp(), dtype=float)
+        b = piece.breakpoints()
+        if b is not None:
             parts += [start + b, start + b[:-1] + np.diff(b) * _LEFT]
     return np.concatenate(parts)
 
@@ -517,7 +581,7 @@ def verify(
             sel = (t >= 0.0) & (t <= T)
             qddd = np.zeros_like(q)
             qddd[sel] = _analytic_jerk(trajectory, t[sel])
-        for quantity, r in state_ratios(loaded, lim, q, qd, qdd, qddd, jv).items():
+        for quantity, r in state_ratios(loaded, lim, (q, qd, qdd, qddd), jv).items():
             worst.add(quantity, r, t, tool=quantity is Quantity.TOOL_SPEED)
     for start, piece in zip(trajectory.starts.tolist(), trajectory.pieces):
         peaks = _exact_peaks(piece)
@@ -554,5 +618,6 @@ def _analytic_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
     for start, p in zip(traj.starts.tolist(), traj.pieces):
         sel = (t >= start) & (t <= start + p.duration)
         if sel.any() and has_jerk(p):
-            out[sel] = joint_jerk(p, t[sel] - start)  # type: ignore[arg-type]
+            tau = t[sel] - start
+            out[sel] = joint_jerk(p, tau) if isinstance(p, Motion) else p.jerk(tau)  # type: ignore[attr-defined]
     return out

@@ -196,7 +196,7 @@ def plot_trajectory(
         ("acceleration", qdd, None if limits is None else [(-a, a) for a in limits.acceleration], 2),
     ]
     if torque and robot is not None:
-        from ..motion.timing import _rnea
+        from ..motion.verify import _rnea
 
         tau = _rnea(robot, q, qd, qdd)
         series.append(("torque", tau, None if limits is None else [(-e, e) for e in limits.effort], -1))
