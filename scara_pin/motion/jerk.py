@@ -24,15 +24,17 @@ time avoids the rest-to-rest singularity of the s-domain (a jerk-limited start h
 polynomial in s); fixing the points in s makes the NLP's data exact and constant: ONE NLP per grid.
 
 **Grids.** The first grid puts the nodes at equal times of a feasible double-S law (:func:`_guess`); the
-second at equal times of the first solution (the intervals then have nearly equal lengths at the
-optimum), solved warm.
+second at equal times of the first solution weighted by where its jerk switches (:func:`_density`: a
+switch inside an interval costs to first order in its length), solved warm.
 
 **Between the points** (the promise is the :mod:`~scara_pin.motion.verify` grid, 10 kHz): the exact
-joint states are evaluated on the trajectory's 10 kHz grid and on both sides of every node; where an
+joint states are evaluated at 8 points inside every interval and on both sides of every node; where an
 interval exceeds a limit by more than 1e-3 the limits at its points are divided by the excess and the
-NLP solved again (warm); then the time scale k that brings the worst ratio there to 1 is applied
-(:func:`~scara_pin.motion.verify.time_scale`: a final correction of a few 1e-4 at most, reported as
-``correction``, never the old global slow-down) and a 2e-6 margin.
+NLP solved again (warm). Then, on the trajectory's 10 kHz grid and both sides of every node, the time
+scale k that brings the worst ratio to 1 is applied (:func:`~scara_pin.motion.verify.time_scale`: a
+final correction of a few 1e-4 at most, reported as ``correction``, never the old global slow-down) with
+a 2e-6 margin. A path that runs an earlier one backwards (a cycle's return move) takes its law reversed
+in time (:meth:`JerkLaw.reversed`), checked the same way.
 
 Why IPOPT through casadi: the NLP is small (5 N + 2 variables), sparse and smooth, its data constant;
 IPOPT with casadi's exact Hessians converges in 15-40 iterations from a feasible start and every step is
@@ -92,6 +94,10 @@ _CORRECTION_MAX = 0.02
 _REGRIDS = 1
 """Grids after the first: each from the last solution, denser where its jerk switches (:func:`_density`)."""
 _PROBES = 8
+_PER_PIECE = 4
+"""Intervals per smooth piece of the path at least (on average; the grid follows the time, not the pieces)."""
+_MAX_INTERVALS = 2000
+"""The most intervals of one NLP (sized before any work: a path through more waypoints is refused)."""
 """Points inside each interval where the tightening rounds check the exact limits (besides the nodes)."""
 _TIGHT_TOL = 1e-3
 """Between-point excess left to the final uniform correction (a time scale of at most ~1e-3)."""
@@ -299,7 +305,7 @@ def _nlp(n: int, torque: bool, dof: int, ipopt_iterations: int) -> Any:
     its own, in reference units: the local tightening).
 
     Returns:
-        (solver, constraint function g(x, p), number of equality rows, number of limit rows).
+        (solver, number of equality rows, number of limit rows).
     """
     import casadi as ca
 
@@ -347,7 +353,7 @@ def _nlp(n: int, torque: bool, dof: int, ipopt_iterations: int) -> Any:
         "ipopt.mumps_scaling": 0, "ipopt.mumps_permuting_scaling": 0,
         "ipopt.warm_start_init_point": "yes", "ipopt.warm_start_bound_push": 1e-9,
         "ipopt.warm_start_mult_bound_push": 1e-9}  # fmt: skip
-    return ca.nlpsol("jerk_time_optimal", "ipopt", nlp, opts), ca.Function("g", [nlp["x"], par], [g]), n_eq, n_lim
+    return ca.nlpsol("jerk_time_optimal", "ipopt", nlp, opts), n_eq, n_lim
 
 
 def _path_data(robot: Robot, path: GeometricPath, s: np.ndarray, torque: bool, Tr: float) -> np.ndarray:
@@ -430,11 +436,15 @@ class _Solver:
     def __init__(self, robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, opts: JerkOptions,
                  segment: int) -> None:  # fmt: skip
         self.robot, self.path, self.lim, self.jv, self.opts, self.segment = robot, path, lim, jv, opts, segment
-        self.n = n = opts.intervals
+        self.knots = np.unique(np.clip(path.knots(), 0.0, 1.0))[1:-1]
+        # a node on every knot, and at least _PER_PIECE intervals per smooth piece on average (a spline through
+        # many waypoints gets more intervals than the default)
+        self.n = n = max(opts.intervals, _PER_PIECE * (len(self.knots) + 1))
+        check_count(f"intervals of the jerk-limited timing ({len(self.knots) + 1} smooth pieces)", n, _MAX_INTERVALS,
+                    "fewer waypoints (each starts a smooth piece of the path)")  # fmt: skip
         self.dof = len(lim.velocity)
         self.torque = lim.effort is not None
-        self.knots = np.unique(np.clip(path.knots(), 0.0, 1.0))[1:-1]
-        self.solver, self.g, self.n_eq, self.n_lim = _nlp(n, self.torque, self.dof, opts.ipopt_iterations)
+        self.solver, self.n_eq, self.n_lim = _nlp(n, self.torque, self.dof, opts.ipopt_iterations)
         guess = _guess(robot, path, lim, jv, n)
         self.Tr = Tr = guess.duration
         e = lim.effort if lim.effort is not None else np.ones(self.dof)
@@ -572,7 +582,7 @@ def _finish(
     robot: Robot, path: GeometricPath, law: JerkLaw, lim: _Limits, jv: np.ndarray, t_start: float, rate: float,
     segment: int, k: float | None = None,
 ) -> tuple[Motion, JerkRatios, float]:
-    """(motion, ratios, k): ``law`` k times slower, its worst ratio on the ``rate`` grid and the nodes 1 - 2e-6.
+    """(motion, ratios, k): ``law`` slowed k times until its worst ratio on the ``rate`` grid and nodes is 1.
 
     The time scale brings the worst ratio on the final grid to 1, with a margin of 2e-6 in time (4e-6 of
     the accelerations): the limits then hold at ANY time, not only on the checked grid (an 8 kHz grid found
