@@ -7,6 +7,7 @@ are imported only by the functions that need them.
 
 import logging
 
+from ._version import __version__
 from .description import (
     JOINT_NAMES,
     PARAMETER_NAMES,
@@ -29,8 +30,6 @@ from .errors import (
 )
 from .model import Kinematics, Robot, pose_from_placement
 from .robots import kinematics_for, load_robot, load_urdf, robot_from_urdf
-
-__version__ = "0.1.0"
 
 __all__ = [
     "JOINT_NAMES",

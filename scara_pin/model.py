@@ -29,7 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._checks import MAGNITUDE_MAX
-from .description import JOINT_COUNTS, JointLimits, RobotParameters, generate_urdf, load_parameters
+from .description import JOINT_COUNTS, JointLimits, RobotParameters, configured
 from .errors import InvalidInputError, ParameterError, UrdfError
 from .units import HUMAN, format_number
 from .urdf_rules import choose_frames, read_tree
@@ -364,8 +364,8 @@ class Robot:
 
         Keyword arguments (``tool_frame``, ``base_frame``) are passed to the constructor.
         """
-        params = load_parameters(robot, overrides)
-        return cls(generate_urdf(params), parameters=params, origin=f"robot {params.name!r}", **kwargs)
+        params, urdf = configured(robot, overrides)  # the description cache: no yaml nor xacro when unchanged
+        return cls(urdf, parameters=params, origin=f"robot {params.name!r}", **kwargs)
 
     @classmethod
     def from_file(cls, path: str | Path, *, package_dirs: Sequence[str | Path] = (), **kwargs: Any) -> Robot:

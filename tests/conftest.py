@@ -6,11 +6,35 @@ rely on ``robot.data`` between two calls.
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
+
 import numpy as np
 import pytest
 from browser import browser, page  # noqa: F401 - the headless Chromium fixtures (tests/browser.py), shared
 
 from scara_pin import Robot, load_robot
+
+_CACHE_ENV = ("SCARA_PIN_CACHE_DIR", "SCARA_PIN_NO_CACHE")
+_saved_env: dict[str, str | None] = {}
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """The description cache (scara_pin.description.cache) of this test process in a folder of its own, never
+    the user's ~/.cache; commands the tests run as subprocesses inherit it. Set before any test module loads."""
+    _saved_env.update({k: os.environ.get(k) for k in _CACHE_ENV})
+    os.environ["SCARA_PIN_CACHE_DIR"] = tempfile.mkdtemp(prefix="scara-pin-cache-")
+    os.environ.pop("SCARA_PIN_NO_CACHE", None)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    shutil.rmtree(os.environ["SCARA_PIN_CACHE_DIR"], ignore_errors=True)
+    for k, v in _saved_env.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v
 
 
 @pytest.fixture(scope="session")

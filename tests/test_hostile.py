@@ -575,8 +575,15 @@ def test_json_is_always_si(args: list[str], capsys: pytest.CaptureFixture[str], 
 
 
 def test_caps_are_what_the_docs_say() -> None:
+    """Every cap of scara_pin/limits.py is in the caps table of docs/cli.md, with its value."""
+    import scara_pin.limits as caps
+
     reference = (Path(__file__).resolve().parents[1] / "docs" / "cli.md").read_text()
     assert f"{MAX_SAMPLES:,}" in reference and f"{MAX_URDF_ELEMENTS:,}" in reference
+    names = [n for n in vars(caps) if n.startswith("MAX_") and n != "MAX_NUMBER"]  # numbers: the grammar's own line
+    assert len(names) >= 20
+    missing = [f"{n} = {getattr(caps, n):,}" for n in names if f"{getattr(caps, n):,}" not in reference]
+    assert not missing, missing
 
 
 def test_urdf_elements_cap_in_the_library() -> None:

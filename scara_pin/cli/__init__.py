@@ -43,7 +43,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
             ``import pinocchio``); a name that is no command builds them all, for argparse's message.
             None: every command.
     """
-    from .. import __version__
+    from .._version import __version__
 
     parser = _Parser(
         prog="scara-pin",

@@ -46,7 +46,6 @@ def cmd_cycle(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units.from_args(args)
-    L = units.length
     path = CyclePath(args.path)
     if path is CyclePath.JUMP:
         for flag, given in (("--arch", args.arch is not None), ("--no-blend", args.no_blend)):
@@ -140,9 +139,11 @@ def cmd_cycle(args: argparse.Namespace) -> int:
           f"{result.placement}")  # fmt: skip
     if path is CyclePath.JUMP:
         jm = move
-        print(f"arch        up to {(jm.z_top + jm.peak) * L:.6g} {Ln} ({jm.peak * L:.3g} above the clearance height), "  # type: ignore[union-attr]
-              f"{jm.bulge * L:.3g} {Ln} off the straight line in plan view; solved in {jm.stats.seconds:.3g} s "  # type: ignore[union-attr]
-              f"({jm.stats.iterations} IPOPT iterations, {jm.stats.solves} solve(s))")  # type: ignore[union-attr]
+        top, peak, bulge = jm.z_top + jm.peak, jm.peak, jm.bulge  # type: ignore[union-attr]
+        print(f"arch        up to {units.num(top, 'length')} {Ln} ({units.num(peak, 'length')} {Ln} above the "
+              f"clearance height), {units.num(bulge, 'length')} {Ln} off the straight line in plan view; solved in "
+              f"{jm.stats.seconds:.3g} s ({jm.stats.iterations} IPOPT iterations, "  # type: ignore[union-attr]
+              f"{jm.stats.solves} solve(s))")  # type: ignore[union-attr]
     print("legs        (binding limits: the share of the leg's time at >= 99.9 % of the limit)")
     for leg in move.legs:
         binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in leg.binding)

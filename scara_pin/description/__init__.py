@@ -44,6 +44,7 @@ __all__ = [
     "JointLimits",
     "RobotParameters",
     "available_robots",
+    "configured",
     "generate_urdf",
     "load_parameters",
     "parameter_names",
@@ -317,18 +318,27 @@ def _read_yaml_text(path: Path) -> str:
         raise ParameterError(str(path), ParameterError.NOTHING, f"cannot be read ({exc})") from None
 
 
-def _read_config(folder: Path) -> tuple[str, dict[str, float]]:
-    """(kind, flat values) of a config folder; the kind is the ``kind:`` key of kinematics.yaml."""
+_CONFIG_FILES = ("kinematics.yaml", "joint_limits.yaml", "physical_parameters.yaml")
+
+
+def _config_texts(folder: Path) -> dict[str, str]:
+    """The three yaml files of a config folder, read with the bounds of every input (a FIFO is refused)."""
+    return {name: _read_yaml_text(folder / name) for name in _CONFIG_FILES}
+
+
+def _read_config(folder: Path, texts: Mapping[str, str] | None = None) -> tuple[str, dict[str, float]]:
+    """(kind, flat values) of a config folder (or of its files' ``texts``); the kind is kinematics.yaml's ``kind:``."""
     import yaml
 
     from .yaml_units import load_yaml
 
+    texts = _config_texts(folder) if texts is None else texts
     values: dict[str, float] = {}
     schema = SCHEMAS["scara"]
-    for filename in ("kinematics.yaml", "joint_limits.yaml", "physical_parameters.yaml"):
+    for filename in _CONFIG_FILES:
         path = folder / filename
-        try:  # bounded read (a FIFO or /dev/zero is refused), UTF-8 checked
-            tree = load_yaml(_read_yaml_text(path))
+        try:
+            tree = load_yaml(texts[filename])
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             where = f" line {mark.line + 1}" if mark is not None else ""
@@ -397,6 +407,40 @@ def load_parameters(
         kind, values = _read_config(folder)
         params = RobotParameters(name, values, folder, kind)
     return params.with_overrides(overrides) if overrides else params
+
+
+def configured(
+    robot: str | Path | RobotParameters = "default", overrides: Mapping[str, object] | None = None
+) -> tuple[RobotParameters, str]:
+    """A configured robot's parameters and generated URDF, as :func:`load_parameters` and :func:`generate_urdf`.
+
+    For a shipped robot or a config folder both come from the description cache when nothing they are
+    made from has changed (:mod:`scara_pin.description.cache`: the yaml files, the xacro templates, xacro
+    itself, the overrides); otherwise they are made and cached.
+    """
+    if isinstance(robot, RobotParameters):
+        params = load_parameters(robot, overrides)
+        return params, generate_urdf(params)
+    from .cache import DescriptionCache
+
+    name, folder = _config_folder(robot)
+    texts = _config_texts(folder)
+    values = {k: _to_float(k, v) for k, v in (overrides or {}).items()}
+    cache = DescriptionCache.default()
+    key = cache.key(name, folder, texts, values, urdf_dir())
+    hit = cache.get(key)
+    if hit is not None:
+        try:
+            params = RobotParameters(name, hit["values"], folder, hit["kind"])
+            return params, hit["urdf"]
+        except (ParameterError, KeyError, TypeError):  # a cache file that does not hold what it should
+            pass
+    kind, read = _read_config(folder, texts)
+    params = RobotParameters(name, read, folder, kind)
+    params = params.with_overrides(values) if values else params
+    urdf = generate_urdf(params)
+    cache.put(key, {"kind": params.kind, "values": dict(params.values), "urdf": urdf})
+    return params, urdf
 
 
 def generate_urdf(
