@@ -78,8 +78,7 @@ if TYPE_CHECKING:
     from ..description import JointLimits
     from ..model import Robot
 
-__all__ = ["JerkLaw", "JerkOptions", "JerkRatios", "JerkResult", "jerk_limited", "minimum_duration",
-           "time_optimal_jerk"]  # fmt: skip
+__all__ = ["JerkLaw", "JerkOptions", "JerkRatios", "JerkResult", "minimum_duration", "time_optimal_jerk"]
 
 logger = logging.getLogger(__name__)
 
@@ -659,7 +658,7 @@ class JerkResult:
 
 def time_optimal_jerk(
     robot: Robot,
-    path: GeometricPath | CartesianPath | Sequence[ArrayLike] | np.ndarray,
+    path: GeometricPath | CartesianPath | Sequence[GeometricPath | CartesianPath] | Sequence[ArrayLike] | np.ndarray,
     jerk: float | ArrayLike,
     *,
     torque: bool = False,
@@ -672,7 +671,8 @@ def time_optimal_jerk(
         robot: the robot (limits; its model for the torques: carry a payload with
             :func:`~scara_pin.motion.payload.with_payload`).
         path: a path, a :class:`~scara_pin.motion.paths.CartesianPath` (each segment rest to rest: the tool
-            stops at every via point, where the line turns), or (m, 4) joint waypoints.
+            stops at every via point, where the line turns), a sequence of those (one after the other, at
+            rest between them; e.g. the paths of a trajectory's motions), or (m, 4) joint waypoints.
         jerk: joint jerk limit [rad/s^3 or m/s^3], one number or one per joint.
         torque: also keep the effort limits (RNEA, gravity included).
         limits: joint limits instead of ``robot.limits``.
@@ -684,14 +684,7 @@ def time_optimal_jerk(
         TimingError: the NLP did not converge (IPOPT's status), or the path is singular.
         InfeasibleError: the static load alone reaches an effort limit somewhere on the path.
     """
-    return _time_paths(robot, path_segments(robot, path), jerk, torque, limits, options)
-
-
-def _time_paths(
-    robot: Robot, paths: Sequence[GeometricPath], jerk: float | ArrayLike, torque: bool, limits: JointLimits | None,
-    options: JerkOptions | None,
-) -> JerkResult:
-    """Each path timed by :func:`_time_path`, one after the other (each rest to rest), sized first."""
+    paths = path_segments(robot, path)
     opts = JerkOptions() if options is None else options
     lim = _limits(robot, limits, None, torque)
     jv = jerk_vector(jerk, len(lim.velocity))
@@ -722,29 +715,3 @@ def _time_paths(
     worst = JerkRatios(max(r.velocity for r in ratios), max(r.acceleration for r in ratios),
                        max(r.jerk for r in ratios), max(tops) if tops else None)  # fmt: skip
     return JerkResult(Trajectory(tuple(out)), worst, k_max, nlps, opts)
-
-
-def jerk_limited(
-    robot: Robot,
-    trajectory: Trajectory,
-    jerk: float | ArrayLike,
-    *,
-    torque: bool = False,
-    limits: JointLimits | None = None,
-    options: JerkOptions | None = None,
-) -> tuple[Trajectory, JerkRatios]:
-    """The paths of ``trajectory``'s motions (any timing), each re-timed by :func:`time_optimal_jerk`.
-
-    Returns:
-        The trajectory and its worst limit ratios over the final check.
-
-    Raises:
-        ParameterError: a piece is not a motion (samples have no path); as :func:`time_optimal_jerk`.
-    """
-    paths = []
-    for piece in trajectory.pieces:
-        if not isinstance(piece, Motion):
-            raise ParameterError("trajectory", type(piece).__name__, "must be made of motions (a path each)")
-        paths.append(piece.path)
-    res = _time_paths(robot, paths, jerk, torque, limits, options)
-    return res.trajectory, res.ratios

@@ -189,7 +189,8 @@ def fir_jerk_limited(
 ) -> tuple[Trajectory, JerkRatios]:
     """The old, jerk-BOUNDED timing: each TOPP-RA motion filtered (:class:`FilteredLaw`) then slowed as a whole.
 
-    Kept as the baseline the time-optimal :func:`jerk_limited` is compared with (it is never faster).
+    Kept as the baseline the time-optimal :func:`~scara_pin.motion.jerk.time_optimal_jerk` is compared with
+    (it is never faster).
 
     Args:
         robot: the robot (its model for the torques: carry the payload in it, see
