@@ -100,7 +100,8 @@ class TimingError(InfeasibleError):
     Attributes:
         return_code: toppra's ``ParameterizationReturnCode`` name (``FailUncontrollable``,
             ``ErrShortPath``, ``ErrForwardPassFail``, ``ErrUnknown``); ``Exception`` when toppra raised;
-            ``VerificationFailed`` when the check after toppra finds a limit no time scaling can meet.
+            ``VerificationFailed`` when the check after the solver finds a limit no time scaling can meet;
+            ``JerkNLP`` from the jerk-limited timing (:mod:`scara_pin.motion.jerk`, IPOPT).
         cause: the likely cause, with numbers.
         segment: index of the failing path segment.
         s: path parameter in [0, 1] of the segment where it fails, when known.
@@ -112,7 +113,8 @@ class TimingError(InfeasibleError):
         self.segment = segment
         self.s = s
         where = f" (segment {segment}" + (f", s = {s:.6f})" if s is not None else ")")
-        super().__init__(f"time-optimal timing failed{where}: {cause} [toppra: {return_code}]")
+        solver = "ipopt" if return_code == "JerkNLP" else "toppra"
+        super().__init__(f"time-optimal timing failed{where}: {cause} [{solver}: {return_code}]")
 
 
 @dataclass(frozen=True)
