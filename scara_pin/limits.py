@@ -29,6 +29,10 @@ from .errors import InvalidInputError
 
 __all__ = [
     "MAX_CALIBRATION_ROWS",
+    "MAX_CELL_BYTES",
+    "MAX_CELL_NODES",
+    "MAX_CELL_OBSTACLES",
+    "MAX_CELL_TRIANGLES",
     "MAX_CHECK_ELEMENTS",
     "MAX_DOCUMENT_BYTES",
     "MAX_FRAMES",
@@ -86,6 +90,19 @@ MAX_POINTS_BYTES = 4 * 1024 * 1024
 """Bytes of one points file (10,000 points at full precision take about 1.5 MB)."""
 MAX_CHECK_ELEMENTS = 50_000
 """Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
+
+# ----------------------------------------------------------------------- cells (obstacles around the robot)
+MAX_CELL_BYTES = 4 * 1024 * 1024
+"""Bytes of one cell file (YAML, URDF or xacro; meshes are read under their own caps)."""
+MAX_CELL_OBSTACLES = 500
+"""Obstacles of one cell, placed boxes of a job included (every one is checked against every link at each of
+the 10 kHz samples of a motion: 500 obstacles and 6 links take about 3 ms a sample)."""
+MAX_CELL_TRIANGLES = 200_000
+"""Mesh triangles of one cell, all its meshes together (coal's bounding-volume tree keeps a distance query
+near a few microseconds up to there)."""
+MAX_CELL_NODES = 100_000
+"""YAML nodes visited while reading one cell file (aliases count each time they are used: an alias bomb is
+refused here, not expanded)."""
 
 # ----------------------------------------------------------------------- files named by packages and meshes
 MAX_MESH_BYTES = 200 * 1024 * 1024

@@ -96,6 +96,7 @@ from .verify import (
     ENDPOINT_TOL,
     TOLERANCE,
     VERIFY_RATE,
+    Clearance,
     LimitViolation,
     _limits,
     jerk_vector,
@@ -107,8 +108,10 @@ from .verify import (
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
+    from ..cell import Cell, Scene
     from ..description import JointLimits
     from ..model import Robot
+    from .avoid import DistanceRow, Rows
     from .symbolic import SymbolicModel
 
 __all__ = [
@@ -191,12 +194,15 @@ class JumpOptions:
         tolerance: IPOPT's convergence tolerance (scaled problem).
         max_iterations: per solve.
         refinements: at most this many re-solves with constraints added inside intervals.
+        avoid_iterations: with a cell, at most this many more re-solves for the obstacle distances
+            (re-linearised each time, :mod:`~scara_pin.motion.avoid`).
     """
 
     intervals: tuple[int, int, int] | None = None
     tolerance: float = 1e-10
     max_iterations: int = 3000
     refinements: int = 6
+    avoid_iterations: int = 40
 
     def __post_init__(self) -> None:
         if self.intervals is not None:
@@ -206,7 +212,7 @@ class JumpOptions:
                 raise ParameterError("intervals", self.intervals, "must be 3 integers in [1, 500]")
             object.__setattr__(self, "intervals", tuple(int(v) for v in n))
         _positive("tolerance", self.tolerance)
-        for name in ("max_iterations", "refinements"):
+        for name in ("max_iterations", "refinements", "avoid_iterations"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v <= 100_000:
                 raise ParameterError(name, v, "must be an integer in [0, 100000]")
@@ -293,6 +299,7 @@ class Leg:
         joint: the joint where that ratio is reached.
         ratio: |value| / limit there (1.0: on the limit).
         binding: every limit at >= :data:`BINDING` on the leg, with its share of the leg's time.
+        closest: with a cell, the pair that comes closest on the leg and its distance [m].
     """
 
     name: str
@@ -303,6 +310,7 @@ class Leg:
     joint: str
     ratio: float
     binding: tuple[Binding, ...] = ()
+    closest: tuple[str, float] | None = None
 
     @property
     def duration(self) -> float:
@@ -311,9 +319,12 @@ class Leg:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
-        return {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
-                "duration": self.duration, "active_limit": self.active, "joint": self.joint, "ratio": self.ratio,
-                "binding": [b.to_dict() for b in self.binding]}  # fmt: skip
+        out = {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
+               "duration": self.duration, "active_limit": self.active, "joint": self.joint, "ratio": self.ratio,
+               "binding": [b.to_dict() for b in self.binding]}  # fmt: skip
+        if self.closest is not None:
+            out["closest"] = {"pair": self.closest[0], "distance": self.closest[1]}
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -337,6 +348,9 @@ class JumpMove:
         payload: the payload carried; jerk: the jerk limits per joint, or None; tool_speed: [m/s] or None.
         lower_bound: what no motion can beat (per move; the cycle's is twice it).
         stats: how the solver got there.
+        moves: 1 (A -> B) or 2 (and back).
+        cell: the cell the move was planned in, or None.
+        distance: with a cell, the smallest verified distance of its checked pairs, which and when.
     """
 
     trajectory: Trajectory
@@ -360,6 +374,8 @@ class JumpMove:
     lower_bound: LowerBound
     stats: SolverStats
     moves: int = 1
+    cell: Cell | None = None
+    distance: Clearance | None = None
 
     @property
     def duration(self) -> float:
@@ -380,7 +396,7 @@ class JumpMove:
             raise InvalidInputError("and_back needs a jump move")
         T = self.trajectory.duration
         back = [Leg(leg.name if leg.name == Phase.TRAVERSE.value else _MIRROR[leg.name], 1, 2 * T - leg.t_end,
-                    2 * T - leg.t_start, leg.active, leg.joint, leg.ratio, leg.binding)
+                    2 * T - leg.t_start, leg.active, leg.joint, leg.ratio, leg.binding, leg.closest)
                 for leg in reversed(self.legs)]  # fmt: skip
         traj = Trajectory((piece, piece.reversed()))
         return replace(self, trajectory=traj, legs=self.legs + tuple(back), moves=2)
@@ -417,6 +433,7 @@ class _Problem:
     tool_speed: float | None
     N: tuple[int, int, int]
     t_scale: float
+    scene: Scene | None = None
 
     @property
     def order(self) -> int:
@@ -468,7 +485,8 @@ class _Transcription:
     intervals).
     """
 
-    def __init__(self, prob: _Problem, points: tuple[_Point, ...], options: JumpOptions) -> None:
+    def __init__(self, prob: _Problem, points: tuple[_Point, ...], options: JumpOptions,
+                 distance_rows: tuple[DistanceRow, ...] = (), avoid: Rows | None = None) -> None:  # fmt: skip
         import casadi as ca
 
         self.prob = P = prob
@@ -478,10 +496,7 @@ class _Transcription:
         T = ca.SX.sym("T", 3)
         X = ca.SX.sym("X", order * dof, Nt + 1)
         U = ca.SX.sym("U", dof, Nt)
-        Xp = ca.repmat(ca.DM(sx.ravel()), 1, Nt + 1) * X
-        Up = ca.repmat(ca.DM(P.control_limit), 1, Nt) * U
-        h = ca.horzcat(*[ca.repmat(T[p] * (P.t_scale / N[p]), 1, N[p]) for p in range(3)])  # 1 x Nt
-        rows = [Xp[i * dof : (i + 1) * dof, :] for i in range(order)]
+        h, rows, Up = self._physical(T, X, U)
         g: list[Any] = []
         lb: list[np.ndarray] = []
         ub: list[np.ndarray] = []
@@ -551,11 +566,18 @@ class _Transcription:
             elif family == "tool speed" and P.tool_speed is not None:
                 v = P.sym.tool_velocity.map(n)(st[0], st[1])
                 add(ca.sum1(v * v) / P.tool_speed**2, -np.inf, 1.0)
+        self.n_rows = len(distance_rows)
         w = ca.vertcat(T, ca.vec(X), ca.vec(U))
         G = ca.vertcat(*g)
         # minimum time; then, as tie-breakers among the minimum-time motions, the lowest arch and smooth controls
         f = (ca.sum1(T) + _TIE_VELOCITY * ca.sumsqr(X[dof : 2 * dof, :]) / (dof * (Nt + 1))
              + _TIE_SMOOTH * ca.sumsqr(U) / (dof * Nt))  # fmt: skip
+        nlp = {"x": w, "f": f, "g": G}
+        if distance_rows and avoid is not None:
+            nlp = self._with_rows(nlp, distance_rows, avoid)
+            lb.append(np.zeros(len(distance_rows)))
+            ub.append(np.full(len(distance_rows), np.inf))
+            G = nlp["g"]
         self.n_x, self.n_g = int(w.shape[0]), int(G.shape[0])
         self.lbg, self.ubg = np.concatenate(lb), np.concatenate(ub)
         lbx_X = np.empty((order * dof, Nt + 1))
@@ -572,12 +594,63 @@ class _Transcription:
         opts: dict[str, Any] = {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False,
                                 "ipopt.tol": options.tolerance, "ipopt.constr_viol_tol": options.tolerance,
                                 "ipopt.max_iter": options.max_iterations, "ipopt.mu_strategy": "adaptive"}  # fmt: skip
-        self.solver = ca.nlpsol("jump", "ipopt", {"x": w, "f": f, "g": G}, opts)
+        self.solver = ca.nlpsol("jump", "ipopt", nlp, opts)
         self.shape = (order, dof, Nt)
 
-    def solve(self, x0: np.ndarray, lam_x: np.ndarray | None, lam_g: np.ndarray | None) -> dict[str, Any]:
-        """One IPOPT solve from x0 (and multipliers, when warm-starting)."""
-        kwargs: dict[str, Any] = {"x0": x0, "lbx": self.lbx, "ubx": self.ubx, "lbg": self.lbg, "ubg": self.ubg}
+    def _physical(self, T: Any, X: Any, U: Any) -> tuple[Any, list[Any], Any]:
+        """(interval lengths (1, Nt), state rows [q, qd(, qdd)] (dof, Nt + 1), controls (dof, Nt)) in SI units."""
+        import casadi as ca
+
+        P = self.prob
+        order, dof, N = P.order, P.robot.dof, P.N
+        Nt = sum(N)
+        Xp = ca.repmat(ca.DM(P.state_scale.ravel()), 1, Nt + 1) * X
+        Up = ca.repmat(ca.DM(P.control_limit), 1, Nt) * U
+        h = ca.horzcat(*[ca.repmat(T[p] * (P.t_scale / N[p]), 1, N[p]) for p in range(3)])  # 1 x Nt
+        return h, [Xp[i * dof : (i + 1) * dof, :] for i in range(order)], Up
+
+    def _with_rows(self, nlp: dict[str, Any], distance_rows: tuple[DistanceRow, ...], avoid: Rows) -> dict[str, Any]:
+        """The NLP with the obstacle rows (:mod:`~scara_pin.motion.avoid`) appended to its constraints.
+
+        Each row keeps its pair's first shape beyond a separating plane taken from the last solution: the
+        planes are parameters (9 per row), re-set after every solve without rebuilding the problem. The forward
+        kinematics of each row's point is written once (mapped over the points), and each pair's separation
+        function is called on it.
+        """
+        import casadi as ca
+
+        from .avoid import BUFFER, DISTANCE_SCALE
+
+        P = self.prob
+        order, dof = P.order, P.robot.dof
+        Nt = sum(P.N)
+        w = nlp["x"]
+        Pd = ca.SX.sym("Pd", len(distance_rows) * avoid.PARAMETERS)
+        nX = order * dof * (Nt + 1)
+        h, rows, Up = self._physical(w[:3], ca.reshape(w[3 : 3 + nX], order * dof, Nt + 1),
+                                     ca.reshape(w[3 + nX :], dof, Nt))  # fmt: skip
+        par = ca.reshape(Pd, avoid.PARAMETERS, len(distance_rows))
+        keys = sorted({(r.k, r.sigma) for r in distance_rows})
+        where = {key: c for c, key in enumerate(keys)}
+        ks = [k for k, _ in keys]
+        tau = ca.repmat(h[0, ks] * ca.DM([sg for _, sg in keys]).T, dof, 1)
+        qs = _propagate(order, [r[:, ks] for r in rows], Up[:, ks], tau)[0]  # dof x points
+        frames = P.sym.joint_frames.map(len(keys))(qs)  # 12 x (njoints * points)
+        nj = frames.shape[1] // len(keys)
+        seps = []
+        for i, r in enumerate(distance_rows):
+            ja, jb = avoid.joints(r.pair)
+            c = where[(r.k, r.sigma)]
+            seps.append(avoid.function(r.pair)(frames[:, c * nj + ja], frames[:, c * nj + jb], par[0:3, i],
+                                               par[3:6, i], par[6:9, i]))  # fmt: skip
+        g_rows = (ca.vertcat(*seps) - (avoid.margin + BUFFER)) / DISTANCE_SCALE
+        return {"x": w, "f": nlp["f"], "g": ca.vertcat(nlp["g"], g_rows), "p": Pd}
+
+    def solve(self, x0: np.ndarray, lam_x: np.ndarray | None, lam_g: np.ndarray | None,
+              params: np.ndarray | None = None) -> dict[str, Any]:  # fmt: skip
+        """One IPOPT solve from x0 (and multipliers, when warm-starting); ``params``: the distance rows' (g, c)."""
+        kwargs: dict[str, Any] = {"x0": x0, "lbx": self.lbx, "ubx": self.ubx, "lbg": self.lbg, "ubg": self.ubg,
+                                  "p": np.zeros(0) if params is None else params}  # fmt: skip
         if lam_x is not None:
             kwargs["lam_x0"] = lam_x
         if lam_g is not None:
@@ -621,6 +694,7 @@ def jump_move(
     end: ArrayLike | None = None,
     branch: str | None = None,
     options: JumpOptions | None = None,
+    cell: Cell | None = None,
 ) -> JumpMove:
     """The time-optimal jump from rest at ``pose_from`` to rest at ``pose_to`` (module docstring), verified.
 
@@ -641,9 +715,13 @@ def jump_move(
         branch: the IK branch of both ends ("right"/"left" for a SCARA; default: the start's, or the
             solution nearest the middle of the joint ranges).
         options: grid and solver options.
+        cell: obstacles, the carried part and the margin (:class:`~scara_pin.cell.Cell`): every checked pair
+            stays at least the margin apart (:mod:`~scara_pin.motion.avoid`), the joint path free to go
+            around or over.
 
     Raises:
-        ParameterError, InvalidInputError: bad input (exit 2), e.g. poses closer than 2 R horizontally.
+        ParameterError, InvalidInputError: bad input (exit 2), e.g. poses closer than 2 R horizontally; a start
+            or goal in collision (:class:`~scara_pin.cell.InCollisionError`, naming the pair).
         InfeasibleError: a pose or the traverse height out of reach, a ceiling below the needed height
             (exit 3); :class:`JumpError` (exit 3): the solver failed, with its reason.
     """
@@ -669,6 +747,13 @@ def jump_move(
         raise InfeasibleError(f"max_height {ceiling:.6g} m is below the height the clearance needs: z_top = "
                               f"{z_top:.6g} m (rise {rise:.6g} m above the higher pose)")  # fmt: skip
     qA, qB = _endpoints(robot, A, B, start, end, branch)
+    scene = None
+    if cell is not None:
+        from ..cell import scene as make_scene
+
+        scene = make_scene(robot, cell)
+        scene.check(qA, "the start (pose_from)")
+        scene.check(qB, "the goal (pose_to)")
     tops = (_top(robot, A, z_top, qA, "pose_from", rise), _top(robot, B, z_top, qB, "pose_to", rise))
     # size the work before doing it: the cheap bound (no ruckig) already says how many samples it will take
     cheap = lower_bound(robot, qA, qB, tops, lim.velocity, lim.acceleration, jv, exact_jerk=False)
@@ -686,15 +771,50 @@ def jump_move(
     lim_all = robot.limits if limits is None else limits
     prob = _Problem(loaded, symbolic_model(loaded), robot, payload, limits, A, B, qA, qB, tops, z_top, R, ceiling,
                     np.array(lim_all.lower), np.array(lim_all.upper), ~np.array(robot.continuous), lim.velocity,
-                    lim.acceleration, jv, lim.effort, lim.tool_speed, N, max(bound.duration / 3.0, 1e-3))  # fmt: skip
-    piece, T, stats = _solve(prob, options)
-    traj = Trajectory((piece,))
-    check = _verify(prob, traj)
+                    lim.acceleration, jv, lim.effort, lim.tool_speed, N, max(bound.duration / 3.0, 1e-3),
+                    scene)  # fmt: skip
+    if scene is None:
+        piece, T, stats = _solve(prob, options)
+        traj = Trajectory((piece,))
+        check = _verify(prob, traj)
+    else:
+        piece, T, stats, traj, check = _solve_in_cell(prob, options, scene, ceiling)
     legs = _legs(prob, check, T)
     stats = replace(stats, seconds=time.perf_counter() - t0)
     return JumpMove(traj, A, B, qA, qB, rise, R, z_top, ceiling, (float(T[0]), float(T[1]), float(T[2])), legs,
                     check.ratios, check.clearance_error, check.peak, check.bulge, payload,
-                    None if jv is None else tuple(jv.tolist()), lim.tool_speed, bound, stats)  # fmt: skip
+                    None if jv is None else tuple(jv.tolist()), lim.tool_speed, bound, stats,
+                    cell=cell, distance=check.distance)  # fmt: skip
+
+
+def _solve_in_cell(prob: _Problem, options: JumpOptions, scene: Scene, ceiling: float | None
+                   ) -> tuple[PolynomialPiece, np.ndarray, SolverStats, Trajectory, _Check]:  # fmt: skip
+    """The best warm starts around or over the obstacles, each solved and verified; the fastest wins."""
+    from .avoid import SECOND_WITHIN, candidates, solve_avoiding
+
+    found = candidates(scene, prob.qA, prob.qB, prob.q_tops, prob.A, prob.B, prob.z_top, ceiling, prob.velocity,
+                       prob.acceleration)  # fmt: skip
+    tries = found[:1] + [c for c in found[1:2] if c.way != found[0].way and c.duration <= SECOND_WITHIN
+                         * found[0].duration]  # fmt: skip
+    best = None
+    error: Exception | None = None
+    iterations = 0
+    for cand in tries:
+        logger.debug("jump in a cell: warm start %s (%.4g s, clearance %.3g m)", cand.way, cand.duration,
+                     cand.clearance)  # fmt: skip
+        try:
+            piece, T, stats = solve_avoiding(prob, options, cand.waypoints)
+            traj = Trajectory((piece,))
+            check = _verify(prob, traj)
+        except JumpError as exc:
+            error = exc
+            continue
+        iterations += stats.iterations
+        if best is None or traj.duration < best[3].duration:
+            best = (piece, T, stats, traj, check)
+    if best is None:
+        raise error if error is not None else JumpError("Not_Solved", "no warm start")
+    return best[0], best[1], replace(best[2], iterations=iterations), best[3], best[4]
 
 
 def _given(robot: Robot, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarray:
@@ -847,34 +967,51 @@ def lower_bound(
 
 
 # ---------------------------------------------------------------------------------------------- solving
-def _warm_start(prob: _Problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Joint lines A -> above A -> above B -> B, each with the quintic law over its fastest duration."""
+def _warm_start(prob: _Problem, waypoints: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Joint lines A -> above A -> [via points] -> above B -> B, each with the quintic law over its fastest duration.
+
+    The lift is the first line, the descent the last, the traverse the lines between (its nodes evenly spaced
+    in time over them).
+    """
     order = prob.order
-    ends = (prob.qA, prob.q_tops[0], prob.q_tops[1], prob.qB)
+    ends = np.array((prob.qA, prob.q_tops[0], prob.q_tops[1], prob.qB)) if waypoints is None else waypoints
+    groups = [ends[:2], ends[1:-1], ends[-2:]]
     T = np.empty(3)
     states: list[np.ndarray] = []
     for p in range(3):
-        q0, q1 = ends[p], ends[p + 1]
-        moving = not np.array_equal(q0, q1)
-        T[p] = line_optimal_duration(q0, q1, prob.velocity, prob.acceleration) * 1.2 if moving else 0.1 * prob.t_scale
-        x = np.linspace(0.0, 1.0, prob.N[p] + 1)
-        s = x**3 * (10.0 - 15.0 * x + 6.0 * x * x)
-        sd = 30.0 * x * x * (1.0 - x) ** 2 / T[p]
-        sdd = 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / T[p] ** 2
-        dq = q1 - q0
-        rows = [q0 + s[:, None] * dq, sd[:, None] * dq, sdd[:, None] * dq][:order]
-        states.append(np.stack(rows, axis=1)[(1 if p else 0) :])
+        lines = list(zip(groups[p][:-1], groups[p][1:]))
+        durations = np.array([line_optimal_duration(q0, q1, prob.velocity, prob.acceleration) * 1.2
+                              if not np.array_equal(q0, q1) else 0.0 for q0, q1 in lines])  # fmt: skip
+        T[p] = durations.sum() if durations.sum() > 0.0 else 0.1 * prob.t_scale
+        t = np.linspace(0.0, T[p], prob.N[p] + 1)
+        starts = np.concatenate([[0.0], np.cumsum(durations)[:-1]])
+        rows = [np.zeros((len(t), len(prob.qA))) for _ in range(3)]
+        for (q0, q1), t0, d in zip(lines, starts, durations):
+            sel = (t >= t0) & (t <= t0 + d) if d > 0.0 else np.zeros(len(t), dtype=bool)
+            x = (t[sel] - t0) / d if d > 0.0 else t[sel]
+            dq = q1 - q0
+            rows[0][sel] = q0 + (x**3 * (10.0 - 15.0 * x + 6.0 * x * x))[:, None] * dq
+            if d > 0.0:
+                rows[1][sel] = (30.0 * x * x * (1.0 - x) ** 2 / d)[:, None] * dq
+                rows[2][sel] = (60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / d**2)[:, None] * dq
+        if not lines or durations.sum() == 0.0:
+            rows[0][:] = groups[p][0]
+        states.append(np.stack(rows[:order], axis=1)[(1 if p else 0) :])
     X = np.concatenate(states)
     h = np.repeat(T / np.array(prob.N), prob.N)
     U = np.diff(X[:, order - 1], axis=0) / h[:, None]
     return T, X, U
 
 
-def _solve(prob: _Problem, options: JumpOptions) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:
-    """Solve, rebuild exactly, refine where a constraint fails between nodes (module docstring)."""
+def _solve(prob: _Problem, options: JumpOptions, waypoints: np.ndarray | None = None
+           ) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:  # fmt: skip
+    """Solve, rebuild exactly, refine where a constraint fails between nodes (module docstring).
+
+    ``waypoints``: the warm start's joint path (default: A, above A, above B, B; :func:`_warm_start`).
+    """
     points: tuple[_Point, ...] = ()
     tr = _Transcription(prob, points, options)
-    x0 = tr.pack(*_warm_start(prob))
+    x0 = tr.pack(*_warm_start(prob, waypoints))
     lam_x: np.ndarray | None = None
     lam_g: np.ndarray | None = None
     iterations = solves = 0
@@ -1020,6 +1157,7 @@ class _Check:
     clearance_error: float
     peak: float
     bulge: float
+    distance: Clearance | None = None
 
 
 def _verify(prob: _Problem, traj: Trajectory) -> _Check:
@@ -1039,7 +1177,8 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     lim = _limits(prob.base, prob.limits, prob.tool_speed, prob.effort is not None)
     try:
         found = verify(prob.base, traj, limits=prob.limits, jerk=prob.jerk, torque=prob.effort is not None,
-                       payload=prob.payload, tool_speed=prob.tool_speed, q_start=prob.qA, q_end=prob.qB).check()
+                       payload=prob.payload, tool_speed=prob.tool_speed, q_start=prob.qA, q_end=prob.qB,
+                       scene=prob.scene).check()
     except LimitViolation as exc:
         raise JumpError("VerificationFailed", exc.reason) from None
     T = traj.duration
@@ -1089,7 +1228,8 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     u = prob.B[:2] - prob.A[:2]
     u = u / np.linalg.norm(u)
     bulge = float(np.max(np.abs((poses[:, 0] - prob.A[0]) * u[1] - (poses[:, 1] - prob.A[1]) * u[0])))
-    return _Check(t, on_grid, table, worst, clearance_error, float(np.max(poses[:, 2]) - prob.z_top), bulge)
+    return _Check(t, on_grid, table, worst, clearance_error, float(np.max(poses[:, 2]) - prob.z_top), bulge,
+                  found.clearance)
 
 
 def _legs(prob: _Problem, check: _Check, T: np.ndarray) -> tuple[Leg, ...]:
@@ -1113,5 +1253,13 @@ def _legs(prob: _Problem, check: _Check, T: np.ndarray) -> tuple[Leg, ...]:
                     binding.append(Binding(name, who, top, share))
         binding.sort(key=lambda x: -x.share)
         who = "tool" if best[0] == "tool speed" else JOINT_NAMES[best[1]]
-        legs.append(Leg(phase.value, 0, float(cuts[p]), float(cuts[p + 1]), best[0], who, best[2], tuple(binding)))
+        closest = None
+        if check.distance is not None and prob.scene is not None:
+            ts, ds, ps = check.distance.samples
+            on = (ts >= cuts[p]) & (ts <= cuts[p + 1])
+            if on.any():
+                i = int(np.argmin(np.where(on, ds, np.inf)))
+                closest = (prob.scene.pairs[int(ps[i])].label, float(ds[i]))
+        legs.append(Leg(phase.value, 0, float(cuts[p]), float(cuts[p + 1]), best[0], who, best[2], tuple(binding),
+                        closest))  # fmt: skip
     return tuple(legs)
