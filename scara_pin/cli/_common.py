@@ -393,6 +393,33 @@ def _add_frame_options(g: Any) -> None:
                    "searched too")  # fmt: skip
 
 
+def add_cell_options(p: argparse.ArgumentParser, *, margin: bool = True) -> None:
+    """``--cell FILE`` (obstacles, the carried part, the margin: docs/cell.md) and ``--margin M``."""
+    g = p.add_argument_group("cell")
+    g.add_argument("--cell", metavar="FILE", help="the robot's cell: obstacles in its base frame, what the tool "
+                   "carries, the margin (YAML, or a URDF/xacro of fixed links; docs/cell.md)")  # fmt: skip
+    if margin:
+        g.add_argument("--margin", type=number_type("--margin"), metavar="M",
+                       help="the smallest distance kept to any obstacle [m, or mm with --mm], instead of the "
+                       "cell file's")  # fmt: skip
+
+
+def cell_from_args(args: argparse.Namespace, units: Units | None = None) -> Any:
+    """The cell named by ``--cell`` (with ``--margin``), or None; the margin in the typed length unit."""
+    path = getattr(args, "cell", None)
+    margin = getattr(args, "margin", None)
+    if path is None:
+        if margin is not None:
+            raise _UsageError("--margin needs --cell")
+        return None
+    from ..cell import load_cell
+
+    if margin is not None and units is not None:
+        margin = margin / units.length
+    packages = tuple(getattr(args, "package_path", None) or ())
+    return load_cell(path, margin=margin, package_dirs=packages)
+
+
 def _add_q(p: argparse.ArgumentParser) -> None:
     p.add_argument("q", nargs="*", metavar="Q",
                    help="joint values q1 q2 q3 q4 (URDF order; SCARA: q3 > 0 lowers the quill; "
