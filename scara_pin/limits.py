@@ -51,6 +51,7 @@ __all__ = [
     "MAX_VISUALS",
     "MAX_WALK_DEPTH",
     "MAX_WALK_ENTRIES",
+    "MAX_WORKSPACE_GRID",
     "MAX_XACRO_FILES",
     "UnreadableFileError",
     "check_count",
@@ -103,6 +104,9 @@ near a few microseconds up to there)."""
 MAX_CELL_NODES = 100_000
 """YAML nodes visited while reading one cell file (aliases count each time they are used: an alias bomb is
 refused here, not expanded)."""
+MAX_WORKSPACE_GRID = 250_000
+"""Grid points of one collision-free region (``workspace --cell --height``: 500 x 500; each reachable point
+costs up to two IK solutions and their distance checks, about 10 s at the cap)."""
 
 # ----------------------------------------------------------------------- files named by packages and meshes
 MAX_MESH_BYTES = 200 * 1024 * 1024
