@@ -52,6 +52,7 @@ __all__ = [
     "JointPath",
     "clear_mask",
     "first_contact",
+    "joint_motion",
     "joint_placements",
     "segment_distance",
 ]
@@ -219,7 +220,7 @@ _REVOLUTE = {f"JointModel{k}{a}": a for k in ("R", "RUB") for a in "XYZ"}
 _PRISMATIC = {f"JointModelP{a}": a for a in "XYZ"}
 
 
-def _joint_motion(joint: Any) -> tuple[str, np.ndarray] | None:
+def joint_motion(joint: Any) -> tuple[str, np.ndarray] | None:
     """("R" or "P", the unit axis in the joint's frame) of a Pinocchio joint of one degree of freedom, or None."""
     name = joint.shortname()
     if name in _REVOLUTE:
@@ -245,7 +246,7 @@ def joint_placements(robot: Any, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     n, nj = len(Q), model.njoints
     R = np.empty((n, nj, 3, 3))
     p = np.empty((n, nj, 3))
-    motions = [_joint_motion(model.joints[j]) for j in range(1, nj)]
+    motions = [joint_motion(model.joints[j]) for j in range(1, nj)]
     if model.nv != robot.dof or any(m is None for m in motions):
         data = model.createData()
         convert = robot.to_pinocchio_q if robot.has_continuous else None
