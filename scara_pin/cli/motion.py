@@ -286,8 +286,7 @@ def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) ->
 
 
 def cmd_jog(args: argparse.Namespace) -> int:
-    """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge (or before
-    contact, with ``--cell``)."""
+    """Jog to the edge: a straight tool move ending at rest on the workspace edge (or before contact: ``--cell``)."""
     from ..motion.jog import jog_to_edge
     from ._common import cell_from_args
 

@@ -157,8 +157,8 @@ def jog_to_edge(
         )
     if contact is not None and not travel > CONTACT_ROOM:
         raise InfeasibleError(f"no room to jog: {contact.pair.a} is at the margin of {contact.pair.b} already "
-                                  f"({contact.distance * 1e3:.6g} mm, margin {sc.margin * 1e3:g} mm) and the "
-                                  "direction brings them closer")  # fmt: skip
+                              f"({contact.distance * 1e3:.6g} mm) and the "
+                              "direction brings them closer")  # fmt: skip
     if not travel > 0:
         raise InfeasibleError(
             f"no room to jog: the edge ({hit.description}) is {hit.distance:.9g} m away, margin {margin:.9g} m"

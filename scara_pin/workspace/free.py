@@ -200,8 +200,11 @@ def _triangles(cell_shape: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def obstacle_outlines(cell: Cell, z: float) -> list[tuple[str, list[np.ndarray], np.ndarray]]:
-    """Per obstacle: (name, its section's segments at height z (each (2, 2), empty when it does not cross z),
-    its plan footprint: the convex hull of its projection (k, 2), closed)."""
+    """Per obstacle: (name, its section at height z, its plan footprint).
+
+    The section is a list of (2, 2) segments (empty when the obstacle does not cross z); the footprint the convex
+    hull of its projection on the plan, (k, 2), closed.
+    """
     import trimesh
     from scipy.spatial import ConvexHull
 
