@@ -66,7 +66,7 @@ __all__ = [
 
 
 
-def load_cell(path: str | Path, **kwargs: Any) -> Cell:
+def load_cell(path: str | Path, **kwargs: Any) -> "Cell":
     """Read a cell file (obstacles, carried part, margin): :func:`scara_pin.cell.load_cell` (imported on first use)."""
     from .cell import load_cell as _load_cell
 

@@ -34,12 +34,14 @@ from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from . import trajectory as tr
 
 if TYPE_CHECKING:
+    from ..cell import Cell
     from ..model import Robot
     from .cycle import ArchMove
     from .jump import JumpMove
     from .payload import Payload
+    from .verify import Clearance
 
-__all__ = ["Method", "MotionPlan", "MotionRequest", "plan_motion"]
+__all__ = ["Method", "MotionPlan", "MotionRequest", "clear_of", "plan_motion"]
 
 class Method(enum.Enum):
     """How a move is made; the value is the sentence ``scara-pin traj`` prints."""
@@ -81,6 +83,9 @@ class MotionRequest:
         path: "jump" (the time-optimal jump, the joint path free) or "lines" (the straight-leg arch).
         clearance_radius: [m] the jump's clearance radius; None: the standard one (path "jump").
         max_height: [m] a ceiling for the tool's z during the arch, or None.
+        cell: obstacles, the carried part and the margin (:mod:`scara_pin.cell`), or None. The jump plans
+            around and over them; every other move's path is fixed: it is verified (every checked pair at every
+            10 kHz sample) and refused if it comes closer than the margin.
     """
 
     start_q: np.ndarray | None = None
@@ -100,6 +105,7 @@ class MotionRequest:
     path: str = "jump"
     clearance_radius: float | None = None
     max_height: float | None = None
+    cell: Cell | None = None
 
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
@@ -143,22 +149,53 @@ class MotionPlan:
         method: how it was made.
         robot: the robot it was planned for (the request's payload attached, when one was given).
         arch: the arch move (its legs, ratios and payload) for ``Method.JUMP`` and ``Method.ARCH``; else None.
+        clearance: with a cell, the smallest verified distance of its checked pairs, which and when.
     """
 
     trajectory: tr.Trajectory
     method: Method
     robot: Robot
     arch: ArchMove | JumpMove | None = None
+    clearance: Clearance | None = None
 
 
 def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
     """Choose the method for ``request`` (see the module docstring) and make the trajectory.
 
+    With a cell (``request.cell``) the jump plans around and over the obstacles; any other move is verified
+    against the cell (:func:`clear_of`) and refused if it comes closer than the margin.
+
     Raises:
         InvalidInputError: a straight line or an arch asked of a robot other than a SCARA, an arch with
-            ``linear``, a payload without ``torque``.
-        InfeasibleError: a pose out of reach, a path the robot cannot follow, or a timing failure.
+            ``linear``, a payload without ``torque``; a start or end in collision (naming the pair).
+        InfeasibleError: a pose out of reach, a path the robot cannot follow, a timing failure, or a fixed path
+            that comes closer than the cell's margin (naming the pair, when and where).
     """
+    plan = _plan(robot, request)
+    if request.cell is None or plan.method is Method.JUMP:
+        return plan
+    from dataclasses import replace
+
+    return replace(plan, clearance=clear_of(robot, plan.trajectory, request.cell))
+
+
+def clear_of(robot: Robot, trajectory: tr.Trajectory, cell: Cell) -> Clearance | None:
+    """The smallest distance of ``cell``'s checked pairs along ``trajectory`` (the 10 kHz verifier's), or an error.
+
+    Raises:
+        InCollisionError: the start or the end is closer than the margin (exit 2, naming the pair).
+        LimitViolation: the path comes closer than the margin (exit 3, naming the pair, when and where).
+    """
+    from ..cell import scene
+    from .verify import verify
+
+    sc = scene(robot, cell)
+    sc.check(trajectory.q_start, "the start")
+    sc.check(trajectory.q_end, "the end")
+    return verify(robot, trajectory, scene=sc).check_clearance().clearance
+
+
+def _plan(robot: Robot, request: MotionRequest) -> MotionPlan:
     if request.linear and robot.kind != "scara":
         raise InvalidInputError(f"a straight tool line (--linear) is SCARA-only for now; robot {robot.name!r} is a "
                                 f"{robot.kind} (joint-space --duration and TOPP-RA timing work)")  # fmt: skip
@@ -248,8 +285,8 @@ def _jump(robot: Robot, request: MotionRequest) -> MotionPlan:
                      clearance_radius=STANDARD_CLEARANCE if request.clearance_radius is None
                      else request.clearance_radius, max_height=request.max_height, payload=request.payload,
                      torque=request.torque, tool_speed=request.tool_speed, start=request.start_q,
-                     end=request.end_q, jerk=request.jerk)  # fmt: skip
-    return MotionPlan(move.trajectory, Method.JUMP, robot, move)
+                     end=request.end_q, jerk=request.jerk, cell=request.cell)  # fmt: skip
+    return MotionPlan(move.trajectory, Method.JUMP, robot, move, move.distance)
 
 
 def _pose_to_q(robot: Robot, pose: np.ndarray | None, near: np.ndarray, what: str) -> np.ndarray:
