@@ -153,8 +153,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     for leg in move.legs:
         binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in leg.binding)
         print(f"  {'out ' if leg.move == 0 else 'back'} {leg.name:<11} {leg.duration:9.6f} s   "
-              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit" + (f"; binding: {binding}" if binding
-                                                                                else "") + closest_text(leg, units))  # fmt: skip
+              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
+              + (f"; binding: {binding}" if binding else "") + closest_text(leg, units))  # fmt: skip
     if cell is not None:
         print(cell_text(cell, move.distance, units))
     if path is CyclePath.LINES:

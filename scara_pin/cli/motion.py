@@ -26,9 +26,9 @@ from ._common import (
     _num,
     _number,
     _read_pose,
-    log,
     add_cell_options,
     cell_from_args,
+    log,
     number_type,
     write_atomic,
 )
