@@ -109,7 +109,7 @@ def test_parallel_cylinders_and_prisms(robot, rng):
         cell = Cell((_obstacle("cylinder", (rp, hi - lo), (x, y, (lo + hi) / 2), "post"),), MARGIN)
         rho = math.hypot(tool[0] - x, tool[1] - y)
 
-        def prisms(plan, z0, z1):  # two vertical prisms: plan gap and height gap
+        def prisms(plan, z0, z1, lo=lo, hi=hi):  # two vertical prisms: plan gap and height gap
             gap = max(lo - z1, z0 - hi, 0.0)
             return math.hypot(max(plan, 0.0), gap)
 
@@ -225,7 +225,8 @@ def test_the_issue_example_reads(tmp_path):
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 1e400\n", "line 4: '1e400' is not a plain finite"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: '0.1'\n", "line 4: obstacle a: radius must be a number"),
     ("obstacles:\n  - name: a\n    shape: cone\n", "line 3: obstacle a: shape 'cone' must be one of"),
-    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 0.1\n    colour: red\n", "line 5: obstacle a: unknown key"),
+    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 0.1\n    colour: red\n",
+     "line 5: obstacle a: unknown key"),
     ("obstacles:\n  - {name: a, shape: sphere, radius: 0.1}\n  - {name: a, shape: sphere, radius: 0.1}\n",
      "line 3: obstacle name 'a' is used twice"),
     ("margin: -1\n", "line 1: margin -1 m must be in [0, 1] m"),
