@@ -163,7 +163,7 @@ def test_a_job_expands_in_order_with_its_settings(robot_default: Robot, tmp_path
     job = Job.load(write_job(tmp_path, TRAY, robot_default))
     assert job.jump.rise == pytest.approx(0.030, abs=1e-15)  # the unit tag read
     assert job.pallets["stack"].layer_height == pytest.approx(0.020, abs=1e-15)
-    assert job.actions == 4 * 3 + 2 + 1
+    assert job.actions == 4 * 3 + 2 + 1 and job.dwell == pytest.approx(4 * 0.05, abs=1e-15)
     program = job.program(robot_default)
     assert program.start == "feeder"
     labels = [(a.kind.value, a.target) if hasattr(a, "kind") else ("dwell", a.at) for a in program.actions]
@@ -332,6 +332,15 @@ def test_another_robot_and_an_output_over_an_input_are_refused(robot_default: Ro
     assert main(["job", str(job), "--robot", "s1"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"error: {job} line {line_of(job, 'robot:')}: the job is for robot 'default'"), err
+
+
+def test_an_output_the_dwells_alone_make_too_long_is_refused_before_any_planning(
+    robot_default: Robot, tmp_path: Path, capsys: pytest.CaptureFixture[str], no_planning: None
+) -> None:  # fmt: skip
+    job = write_job(tmp_path, "steps:\n  - jump: feeder\n  - for: 100\n    do: [{dwell: 10}]\n", robot_default)
+    assert main(["job", str(job), "--out", str(tmp_path / "o.csv"), "--rate", "10000"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "samples of --out (at least the dwells' 1000 s at 10000 Hz) would be 1e+07, above the cap" in err, err
 
 
 def test_the_job_file_is_sized_first(tmp_path: Path) -> None:

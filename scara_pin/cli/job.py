@@ -9,6 +9,7 @@ from typing import Any
 
 from ..errors import InvalidInputError, ParameterError
 from ..files import check_output_path, check_outputs_apart
+from ..limits import MAX_SAMPLES, check_count
 from ._common import Units, _acceleration, _add_acceleration, _add_robot_options, _load, _needs_wrist, number_type
 
 _VIEW_RATE = 200.0
@@ -29,6 +30,9 @@ def cmd_job(args: argparse.Namespace) -> int:
         raise ParameterError("--rate", args.rate, "must be > 0", "Hz")
     job = Job.load(args.file)
     check_outputs_apart(named, [args.file, job.points_file, job.cell])
+    if args.out:  # the dwells alone already take this many samples: refused before the moves are planned
+        check_count(f"samples of --out (at least the dwells' {job.dwell:.6g} s at {args.rate:.6g} Hz)",
+                    job.dwell * args.rate + 1.0, MAX_SAMPLES, "lower --rate")  # fmt: skip
     if args.robot is None and args.urdf is None and job.robot is not None:
         args.robot = job.robot
     units = Units()  # a job's numbers are SI, and so is --acceleration here

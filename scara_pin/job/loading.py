@@ -60,10 +60,10 @@ from .steps import (
     Setting,
     Step,
     Target,
-    count_actions,
     expand,
     located,
     parse_target,
+    tally,
 )
 
 if TYPE_CHECKING:
@@ -188,6 +188,7 @@ class Job:
         cell: the cell file (obstacles), or None.
         carry: what the tool carries, or None.
         actions: the number of moves and dwells the steps expand to.
+        dwell: [s] the time of all its dwells: a lower bound of its total, known before any planning.
         lines: the line of each top-level key, and of each pallet (``"pallets.NAME"``).
     """
 
@@ -204,6 +205,7 @@ class Job:
     cell: Path | None = None
     carry: Carry | None = None
     actions: int = 0
+    dwell: float = 0.0
     lines: Mapping[str, int | None] = field(default_factory=dict)
 
     @classmethod
@@ -286,12 +288,12 @@ def load_job(path: str | Path) -> Job:
     if not isinstance(steps_at.value, list) or not steps_at.value:
         steps_at.fail("steps must be a non-empty list")
     steps = _steps(steps_at, points, pallets, {}, 0)
-    count = count_actions(steps, pallets)
+    count, dwell = tally(steps, pallets)
     if count > MAX_JOB_STEPS:
         steps_at.fail(f"the steps expand to {count:,} moves and dwells, above the cap of {MAX_JOB_STEPS:,} "
                       "(MAX_JOB_STEPS): split the job")  # fmt: skip
     return Job(path, points_file, points, pallets, steps, robot, start, shape, torque, payload, cell, carry, count,
-               lines)  # fmt: skip
+               dwell, lines)  # fmt: skip
 
 
 def _points(at: _At, job: Path) -> tuple[Path, PointSet]:

@@ -52,10 +52,10 @@ __all__ = [
     "Setting",
     "Step",
     "Target",
-    "count_actions",
     "expand",
     "located",
     "parse_target",
+    "tally",
 ]
 
 _NAME = r"[A-Za-z][A-Za-z0-9_.\-]{0,31}"
@@ -190,16 +190,19 @@ class Loop:
 Step = Setting | MotionStep | Dwell | Loop
 
 
-def count_actions(steps: tuple[Step, ...], pallets: Mapping[str, Pallet]) -> int:
-    """The number of moves and dwells ``steps`` expand to, loops unrolled (counted, not built)."""
-    n = 0
+def tally(steps: tuple[Step, ...], pallets: Mapping[str, Pallet]) -> tuple[int, float]:
+    """(moves and dwells, seconds of dwell) ``steps`` expand to, loops unrolled: counted, never built."""
+    n, dwell = 0, 0.0
     for step in steps:
         if isinstance(step, Loop):
             times = step.over if isinstance(step.over, int) else pallets[step.over].places
-            n += times * count_actions(step.body, pallets)
+            inner = tally(step.body, pallets)
+            n, dwell = n + times * inner[0], dwell + times * inner[1]
+        elif isinstance(step, Dwell):
+            n, dwell = n + 1, dwell + step.seconds
         elif not isinstance(step, Setting):
             n += 1
-    return n
+    return n, dwell
 
 
 @dataclass(frozen=True, eq=False)
