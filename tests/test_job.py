@@ -329,6 +329,8 @@ def test_another_robot_and_an_output_over_an_input_are_refused(robot_default: Ro
     assert "it is the input" in capsys.readouterr().err and job.read_text() == before
     assert main(["job", str(job), "--plot", str(tmp_path / "points.yaml")]) == 2
     assert "it is the input" in capsys.readouterr().err
+    assert main(["job", str(job), "--out", str(tmp_path / "a.csv"), "--html", str(tmp_path / "." / "a.csv")]) == 2
+    assert "two outputs to one file" in capsys.readouterr().err
     assert main(["job", str(job), "--robot", "s1"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"error: {job} line {line_of(job, 'robot:')}: the job is for robot 'default'"), err
