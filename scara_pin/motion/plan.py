@@ -35,6 +35,7 @@ from . import trajectory as tr
 
 if TYPE_CHECKING:
     from ..cell import Cell
+    from ..description import JointLimits
     from ..model import Robot
     from .cycle import ArchMove
     from .jump import JumpMove
@@ -86,6 +87,8 @@ class MotionRequest:
         cell: obstacles, the carried part and the margin (:mod:`scara_pin.cell`), or None. The jump plans
             around and over them; every other move's path is fixed: it is verified (every checked pair at every
             10 kHz sample) and refused if it comes closer than the margin.
+        limits: joint limits instead of ``robot.limits`` for the time-optimal moves and the jump (a speed
+            override scales them); None: the robot's.
     """
 
     start_q: np.ndarray | None = None
@@ -106,6 +109,7 @@ class MotionRequest:
     clearance_radius: float | None = None
     max_height: float | None = None
     cell: Cell | None = None
+    limits: JointLimits | None = None
 
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
@@ -138,6 +142,12 @@ class MotionRequest:
                                     "vertically")  # fmt: skip
         if not self.arch and (self.rise, self.blend, self.clearance_radius, self.max_height) != (None,) * 4:
             raise InvalidInputError("rise, blend, clearance radius and max height shape an arch move: set arch")
+        if self.limits is not None and self.duration is not None:
+            raise InvalidInputError("limits shape a time-optimal move: a move of a given duration is only checked "
+                                    "against the robot's")  # fmt: skip
+        if self.limits is not None and self.arch and self.path == "lines":
+            raise InvalidInputError("limits other than the robot's apply to the jump (path 'jump'), not the "
+                                    "straight-leg arch")  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -222,10 +232,13 @@ def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Traj
     if request.jerk is not None:
         from .jerk import time_optimal_jerk
 
+        if request.limits is not None:
+            raise InvalidInputError("limits other than the robot's are not supported with a jerk limit")
         return time_optimal_jerk(robot, path, request.jerk, torque=request.torque).trajectory  # type: ignore[arg-type]
     from .timing import time_optimal
 
-    return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque)  # type: ignore[arg-type]
+    return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque,  # type: ignore[arg-type]
+                        limits=request.limits)  # fmt: skip
 
 
 def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -254,7 +267,7 @@ def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
             return MotionPlan(tr.timed(path, request.duration), Method.JOINT_SPLINE_QUINTIC, robot)
         return MotionPlan(tr.quintic(q_from, q_to, request.duration), Method.JOINT_QUINTIC, robot)
     if not vias and request.tool_speed is None and not request.torque and request.jerk is None:
-        lim = robot.limits
+        lim = robot.limits if request.limits is None else request.limits
         return MotionPlan(tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), Method.JOINT_TRAPEZOID, robot)
     method = Method.JOINT_TOPPRA if request.jerk is None else Method.JOINT_JERK
     return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), method, robot)
@@ -285,7 +298,7 @@ def _jump(robot: Robot, request: MotionRequest) -> MotionPlan:
                      clearance_radius=STANDARD_CLEARANCE if request.clearance_radius is None
                      else request.clearance_radius, max_height=request.max_height, payload=request.payload,
                      torque=request.torque, tool_speed=request.tool_speed, start=request.start_q,
-                     end=request.end_q, jerk=request.jerk, cell=request.cell)  # fmt: skip
+                     end=request.end_q, jerk=request.jerk, limits=request.limits, cell=request.cell)  # fmt: skip
     return MotionPlan(move.trajectory, Method.JUMP, robot, move, move.distance)
 
 
