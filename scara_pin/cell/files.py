@@ -308,7 +308,7 @@ def _shape(reader: _Reader, item: _Node, what: str, folder: Path | None, *, name
 def _mesh_shape(reader: _Reader, d: dict[str, _Node], what: str, folder: Path | None, xyz: list[float],
                 rpy: list[float]) -> Shape:  # fmt: skip
     from ..description.mesh_paths import MeshProblem
-    from ..description.meshes import load_mesh
+    from .meshes import load_mesh
 
     file = d["file"].value
     if not isinstance(file, str) or not file or len(file) > 4096:
@@ -339,10 +339,10 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     import pinocchio as pin
 
     from ..description.mesh_paths import MeshProblem, mesh_file
-    from ..description.meshes import _scale, load_mesh
     from ..description.packages import PackagePath, read_robot_file
     from ..description.placeholders import placeholder_urdf
     from ..limits import check_input_file
+    from .meshes import _scale, load_mesh
 
     check_input_file(path, "cell file", MAX_CELL_BYTES)
     packages: PackagePath = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
