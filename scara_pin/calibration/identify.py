@@ -1,13 +1,13 @@
 """Which errors the measurements can separate: the base parameters of an identification Jacobian.
 
 The identification Jacobian ``W`` (one row per measured coordinate, one column per candidate error, at the
-nominal description) tells what each error does to the measurements. Two errors whose columns are
+nominal description or at an estimate) tells what each error does to the measurements. Two errors whose columns are
 proportional, or a column in the span of others, cannot be told apart by any fit: such a column is fixed
 at its nominal value (zero error) and the errors it depends on absorb it (FIGAROH's base parameters, from
 a QR decomposition of the regressor).
 
-The columns are taken in the error model's order of preference
-(:mod:`scara_pin.calibration.chain`), each scaled to unit norm (so that metres, radians and scales
+The columns are taken in an order of preference (the error model's, :mod:`scara_pin.calibration.chain`; at
+an estimate, the errors already identified first), each scaled to unit norm (so that metres, radians and scales
 compare), by a QR decomposition without pivoting kept column by column (Gram-Schmidt, orthogonalised
 twice): a column is kept when the part of it outside the span of the columns kept before is at least
 ``IDENTIFY_TOL`` of its norm (``|R_ii|`` of the unit column, the sine of its angle to that span); below,

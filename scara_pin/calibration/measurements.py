@@ -102,8 +102,8 @@ class Measurements:
         rank[np.argsort(first)] = np.arange(len(first))  # number the poses in the rows' order
         return rank[inverse.reshape(-1)], len(first)
 
-    def check(self, robot: Robot) -> list[str]:
-        """Refuse readings the robot cannot take; return the readings outside the joint limits, in words.
+    def check(self, robot: Robot) -> None:
+        """Refuse readings the robot cannot take (the limits: :func:`~scara_pin.calibration.screen.screen`).
 
         Raises:
             InvalidInputError: not ``robot.dof`` readings per row, or a reading beyond +/-1e6 (naming the row).
@@ -111,16 +111,11 @@ class Measurements:
         if self.q.shape[1] != robot.dof:
             raise InvalidInputError(f"{self.source}: {self.q.shape[1]} joint readings per row; robot "
                                     f"{robot.name!r} has {robot.dof} joints")  # fmt: skip
-        outside = []
         for k, q in enumerate(self.q):
             try:
                 robot.check_q(q)
             except ParameterError as exc:
                 raise InvalidInputError(f"{self.source}, {self.where(k)}: {exc}") from None
-            bad = robot.outside_limits(q, tol=1e-9)
-            if bad:
-                outside.append(f"{self.where(k)}: {'; '.join(bad)}")
-        return outside
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str], dof: int) -> Measurements:
