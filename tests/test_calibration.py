@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from calibration_truth import write_csv
 from scipy.spatial.transform import Rotation
 
 from scara_pin import InvalidInputError, load_robot, robot_from_urdf
@@ -93,13 +94,6 @@ def simulate(truth, n: int, rng: np.random.Generator, noise: float = 0.0, q3: fl
     readings = q.copy()
     readings[:, 2] /= SCALE
     return readings, p, yaw, q
-
-
-def write_csv(path: Path, q: np.ndarray, p: np.ndarray, yaw: np.ndarray | None = None) -> Path:
-    cols = [f"q{i + 1}" for i in range(q.shape[1])] + ["x", "y", "z"] + (["yaw"] if yaw is not None else [])
-    rows = np.column_stack([q, p] + ([yaw] if yaw is not None else []))
-    path.write_text(",".join(cols) + "\n" + "\n".join(",".join(repr(float(v)) for v in r) for r in rows) + "\n")
-    return path
 
 
 @pytest.fixture(scope="module")

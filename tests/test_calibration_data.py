@@ -75,7 +75,8 @@ DEG = np.array([180 / math.pi, 180 / math.pi, 1.0, 180 / math.pi])
     ("positions 1e11", "times the model's: x, y, z must be in metres"),
     ("readings in degrees", "the joint readings look like degrees"),
     ("a 33 deg offset: readings outside the limits", "rows have readings outside the joint limits (line "),
-    ("one pose repeated 60 times", "60 rows hold 1 distinct poses"),
+    ("one pose repeated 60 times", "60 rows hold 1 distinct pose (rows with the same readings measure one pose "
+     "again) for 18 identifiable parameters"),
     ("12 poses measured 5 times", "60 rows hold 12 distinct poses (rows with the same readings measure one pose "
      "again) for 18 identifiable parameters"),
 ])  # fmt: skip

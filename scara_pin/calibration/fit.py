@@ -250,7 +250,8 @@ def _solve(problem: _Problem, loss: Loss, opt: CalibrationOptions, start: _Solut
     """The identified errors fitted, identifiability judged at the nominal model, then at each estimate.
 
     ``start``: a solution on other rows of the same chain: its second-order errors are kept (if these poses
-    identify them at its estimate) and the fit starts from its estimate (the same minimum, sooner).
+    identify them at its estimate), those it left fixed stay fixed, and the fit starts from its estimate (the
+    same minimum, sooner).
     """
     size = problem.chain.size
     zero = np.zeros(size)
@@ -261,6 +262,7 @@ def _solve(problem: _Problem, loss: Loss, opt: CalibrationOptions, start: _Solut
     weak: dict[int, str] = {}
     theta = zero
     if start is not None:
+        weak = dict(start.weak)
         if start.second:
             _, Js = problem.residuals(start.theta)
             order = kept + list(start.second) + [k for k in range(size) if k not in kept and k not in start.second]

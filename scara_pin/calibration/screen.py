@@ -183,8 +183,9 @@ def screen(chain: ChainModel, measurements: Measurements, count: int, *,
         )
     pose, distinct = m.poses()
     if distinct < count:
-        poses = (f"{distinct} measured poses" if distinct == len(m) else
-                 f"{len(m)} rows hold {distinct} distinct poses (rows with the same readings measure one pose again)")
+        plural = "s" if distinct != 1 else ""
+        poses = (f"{distinct} measured poses" if distinct == len(m) else f"{len(m)} rows hold {distinct} distinct "
+                 f"pose{plural} (rows with the same readings measure one pose again)")  # fmt: skip
         raise InvalidInputError(
             f"{src}: {poses} for {count} identifiable parameters: at least {count} distinct poses are needed, a few "
             f"times more to average the noise (scara-pin calibrate --plan {3 * count} proposes poses)"
