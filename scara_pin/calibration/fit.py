@@ -24,8 +24,9 @@ The steps of :func:`calibrate`:
 4. with a robust loss (the default, soft_l1): the rows whose weighted residual exceeds ``outlier_sigmas``
    robust standard deviations (the median norm of a row's residual over the median of a chi distribution
    with as many degrees of freedom as the row has coordinates) are outliers, listed and left out; the final
-   fit is the linear one of step 3 on the other rows. With the linear loss they are kept, and named in a
-   warning;
+   fit is the linear one of step 3 on the other rows, and the outliers are judged again against it (its
+   inlying rows give the standard deviation; a soft_l1 fit still leans towards gross rows) until they stay
+   the same. With the linear loss they are kept, and named in a warning;
 5. the covariance ``sigma^2 (J^T J)^-1`` of the identified errors, ``sigma^2`` the residual sum of squares over
    the redundancy (rows x coordinates minus identified errors), and each row's standardised residual
    ``sqrt(r^T (I - H)^-1 r) / sigma`` (``H``: the row's block of the hat matrix; ``I + H`` for a row left out);
@@ -151,8 +152,8 @@ class _Problem:
     def __post_init__(self) -> None:
         self.qpin = self.chain.pinocchio_q(self.measurements.q)
         self.target = self.measurements.values()
-        self.pose, count = self.measurements.poses()
-        self.distinct = np.array([int(np.flatnonzero(self.pose == k)[0]) for k in range(count)], dtype=int)
+        self.pose, _ = self.measurements.poses()
+        self.distinct = np.unique(self.pose, return_index=True)[1]  # the first row of each pose, in pose order
 
     def residuals(self, theta: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """(n, k) residuals (model minus measurement, yaw wrapped, unweighted) and the weighted Jacobian."""
@@ -223,9 +224,13 @@ def _robust_sigma(w: np.ndarray) -> float:
     return float(np.median(np.linalg.norm(w, axis=1))) / math.sqrt(float(chi2.ppf(0.5, w.shape[1]))) if w.size else 0.0
 
 
-def _inliers(w: np.ndarray, sigmas: float) -> np.ndarray:
-    """The rows of the (n, k) weighted residuals within ``sigmas`` robust standard deviations (or the floor)."""
-    return np.linalg.norm(w, axis=1) <= max(sigmas * _robust_sigma(w), OUTLIER_FLOOR)
+def _inliers(w: np.ndarray, sigmas: float, among: np.ndarray | None = None) -> np.ndarray:
+    """The rows of the (n, k) weighted residuals within ``sigmas`` robust standard deviations (or the floor).
+
+    The standard deviation from the rows ``among`` (a mask; default all).
+    """
+    sigma = _robust_sigma(w if among is None else w[among])
+    return np.linalg.norm(w, axis=1) <= max(sigmas * sigma, OUTLIER_FLOOR)
 
 
 @dataclass(frozen=True)
@@ -246,12 +251,13 @@ class _Solution:
     nfev: int
 
 
-def _solve(problem: _Problem, loss: Loss, opt: CalibrationOptions, start: _Solution | None = None) -> _Solution:
+def _solve(problem: _Problem, loss: Loss, opt: CalibrationOptions, start: _Solution | None = None, *,
+           keep_weak: bool = True) -> _Solution:  # fmt: skip
     """The identified errors fitted, identifiability judged at the nominal model, then at each estimate.
 
     ``start``: a solution on other rows of the same chain: its second-order errors are kept (if these poses
-    identify them at its estimate), those it left fixed stay fixed, and the fit starts from its estimate (the
-    same minimum, sooner).
+    identify them at its estimate), those it left fixed stay fixed (with ``keep_weak``; else they are tested
+    again), and the fit starts from its estimate (the same minimum, sooner).
     """
     size = problem.chain.size
     zero = np.zeros(size)
@@ -262,7 +268,7 @@ def _solve(problem: _Problem, loss: Loss, opt: CalibrationOptions, start: _Solut
     weak: dict[int, str] = {}
     theta = zero
     if start is not None:
-        weak = dict(start.weak)
+        weak = dict(start.weak) if keep_weak else {}
         if start.second:
             _, Js = problem.residuals(start.theta)
             order = kept + list(start.second) + [k for k in range(size) if k not in kept and k not in start.second]
@@ -419,16 +425,25 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
     zero = np.zeros(chain.size)
     problem = _Problem(chain, measurements, screening.device0, opt.yaw_weight)
     used = np.ones(n, dtype=bool)
-    if opt.loss is not Loss.LINEAR:
-        rough = _solve(problem, opt.loss, opt)
-        r, _ = problem.residuals(rough.theta, jacobian=False)
+    start: _Solution | None = None
+    if opt.loss is not Loss.LINEAR:  # the robust fit's outliers, then each linear fit's, until they stay the same
+        start = _solve(problem, opt.loss, opt)
+        r, _ = problem.residuals(start.theta, jacobian=False)
         used = _inliers(problem.weighted(r), opt.outlier_sigmas)
+    for attempt in range(MAX_PASSES):
         left = len(np.unique(problem.pose[used]))
         if left < count:
             raise InvalidInputError(f"{measurements.source}: {int((~used).sum())} of {n} rows are outliers: "
                                     f"{left} distinct poses remain for {count} identifiable parameters")  # fmt: skip
-    final = problem.subset(used)
-    sol = _solve(final, Loss.LINEAR, opt, rough if opt.loss is not Loss.LINEAR else None)
+        final = problem.subset(used)
+        sol = _solve(final, Loss.LINEAR, opt, start, keep_weak=False)
+        if opt.loss is Loss.LINEAR:
+            break
+        r, _ = problem.residuals(sol.theta, jacobian=False)
+        again = _inliers(problem.weighted(r), opt.outlier_sigmas, used)
+        if np.array_equal(again, used) or attempt == MAX_PASSES - 1:
+            break
+        used, start = again, sol
     theta, kept = sol.theta, sol.kept
     covariance, sigma = _covariance(final, theta, kept)
     if len(sol.nominal.kept) < count:
