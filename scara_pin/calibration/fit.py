@@ -450,7 +450,7 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
         notes.append(f"these poses identify {len(sol.nominal.kept)} of the {count} errors a richer set of poses "
                      "would: add poses (scara-pin calibrate --plan proposes well-conditioned ones)")  # fmt: skip
     r_before, _ = problem.residuals(zero, jacobian=False)
-    r_after, J_after = problem.residuals(theta)
+    r_after, _ = problem.residuals(theta, jacobian=False)
     standardised = _standardised(problem, used, theta, kept, sigma)
     dist = np.linalg.norm(r_after[:, :3], axis=1)
     outliers = tuple(Outlier(int(i), measurements.where(int(i)), float(dist[i]), float(standardised[i]))
