@@ -7,12 +7,15 @@ request, 1 for an internal error (a bug, or a broken installation).
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import ClassVar
 
 __all__ = [
     "DescriptionError",
     "InfeasibleError",
     "InvalidInputError",
+    "JobFileError",
+    "JobStepError",
     "NoSolutionError",
     "ParameterError",
     "ScaraError",
@@ -94,3 +97,37 @@ class NoSolutionError(InfeasibleError):
 
 class DescriptionError(ScaraError):
     """The packaged description templates failed to expand (a bug or a broken install; exit code 1)."""
+
+
+class _Located(Exception):
+    """An error in a job file: the file, the line (or None) and the reason, said in that order."""
+
+    path: Path
+    line: int | None
+    reason: str
+
+    def __init__(self, path: Path, line: int | None, reason: str) -> None:
+        self.path = path
+        self.line = line
+        self.reason = reason
+        super().__init__(f"{path}{f' line {line}' if line is not None else ''}: {reason}")
+
+
+class JobFileError(_Located, InvalidInputError):
+    """A job file that cannot be run as written (exit code 2): what is wrong, and where.
+
+    Attributes:
+        path: the job file.
+        line: the line (from 1) of the offending value, or None when it has none (the file itself).
+        reason: the sentence.
+    """
+
+
+class JobStepError(_Located, InfeasibleError):
+    """A step of a job the robot cannot make (exit code 3): a place out of reach, a move the planner cannot plan.
+
+    Attributes:
+        path: the job file.
+        line: the line (from 1) of the step.
+        reason: the sentence.
+    """

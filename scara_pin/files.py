@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 import stat
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
@@ -34,6 +34,7 @@ __all__ = [
     "STDOUT",
     "atomic_output",
     "check_output_path",
+    "check_outputs_apart",
     "save_figure",
     "write_atomic_with",
     "write_text_atomic",
@@ -75,6 +76,35 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
             raise InvalidInputError(f"cannot write {path}: it is {kind}; scara-pin writes regular files only "
                                     "(or - for standard output)")  # fmt: skip
     return path
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet): the same name is the same file
+        return a.resolve() == b.resolve()
+
+
+def check_outputs_apart(
+    outputs: Sequence[str | os.PathLike[str] | None], inputs: Sequence[str | os.PathLike[str] | None] = ()
+) -> None:
+    """Refuse an output that is one of the ``inputs`` (it would be written over) or another output.
+
+    Standard output (``-``) and None are skipped. A file is recognised through links and ``..`` (the same
+    file on disk; for names that do not exist yet, the same resolved path).
+
+    Raises:
+        InvalidInputError: naming the two options' files.
+    """
+    named = [Path(p) for p in outputs if p is not None and str(p) != STDOUT]
+    sources = [Path(p) for p in inputs if p is not None and str(p) != STDOUT]
+    for k, out in enumerate(named):
+        for src in sources:
+            if _same_file(out, src):
+                raise InvalidInputError(f"cannot write {out}: it is the input {src}; write the output elsewhere")
+        for other in named[:k]:
+            if _same_file(out, other):
+                raise InvalidInputError(f"cannot write two outputs to one file, {other} and {out}")
 
 
 def _new_temp(folder: Path, name: str, created: list[Path]) -> Path:

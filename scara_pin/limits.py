@@ -36,6 +36,9 @@ __all__ = [
     "MAX_CHECK_ELEMENTS",
     "MAX_DOCUMENT_BYTES",
     "MAX_FRAMES",
+    "MAX_JOB_BYTES",
+    "MAX_JOB_DEPTH",
+    "MAX_JOB_STEPS",
     "MAX_LINE_CHARS",
     "MAX_MESH_BYTES",
     "MAX_NUMBER",
@@ -89,6 +92,13 @@ MAX_POINTS = 10_000
 """Taught points of one points file (``teach --points``, ``traj --points``): a cell has tens."""
 MAX_POINTS_BYTES = 4 * 1024 * 1024
 """Bytes of one points file (10,000 points at full precision take about 1.5 MB)."""
+MAX_JOB_BYTES = 2 * 1024 * 1024
+"""Bytes of one job file (``scara-pin job``): a job is a page of steps; its pallets and loops make it long."""
+MAX_JOB_DEPTH = 4
+"""``for`` loops nested in one another in a job (a pallet's layers, rows and columns are one loop)."""
+MAX_JOB_STEPS = 10_000
+"""Moves and dwells one job expands to, its loops unrolled (counted before any is built; each new jump is a
+solve of about 0.1-0.5 s)."""
 MAX_CHECK_ELEMENTS = 50_000
 """Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
 

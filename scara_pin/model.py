@@ -398,7 +398,7 @@ class Robot:
     def visual_model(self) -> pin.GeometryModel:
         """Visual geometry of the URDF, built on first use; each mesh is a placeholder box.
 
-        Pinocchio never reads a mesh file: :func:`scara_pin.description.meshes.visual_meshes` reads them (found
+        Pinocchio never reads a mesh file: :func:`scara_pin.cell.meshes.visual_meshes` reads them (found
         and checked as that module says) under the same geometry names.
         """
         from .description.placeholders import placeholder_urdf

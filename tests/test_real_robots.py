@@ -24,8 +24,8 @@ import trimesh
 from browser import next_frames, orange_pixels
 
 from scara_pin import Robot, load_robot
+from scara_pin.cell.meshes import MeshProblem, resolve_mesh, visual_meshes
 from scara_pin.cli import main
-from scara_pin.description.meshes import MeshProblem, resolve_mesh, visual_meshes
 from scara_pin.description.packages import PackagePath
 from scara_pin.description.placeholders import PLACEHOLDER_SIZE
 from scara_pin.errors import UrdfError

@@ -39,6 +39,7 @@ before any geometry is built; meshes are read by :func:`scara_pin.description.me
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -57,6 +58,8 @@ __all__ = ["FORMAT", "load_cell", "parse_cell"]
 
 FORMAT = "scara-pin cell 1"
 """The ``format`` line of a YAML cell file."""
+_NUMBERISH = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
+"""A plain YAML scalar that YAML 1.1 leaves as text but the command line reads as a number (``1e-3``)."""
 _TOP_KEYS = ("format", "margin", "obstacles", "carried", "allow")
 _SHAPE_KEYS = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",), "mesh": ("file",)}
 _OPTIONAL = {"box": (), "cylinder": (), "sphere": (), "mesh": ("scale",)}
@@ -164,6 +167,11 @@ class _Reader:
                                  "(decimal digits, a point, an exponent)")  # fmt: skip
             return value
         if tag == "tag:yaml.org,2002:str":
+            if not node.style and _NUMBERISH.fullmatch(text):  # plain (libyaml: ""); YAML 1.1 reads 1e-3 as text
+                value = number_text(text)
+                if not math.isfinite(value):
+                    raise self.error(node.start_mark.line + 1, f"{text[:40]!r} is not a plain finite number")
+                return value
             return text
         if tag == "tag:yaml.org,2002:null":
             return None
@@ -300,7 +308,7 @@ def _shape(reader: _Reader, item: _Node, what: str, folder: Path | None, *, name
 def _mesh_shape(reader: _Reader, d: dict[str, _Node], what: str, folder: Path | None, xyz: list[float],
                 rpy: list[float]) -> Shape:  # fmt: skip
     from ..description.mesh_paths import MeshProblem
-    from ..description.meshes import load_mesh
+    from .meshes import load_mesh
 
     file = d["file"].value
     if not isinstance(file, str) or not file or len(file) > 4096:
@@ -331,10 +339,10 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     import pinocchio as pin
 
     from ..description.mesh_paths import MeshProblem, mesh_file
-    from ..description.meshes import _scale, load_mesh
     from ..description.packages import PackagePath, read_robot_file
     from ..description.placeholders import placeholder_urdf
     from ..limits import check_input_file
+    from .meshes import _scale, load_mesh
 
     check_input_file(path, "cell file", MAX_CELL_BYTES)
     packages: PackagePath = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)

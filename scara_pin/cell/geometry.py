@@ -85,7 +85,7 @@ def robot_geometry(robot: Robot) -> RobotGeometry:
         return cached  # type: ignore[no-any-return]
     import pinocchio as pin
 
-    from ..description.meshes import collision_meshes
+    from .meshes import collision_meshes
 
     gm = pin.GeometryModel(robot.collision_model)  # a copy: placeholders replaced below
     meshes = {m.name: m for m in collision_meshes(robot)} if "<mesh" in robot.urdf else {}

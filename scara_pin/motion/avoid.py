@@ -87,8 +87,12 @@ ROW_POINTS = (0.0,)
 """Where rows go in an interval (fractions of it; 0 is its start node)."""
 CONVERGED = 1e-7
 """[m] the largest shortfall below the margin at the checked points when the iterations stop."""
-CONVERGED_TIME = 1e-7
-"""Relative change of the duration between two solves below which the re-linearisation has converged."""
+CONVERGED_TIME = 1e-6
+"""Relative change of the duration between two solves below which the re-setting of the planes has converged."""
+DEEP = 0.001
+"""[m] a solution this far inside the margin is not re-solved from: the next solve starts from the last clear one."""
+RESOLVE_ITERATIONS = 500
+"""IPOPT iterations allowed to a re-solve (warm-started from the last solution; the first solve has the jump's)."""
 _PATH_SAMPLES = 24
 """Samples of each joint line of a warm-start candidate checked against the cell."""
 SLACK = 0.003
@@ -97,7 +101,7 @@ _STEP = 0.005
 """[m] the step of the heights and offsets tried by the candidates."""
 _MAX_OFFSET = 0.4
 """[m] the largest plan-view offset of an AROUND candidate's via point."""
-_SMOOTH = 1e-4
+_SMOOTH = 1e-3
 """The eps of the smoothed |x| = sqrt(x^2 + eps^2) in the shapes' supports (at most eps times a size: safe)."""
 SECOND_WITHIN = 1.3
 """The second candidate is solved too when its joint lines take at most this times the best's."""
@@ -462,6 +466,7 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
     retried = False
     iterations = solves = 0
     duration = math.inf
+    last_clear: tuple[PolynomialPiece, np.ndarray, Any] | None = None  # a solved motion clear of the cell
     while True:
         sol = tr.solve(x0, None, None, params)
         iterations += sol["iterations"]
@@ -473,6 +478,10 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
                 params = rows.parameters(clear[0], rebase=True)
                 x0 = clear[1][: tr.n_x]
                 continue
+            if last_clear is not None:  # the planes stopped moving it: the last solved clear motion stands
+                log.debug("jump in a cell: re-solve %s; keeping the last clear solution", sol["status"])
+                piece, T = last_clear[0], last_clear[2]
+                break
             if sol["status"] in ("Infeasible_Problem_Detected", "Restoration_Failed", "Maximum_Iterations_Exceeded"):
                 raise infeasible(scene, _rebuild(prob, T, U) if clear is None else clear[0], sol["status"])
             raise JumpError(sol["status"], _failure(sol["status"], options))
@@ -483,19 +492,23 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
         params = rows.parameters(piece, None if clear is None else clear[0])
         if worst >= -CONVERGED:
             clear = (piece, sol["x"])
+            if not new:
+                last_clear = (piece, sol["x"], T)
             retried = False
         settled = worst >= -CONVERGED and abs(piece.duration - duration) <= CONVERGED_TIME * piece.duration
         duration = piece.duration
         if not new and not added and settled:
             break
         if solves > options.refinements + options.avoid_iterations:
-            if worst < -CONVERGED:
-                raise infeasible(scene, piece, "Not_Converged")
-            break
-        x0 = sol["x"]
+            if last_clear is not None:
+                piece, T = last_clear[0], last_clear[2]
+                break
+            raise infeasible(scene, piece, "Not_Converged")
+        # from a motion deep in an obstacle the re-solve struggles: start again from the last clear one
+        x0 = clear[1][: tr.n_x] if worst < -DEEP and clear is not None else sol["x"]
         if new or added:
             points = points + tuple(new)
-            tr = _Transcription(prob, points, options, rows.rows, rows)
+            tr = _Transcription(prob, points, options, rows.rows, rows, resolve=True)
     stats = SolverStats(sol["status"], iterations, solves, prob.N, tr.n_x, tr.n_g, 0.0)
     log.debug("jump in a cell: %s", stats)
     return piece, T, stats

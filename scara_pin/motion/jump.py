@@ -486,7 +486,8 @@ class _Transcription:
     """
 
     def __init__(self, prob: _Problem, points: tuple[_Point, ...], options: JumpOptions,
-                 distance_rows: tuple[DistanceRow, ...] = (), avoid: Rows | None = None) -> None:  # fmt: skip
+                 distance_rows: tuple[DistanceRow, ...] = (), avoid: Rows | None = None,
+                 resolve: bool = False) -> None:  # fmt: skip
         import casadi as ca
 
         self.prob = P = prob
@@ -594,6 +595,10 @@ class _Transcription:
         opts: dict[str, Any] = {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False,
                                 "ipopt.tol": options.tolerance, "ipopt.constr_viol_tol": options.tolerance,
                                 "ipopt.max_iter": options.max_iterations, "ipopt.mu_strategy": "adaptive"}  # fmt: skip
+        if resolve:  # a re-solve from the last solution (obstacle rows re-set): it converges fast or not at all
+            from .avoid import RESOLVE_ITERATIONS
+
+            opts["ipopt.max_iter"] = min(options.max_iterations, RESOLVE_ITERATIONS)
         self.solver = ca.nlpsol("jump", "ipopt", nlp, opts)
         self.shape = (order, dof, Nt)
 

@@ -171,10 +171,18 @@ class Clearance:
     pair: str
     time: float
     samples: tuple[np.ndarray, np.ndarray, np.ndarray] = field(repr=False, compare=False)
+    where: tuple[float, float, float] | None = None
+
+    def describe(self) -> str:
+        """``link2 - post 1.2 mm deep at t = 0.1234 s near (290, -52, 0) mm in base (margin 2 mm)``."""
+        how = f"{-self.distance * 1e3:.4g} mm deep" if self.distance < 0 else f"{self.distance * 1e3:.4g} mm apart"
+        at = "" if self.where is None else " near (" + ", ".join(f"{v * 1e3:.1f}" for v in self.where) + ") mm in base"
+        return f"{self.pair} {how} at t = {self.time:.6g} s{at} (margin {self.margin * 1e3:g} mm)"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
-        return {"distance": self.distance, "margin": self.margin, "pair": self.pair, "time": self.time}
+        return {"distance": self.distance, "margin": self.margin, "pair": self.pair, "time": self.time,
+                "where": None if self.where is None else list(self.where)}  # fmt: skip
 
 
 class LimitViolation(InfeasibleError):
@@ -260,11 +268,17 @@ class Verification:
         if not self.rest <= REST_TOL:
             raise LimitViolation(f"the trajectory is not at rest at an end: {self.rest:.3g} of a limit "
                                  f"(allowed {REST_TOL:g})")  # fmt: skip
+        return self.check_clearance()
+
+    def check_clearance(self) -> Verification:
+        """Self, if no checked pair of the cell came closer than its margin (beyond :data:`DISTANCE_TOL`); else raise.
+
+        Raises:
+            LimitViolation: naming the pair, how close, when and where (exit 3).
+        """
         c = self.clearance
         if c is not None and not c.distance >= c.margin - DISTANCE_TOL:
-            depth = f"{-c.distance * 1e3:.4g} mm deep" if c.distance < 0 else f"{c.distance * 1e3:.4g} mm apart"
-            raise LimitViolation(f"{c.pair} are {depth} at t = {c.time:.6g} s: closer than the margin "
-                                 f"{c.margin * 1e3:g} mm")  # fmt: skip
+            raise LimitViolation(f"the motion comes closer than the margin: {c.describe()}")
         return self
 
 
@@ -663,7 +677,10 @@ def verify(
         order = np.argsort(times[within], kind="stable")
         ts, ds, ps = times[within][order], nearest[within][order], nearest_pair[within][order]
         i = int(np.argmin(ds))
-        clearance = Clearance(float(ds[i]), scene.margin, scene.pairs[int(ps[i])].label, float(ts[i]), (ts, ds, ps))
+        closest = scene.distances(trajectory.sample(np.array([ts[i]]))[0][0]).closest
+        where = None if closest is None else tuple(float(v) for v in (closest.point_a + closest.point_b) / 2.0)
+        clearance = Clearance(float(ds[i]), scene.margin, scene.pairs[int(ps[i])].label, float(ts[i]), (ts, ds, ps),
+                              where)  # type: ignore[arg-type]
     return Verification(T, rate, len(times), v, a, worst.get(Quantity.JERK), worst.get(Quantity.JERK_DIFFERENCES),
                         floor, worst.get(Quantity.TORQUE), worst.get(Quantity.TOOL_SPEED), start_err, end_err,
                         rest, clearance)  # fmt: skip

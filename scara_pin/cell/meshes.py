@@ -56,6 +56,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import number_text
+from ..description.mesh_paths import MeshProblem, mesh_file, resolve_mesh
+from ..description.placeholders import PLACEHOLDER_SIZE
 from ..errors import InvalidInputError
 from ..limits import (
     MAX_MESH_BYTES,
@@ -67,8 +69,6 @@ from ..limits import (
     read_bytes,
 )
 from ..signals import raise_pending
-from .mesh_paths import MeshProblem, mesh_file, resolve_mesh
-from .placeholders import PLACEHOLDER_SIZE
 
 if TYPE_CHECKING:
     from ..model import Robot
