@@ -299,7 +299,6 @@ def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) ->
 def cmd_jog(args: argparse.Namespace) -> int:
     """Jog to the edge: a straight tool move ending at rest on the workspace edge (or before contact: ``--cell``)."""
     from ..motion.jog import jog_to_edge
-    from ._common import cell_from_args
 
     units = Units.from_args(args)
     _check_outputs(args, (args.out, args.plot))
@@ -413,12 +412,5 @@ def register(sub: Any) -> None:
     p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
     _add_units(p, inputs=True)
     _add_robot_options(p)
-    _add_jog_cell(p)
+    add_cell_options(p, margin=False)  # --margin above: the jog's own, and the cell's when given
     p.set_defaults(func=cmd_jog)
-
-
-def _add_jog_cell(p: argparse.ArgumentParser) -> None:
-    """``jog --cell FILE``: its ``--margin`` is the jog's own (also the cell's when given)."""
-    from ._common import add_cell_options
-
-    add_cell_options(p, margin=False)
