@@ -48,6 +48,8 @@ __all__ = [
     "MAX_WALK_DEPTH",
     "MAX_WALK_ENTRIES",
     "MAX_XACRO_FILES",
+    "MAX_YAML_DEPTH",
+    "MAX_YAML_NODES",
     "UnreadableFileError",
     "check_count",
     "check_input_file",
@@ -84,6 +86,11 @@ MAX_POINTS = 10_000
 """Taught points of one points file (``teach --points``, ``traj --points``): a cell has tens."""
 MAX_POINTS_BYTES = 4 * 1024 * 1024
 """Bytes of one points file (10,000 points at full precision take about 1.5 MB)."""
+MAX_YAML_NODES = 500_000
+"""Values (scalars, lists, mappings) of one yaml document, an alias counted at the size of all it stands for
+(a points file of 10,000 points holds about 150,000; 520 bytes of nested aliases stand for 9^9)."""
+MAX_YAML_DEPTH = 64
+"""Levels of nesting of one yaml document (a points file has 4)."""
 MAX_CHECK_ELEMENTS = 50_000
 """Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
 
