@@ -9,8 +9,16 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InvalidInputError
-from ..files import check_output_path
-from ._common import Units, _add_robot_options, _add_units, _load, integer_type, number_type, write_atomic
+from ._common import (
+    Units,
+    _add_robot_options,
+    _add_units,
+    _load,
+    check_command_outputs,
+    integer_type,
+    number_type,
+    write_atomic,
+)
 
 _GROUPS = ("offsets", "scale", "origins", "tool")
 
@@ -34,9 +42,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
     if (args.measurements is None) == (args.plan is None):
         raise InvalidInputError("give --measurements FILE (calibrate) or --plan N (the poses to measure), one of them")
-    for path in (args.out, args.plot, args.overlay):
-        if path not in (None, "-"):  # refused before any work
-            check_output_path(path)
+    # before any work: each name (the plot's ending too), none on --measurements or the robot's files, nor two on
+    # one file
+    check_command_outputs(args, {"--out": args.out, "--overlay": args.overlay, "--plot": args.plot},
+                          figures=("--plot",))  # fmt: skip
     if args.overlay is not None and args.urdf is not None:
         raise InvalidInputError("--overlay writes the yaml parameters of a configured robot (--robot), "
                                 "not of a URDF file")  # fmt: skip
