@@ -30,7 +30,6 @@ from .errors import InvalidInputError
 __all__ = [
     "MAX_CALIBRATION_ROWS",
     "MAX_CELL_BYTES",
-    "MAX_CELL_NODES",
     "MAX_CELL_OBSTACLES",
     "MAX_CELL_TRIANGLES",
     "MAX_CHECK_ELEMENTS",
@@ -56,6 +55,8 @@ __all__ = [
     "MAX_WALK_ENTRIES",
     "MAX_WORKSPACE_GRID",
     "MAX_XACRO_FILES",
+    "MAX_YAML_DEPTH",
+    "MAX_YAML_NODES",
     "UnreadableFileError",
     "check_count",
     "check_input_file",
@@ -99,6 +100,11 @@ MAX_JOB_DEPTH = 4
 MAX_JOB_STEPS = 10_000
 """Moves and dwells one job expands to, its loops unrolled (counted before any is built; each new jump is a
 solve of about 0.1-0.5 s)."""
+MAX_YAML_NODES = 500_000
+"""Values (scalars, lists, mappings) of one yaml document, an alias counted at the size of all it stands for
+(a points file of 10,000 points holds about 150,000; 520 bytes of nested aliases stand for 9^9)."""
+MAX_YAML_DEPTH = 64
+"""Levels of nesting of one yaml document (a points file has 4)."""
 MAX_CHECK_ELEMENTS = 50_000
 """Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
 
@@ -111,9 +117,6 @@ the 10 kHz samples of a motion: 500 obstacles and 6 links take about 3 ms a samp
 MAX_CELL_TRIANGLES = 200_000
 """Mesh triangles of one cell, all its meshes together (coal's bounding-volume tree keeps a distance query
 near a few microseconds up to there)."""
-MAX_CELL_NODES = 100_000
-"""YAML nodes visited while reading one cell file (aliases count each time they are used: an alias bomb is
-refused here, not expanded)."""
 MAX_WORKSPACE_GRID = 250_000
 """Grid points of one collision-free region (``workspace --cell --height``: 500 x 500; each reachable point
 costs up to two IK solutions and their distance checks, about 10 s at the cap)."""

@@ -14,10 +14,10 @@ to the obstacles in closed form:
   between their height ranges (0 when they overlap);
 - the robot's own self-collision pair that the jump can reach: the flange rising into link2 (the flange's
   top at z + 0.01 must stay margin below link2's bottom, z = -0.03);
-- a low axis-aligned BOX under the links: the flange's distance is ``sqrt(max(dxy - r, 0)^2 + max(dz, 0)^2)``
-  (dxy: the plan distance from the flange's axis to the box's rectangle, dz: the flange's bottom above the
-  box's top); the quill is above the flange and narrower, and the links are more than the margin above the
-  box (asserted), so they never come closer.
+- a low axis-aligned WALL across the path under the links (long in x: the tool stays within its x extent,
+  asserted after the solve): the flange's distance is ``sqrt(max(|y - yc| - hy - r, 0)^2 + max(dz, 0)^2)``
+  (dz: the flange's bottom above the wall's top); the quill is above the flange and narrower, and the links
+  are more than the margin above the wall (asserted), so they never come closer.
 
 Transcription (different from the planner's): three phases of free durations as the jump rule has them
 (lift within R of A horizontally, traverse at or above z_top, descend within R of B), N = (24, 36, 24)
@@ -111,16 +111,14 @@ def distances(q, posts, boxes, margin):
             out.append(ca.fmax(d_rect - p.radius, 0.0) ** 2 + gap(-half, half) ** 2 - margin**2)
     # the flange under link2 (a self-collision pair of the robot: the quill slides through the arm's end)
     out.append(-LINK_HALF[1] - (tool[2] + FLANGE_H) - margin)
-    for b in boxes:
-        dx = ca.fmax(ca.fabs(tool[0] - b.x) - b.hx, 0.0)
-        dy = ca.fmax(ca.fabs(tool[1] - b.y) - b.hy, 0.0)
-        dxy = ca.sqrt(dx * dx + dy * dy + 1e-18)
-        dz = tool[2] - b.top
-        out.append(ca.fmax(dxy - FLANGE_R, 0.0) ** 2 + ca.fmax(dz, 0.0) ** 2 - margin**2)
+    for b in boxes:  # a wall across the path: the tool stays within its x extent (checked after the solve)
+        dy = ca.fmax(ca.fabs(tool[1] - b.y) - b.hy - FLANGE_R, 0.0)
+        dz = ca.fmax(tool[2] - b.top, 0.0)
+        out.append(dy * dy + dz * dz - margin**2)
     return out
 
 
-def minimum_time(robot, A, B, posts=(), boxes=(), margin=0.002, vias=((),), N=(16, 24, 16)):
+def minimum_time(robot, A, B, posts=(), boxes=(), margin=0.002, vias=((),), N=(16, 24, 16), top=None):
     """The fastest jump A -> B (rest to rest) keeping the jump rule and every distance; (time, q samples).
 
     Args:
@@ -130,6 +128,7 @@ def minimum_time(robot, A, B, posts=(), boxes=(), margin=0.002, vias=((),), N=(1
         margin: [m].
         vias: warm starts, each a tuple of tool via points (x, y, z) between above A and above B.
         N: intervals per phase.
+        top: [m] the height of the warm starts' points above A and B (default: the jump rule's z_top).
     """
     import casadi as ca
 
@@ -191,8 +190,9 @@ def minimum_time(robot, A, B, posts=(), boxes=(), margin=0.002, vias=((),), N=(1
                         "ipopt.max_iter": 3000})  # fmt: skip
     best = None
     for via in vias:
-        tops = [np.array([A[0], A[1], z_top, A[3]]), *[np.array([*v, A[3]]) for v in via],
-                np.array([B[0], B[1], z_top, B[3]])]
+        zt = z_top if top is None else top
+        tops = [np.array([A[0], A[1], zt, A[3]]), *[np.array([*v, A[3]]) for v in via],
+                np.array([B[0], B[1], zt, B[3]])]
         way = [qA]
         for pose in tops:
             way.append(robot.ik(pose).nearest(way[-1], branch=br).q)
@@ -213,7 +213,12 @@ def minimum_time(robot, A, B, posts=(), boxes=(), margin=0.002, vias=((),), N=(1
         sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
         if not solver.stats()["success"]:
             continue
-        t = float(np.sum(np.array(sol["x"])[:3]))
+        x = np.array(sol["x"]).ravel()
+        t = float(np.sum(x[:3]))
+        qs = x[3 : 3 + 4 * (n + 1)].reshape(n + 1, 4)
+        for b in boxes:
+            tx = L1 * np.cos(qs[:, 0]) + L2 * np.cos(qs[:, 0] + qs[:, 1])
+            assert np.all(np.abs(tx - b.x) <= b.hx), "the tool left the wall's x extent: the wall model does not hold"
         if best is None or t < best[0]:
             best = (t, np.array(sol["x"]).ravel())
     assert best is not None, "no warm start converged"

@@ -225,7 +225,7 @@ def test_the_loop_without_a_tracker(tmp_path, capsys) -> None:
     assert rc == 0 and doc["before"]["rms"] > 1e-4 and 0.5 <= doc["after"]["rms"] / 1e-5 <= 1.2
     # the plan is an input: never written over
     rc, _, err = run(["calibrate", *ROBOT, "--simulate", str(plan), "--out", str(plan)], capsys)
-    assert rc == 2 and "is the plan --simulate reads" in err and plan.read_text().startswith("# scara-pin calibrate")
+    assert rc == 2 and "is the file --simulate" in err and plan.read_text().startswith("# scara-pin calibrate")
 
 
 def test_simulated_measurements_are_the_perturbed_copy_the_file_describes(tmp_path, nominal) -> None:

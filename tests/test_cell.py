@@ -221,8 +221,8 @@ def test_the_issue_example_reads(tmp_path):
     ("obstacles: [\n  - {name: a, shape: box, size: [1, 2]]\n", "line"),  # malformed YAML
     ("obstacles:\n  - name: a\n    shape: box\n    size: [0.1, -0.2, 0.1]\n", "obstacle a: box y -0.2"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: .nan\n", "line 4"),
-    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 0x10\n", "not a plain finite number"),
-    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 1e400\n", "line 4: '1e400' is not a plain finite"),
+    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 0x10\n", "line 4: obstacle a: radius must be a number"),
+    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 1e400\n", "line 4: obstacle a: radius inf is not a plain"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: '0.1'\n", "line 4: obstacle a: radius must be a number"),
     ("obstacles:\n  - name: a\n    shape: cone\n", "line 3: obstacle a: shape 'cone' must be one of"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 0.1\n    colour: red\n",
@@ -258,7 +258,7 @@ def test_an_alias_bomb_is_refused_before_it_expands(tmp_path):
     path = tmp_path / "bomb.yaml"
     path.write_text("\n".join(levels) + "\n")
     t0 = time.perf_counter()
-    with pytest.raises(InvalidInputError, match="YAML nodes"):
+    with pytest.raises(InvalidInputError, match="holds more than"):
         load_cell(path)
     assert time.perf_counter() - t0 < 5.0
 

@@ -248,7 +248,7 @@ REFUSED = [
     ("nested too deep", _nested(MAX_JOB_DEPTH + 1), f"var: v{MAX_JOB_DEPTH}",
      f"nested {MAX_JOB_DEPTH + 1} deep, above the cap of {MAX_JOB_DEPTH}"),
     ("too many moves",
-     _steps("  - for: 1000\n    do:\n      - for: 11\n        var: j\n        do: [{jump: feeder}]\n"), "steps:",
+     _steps("  - for: 1000\n    do:\n      - for: 11\n        var: j\n        do: [{jump: feeder}]\n"), "- for: 1000",
      f"11,000 moves and dwells, above the cap of {MAX_JOB_STEPS:,}"),
     ("speed 0", _steps("  - speed: 0\n  - jump: feeder\n"), "speed: 0", "speed is 0 %; it must be in (0, 100]"),
     ("speed 150", _steps("  - speed: 150\n  - jump: feeder\n"), "speed: 150", "speed is 150 %"),
@@ -326,11 +326,11 @@ def test_another_robot_and_an_output_over_an_input_are_refused(robot_default: Ro
     job = write_job(tmp_path, "steps:\n  - jump: feeder\n", robot_default)
     before = job.read_text()
     assert main(["job", str(job), "--out", str(job)]) == 2
-    assert "it is the input" in capsys.readouterr().err and job.read_text() == before
-    assert main(["job", str(job), "--plot", str(tmp_path / "points.yaml")]) == 2
-    assert "it is the input" in capsys.readouterr().err
+    assert "it would be replaced" in capsys.readouterr().err and job.read_text() == before
+    assert main(["job", str(job), "--out", str(tmp_path / "points.yaml")]) == 2  # the points file the job names
+    assert "it would be replaced" in capsys.readouterr().err
     assert main(["job", str(job), "--out", str(tmp_path / "a.csv"), "--html", str(tmp_path / "." / "a.csv")]) == 2
-    assert "two outputs to one file" in capsys.readouterr().err
+    assert "one output would replace the other" in capsys.readouterr().err
     assert main(["job", str(job), "--robot", "s1"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"error: {job} line {line_of(job, 'robot:')}: the job is for robot 'default'"), err

@@ -22,8 +22,10 @@
       xyz: [0, 0, 0.015]       # tool0's z points down, out of the flange: +z is below the flange
     allow: [[link1, base_link]]   # optional: pairs of names never checked (links, obstacles, carried)
 
-Numbers follow the command line's grammar (plain decimals: ``0x1``, ``1_000`` or ``1:30`` are refused);
-xacro's unit tags are read (``!degrees 90``). Errors name the file and the line.
+The file is read by the package's one bounded yaml loader (alias bombs refused at
+:data:`~scara_pin.limits.MAX_YAML_NODES`); numbers follow the command line's grammar (``1e-3`` is a number;
+``0x1``, ``1_000`` or ``1:30`` are refused); xacro's unit tags are read (``!degrees 90``). Errors name the
+file and the line.
 
 **URDF or xacro** (for ROS users): a ``<robot>`` whose links are joined by ``fixed`` joints; its root link
 is the robot's ``base`` frame, and every ``<collision>`` of every link is an obstacle named after its link
@@ -39,15 +41,13 @@ before any geometry is built; meshes are read by :func:`scara_pin.description.me
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import number_text
 from ..errors import InvalidInputError, UrdfError
-from ..limits import MAX_CELL_BYTES, MAX_CELL_NODES, MAX_CELL_OBSTACLES, check_count, read_text
+from ..limits import MAX_CELL_BYTES, MAX_CELL_OBSTACLES, check_count, read_text
 from .cell import DEFAULT_MARGIN, Cell, Obstacle, check_name
 from .shapes import KINDS, Shape
 
@@ -58,8 +58,6 @@ __all__ = ["FORMAT", "load_cell", "parse_cell"]
 
 FORMAT = "scara-pin cell 1"
 """The ``format`` line of a YAML cell file."""
-_NUMBERISH = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+")
-"""A plain YAML scalar that YAML 1.1 leaves as text but the command line reads as a number (``1e-3``)."""
 _TOP_KEYS = ("format", "margin", "obstacles", "carried", "allow")
 _SHAPE_KEYS = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",), "mesh": ("file",)}
 _OPTIONAL = {"box": (), "cylinder": (), "sphere": (), "mesh": ("scale",)}
@@ -106,227 +104,173 @@ def load_cell(
 
 
 # ---------------------------------------------------------------------------------------------- YAML
-class _Node:
-    """A YAML value with the line it starts on (1-based)."""
-
-    __slots__ = ("line", "value")
-
-    def __init__(self, value: Any, line: int) -> None:
-        self.value = value
-        self.line = line
-
-
 class _Reader:
-    """Turns a composed YAML node graph into _Node values, counting every node visited (aliases each time)."""
+    """Errors that name the cell file and the line of the value (the shared loader's lines)."""
 
     def __init__(self, origin: str) -> None:
         self.origin = origin
-        self.visited = 0
 
-    def error(self, line: int, message: str) -> InvalidInputError:
-        return InvalidInputError(f"{self.origin} line {line}: {message}")
-
-    def read(self, node: Any) -> _Node:
-        import yaml
-
-        self.visited += 1
-        if self.visited > MAX_CELL_NODES:
-            raise self.error(node.start_mark.line + 1, f"more than {MAX_CELL_NODES:,} YAML nodes (aliases counted "
-                             "each time they are used), the cap")  # fmt: skip
-        line = node.start_mark.line + 1
-        if isinstance(node, yaml.MappingNode):
-            out: dict[str, _Node] = {}
-            for key, value in node.value:
-                k = self.read(key)
-                if not isinstance(k.value, str):
-                    raise self.error(k.line, "a key must be a name")
-                if k.value in out:
-                    raise self.error(k.line, f"key {k.value[:40]!r} is given twice")
-                out[k.value] = self.read(value)
-            return _Node(out, line)
-        if isinstance(node, yaml.SequenceNode):
-            return _Node([self.read(v) for v in node.value], line)
-        return _Node(self.scalar(node), line)
-
-    def scalar(self, node: Any) -> Any:
-        from ..description.yaml_units import unit_tags
-
-        tag, text = node.tag, node.value
-        if len(text) > 1000:
-            raise self.error(node.start_mark.line + 1, "a value longer than 1000 characters")
-        units = unit_tags()
-        if tag in units:
-            value = number_text(text)
-            if not math.isfinite(value):
-                raise self.error(node.start_mark.line + 1, f"{tag} {text[:40]!r} is not a plain number")
-            return value * units[tag]
-        if tag in ("tag:yaml.org,2002:int", "tag:yaml.org,2002:float"):
-            value = number_text(text)
-            if not math.isfinite(value):
-                raise self.error(node.start_mark.line + 1, f"{text[:40]!r} is not a plain finite number "
-                                 "(decimal digits, a point, an exponent)")  # fmt: skip
-            return value
-        if tag == "tag:yaml.org,2002:str":
-            if not node.style and _NUMBERISH.fullmatch(text):  # plain (libyaml: ""); YAML 1.1 reads 1e-3 as text
-                value = number_text(text)
-                if not math.isfinite(value):
-                    raise self.error(node.start_mark.line + 1, f"{text[:40]!r} is not a plain finite number")
-                return value
-            return text
-        if tag == "tag:yaml.org,2002:null":
-            return None
-        if tag == "tag:yaml.org,2002:bool":
-            return text.lower() in ("true", "yes", "on")
-        raise self.error(node.start_mark.line + 1, f"the tag {str(tag)[:40]!r} is not read in a cell file")
+    def error(self, line: int | None, message: str) -> InvalidInputError:
+        return InvalidInputError(f"{self.origin}{'' if line is None else f' line {line}'}: {message}")
 
 
 def parse_cell(text: str, origin: str = "cell", folder: Path | None = None) -> Cell:
     """A cell from the text of a YAML cell file (module docstring); ``folder`` holds its mesh files.
 
+    The text is read by the package's one bounded yaml loader (:func:`scara_pin.description.yaml_units.load_yaml`:
+    alias bombs refused, numbers in the command line's grammar, xacro's unit tags).
+
     Raises:
         InvalidInputError: malformed YAML or a bad value, naming ``origin`` and the line.
     """
-    import yaml
-
-    from ..description.yaml_units import yaml_problem
+    from ..description.yaml_units import load_yaml, yaml_line
 
     reader = _Reader(origin)
-    try:
-        node = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except yaml.YAMLError as exc:
-        line, problem = yaml_problem(exc)
-        raise InvalidInputError(f"{origin}{'' if line is None else f' line {line}'}: not valid YAML ({problem})") \
-            from None  # fmt: skip
-    if node is None:
+    top = load_yaml(text, origin)
+    if top is None:
         raise InvalidInputError(f"{origin}: the file is empty (a cell is a mapping with 'obstacles')")
-    top = reader.read(node)
-    if not isinstance(top.value, dict):
-        raise reader.error(top.line, "a cell file is a mapping with 'obstacles' (and margin, carried, allow)")
-    keys = top.value
-    unknown = [k for k in keys if k not in _TOP_KEYS]
+    if not isinstance(top, dict):
+        raise reader.error(yaml_line(top), "a cell file is a mapping with 'obstacles' (and margin, carried, allow)")
+    unknown = [k for k in top if k not in _TOP_KEYS]
     if unknown:
-        raise reader.error(keys[unknown[0]].line, f"unknown key {unknown[0][:40]!r} (keys: {', '.join(_TOP_KEYS)})")
-    if "format" in keys and keys["format"].value != FORMAT:
-        raise reader.error(keys["format"].line, f"format {str(keys['format'].value)[:40]!r} is not {FORMAT!r}")
+        raise reader.error(yaml_line(top, unknown[0]), f"unknown key {str(unknown[0])[:40]!r} (keys: "
+                           f"{', '.join(_TOP_KEYS)})")  # fmt: skip
+    if "format" in top and top["format"] != FORMAT:
+        raise reader.error(yaml_line(top, "format"), f"format {str(top['format'])[:40]!r} is not {FORMAT!r}")
     margin = DEFAULT_MARGIN
-    if "margin" in keys:
-        margin = _number(reader, keys["margin"], "margin")
+    if "margin" in top:
+        margin = _number(reader, top, "margin", "margin")
         if not 0.0 <= margin <= 1.0:
-            raise reader.error(keys["margin"].line, f"margin {margin:.6g} m must be in [0, 1] m")
+            raise reader.error(yaml_line(top, "margin"), f"margin {margin:.6g} m must be in [0, 1] m")
     obstacles: list[Obstacle] = []
-    raw = keys.get("obstacles")
-    if raw is not None and raw.value is not None:
-        if not isinstance(raw.value, list):
-            raise reader.error(raw.line, "obstacles must be a list")
-        check_count(f"{origin}: obstacles", len(raw.value), MAX_CELL_OBSTACLES)
-        for item in raw.value:
-            obstacles.append(_obstacle(reader, item, folder))
+    raw = top.get("obstacles")
+    if raw is not None:
+        if not isinstance(raw, list):
+            raise reader.error(yaml_line(top, "obstacles"), "obstacles must be a list")
+        check_count(f"{origin}: obstacles", len(raw), MAX_CELL_OBSTACLES)
+        seen: set[str] = set()
+        for i in range(len(raw)):
+            o = _obstacle(reader, raw, i, folder)
+            if o.name in seen:
+                raise reader.error(o.line, f"obstacle name {o.name!r} is used twice")
+            seen.add(o.name)
+            obstacles.append(o)
     carried = None
-    if "carried" in keys and keys["carried"].value is not None:
-        carried = _shape(reader, keys["carried"], "the carried part", folder, named=False)
+    if top.get("carried") is not None:
+        carried = _shape(reader, top, "carried", "the carried part", folder, named=False)
     allow: list[tuple[str, str]] = []
-    if "allow" in keys and keys["allow"].value is not None:
-        if not isinstance(keys["allow"].value, list):
-            raise reader.error(keys["allow"].line, "allow must be a list of pairs of names")
-        for pair in keys["allow"].value:
-            if not isinstance(pair.value, list) or len(pair.value) != 2:
-                raise reader.error(pair.line, "allow takes pairs of names: [link1, base_link]")
-            a, b = pair.value
-            allow.append((_name(reader, a, "allow"), _name(reader, b, "allow")))
+    if top.get("allow") is not None:
+        pairs = top["allow"]
+        if not isinstance(pairs, list):
+            raise reader.error(yaml_line(top, "allow"), "allow must be a list of pairs of names")
+        for i, pair in enumerate(pairs):
+            if not isinstance(pair, list) or len(pair) != 2:
+                raise reader.error(yaml_line(pairs, i), "allow takes pairs of names: [link1, base_link]")
+            allow.append((_name(reader, pair, 0, "allow"), _name(reader, pair, 1, "allow")))
+    return Cell(tuple(obstacles), margin, carried, tuple(allow), origin)
+
+
+def _number(reader: _Reader, data: Any, key: Any, what: str) -> float:
+    from ..description.yaml_units import yaml_line
+
+    v = data[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise reader.error(yaml_line(data, key), f"{what} must be a number")
+    if not math.isfinite(v):
+        raise reader.error(yaml_line(data, key), f"{what} {v!r} is not a plain finite number")
+    return float(v)
+
+
+def _numbers(reader: _Reader, data: Any, key: Any, what: str, n: int) -> list[float]:
+    from ..description.yaml_units import yaml_line
+
+    v = data[key]
+    if not isinstance(v, list) or len(v) != n:
+        raise reader.error(yaml_line(data, key), f"{what} must be a list of {n} numbers")
+    return [_number(reader, v, i, what) for i in range(n)]
+
+
+def _name(reader: _Reader, data: Any, key: Any, what: str) -> str:
+    from ..description.yaml_units import yaml_line
+
     try:
-        return Cell(tuple(obstacles), margin, carried, tuple(allow), origin)
-    except InvalidInputError as exc:  # a duplicate name: say the line of the second one
-        message = str(exc)
-        for o in obstacles:
-            if f"{o.name!r} is used twice" in message and o is not obstacles[[p.name for p in obstacles].index(o.name)]:
-                raise reader.error(o.line, f"obstacle name {o.name!r} is used twice") from None
-        raise
-
-
-def _number(reader: _Reader, node: _Node, what: str) -> float:
-    v = node.value
-    if isinstance(v, bool) or not isinstance(v, float):
-        raise reader.error(node.line, f"{what} must be a number")
-    return v
-
-
-def _numbers(reader: _Reader, node: _Node, what: str, n: int) -> list[float]:
-    if not isinstance(node.value, list) or len(node.value) != n:
-        raise reader.error(node.line, f"{what} must be a list of {n} numbers")
-    return [_number(reader, v, what) for v in node.value]
-
-
-def _name(reader: _Reader, node: _Node, what: str) -> str:
-    try:
-        return check_name(node.value, what)
+        return check_name(data[key], what)
     except InvalidInputError as exc:
-        raise reader.error(node.line, str(exc)) from None
+        raise reader.error(yaml_line(data, key), str(exc)) from None
 
 
-def _obstacle(reader: _Reader, item: _Node, folder: Path | None) -> Obstacle:
-    if not isinstance(item.value, dict):
-        raise reader.error(item.line, "an obstacle is a mapping with name, shape, its sizes and xyz")
-    if "name" not in item.value:
-        raise reader.error(item.line, "an obstacle needs a name")
-    name = _name(reader, item.value["name"], "obstacle name")
-    return Obstacle(name, _shape(reader, item, f"obstacle {name}", folder, named=True), item.line)
+def _obstacle(reader: _Reader, items: list[Any], i: int, folder: Path | None) -> Obstacle:
+    from ..description.yaml_units import yaml_line
+
+    item = items[i]
+    line = yaml_line(items, i)
+    if not isinstance(item, dict):
+        raise reader.error(line, "an obstacle is a mapping with name, shape, its sizes and xyz")
+    if "name" not in item:
+        raise reader.error(line, "an obstacle needs a name")
+    name = _name(reader, item, "name", "obstacle name")
+    return Obstacle(name, _shape(reader, items, i, f"obstacle {name}", folder, named=True), line or 0)
 
 
-def _shape(reader: _Reader, item: _Node, what: str, folder: Path | None, *, named: bool) -> Shape:
-    if not isinstance(item.value, dict):
-        raise reader.error(item.line, f"{what} is a mapping with shape, its sizes and xyz")
-    d = item.value
+def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | None, *, named: bool) -> Shape:
+    from ..description.yaml_units import yaml_line
+
+    d = parent[key]
+    line = yaml_line(parent, key)
+    if not isinstance(d, dict):
+        raise reader.error(line, f"{what} is a mapping with shape, its sizes and xyz")
     if "shape" not in d:
-        raise reader.error(item.line, f"{what}: no shape (one of {', '.join(KINDS)})")
-    kind = d["shape"].value
+        raise reader.error(line, f"{what}: no shape (one of {', '.join(KINDS)})")
+    kind = d["shape"]
     if kind not in KINDS:
-        raise reader.error(d["shape"].line, f"{what}: shape {str(kind)[:40]!r} must be one of {', '.join(KINDS)}")
+        raise reader.error(yaml_line(d, "shape"), f"{what}: shape {str(kind)[:40]!r} must be one of {', '.join(KINDS)}")
     allowed = ("name",) * named + ("shape", "xyz", "rpy") + _SHAPE_KEYS[kind] + _OPTIONAL[kind]
-    for key, node in d.items():
-        if key not in allowed:
-            raise reader.error(node.line, f"{what}: unknown key {key[:40]!r} for a {kind} (keys: {', '.join(allowed)})")
-    for key in _SHAPE_KEYS[kind]:
-        if key not in d:
-            raise reader.error(item.line, f"{what}: a {kind} needs {' and '.join(_SHAPE_KEYS[kind])}")
-    xyz = _numbers(reader, d["xyz"], f"{what}: xyz", 3) if "xyz" in d else [0.0, 0.0, 0.0]
-    rpy = _numbers(reader, d["rpy"], f"{what}: rpy", 3) if "rpy" in d else [0.0, 0.0, 0.0]
+    for k in d:
+        if k not in allowed:
+            raise reader.error(yaml_line(d, k), f"{what}: unknown key {str(k)[:40]!r} for a {kind} (keys: "
+                               f"{', '.join(allowed)})")  # fmt: skip
+    for k in _SHAPE_KEYS[kind]:
+        if k not in d:
+            raise reader.error(line, f"{what}: a {kind} needs {' and '.join(_SHAPE_KEYS[kind])}")
+    xyz = _numbers(reader, d, "xyz", f"{what}: xyz", 3) if "xyz" in d else [0.0, 0.0, 0.0]
+    rpy = _numbers(reader, d, "rpy", f"{what}: rpy", 3) if "rpy" in d else [0.0, 0.0, 0.0]
     try:
         if kind == "box":
-            size = tuple(_numbers(reader, d["size"], f"{what}: size", 3))
+            size = tuple(_numbers(reader, d, "size", f"{what}: size", 3))
             return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
         if kind == "mesh":
             return _mesh_shape(reader, d, what, folder, xyz, rpy)
-        size = tuple(_number(reader, d[k], f"{what}: {k}") for k in _SHAPE_KEYS[kind])
+        size = tuple(_number(reader, d, k, f"{what}: {k}") for k in _SHAPE_KEYS[kind])
         return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
     except InvalidInputError as exc:
         message = str(exc)
         if message.startswith(reader.origin):
             raise
-        raise reader.error(item.line, message) from None
+        raise reader.error(line, message) from None
 
 
-def _mesh_shape(reader: _Reader, d: dict[str, _Node], what: str, folder: Path | None, xyz: list[float],
+def _mesh_shape(reader: _Reader, d: dict[str, Any], what: str, folder: Path | None, xyz: list[float],
                 rpy: list[float]) -> Shape:  # fmt: skip
     from ..description.mesh_paths import MeshProblem
+    from ..description.yaml_units import yaml_line
     from .meshes import load_mesh
 
-    file = d["file"].value
+    file = d["file"]
     if not isinstance(file, str) or not file or len(file) > 4096:
-        raise reader.error(d["file"].line, f"{what}: file must be a file name")
+        raise reader.error(yaml_line(d, "file"), f"{what}: file must be a file name")
     scale = [1.0, 1.0, 1.0]
     if "scale" in d:
-        s = d["scale"]
-        scale = [_number(reader, s, f"{what}: scale")] * 3 if not isinstance(s.value, list) \
-            else _numbers(reader, s, f"{what}: scale", 3)  # fmt: skip
-        if not all(math.isfinite(v) and v != 0.0 and abs(v) <= 1e6 for v in scale):
-            raise reader.error(s.line, f"{what}: scale must be finite, nonzero numbers")
+        scale = _numbers(reader, d, "scale", f"{what}: scale", 3) if isinstance(d["scale"], list) \
+            else [_number(reader, d, "scale", f"{what}: scale")] * 3  # fmt: skip
+        if not all(v != 0.0 and abs(v) <= 1e6 for v in scale):
+            raise reader.error(yaml_line(d, "scale"), f"{what}: scale must be finite, nonzero numbers")
     path = Path(file)
     if not path.is_absolute():
         path = (folder or Path.cwd()) / path
     try:
         geometry = load_mesh(path, file)
     except MeshProblem as exc:
-        raise reader.error(d["file"].line, f"{what}: {exc}") from None
+        raise reader.error(yaml_line(d, "file"), f"{what}: {exc}") from None
     return Shape("mesh", (), np.array(xyz), np.array(rpy), geometry.vertices * np.array(scale), geometry.faces,
                  file, what)  # fmt: skip
 

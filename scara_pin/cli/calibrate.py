@@ -14,8 +14,17 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidInputError
-from ..files import check_output_path
-from ._common import Units, _add_robot_options, _add_units, _load, integer_type, log, number_type, write_atomic
+from ._common import (
+    Units,
+    _add_robot_options,
+    _add_units,
+    _load,
+    check_command_outputs,
+    integer_type,
+    log,
+    number_type,
+    write_atomic,
+)
 
 _GROUPS = ("offsets", "scale", "origins", "tool")
 
@@ -43,9 +52,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if sum(x is not None for x in (args.measurements, args.plan, args.simulate)) != 1:
         raise InvalidInputError("give --measurements FILE (calibrate), --plan N (the poses to measure) or --simulate "
                                 "PLAN (measure them on a perturbed copy of the robot), one of them")  # fmt: skip
-    for path in (args.out, args.plot, args.overlay):
-        if path not in (None, "-"):  # refused before any work
-            check_output_path(path)
+    # before any work: each name (the plot's ending too), none on --measurements, --simulate or the robot's files,
+    # nor two on one file
+    check_command_outputs(args, {"--out": args.out, "--overlay": args.overlay, "--plot": args.plot},
+                          figures=("--plot",))  # fmt: skip
     if args.overlay is not None and args.urdf is not None:
         raise InvalidInputError("--overlay writes the yaml parameters of a configured robot (--robot), "
                                 "not of a URDF file")  # fmt: skip
@@ -136,8 +146,6 @@ def _simulate(args: argparse.Namespace, robot: Any, units: Units) -> int:
 
     if args.plot is not None or args.overlay is not None:
         raise InvalidInputError("--plot and --overlay go with --measurements, not --simulate")
-    if args.out not in (None, "-") and Path(args.out).resolve() == Path(args.simulate).resolve():
-        raise InvalidInputError(f"--out {args.out} is the plan --simulate reads: name another file")
     plan = Measurements.from_csv(args.simulate, robot.dof)
     sim = simulate(robot, plan.q, seed=args.seed, noise=args.noise, yaw=args.yaw or plan.yaw is not None,
                    yaw_weight=args.yaw_weight)  # fmt: skip

@@ -22,6 +22,7 @@ from ._common import (
     _read_pose,
     add_cell_options,
     cell_from_args,
+    check_command_outputs,
     number_type,
 )
 from ._points import add_points_options, use_points
@@ -48,6 +49,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units.from_args(args)
+    check_command_outputs(args, {"--out": args.out, "--plot": args.plot}, figures=("--plot",))  # before any work
     path = CyclePath(args.path)
     if path is CyclePath.JUMP:
         for flag, given in (("--arch", args.arch is not None), ("--no-blend", args.no_blend)):

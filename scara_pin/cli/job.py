@@ -7,10 +7,19 @@ import json
 import sys
 from typing import Any
 
-from ..errors import InvalidInputError, ParameterError
-from ..files import check_output_path, check_outputs_apart
+from ..errors import ParameterError
+from ..files import check_outputs
 from ..limits import MAX_SAMPLES, check_count
-from ._common import Units, _acceleration, _add_acceleration, _add_robot_options, _load, _needs_wrist, number_type
+from ._common import (
+    Units,
+    _acceleration,
+    _add_acceleration,
+    _add_robot_options,
+    _load,
+    _needs_wrist,
+    check_command_outputs,
+    number_type,
+)
 
 _VIEW_RATE = 200.0
 """[Hz] the samples handed to the viewer page (it interpolates between them)."""
@@ -20,16 +29,12 @@ def cmd_job(args: argparse.Namespace) -> int:
     """Plan a job file: every move as fast as the limits allow, verified; print the table or JSON; write outputs."""
     from ..job import Job
 
-    outputs = {"trajectory": args.out, "plot": args.plot, "page": args.html}
-    named = [p for p in outputs.values() if p]
-    for out in named:
-        check_output_path(out)
-    if named.count("-") + bool(args.json) > 1:
-        raise InvalidInputError("only one output can go to standard output (-), and --json prints there too")
+    outputs = {"--out": args.out, "--plot": args.plot, "--html": args.html}
+    check_command_outputs(args, outputs, figures=("--plot",))  # names, stdout, the job file and the robot's
     if not args.rate > 0:  # parsed by the one number grammar: finite, ASCII digits
         raise ParameterError("--rate", args.rate, "must be > 0", "Hz")
     job = Job.load(args.file)
-    check_outputs_apart(named, [args.file, job.points_file, job.cell])
+    check_outputs(outputs, {"points": job.points_file, "cell": job.cell})  # the files the job names
     if args.out:  # the dwells alone already take this many samples: refused before the moves are planned
         check_count(f"samples of --out (at least the dwells' {job.dwell:.6g} s at {args.rate:.6g} Hz)",
                     job.dwell * args.rate + 1.0, MAX_SAMPLES, "lower --rate")  # fmt: skip

@@ -27,6 +27,7 @@ from ._common import (
     _scaled,
     add_cell_options,
     cell_from_args,
+    check_command_outputs,
     integer_type,
     log,
 )
@@ -159,6 +160,8 @@ def _geared_text(robot: Robot, q: ArrayLike, units: Units) -> str:
 def cmd_ik(args: argparse.Namespace) -> int:
     """Inverse kinematics: every joint solution for a tool pose (closed form, or numeric)."""
     units = Units.from_args(args)
+    if args.input:  # refused before any work: --output must not be --input (nor a device)
+        check_command_outputs(args, {"--output": args.output})
     robot = _load(args, units)
     if args.input:
         if args.numeric:

@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..files import check_output_path
 from ._common import (
     _POSE_KINDS,
     Units,
@@ -28,6 +27,7 @@ from ._common import (
     _read_pose,
     add_cell_options,
     cell_from_args,
+    check_command_outputs,
     log,
     number_type,
     write_atomic,
@@ -40,15 +40,6 @@ if TYPE_CHECKING:
     pass
 
 
-def _check_outputs(args: argparse.Namespace, outputs: tuple[str | None, ...]) -> None:
-    """Refuse bad output names before any work: devices, folders, and two outputs on stdout."""
-    named = [out for out in outputs if out]
-    for out in named:
-        check_output_path(out)
-    if named.count("-") + bool(args.json) > 1:
-        raise InvalidInputError("only one output can go to standard output (-), and --json prints there too")
-
-
 def cmd_traj(args: argparse.Namespace) -> int:
     """A trajectory between configurations or poses: quintic, time-optimal, or a straight tool line."""
     import numpy as np
@@ -57,7 +48,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units.from_args(args)
-    _check_outputs(args, (args.out, args.setpoints, args.plot))
+    check_command_outputs(args, {"--out": args.out, "--setpoints": args.setpoints, "--plot": args.plot},
+                          figures=("--plot",))  # before any work  # fmt: skip
     robot = _load(args, units)
     use_points(args, robot, units, "traj")  # --points FILE --through P1 .. Pn: their q as --from, --via, --to
     for flag in ("linear", "arch", "plot", "payload"):
@@ -301,7 +293,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     from ..motion.jog import jog_to_edge
 
     units = Units.from_args(args)
-    _check_outputs(args, (args.out, args.plot))
+    check_command_outputs(args, {"--out": args.out, "--plot": args.plot}, figures=("--plot",))  # before any work
     robot = _load(args, units)
     if robot.kind != "scara":
         raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")

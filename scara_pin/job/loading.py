@@ -95,32 +95,21 @@ class Carry:
 
 
 class _At:
-    """A value of the job file and its yaml node (for its line); :meth:`fail` refuses it, naming the line."""
+    """A value of the job file and the line where it is written; :meth:`fail` refuses it, naming the line."""
 
-    def __init__(self, value: Any, node: Any, path: Path, name: str, key: Any = None) -> None:
-        self.value, self.node, self.path, self.name = value, node, path, name
-        self.key = node if key is None else key  # where the entry begins: its key in a mapping
-
-    @property
-    def line(self) -> int | None:
-        mark = getattr(self.key, "start_mark", None)
-        return None if mark is None else int(mark.line) + 1
+    def __init__(self, value: Any, path: Path, name: str, line: int | None) -> None:
+        self.value, self.path, self.name, self.line = value, path, name, line
 
     def fail(self, reason: str) -> NoReturn:
         raise JobFileError(self.path, self.line, reason)
 
     def child(self, key: str | int, name: str | None = None) -> _At:
-        """The value at ``key`` of this mapping (or index of this list), with its own node when there is one."""
-        import yaml
+        """The value at ``key`` of this mapping (or index of this list), with its line (the shared loader's)."""
+        from ..description.yaml_units import yaml_line
 
-        node, key_node = self.node, None
-        if isinstance(key, int) and isinstance(node, yaml.SequenceNode) and key < len(node.value):
-            node = node.value[key]
-        elif isinstance(key, str) and isinstance(node, yaml.MappingNode):
-            key_node, node = next(((k, v) for k, v in node.value if isinstance(k, yaml.ScalarNode) and k.value == key),
-                                  (self.key, node))  # fmt: skip
         label = name if name is not None else (f"{self.name}[{key}]" if isinstance(key, int) else str(key))
-        return _At(self.value[key], node, self.path, label, key_node)
+        line = yaml_line(self.value, key)
+        return _At(self.value[key], self.path, label, self.line if line is None else line)
 
     def mapping(self, keys: tuple[str, ...], required: tuple[str, ...] = ()) -> dict[str, _At]:
         """The entries of a mapping with only ``keys`` (and every ``required`` one)."""
@@ -245,20 +234,16 @@ def load_job(path: str | Path) -> Job:
         JobFileError: the file, the line and the reason of the first problem (exit 2).
         InvalidInputError: the file cannot be read (missing, not a regular file, over its cap, not UTF-8).
     """
-    import yaml
-
-    from ..description.yaml_units import load_yaml, yaml_problem
+    from ..description.yaml_units import load_yaml, yaml_line
+    from ..errors import YamlError
 
     path = Path(path)
     text = read_text(check_input_file(path, "job file", MAX_JOB_BYTES), "job file", MAX_JOB_BYTES)
     try:
-        data = load_yaml(text)
-    except yaml.YAMLError as exc:
-        line, problem = yaml_problem(exc)
-        raise JobFileError(path, line, f"not valid YAML ({problem})") from None
-    # the same text composed (never constructed): the nodes give each value's line
-    root = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # noqa: S506 (safe)
-    top = _At(data, root, path, "the job")
+        data = load_yaml(text, str(path))  # the one bounded loader: every value knows its line
+    except YamlError as exc:
+        raise JobFileError(path, exc.line, exc.problem if exc.refused else f"not valid YAML ({exc.problem})") from None
+    top = _At(data, path, "the job", yaml_line(data))
     entries = top.mapping(_KEYS, required=("points", "steps"))
     lines = {k: at.line for k, at in entries.items()}
     if "format" in entries and entries["format"].value != FORMAT:

@@ -347,7 +347,8 @@ def candidates(
     velocity: np.ndarray,
     acceleration: np.ndarray,
 ) -> list[Candidate]:
-    """Warm starts for the jump in the cell, best first (module docstring); the straight one when it is clear."""
+    """Warm starts for the jump in the cell (module docstring): the straight one when it is clear; else the clear
+    ones, fastest first; else (none clears) every one tried, the least colliding first."""
     robot = scene.robot
     straight = np.array([qA, tops[0], tops[1], qB])
     t, clear = _score(scene, straight, velocity, acceleration)
@@ -395,8 +396,8 @@ def candidates(
                     break
             offset += _STEP
     clear_ones = sorted((c for c in found if c.clearance >= 0.0), key=lambda c: c.duration)
-    if not clear_ones:  # none clears: the least colliding, the planner may still find a way
-        return sorted(found, key=lambda c: -c.clearance)[:1]
+    if not clear_ones:  # none clears: every one tried, the least colliding first (the planner may still find a way)
+        return sorted(found, key=lambda c: -c.clearance)
     return clear_ones
 
 
@@ -426,6 +427,24 @@ def blocking(scene: Scene, piece: PolynomialPiece) -> str:
     if found is None:  # pragma: no cover - a scene without pairs plans no rows
         return "no pair"
     return describe(found, scene.margin) + f" at t = {piece.breaks[k[i]] + s[i] * h[k[i]]:.4g} s"
+
+
+def blocked(scene: Scene, tried: list[Candidate], status: str) -> InfeasibleError:
+    """The error of a jump for which no way around or over clears the cell (exit 3): each way and what blocks it."""
+    from ..cell import describe
+    from .jump import JumpError
+
+    parts = []
+    for c in tried:
+        samples = _line_samples(c.waypoints)
+        D = scene.distance_array(samples)
+        i = int(np.argmin(D.min(axis=1)))
+        found = scene.distances(samples[i]).closest
+        if found is not None:
+            parts.append(f"{c.way}: {describe(found, scene.margin)}")
+    return JumpError(status, "no collision-free motion found within the limits: " + "; ".join(parts)
+                     + f"; neither the traverse raised up to the stroke's top nor via points up to {_MAX_OFFSET:g} m "
+                     "to either side clear it, and the solver found no way from there")  # fmt: skip
 
 
 def infeasible(scene: Scene, piece: PolynomialPiece, status: str) -> InfeasibleError:
