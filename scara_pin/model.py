@@ -195,7 +195,7 @@ class Robot:
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
         kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file is a palletizer when it has
-            the palletizer's layout and its flange stays level, :func:`_urdf_kind`; else it counts as a SCARA).
+            the palletizer's layout and its flange stays level; else it counts as a SCARA).
         continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
         dof: the number of joint values in q, 4 or 3 (a SCARA without a wrist; :data:`JOINT_COUNTS`).
         base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
@@ -339,8 +339,8 @@ class Robot:
         """``baseMtool``: the placement of the tool frame in the base frame, at ``q``.
 
         Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
-        An instance calls the closure of :func:`_per_call_paths` directly (this method is what a subclass
-        overrides, and what ``super()`` reaches).
+        An instance calls a closure made for it at load directly (this method is what a subclass overrides,
+        and what ``super()`` reaches).
         """
         return self._per_call[0](q)
 

@@ -60,6 +60,6 @@ def load_yaml(text: str) -> Any:
 
 
 def yaml_problem(exc: Exception) -> tuple[int | None, str]:
-    """(line number from 1, or None; what is wrong) of a :class:`yaml.YAMLError`, for a one-line message."""
+    """(line number from 1, or None; what is wrong) of a ``yaml.YAMLError``, for a one-line message."""
     mark = getattr(exc, "problem_mark", None)
     return (None if mark is None else mark.line + 1), getattr(exc, "problem", None) or type(exc).__name__

@@ -23,8 +23,8 @@ and every inner point,
 time avoids the rest-to-rest singularity of the s-domain (a jerk-limited start has ``sd ~ s^(2/3)``, no
 polynomial in s); fixing the points in s makes the NLP's data exact and constant: ONE NLP per grid.
 
-**Grids.** The first grid puts the nodes at equal times of a feasible double-S law (:func:`_guess`); the
-second at equal times of the first solution weighted by where its jerk switches (:func:`_density`: a
+**Grids.** The first grid puts the nodes at equal times of a feasible double-S law; the
+second at equal times of the first solution weighted by where its jerk switches (a
 switch inside an interval costs to first order in its length), solved warm.
 
 **Between the points** (the promise is the :mod:`~scara_pin.motion.verify` grid, 10 kHz): the exact
@@ -161,8 +161,10 @@ class JerkLaw(TimeLaw):
         t: (N + 1,) node times from 0 [s].
         c: (N,) path jerks [1/s^3].
         knots: the path's knots that nodes sit on (a node within 1e-9 of one starts exactly at it).
-        s, sd, sdd: (N + 1,) node states (derived).
-        duration: t[-1] [s].
+        s: (N + 1,) node path positions (derived) [-].
+        sd: (N + 1,) node path velocities (derived) [1/s].
+        sdd: (N + 1,) node path accelerations (derived) [1/s^2].
+        duration: ``t[-1]`` [s].
     """
 
     t: np.ndarray

@@ -44,13 +44,14 @@ the robot's tool position and inverse dynamics written from its Pinocchio model,
   ``JumpOptions.refinements`` times.
 
 Among the minimum-time motions (the time is unique, the path is not: the joints that do not bind can
-move in many ways) the objective's tie-breaking terms pick the calmest (:data:`_TIE_VELOCITY`,
-:data:`_TIE_SMOOTH`): the quill brakes at once after the lift and holds (the lowest single-hump arch).
+move in many ways) the objective's small tie-breaking terms (the mean squared joint velocity, then the
+smoothness of the controls) pick the calmest: the quill brakes at once after the lift and holds (the lowest
+single-hump arch).
 
 **Output.** The states are integrated again from A in floating point with the solved controls, and the
 rounding left at B (about the solver's tolerance) is removed by the least-norm change of the controls
 that ends exactly at rest at B (the end state is linear in the controls). The result is then verified
-by independent routes (:func:`_verify`): the package's verifier (:func:`~scara_pin.motion.verify.verify`:
+by independent routes: the package's verifier (:func:`~scara_pin.motion.verify.verify`:
 Pinocchio at 10 kHz and at every breakpoint on both sides, the exact jerk and the jerk by third
 differences, the torques with the payload, endpoints, rest), the same ratios inside every interval and at
 the polynomial extrema, and the clearance, ceiling,

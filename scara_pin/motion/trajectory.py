@@ -6,12 +6,12 @@ is ``s(t)`` for ``t`` in [0, T]; the chain rule gives the joint trajectory
     q(t) = q(s(t)),    qd = q'(s) sd,    qdd = q'(s) sdd + q''(s) sd^2,
 
 with ``'`` a derivative in ``s`` and ``d`` one in ``t``. The paths (:class:`JointLine`,
-:class:`JointSpline`, and the straight tool lines of :func:`cartesian_path`) are in :mod:`scara_pin.paths`.
+:class:`JointSpline`, and the straight tool lines of :func:`cartesian_path`) are in :mod:`scara_pin.motion.paths`.
 
 Time laws: :class:`QuinticLaw` (``jtraj``: zero velocity and acceleration at both ends),
 :class:`TrapezoidLaw` (bang-coast-bang, time-optimal on a straight joint line), :class:`ProfileLaw`
 (piecewise-constant path acceleration between grid points: the exact output of a TOPP-RA profile, see
-:mod:`scara_pin.timing`).
+:mod:`scara_pin.motion.timing`).
 
 A :class:`Trajectory` strings motions together, rest to rest. Outside [0, T] it holds its end positions
 (zero velocity and acceleration). It samples at any times, resamples at a fixed rate, exports to CSV and

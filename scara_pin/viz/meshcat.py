@@ -192,7 +192,7 @@ def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.nda
 def read_trajectory_csv(path: str | os.PathLike[str], dof: int = 4) -> tuple[np.ndarray, np.ndarray]:
     """Read the times and joint values of a trajectory CSV (columns ``t,q1..q{dof}``; others ignored).
 
-    Reads the files of :meth:`scara_pin.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``)
+    Reads the files of :meth:`scara_pin.motion.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``)
     with the package's one CSV reader (:func:`scara_pin.tables.read_csv`: bounded, blank lines and lines
     starting with ``#`` skipped).
 
