@@ -20,6 +20,7 @@ from __future__ import annotations
 import enum
 import logging
 import math
+import os
 from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
@@ -412,6 +413,16 @@ class Robot:
         return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
 
     # ----------------------------------------------------------------- a summary for people (repr, notebooks)
+    def plot(self, q: object = None, path: str | os.PathLike[str] | None = None, **kwargs: Any) -> Any:
+        """The arm at ``q`` as a matplotlib stick figure (a Figure; written to ``path`` when one is given).
+
+        ``robot.plot(q)`` is :func:`scara_pin.stick.plot_robot` (its keywords: ``units``, ``view`` ``"3d"`` /
+        ``"top"`` / ``"side"``, ``ax``, ``title``, ``dpi``). matplotlib is imported only when it draws.
+        """
+        from .stick import plot_robot
+
+        return plot_robot(self, q, path, **kwargs)
+
     def summary(self) -> tuple[str, list[list[str]]]:
         """The robot at a glance: a headline and one row per joint, in degrees and millimetres.
 

@@ -418,11 +418,11 @@ def test_q1_on_its_limit_with_a_nearly_stretched_elbow_is_solved() -> None:
 # the layers, lowest first (STYLE.md: description -> model -> kinematics -> workspace -> motion -> viz -> cli);
 # a module may import its own layer and those below, never one above
 LAYERS = (
-    ("_typing", "_version", "errors", "signals", "units"),
+    ("_typing", "_version", "errors", "signals", "units", "summary"),
     ("limits", "files", "urdf_rules"),
     ("description",),
     ("_checks", "tables", "_urdf_checks"),
-    ("model", "chain"),
+    ("model", "chain", "stick"),
     ("kinematics",),
     ("calibration",),  # beside kinematics: imports description, model, kinematics; nothing lower imports it
     ("robots", "workspace", "lint"),

@@ -9,11 +9,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..summary import Summarized
 from .chain import Group, MeasurementFrame
 
 if TYPE_CHECKING:
     import pinocchio as pin
 
+    from ..units import DisplayUnits
     from .chain import ChainModel
     from .measurements import Measurements
 
@@ -126,8 +128,8 @@ class CrossValidation:
     held_out: ResidualStats
 
 
-@dataclass(frozen=True, eq=False)
-class CalibrationResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class CalibrationResult(Summarized):
     """A calibrated robot: the identified errors, their covariance, the residuals and the report.
 
     Attributes:
@@ -246,6 +248,10 @@ class CalibrationResult:
             "identified": list(self.identified),
             "covariance": self.covariance.tolist(),
         }  # fmt: skip
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """:meth:`report` in ``units`` (default SI): what ``scara-pin calibrate`` prints."""
+        return self.report("m", "rad") if units is None else self.report(units.length, units.angle)
 
     def report(self, length_unit: str = "m", angle_unit: str = "rad") -> str:
         """The report in words: residuals, identified errors with their deviations, fixed ones and why."""

@@ -58,6 +58,7 @@ import numpy as np
 from .._checks import _positive
 from ..errors import InfeasibleError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
+from ..summary import Summarized
 from .paths import CartesianPath, GeometricPath, path_segments
 from .timing import TimingError
 from .trajectory import Motion, TimeLaw, Trajectory
@@ -77,6 +78,7 @@ if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..description import JointLimits
     from ..model import Robot
+    from ..units import DisplayUnits
 
 __all__ = ["JerkLaw", "JerkOptions", "JerkRatios", "JerkResult", "minimum_duration", "time_optimal_jerk"]
 
@@ -639,8 +641,8 @@ def _probe_times(law: JerkLaw) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------------------------- public
-@dataclass(frozen=True, eq=False)
-class JerkResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class JerkResult(Summarized):
     """A jerk-limited time-optimal trajectory and how it was obtained.
 
     Attributes:
@@ -656,6 +658,14 @@ class JerkResult:
     correction: float
     nlps: int
     options: JerkOptions = field(default_factory=JerkOptions)
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The duration and the worst ratio of each limit (ratios have no unit)."""
+        r = self.ratios
+        torque = "" if r.torque is None else f", torque {r.torque:.4f}"
+        return (f"JerkResult {self.trajectory.duration:.6f} s ({len(self.trajectory.pieces)} segment(s), {self.nlps} "
+                f"NLP(s)): worst |value| / limit: velocity {r.velocity:.4f}, acceleration {r.acceleration:.4f}, "
+                f"jerk {r.jerk:.4f}{torque}")  # fmt: skip
 
 
 def time_optimal_jerk(

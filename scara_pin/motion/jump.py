@@ -90,7 +90,9 @@ from ..description import JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..kinematics.validate import _pose_error
 from ..limits import MAX_SAMPLES, check_count
-from .payload import Payload, with_payload
+from ..summary import Summarized
+from ..units import SI, DisplayUnits
+from .payload import Payload, PayloadLike, as_payload, with_payload
 from .polynomial import PolynomialPiece
 from .trajectory import Trajectory, line_optimal_duration
 from .verify import (
@@ -310,6 +312,12 @@ class Leg:
         """[s]."""
         return self.t_end - self.t_start
 
+    def line(self) -> str:
+        """The leg in one line, as ``scara-pin cycle`` prints it (ratios have no unit; times in s)."""
+        binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in self.binding)
+        return (f"  {'out ' if self.move == 0 else 'back'} {self.name:<11} {self.duration:9.6f} s   {self.active} of "
+                f"{self.joint} at {self.ratio:.4f} of its limit" + (f"; binding: {binding}" if binding else ""))
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
@@ -317,8 +325,8 @@ class Leg:
                 "binding": [b.to_dict() for b in self.binding]}  # fmt: skip
 
 
-@dataclass(frozen=True, eq=False)
-class JumpMove:
+@dataclass(frozen=True, eq=False, repr=False)
+class JumpMove(Summarized):
     """A verified time-optimal jump (or the cycle out and back) and how its limits are used.
 
     Attributes:
@@ -371,6 +379,22 @@ class JumpMove:
     def gap(self) -> float:
         """The duration above the lower bound, relative (0.2: 20 % above)."""
         return self.duration / (self.moves * self.lower_bound.duration) - 1.0
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The move in a few lines: its time, the bound, the arch, the legs (lengths in ``units``, default SI)."""
+        u = SI if units is None else units
+        Ln = u.name("length")
+        what = "jump move" if self.moves == 1 else f"jump cycle ({self.moves} moves)"
+        return "\n".join([
+            f"{what}   {self.duration:.6f} s, {100 * self.gap:.1f} % above its lower bound "
+            f"{self.moves * self.lower_bound.duration:.6f} s ({self.lower_bound.reason})",
+            f"from {u.format_vector(self.pose_from[:3], 'length')} to {u.format_vector(self.pose_to[:3], 'length')} "
+            f"{Ln}, payload {self.payload.mass:g} kg" + (f", jerk limit {list(self.jerk)}" if self.jerk else ""),
+            f"arch   up to {u.format(self.z_top + self.peak, 'length')} {Ln} ({u.format(self.peak, 'length')} {Ln} "
+            f"above the clearance height), {u.format(self.bulge, 'length')} {Ln} off the straight line in plan view",
+            "legs   (binding limits: the share of the leg's time at >= 99.9 % of the limit)",
+            *(leg.line() for leg in self.legs),
+        ])  # fmt: skip
 
     def and_back(self) -> JumpMove:
         """The move followed by its time reversal (B -> A): the cycle (module docstring, "Return move")."""
@@ -613,7 +637,7 @@ def jump_move(
     rise: float = STANDARD_RISE,
     clearance_radius: float = STANDARD_CLEARANCE,
     max_height: float | None = None,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     jerk: float | ArrayLike | None = None,
     torque: bool = True,
     tool_speed: float | None = None,
@@ -632,7 +656,8 @@ def jump_move(
         rise: [m] > 0, how high above the higher pose the tool must be away from both.
         clearance_radius: [m] > 0, R: within R of a pose (horizontally) the tool may be lower.
         max_height: [m] a ceiling for the tool's z (base frame), or None.
-        payload: carried by the tool (torques); default none.
+        payload: carried by the tool (torques): a :class:`~scara_pin.motion.payload.Payload` or a mass [kg];
+            default none.
         jerk: joint jerk limit [rad/s^3, m/s^3], one or four numbers; None: not limited.
         torque: respect the effort limits (inverse dynamics with the payload).
         tool_speed: [m/s] a limit of the tool origin's speed, or None.
@@ -658,7 +683,7 @@ def jump_move(
     ceiling = None
     if max_height is not None:
         ceiling = float(_vector("max_height", [max_height], 1)[0])
-    payload = Payload() if payload is None else payload
+    payload = as_payload(payload)
     lim = _limits(robot, limits, tool_speed, torque)
     jv = None if jerk is None else jerk_vector(jerk)
     D = float(np.hypot(*(B[:2] - A[:2])))

@@ -55,13 +55,15 @@ from .._checks import _limit_vector, _positive
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
+from ..summary import Summarized
 from .paths import GeometricPath, JointLine, third_by_differences
-from .payload import Payload, with_payload
+from .payload import PayloadLike, with_payload
 from .trajectory import Motion, Trajectory
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..model import Robot
+    from ..units import DisplayUnits
 
 __all__ = [
     "ENDPOINT_TOL",
@@ -115,6 +117,10 @@ class Quantity(enum.Enum):
     TOOL_SPEED = "tool speed"
 
 
+_QUANTITY_WORD = {q: "jerk" if q is Quantity.JERK_DIFFERENCES else q.value for q in Quantity}
+"""How each quantity is named in a summary (the third differences are the jerk's measure there)."""
+
+
 @dataclass(frozen=True)
 class Worst:
     """The largest |value| / limit of one quantity over the verified samples.
@@ -157,9 +163,9 @@ class LimitViolation(InfeasibleError):
         super().__init__(reason)
 
 
-@dataclass(frozen=True)
-class Verification:
-    """What :func:`verify` found.
+@dataclass(frozen=True, repr=False)
+class Verification(Summarized):
+    """What :func:`verify` found (``repr``: one line per limit checked, its worst ratio and where).
 
     Attributes:
         duration: [s] of the trajectory.
@@ -205,6 +211,31 @@ class Verification:
         """{quantity name: worst ratio or None}, JSON-ready."""
         found = {w.quantity: w.ratio for w in self.quantities}
         return {q.value: found.get(q) for q in Quantity}
+
+    def limited(self) -> tuple[Worst, ...]:
+        """The worst ratio of each limit checked; a limit not given is left out.
+
+        Velocity, acceleration, jerk (the analytic jerk where the motions have one, else the third
+        differences), torque, tool speed.
+        """
+        jerk = self.jerk if self.jerk is not None else self.jerk_differences
+        return tuple(w for w in (self.velocity, self.acceleration, jerk, self.torque, self.tool_speed) if w is not None)
+
+    def ratio_text(self) -> str:
+        """``velocity 0.9159 (joint1), acceleration 1.0000 (joint1), torque 0.6757 (joint2)``: :meth:`limited`."""
+        return ", ".join(f"{_QUANTITY_WORD[w.quantity]} {w.ratio:.4f} ({w.where.split(' at ')[0]})"
+                         for w in self.limited())  # fmt: skip
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The verification in a few lines: each limit's worst ratio, where and when (ratios have no unit)."""
+        try:
+            self.check()
+            verdict = "within the limits"
+        except LimitViolation as exc:
+            verdict = f"NOT within the limits: {exc}"
+        lines = [f"Verification of {self.duration:.6g} s at {self.rate:g} Hz ({self.samples} samples): {verdict}"]
+        lines += [f"  {_QUANTITY_WORD[w.quantity]:<13} {w.ratio:.6f} of its limit, {w.where}" for w in self.limited()]
+        return "\n".join(lines)
 
     def check(self, tolerance: float = TOLERANCE) -> Verification:
         """Self, if every ratio is <= 1 + ``tolerance`` and the endpoints and rest hold; else raise.
@@ -530,7 +561,7 @@ def verify(
     limits: JointLimits | None = None,
     jerk: float | ArrayLike | None = None,
     torque: bool = False,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     tool_speed: float | None = None,
     rate: float = VERIFY_RATE,
     q_start: ArrayLike | None = None,
@@ -544,7 +575,8 @@ def verify(
         limits: joint limits instead of ``robot.limits``.
         jerk: joint jerk limit(s) [rad/s^3 or m/s^3], one or one per joint; None: jerk not checked.
         torque: check the effort limits (RNEA, gravity included).
-        payload: carried by the tool for the torques (:func:`~scara_pin.motion.payload.with_payload`).
+        payload: carried by the tool for the torques: a :class:`~scara_pin.motion.payload.Payload` or a mass
+            [kg] (:func:`~scara_pin.motion.payload.with_payload`).
         tool_speed: [m/s] limit of the tool origin's speed, optional.
         rate: [Hz] of the verified grid.
         q_start: the configuration the trajectory must start at, optional.
