@@ -119,9 +119,11 @@ def results(robot):
     }
 
 
-@pytest.mark.parametrize("kind", ["IKResult", "BatchIKResult", "MotionPlan", "Trajectory", "Verification", "CycleResult",
-                                  "JumpMove", "ArchMove", "JerkResult", "Workspace", "ExperimentPlan", "SceneView",
-                                  "Robot"])  # fmt: skip
+KINDS = ("IKResult", "BatchIKResult", "MotionPlan", "Trajectory", "Verification", "CycleResult", "JumpMove", "ArchMove",
+         "JerkResult", "Workspace", "ExperimentPlan", "SceneView", "Robot")  # fmt: skip
+
+
+@pytest.mark.parametrize("kind", KINDS)
 def test_results_print_a_short_summary(results, kind) -> None:
     obj = results[kind]
     text = repr(obj)
