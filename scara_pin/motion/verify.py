@@ -84,6 +84,7 @@ __all__ = [
     "state_ratios",
     "static_load",
     "static_overload",
+    "static_payload",
     "time_scale",
     "torque_coefficients",
     "trajectory_jerk",
@@ -386,6 +387,31 @@ def static_load(robot: Robot, q: np.ndarray) -> np.ndarray:
     """g(q) (n, dof): the joint efforts that hold the robot still (RNEA at rest, gravity and payload)."""
     zero = np.zeros_like(q)
     return _rnea(robot, q, zero, zero)
+
+
+def static_payload(robot: Robot, q: np.ndarray, limits: JointLimits | None = None) -> float:
+    """The largest point mass [kg] at the tool frame's origin that the effort limits hold at rest at every row of q.
+
+    The static load is linear in the mass: ``g(q; m) = g0(q) + m g1(q)`` (``g1`` the load of 1 kg, the
+    difference of two :func:`static_load` calls), and ``|g0 + m g1| <= effort`` per joint gives
+    ``m <= (effort - sign(g1) g0) / |g1|`` wherever ``g1 != 0``. A SCARA's only loaded joint is the vertical
+    quill (constant over q); a palletizer's depends on q: the minimum is over the rows given.
+
+    Args:
+        robot: the robot (its model: gravity and the links' masses).
+        q: (n, dof) configurations [rad, m].
+        limits: limits instead of ``robot.limits`` (their efforts).
+
+    Returns:
+        the mass [kg]; 0 when the arm alone already exceeds an effort somewhere; inf when no joint carries it.
+    """
+    effort = np.asarray((robot.limits if limits is None else limits).effort, dtype=float)
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    g0 = static_load(robot, q)
+    g1 = static_load(with_payload(robot, 1.0), q) - g0
+    carried = np.abs(g1) > 1e-12 * max(1.0, float(np.abs(g0).max()))
+    room = np.where(carried, (effort - np.sign(g1) * g0) / np.where(carried, np.abs(g1), 1.0), np.inf)
+    return max(0.0, float(room.min()))
 
 
 def torque_coefficients(robot: Robot, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, ...]:
