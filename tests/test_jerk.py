@@ -230,6 +230,9 @@ def test_blended_arch_never_slower_than_the_simpler_plans(robot, issue_arch):
     old, _ = fir_jerk_limited(robot, parameterize(robot, path, torque=True).trajectory, JERK, torque=True)
     assert blended.duration <= corners.trajectory.duration
     assert blended.duration <= old.duration
+    import importlib.util
+
+    assert importlib.util.find_spec("scara_pin.motion.jerk_fir") is None  # a baseline: benchmarks/, not the package
 
 
 def test_arch_near_an_independent_minimum(robot, issue_arch):
