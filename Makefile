@@ -59,7 +59,7 @@ bench-calibration: $(VENV)/.installed-test
 
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[test,lint]'
-	$(BIN)/ruff check scara_pin tests benchmarks
+	$(BIN)/ruff check scara_pin tests benchmarks tools
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
 # the documentation site from docs/ and the docstrings, into site/; a warning fails the build
