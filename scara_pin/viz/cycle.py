@@ -6,7 +6,7 @@ Object-oriented matplotlib (a Figure on the Agg canvas, no pyplot, no global sta
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -16,6 +16,8 @@ from .plots import finish, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
+
+    from ..cell import Cell
 
     from ..description import JointLimits
     from ..model import Robot
@@ -98,6 +100,9 @@ def plot_cycle(
             plan.plot((pose[0] + R * np.cos(angle)) * k, (pose[1] + R * np.sin(angle)) * k, "k:", lw=1)
         ends = np.array([move.pose_from[:2], move.pose_to[:2]]) * k  # type: ignore[union-attr]
         plan.plot(ends[:, 0], ends[:, 1], "k--", lw=1)
+    cell = getattr(move, "cell", None)
+    if cell is not None:
+        _draw_cell(side, plan, cell, start, direction / norm, k)
     side.set(xlabel=f"along the traverse [{Ln}]", ylabel=f"z [{Ln}]", title="side view (tool path)")
     side.legend(fontsize="small")
     plan.plot([0.0], [0.0], "k+", ms=12)
@@ -122,6 +127,44 @@ def plot_cycle(
     if title:
         fig.suptitle(title)
     return finish(fig, path, dpi)
+
+
+def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarray, k: float) -> None:
+    """The obstacles of a cell: their outline in plan view (the convex hull of the shape's points: a circle's for a
+    vertical cylinder or a sphere) and, in the side view, the box they span along the traverse and in z."""
+    from matplotlib.patches import Polygon, Rectangle
+
+    angle = np.linspace(0.0, 2.0 * np.pi, 73)
+    for i, o in enumerate(cell.obstacles):
+        shape = o.shape
+        if shape.kind in ("cylinder", "sphere") and abs(shape.rotation[2, 2]) > 1.0 - 1e-9:
+            r = shape.size[0]
+            ring = shape.xyz[:2] + r * np.column_stack([np.cos(angle), np.sin(angle)])
+            half = shape.size[1] / 2.0 if shape.kind == "cylinder" else r
+            pts = np.column_stack([np.repeat(ring, 2, axis=0), np.tile([shape.xyz[2] - half, shape.xyz[2] + half],
+                                                                       len(ring))])  # fmt: skip
+        else:
+            pts = shape.corners()
+        hull = _hull(pts[:, :2])
+        label = "obstacles" if i == 0 else None
+        plan.add_patch(Polygon(hull * k, closed=True, facecolor="0.75", edgecolor="0.35", lw=1, label=label))
+        plan.annotate(o.name, shape.xyz[:2] * k, fontsize="x-small", ha="center", va="center")
+        along = (pts[:, :2] - start) @ u
+        side.add_patch(Rectangle((along.min() * k, pts[:, 2].min() * k), float(np.ptp(along)) * k,
+                                 float(np.ptp(pts[:, 2])) * k, facecolor="0.85", edgecolor="0.35", lw=1, zorder=0,
+                                 label=label))  # fmt: skip
+    side.autoscale_view()
+    plan.autoscale_view()
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """The convex hull of 2-D points (scipy's Qhull), counterclockwise."""
+    from scipy.spatial import ConvexHull
+
+    pts = np.unique(points, axis=0)
+    if len(pts) < 3:
+        return pts
+    return pts[ConvexHull(pts).vertices]
 
 
 def _jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
