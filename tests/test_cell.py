@@ -222,7 +222,7 @@ def test_the_issue_example_reads(tmp_path):
     ("obstacles:\n  - name: a\n    shape: box\n    size: [0.1, -0.2, 0.1]\n", "obstacle a: box y -0.2"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: .nan\n", "line 4"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 0x10\n", "line 4: obstacle a: radius must be a number"),
-    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 1e400\n", "line 4: obstacle a: radius inf is not a plain"),
+    ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 1e400\n", "line 4: obstacle a: radius inf is not"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: '0.1'\n", "line 4: obstacle a: radius must be a number"),
     ("obstacles:\n  - name: a\n    shape: cone\n", "line 3: obstacle a: shape 'cone' must be one of"),
     ("obstacles:\n  - name: a\n    shape: sphere\n    radius: 0.1\n    colour: red\n",
