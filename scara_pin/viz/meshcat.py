@@ -88,7 +88,7 @@ _PATH_COLOR = 0x1E90FF  # dodger blue: the tool path
 _WORKSPACE_COLOR = 0x2E8B57  # sea green: the workspace boundary
 _GRID_COLOR = 0x8C96A0  # grey blue: the floor grid
 OBSTACLE_COLOR = 0x6A5ACD
-"""Slate blue: a cell's obstacles (drawn at :data:`_CELL_OPACITY`)."""
+"""Slate blue: a cell's obstacles (drawn three-quarters opaque)."""
 CARRIED_COLOR = 0x20B2AA
 """Light sea green: the part the tool carries."""
 _CELL_OPACITY = 0.75
