@@ -69,7 +69,7 @@ _MIN_STEP = 1e-15
 
 
 class JointPath(Protocol):
-    """A joint path ``q(s)``, ``s`` in [0, 1]: the motion layer's ``GeometricPath`` (``scara_pin.motion.paths``) is one."""
+    """A joint path ``q(s)``, ``s`` in [0, 1]: ``GeometricPath`` of ``scara_pin.motion.paths`` is one."""
 
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
         """(q, q', ...) at the parameters ``s`` (1-D), each (n, dof)."""
