@@ -95,7 +95,7 @@ def cmd_urdf(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable."""
     from ..lint import check_urdf_file
-    from .check_cell import report_with_cell
+    from ._check_cell import report_with_cell
 
     report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or (),
                              lock=_parse_locks(args.lock))
@@ -118,7 +118,7 @@ def register(sub: Any) -> None:
     p.add_argument("file", metavar="FILE.urdf", help="the URDF (or .xacro, expanded) to check")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_frame_options(p.add_argument_group("robot"))
-    from .check_cell import add_check_cell_options
+    from ._check_cell import add_check_cell_options
 
     add_check_cell_options(p)
     p.set_defaults(func=cmd_check)
