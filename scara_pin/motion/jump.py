@@ -47,7 +47,7 @@ the robot's tool position and inverse dynamics written from its Pinocchio model,
   nearest point was seen with a 14 kg payload). The rigid-body torque of the motion played ``k`` times
   slower is tau_k(t) = (tau(t/k) - g(q)) / k^2 + g(q) (the velocity enters squared, the acceleration
   once), so the smallest ``k >= 1`` that brings every torque, sampled at 256 points of every interval, to
-  its limit is found in closed form and the motion slowed by it (:func:`_torque_stretch`: a few 1e-6
+  its limit is found in closed form and the motion slowed by it (``_torque_stretch``: a few 1e-6
   relative at most after the refinement; every other ratio only drops, the path is the same).
 
 Among the minimum-time motions (the time is unique, the path is not: the joints that do not bind can
@@ -177,7 +177,7 @@ _NEAR = 0.02
 _NODES = -1
 """The interval index of a :class:`_Point` that stands for every node (both sides) of its family."""
 _STRETCH_POINTS = 256
-"""Points per interval where :func:`_torque_stretch` samples the torque."""
+"""Points per interval where ``_torque_stretch`` samples the torque."""
 _QUANTITIES = ("velocity", "acceleration", "jerk", "torque", "tool speed")
 
 
