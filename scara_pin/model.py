@@ -31,8 +31,8 @@ import pinocchio as pin
 from ._checks import MAGNITUDE_MAX
 from .description import JOINT_COUNTS, JointLimits, RobotParameters, configured
 from .errors import InvalidInputError, ParameterError, UrdfError
-from .units import HUMAN, format_number
-from .urdf_rules import choose_frames, read_tree
+from .units import HUMAN, DisplayUnits, format_number
+from .urdf_rules import choose_frames, edges_of, read_tree, resolve_mimics
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -117,15 +117,14 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
     """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
     import xml.etree.ElementTree as ET
 
-    from ._urdf_checks import check_urdf_tree, xacro_leftovers
+    from ._urdf_checks import check_root, check_urdf_tree, xacro_leftovers
 
     try:
         root = ET.fromstring(urdf)
     except ET.ParseError as exc:
         line, column = exc.position
         raise UrdfError(f"{origin}: malformed XML at line {line}, column {column + 1}") from None
-    if root.tag != "robot":
-        raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
+    check_root(root, origin)
     # urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state):
     # its rules are checked first, in Python, so that it only sees documents it accepts.
     # the rule `scara-pin check` applies (xacro-not-expanded / xacro-ignored); the text search spares a walk
@@ -137,6 +136,8 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
     check_urdf_tree(root, origin)
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
     mimic = root.find("joint/mimic") is not None
+    if mimic:  # Pinocchio takes one level of mimic: a mimic of a mimic is handed to it composed
+        urdf = _composed_mimics(root, urdf, origin)
     try:
         model = pin.buildModelFromXML(urdf, mimic=True) if mimic else pin.buildModelFromXML(urdf)
     except (ValueError, RuntimeError) as exc:
@@ -147,6 +148,24 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
             f"({model.nbodies - 1} bodies, nq = 0): the kinematic tree is empty or disconnected"
         )
     return model
+
+
+def _composed_mimics(root: Any, urdf: str, origin: str) -> str:
+    """The URDF text with each chain of ``<mimic>`` joints composed down to its free joint (the text when none).
+
+    Raises:
+        UrdfError: a mimic that cannot be resolved (:func:`scara_pin.urdf_rules.resolve_mimics` names it).
+    """
+    import xml.etree.ElementTree as ET
+
+    resolved = resolve_mimics(edges_of(root)[1], origin)
+    if not any(m.via for m in resolved.values()):
+        return urdf
+    for el in root.findall("joint"):
+        m = resolved.get(el.get("name", ""))
+        if m is not None and m.via:
+            el.find("mimic").attrib.update(joint=m.source, multiplier=repr(m.multiplier), offset=repr(m.offset))
+    return ET.tostring(root, encoding="unicode")
 
 
 _CONTINUOUS = frozenset(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"))
@@ -569,15 +588,35 @@ class Robot:
         """The URDF names of the joints of q, in q order (mimic joints are not in q)."""
         return tuple(self.model.names[j] for j in range(1, self.model.njoints) if self.model.joints[j].nv > 0)
 
-    def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:
-        """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
+    @property
+    def default_q(self) -> np.ndarray:
+        """Where the robot rests by default (a page's first pose, the pendant's start), a new array.
+
+        q = 0, each joint whose limits exclude 0 at its nearest limit (:func:`scara_pin.urdf_rules.zero_within`).
+        """
+        from .urdf_rules import zero_within
+
+        return np.array([0.0 if c else zero_within(lo, hi)
+                         for c, lo, hi in zip(self.continuous, self.limits.lower, self.limits.upper)])  # fmt: skip
+
+    def outside_limits(self, q: np.ndarray, tol: float = 0.0, units: DisplayUnits | None = None) -> list[str]:
+        """The joints of ``q`` outside their position limits (by more than ``tol``), with values.
+
+        ``units``: the values in these units, named (``joint3 = 0 deg outside [10, 150] deg``); default SI
+        without unit names.
+        """
         out = []
         for i, joint in enumerate(self.joint_names):
             if self.continuous[i]:  # no position limit
                 continue
             lo, hi = self.limits.lower[i], self.limits.upper[i]
             if not lo - tol <= q[i] <= hi + tol:
-                out.append(f"{joint} = {q[i]:.9g} outside [{lo:.9g}, {hi:.9g}]")
+                if units is None:
+                    out.append(f"{joint} = {q[i]:.9g} outside [{lo:.9g}, {hi:.9g}]")
+                else:
+                    kind = self.joint_kinds[i]
+                    out.append(f"{joint} = {units.format(q[i], kind)} {units.name(kind)} outside "
+                               f"[{units.format(lo, kind)}, {units.format(hi, kind)}] {units.name(kind)}")  # fmt: skip
         return out
 
     # ----------------------------------------------------------------- kinematics
@@ -687,8 +726,10 @@ def _urdf_kind(robot: Robot) -> str:
 
     The layout (:func:`scara_pin.chain.palletizer_layout`): a vertical waist, two parallel horizontal arm
     joints, a vertical flange. Level: the tool's z axis keeps its direction at
-    :data:`~scara_pin.chain.LEVEL_PROBES` (the levelling parallelogram, modelled by ``<mimic>`` joints).
-    Whether the palletizer's closed form then fits the model is its kinematics' check (FK at sampled q).
+    :data:`~scara_pin.chain.LEVEL_PROBES` (the levelling parallelogram, modelled by ``<mimic>`` joints). Both
+    are read from the geometry, whatever the order of the joints and their zero pose; the palletizer's
+    geometry is then read the same way (:mod:`scara_pin.kinematics.palletizer_model`), which says where a
+    model departs from its closed form.
     """
     from .chain import AXIS_TOL, LEVEL_PROBES, flange_pitch, palletizer_layout
 

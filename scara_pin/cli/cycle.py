@@ -77,7 +77,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     limits = robot.limits
     jerk = _jerk(args)
     common = {"start": start, "direction": direction, "span": span, "rise": rise, "payload": _payload(args, units),
-              "jerk": jerk, "limits": limits, "max_height": ceiling}  # fmt: skip
+              "jerk": jerk, "limits": limits, "max_height": ceiling, "torque": not args.no_torque}  # fmt: skip
     if path is CyclePath.JUMP:
         result = standard_cycle(robot, path=path, clearance_radius=radius, **common)  # type: ignore[arg-type]
     else:
@@ -110,6 +110,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             "span": result.span, "rise": result.rise, "blend": result.blend,
             "clearance_radius": result.clearance_radius, "max_height": result.max_height,
             "payload": move.payload.to_dict(),
+            "torque": result.torque,
+            "joints": list(robot.joint_names),
             "q_start": move.trajectory.q_start.tolist(),
             "outputs": outputs,
             "units": {"length": "m", "angle": "rad", "time": "s"},
@@ -127,7 +129,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     what = ("jump (time-optimal, joint path free)" if path is CyclePath.JUMP
             else f"straight-leg arch (lines and blends, {timing})")  # fmt: skip
     print(f"robot       {robot.name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
-          + (f", jerk limit {list(move.jerk)}" if move.jerk else ""))  # fmt: skip
+          + (f", jerk limit {list(move.jerk)}" if move.jerk else "")
+          + ("" if result.torque else "; effort limits left out (--no-torque): torques not checked"))  # fmt: skip
     print(f"cycle time  {_num(result.cycle_time, 6)} s (up {units.num(result.rise, 'length')}, across "
           f"{units.num(result.span, 'length')}, down and back [{Ln}]"
           + (f"; clearance radius {units.num(radius, 'length')} {Ln})" if path is CyclePath.JUMP
@@ -196,6 +199,8 @@ def register(sub: Any) -> None:
     g.add_argument("--payload", metavar="KG", help="payload mass at the tool (default 0)")
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")
     g.add_argument("--jerk-limit", nargs="+", metavar="J", help="joint jerk limit, one or 4 (rad/s^3, m/s^3)")
+    g.add_argument("--no-torque", action="store_true",
+                   help="leave the effort limits out (a URDF's placeholder efforts); said in the output")
     _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",

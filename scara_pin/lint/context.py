@@ -12,6 +12,7 @@ make it well-formed found no error (the table's gates).
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import os
@@ -25,17 +26,19 @@ from xml.etree.ElementTree import Element, TreeBuilder
 import numpy as np
 
 from .._checks import number_text
-from ..urdf_rules import MOVABLE, FrameChoice
+from ..urdf_rules import MOVABLE, FrameChoice, JointEdge, Mimic, resolve_mimics
 from .report import Finding, Severity
 
 if TYPE_CHECKING:
     from ..description.xacro_sources import SourceMap
     from ..model import Robot
 
-__all__ = ["KNOWN_TYPES", "Context", "LintJoint", "Stop", "rpy_matrix", "shown_path"]
+__all__ = ["KNOWN_TYPES", "SAMPLES", "Context", "LintJoint", "Stop", "rpy_matrix", "shown_path"]
 
 KNOWN_TYPES = (*MOVABLE, "fixed", "floating", "planar")
 """URDF joint types."""
+SAMPLES = 200
+"""Seeded uniform configurations (seed 0) a rule samples besides the limits' combinations (:attr:`Context.samples`)."""
 
 
 class Stop(Exception):
@@ -245,9 +248,14 @@ class Context:
 
     # ------------------------------------------------------------------------------------------ the file
     @cached_property
+    def parsed(self) -> tuple[Element, dict[Element, int]]:
+        """The document's tree and each element's line (:func:`parse`; the ``malformed-xml`` rule parses it)."""
+        return parse(self.text)
+
+    @cached_property
     def document(self) -> Document:
-        """The document's links and joints as written (the ``malformed-xml`` rule parses it first)."""
-        root, lines = parse(self.text)
+        """The document's links and joints as written (read once the ``too-large`` rule has sized it)."""
+        root, lines = self.parsed
         links = [(el.get("name") or "", el) for el in root.findall("link")]
         joints = []
         for el in root.findall("joint"):
@@ -306,6 +314,25 @@ class Context:
     """The tool and base frames (set by the ``frame-missing`` rule: the loader's choose_frames)."""
 
     @cached_property
+    def edges(self) -> list[JointEdge]:
+        """The joints as the loader's rules read them (:class:`scara_pin.urdf_rules.JointEdge`), file order."""
+        out = []
+        for j in self.tree.joints.values():
+            src, m, c = (None, 1.0, 0.0) if j.mimic is None else j.mimic
+            out.append(JointEdge(j.name, j.type, j.parent, j.child, mimic=src, multiplier=m, offset=c))
+        return out
+
+    @cached_property
+    def mimics(self) -> tuple[dict[str, Mimic], Exception | None]:
+        """(each mimic joint resolved to its free joint, None), or ({}, why they cannot be: the loader's error)."""
+        from ..errors import UrdfError
+
+        try:
+            return resolve_mimics(self.edges, self.source), None
+        except UrdfError as exc:
+            return {}, exc
+
+    @cached_property
     def chain(self) -> Chain:
         """The joints of q (:class:`Chain`)."""
         tree = self.tree
@@ -333,6 +360,60 @@ class Context:
         """The angle between a joint of q's axis and the base z axis, either way [rad]."""
         a = self.axes[joint]
         return math.atan2(math.hypot(a[0], a[1]), abs(a[2]))
+
+    @cached_property
+    def samples(self) -> np.ndarray:
+        """Configurations of the joints of q (rows), where rules measure what a quirk costs.
+
+        Each joint at its lower limit, mid-range and upper limit in every combination, then :data:`SAMPLES`
+        seeded uniform ones (a continuous joint: one turn).
+        """
+        ranges = []
+        for j in self.chain.joints:
+            lo, hi = (j.numbers("lower") or (0.0,))[0], (j.numbers("upper") or (0.0,))[0]
+            ranges.append((-math.pi, math.pi) if j.type == "continuous" or not math.isfinite(lo + hi) else (lo, hi))
+        grid = np.array(list(itertools.product(*[(lo, (lo + hi) / 2.0, hi) for lo, hi in ranges]))).reshape(
+            -1, len(ranges))  # fmt: skip
+        rng = np.random.default_rng(0)
+        return np.vstack([grid, rng.uniform([r[0] for r in ranges], [r[1] for r in ranges], (SAMPLES, len(ranges)))])
+
+    def tool_position(self, q: np.ndarray, rpy: tuple[str, tuple[float, ...]] | None = None) -> np.ndarray:
+        """The tool point in the base frame at ``q`` (the joints of q), by the linter's own walk [m].
+
+        ``rpy``: (a joint, the rpy its origin takes instead of the file's). Geared joints follow their free
+        joint (:attr:`mimics`); locked ones sit at their ``--lock`` value, else 0 (or their nearest limit).
+        """
+        from ..urdf_rules import zero_within
+
+        index = {j.name: i for i, j in enumerate(self.chain.joints)}
+        resolved = self.mimics[0]
+
+        def value(j: LintJoint) -> float:
+            if j.name in index:
+                return float(q[index[j.name]])
+            if j.name in resolved:
+                m = resolved[j.name]
+                src = self.tree.joints[m.source]
+                return m.multiplier * value(src) + m.offset
+            lo, hi = (j.numbers("lower") or (None,))[0], (j.numbers("upper") or (None,))[0]
+            return self.lock.get(j.name, 0.0 if j.type == "continuous" else zero_within(lo, hi))
+
+        M = np.eye(4)
+        for j in self.tree.supports(self.chosen.tool):
+            T = np.eye(4)
+            T[:3, :3] = rpy_matrix(*(rpy[1] if rpy is not None and rpy[0] == j.name else j.rpy))
+            T[:3, 3] = j.xyz
+            if j.movable:
+                axis, v = np.asarray(j.axis) / np.linalg.norm(j.axis), value(j)
+                motion = np.eye(4)
+                if j.type == "prismatic":
+                    motion[:3, 3] = axis * v
+                else:  # Rodrigues
+                    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+                    motion[:3, :3] = np.eye(3) + math.sin(v) * K + (1.0 - math.cos(v)) * (K @ K)
+                T = T @ motion
+            M = M @ T
+        return (self.base_from_root @ M)[:3, 3]
 
     @property
     def tool(self) -> str | None:

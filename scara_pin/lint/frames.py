@@ -12,14 +12,15 @@ import math
 import numpy as np
 
 from ..kinematics.scara_geometry import NEAR_PARALLEL_TOL, WRIST_TILT_MAX  # beyond: tilted (the wrist: up to the max)
-from ..urdf_rules import JointEdge, choose_frames
-from .context import Context, LintJoint, Stop
+from ..urdf_rules import TOOL_NAMES, choose_frames
+from .context import SAMPLES, Context, LintJoint, Stop
 from .report import Severity
 
 __all__ = [
     "FULL_PRECISION", "OFFSET_RANGE", "RPY_EXACT", "RPY_NEAR", "TILT_TOL", "axis_down", "axis_flipped",
     "axis_near_parallel", "axis_tilted", "frame_missing", "length_implausible", "prismatic_position",
-    "rpy_approximate", "tool_frame", "wrist_tilted", "zero_pose_bent", "zero_pose_direction", "zero_pose_folded",
+    "rpy_approximate", "tool_ambiguous", "tool_frame", "wrist_tilted", "zero_pose_bent", "zero_pose_direction",
+    "zero_pose_folded",
 ]  # fmt: skip
 
 TILT_TOL = 1e-6
@@ -39,11 +40,8 @@ def frame_missing(ctx: Context) -> None:
     """``--tool``/``--base`` names no link, or a base that moves: the loader's frames (choose_frames)."""
     from ..errors import UrdfError
 
-    tree = ctx.tree
-    edges = [JointEdge(j.name, j.type, j.parent, j.child, mimic=None if j.mimic is None else j.mimic[0])
-             for j in tree.joints.values()]  # fmt: skip
     try:
-        ctx.chosen = choose_frames(list(tree.links), edges, tool=ctx.tool_asked, base=ctx.base_asked,
+        ctx.chosen = choose_frames(list(ctx.tree.links), ctx.edges, tool=ctx.tool_asked, base=ctx.base_asked,
                                    origin=ctx.source)  # fmt: skip
     except UrdfError as exc:
         ctx.error("frame-missing", str(exc).removeprefix(f"{ctx.source}: "))
@@ -51,9 +49,27 @@ def frame_missing(ctx: Context) -> None:
 
 
 def tool_frame(ctx: Context) -> None:
-    """No ``tool0``: which link is the tool, and why (the loader's choice)."""
-    if ctx.chosen.note is not None and ctx.tool is not None:
-        ctx.add(Severity.INFO, "tool-frame", ctx.chosen.note)
+    """No ``tool0``: which link is the tool, why (the loader's choice), and the other links the tree ends in."""
+    chosen = ctx.chosen
+    if chosen.note is None or ctx.tool is None:
+        return
+    others = ", ".join(f"{c.link} ({len(c.free)})" for c in chosen.alternatives[:6])
+    more = f" and {len(chosen.alternatives) - 6} more" if len(chosen.alternatives) > 6 else ""
+    ctx.add(Severity.INFO, "tool-frame", chosen.note + (f"; the tree's other ends (free joints to them): {others}{more}"
+                                                        if others else ""))  # fmt: skip
+
+
+def tool_ambiguous(ctx: Context) -> None:
+    """No ``tool0``, and two links end equally long chains with no name to tell them apart."""
+    chosen = ctx.chosen
+    if not chosen.ambiguous or ctx.tool is None:
+        return
+    tied = [c.link for c in chosen.alternatives if len(c.free) == len(chosen.alternatives[0].free)]
+    n = len(chosen.alternatives[0].free)
+    ctx.add(Severity.WARNING, "tool-ambiguous",
+            f"the tool frame is ambiguous: {chosen.tool} and {', '.join(tied)} each end a chain of {n} free joints "
+            f"and no name ({', '.join(TOOL_NAMES)}) tells them apart; {chosen.tool} is taken (the deepest, then the "
+            "first in the file): name the tool with --tool, or add a tool0 link")  # fmt: skip
 
 
 def _wrist_only(ctx: Context) -> bool:
@@ -206,22 +222,28 @@ def _full_precision(value: float) -> bool:
 
 
 def rpy_approximate(ctx: Context) -> None:
-    """An rpy value such as 3.14 or 1.5708 near a multiple of pi/2, with the tool position error it causes."""
+    """An rpy value such as 3.14 or 1.5708 near a multiple of pi/2, with the tool position error it causes.
+
+    The error is measured, not estimated: the tool point with the value as written against the exact value,
+    the most over the configurations of :attr:`~scara_pin.lint.context.Context.samples` (the limits' corners
+    and seeded ones), by the linter's own walk of the chain.
+    """
     tool = ctx.tool
-    bMo = ctx.base_from_root
-    p_tool = (bMo @ ctx.tree.link_world[tool])[:3, 3] if tool else np.zeros(3)
+    on_path = {j.name for j in ctx.tree.supports(tool)} if tool else set()
     for j in ctx.tree.order:
-        for axis_name, value in zip(("roll", "pitch", "yaw"), j.rpy):
+        for axis_name, (k, value) in zip(("roll", "pitch", "yaw"), enumerate(j.rpy)):
             n = round(value / (math.pi / 2))
             err = value - n * math.pi / 2
             if n == 0 or not RPY_EXACT < abs(err) < RPY_NEAR or _full_precision(value):
                 continue
             exact = {1: "pi/2", -1: "-pi/2", 2: "pi", -2: "-pi"}.get(n, f"{n}*pi/2")
-            dist = float(np.linalg.norm(p_tool - (bMo @ j.world)[:3, 3])) if tool else 0.0
-            mm = abs(err) * dist * 1000.0
-            sev = Severity.WARNING if mm >= 1e-3 else Severity.INFO
-            ctx.add(sev, "rpy-approximate",
+            fixed = tuple(n * math.pi / 2 if i == k else v for i, v in enumerate(j.rpy))
+            mm = 1000.0 * max((float(np.linalg.norm(ctx.tool_position(q) - ctx.tool_position(q, (j.name, fixed))))
+                               for q in ctx.samples), default=0.0) if j.name in on_path else 0.0  # fmt: skip
+            where = (f"the tool point moves up to {mm:.3g} mm from where {exact} puts it (the most over "
+                     f"{len(ctx.samples)} configurations: the limits' corners and {SAMPLES} seeded)"
+                     if j.name in on_path else f"joint {j.name} does not carry the tool: 0 mm at the tool")
+            ctx.add(Severity.WARNING if mm >= 1e-3 else Severity.INFO, "rpy-approximate",
                     f"joint {j.name}: rpy {axis_name} = {value!r} approximates {exact} (error {abs(err):.3g} rad = "
-                    f"{math.degrees(abs(err)):.3g} deg); the tool is {dist:.4g} m from this joint at q = 0: about "
-                    f"{mm:.3g} mm of position error at full reach; write {exact} as {n * math.pi / 2!r}",
+                    f"{math.degrees(abs(err)):.3g} deg): {where}; write {exact} as {n * math.pi / 2!r}",
                     j.origin_line, j.name)  # fmt: skip

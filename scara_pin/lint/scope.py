@@ -9,10 +9,17 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .context import Context
 from .report import Severity
 
-__all__ = ["closed_form_refused", "near_parallel", "not_a_scara", "not_loadable", "palletizer"]
+__all__ = ["EFFORT_SAMPLES", "closed_form_refused", "effort_limit", "near_parallel", "not_a_scara", "not_loadable",
+           "palletizer"]
+
+EFFORT_SAMPLES = 64
+"""Configurations (seeded, uniform in the joint ranges; q = 0 too) at which the static loads are compared with the
+effort limits."""
 
 
 def not_loadable(ctx: Context) -> None:
@@ -75,3 +82,30 @@ def near_parallel(ctx: Context) -> None:
             f"near-parallel; unrefined, the closed form (ideal vertical axes) would miss the tool pose by up to "
             f"{err.position * 1000:.3g} mm{yaw} (max over {err.samples} sampled configurations, seed {err.seed}); "
             "the toolkit refines every solution on the model as written (Newton, to 1e-9)")
+
+
+def effort_limit(ctx: Context) -> None:
+    """An effort limit that stops torque-limited timing: 0 (a placeholder), or below the static load somewhere."""
+    import pinocchio as pin
+
+    robot = ctx.robot
+    if robot is None:
+        return
+    effort, names = np.array(robot.limits.effort, dtype=float), robot.joint_names
+    units = ["N" if k == "length" else "N m" for k in robot.joint_kinds]
+    zero = [n for n, e in zip(names, effort) if not e > 0.0]
+    if zero:
+        ctx.add(Severity.WARNING, "effort-limit", f"{', '.join(zero)}: effort limit 0, a placeholder: torque-limited "
+                "timing (cycle, traj --torque) refuses it; cycle --no-torque leaves the efforts out")  # fmt: skip
+    lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
+    qs = np.vstack([robot.default_q, np.random.default_rng(0).uniform(lo, hi, (EFFORT_SAMPLES, robot.dof))])
+    data = robot.model.createData()
+    g = np.array([pin.computeGeneralizedGravity(robot.model, data, robot.to_pinocchio_q(q)) for q in qs])
+    ratio = np.where(effort > 0.0, np.abs(g) / np.where(effort > 0.0, effort, 1.0), 0.0)
+    for j in np.flatnonzero(ratio.max(axis=0) >= 1.0).tolist():
+        i = int(np.argmax(ratio[:, j]))
+        ctx.add(Severity.WARNING, "effort-limit",
+                f"the static load on {names[j]} reaches {abs(g[i, j]):.4g} {units[j]} (the weight it carries, at q = "
+                f"{np.round(qs[i], 6).tolist()}) against its effort limit {effort[j]:g} {units[j]}: placeholder "
+                "efforts or masses? torque-limited timing (cycle, traj --torque) refuses to move it, the robot "
+                "cannot even hold still there; cycle --no-torque leaves the efforts out")  # fmt: skip

@@ -6,6 +6,7 @@ Each rule is a function of the :class:`~scara_pin.lint.context.Context`; its cod
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from .._urdf_checks import xacro_leftovers
@@ -15,7 +16,7 @@ from .report import Finding, Severity
 
 __all__ = [
     "disconnected", "duplicate_name", "geared", "joint_count", "joint_type", "joints", "locked",
-    "malformed_xml", "missing_link", "missing_name", "no_wrist", "not_serial", "root_not_robot",
+    "malformed_xml", "mimic_unresolved", "missing_link", "missing_name", "no_wrist", "not_serial", "root_not_robot",
     "too_large", "two_parents", "unreadable", "xacro_failed", "xacro_ignored", "xacro_not_expanded",
 ]  # fmt: skip
 
@@ -61,7 +62,7 @@ def xacro_failed(ctx: Context) -> None:
 def malformed_xml(ctx: Context) -> None:
     """The text is not well-formed XML (expat's reason and line)."""
     try:
-        _ = ctx.document
+        _ = ctx.parsed
     except Exception as exc:  # expat.ExpatError (malformed), ValueError (encoding declarations)
         ctx.error("malformed-xml", f"malformed XML: {getattr(exc, 'args', [exc])[0]}", getattr(exc, "lineno", None))
         raise Stop from None
@@ -69,9 +70,9 @@ def malformed_xml(ctx: Context) -> None:
 
 def root_not_robot(ctx: Context) -> None:
     """The root element is not ``<robot>``."""
-    root = ctx.document.root
+    root, lines = ctx.parsed
     if root.tag != "robot":
-        ctx.error("root-not-robot", f"the root element is <{root.tag}>, not <robot>", ctx.document.line(root))
+        ctx.error("root-not-robot", f"the root element is <{root.tag}>, not <robot>", lines.get(root))
         raise Stop
 
 
@@ -79,7 +80,8 @@ def too_large(ctx: Context) -> None:
     """More links and joints than :data:`~scara_pin.limits.MAX_CHECK_ELEMENTS`."""
     from ..limits import MAX_CHECK_ELEMENTS
 
-    size = len(ctx.document.links) + len(ctx.document.joints)
+    root = ctx.parsed[0]
+    size = len(root.findall("link")) + len(root.findall("joint"))
     if size > MAX_CHECK_ELEMENTS:
         ctx.error("too-large", f"{size} links and joints, above the cap of {MAX_CHECK_ELEMENTS:,}")
         raise Stop
@@ -188,13 +190,31 @@ def locked(ctx: Context) -> None:
 
 
 def geared(ctx: Context) -> None:
-    """A ``<mimic>`` joint: it follows another, not in q."""
+    """A ``<mimic>`` joint: it follows another, not in q (a mimic of a mimic: the composition, to the free joint)."""
+    resolved = ctx.mimics[0]
     for j in ctx.chain.movable:
         if j.mimic is not None:
             src, m, c = j.mimic
             unit = "m" if j.type == "prismatic" else "rad"
+            r = resolved.get(j.name)
+            through = "" if r is None or not r.via else (
+                f"; {src} follows {' -> '.join(r.via[1:] + (r.source,))} in turn: {j.name} = {r.multiplier:.9g} * "
+                f"{r.source} + {r.offset:.9g} {unit}, as the toolkit hands it to Pinocchio")  # fmt: skip
             ctx.add(Severity.INFO, "geared", f"joint {j.name} follows {src} (<mimic>): {j.name} = {m:.9g} * {src} "
-                    f"+ {c:.9g} {unit}; not a degree of freedom (not in q), reported beside it", j.line, j.name)
+                    f"+ {c:.9g} {unit}{through}; not a degree of freedom (not in q), reported beside it", j.line,
+                    j.name)  # fmt: skip
+
+
+def mimic_unresolved(ctx: Context) -> None:
+    """A ``<mimic>`` that leads to no free joint (a loop, a missing or fixed source) or that Pinocchio cannot take."""
+    error = ctx.mimics[1]
+    if error is not None:
+        text = str(error).removeprefix(f"{ctx.source}: ")
+        found = ((re.search(rf"(?<!\w){re.escape(name)}(?!\w)", text), name) for name in ctx.tree.joints)
+        at = [(m.start(), name) for m, name in found if m is not None]
+        joint = ctx.tree.joints[min(at)[1]] if at else None  # the first joint the message names
+        ctx.error("mimic-unresolved", text, joint.line if joint else None,
+                  joint.name if joint else None)  # fmt: skip
 
 
 def _listing(ctx: Context) -> str:
@@ -210,18 +230,31 @@ def joints(ctx: Context) -> None:
     ctx.add(Severity.INFO, "joints", f"{len(ctx.chain.joints)} movable joints in chain order: {_listing(ctx)}")
 
 
+def _branched(ctx: Context) -> bool:
+    """Not 4 joints (or 3) on the chain, but as many free joints in the whole tree: one hung on the wrong link."""
+    chain = ctx.chain
+    return bool(chain.off_chain) and len(chain.joints) + len(chain.off_chain) in JOINT_COUNTS
+
+
 def joint_count(ctx: Context) -> None:
-    """Not 4 joints (or 3 without a wrist) on a chain that is the whole tree."""
+    """Not 4 joints (or 3 without a wrist) on the chain root -> tool; the joints off it are locked, not blamed."""
     n = len(ctx.chain.joints)
-    if n not in JOINT_COUNTS and not ctx.chain.off_chain:
+    if n in JOINT_COUNTS or _branched(ctx):
+        return
+    if not ctx.chain.off_chain:
         ctx.error("joint-count", f"a SCARA has 4 movable joints (3 revolute, 1 prismatic), or 3 without a wrist (2 "
                   f"revolute, 1 prismatic); this file has {n}: {_listing(ctx)}")  # fmt: skip
+        return
+    ctx.error("joint-count", f"the chain {ctx.tree.root} -> {ctx.chosen.tool} has {n} free joints: {_listing(ctx)}; "
+              f"a SCARA has 4 (3 without a wrist) ({len(ctx.chain.off_chain)} joint(s) off the chain are locked, "
+              "not counted): --tool picks an arm's last link, --lock JOINT=VALUE fixes a joint of the chain, "
+              "<mimic> makes a passive joint follow another")  # fmt: skip
 
 
 def not_serial(ctx: Context) -> None:
-    """Not 4 joints on the chain, the others hung off it: where the tree branches (a joint on the wrong link)."""
+    """Too few joints on the chain, the others hung off it: where the tree branches (a joint on the wrong link)."""
     chain = ctx.chain
-    if len(chain.joints) in JOINT_COUNTS or not chain.off_chain:
+    if len(chain.joints) in JOINT_COUNTS or not _branched(ctx):
         return
     free = [j for j in chain.movable if j.mimic is None and j.name not in ctx.lock]
     for a, b in zip(free, free[1:]):
