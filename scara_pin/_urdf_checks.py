@@ -31,14 +31,16 @@ __all__ = [
     "PrecheckRule",
     "check_root",
     "check_urdf_tree",
+    "urdfdom_ignores",
     "xacro_leftovers",
 ]
 
 _JOINT_TYPES = frozenset(("revolute", "continuous", "prismatic", "fixed", "floating", "planar"))
+_INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 # (element path below a link or joint, attribute, number of values); numbers urdfdom parses
 _INERTIAL_NUMBERS = (
     ("inertial/origin", "xyz", 3), ("inertial/origin", "rpy", 3), ("inertial/mass", "value", 1),
-    *(("inertial/inertia", a, 1) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")),
+    *(("inertial/inertia", a, 1) for a in _INERTIA),
 )  # fmt: skip
 _GEOMETRY_NUMBERS = (
     ("origin", "xyz", 3), ("origin", "rpy", 3), ("geometry/box", "size", 3), ("geometry/cylinder", "radius", 1),
@@ -149,6 +151,10 @@ def _inertial(root: ET.Element, origin: str) -> None:
             for part in ("mass", "inertia"):
                 if inertial.find(part) is None:
                     raise _refuse("inertial", origin, f"{where} <inertial> has no <{part}>")
+            inertia = inertial.find("inertia")
+            missing = [a for a in _INERTIA if inertia is not None and a not in inertia.attrib]
+            if missing:
+                raise _refuse("inertial", origin, f"{where} <inertia> has no {', '.join(missing)}")
         mass = link.find("inertial/mass")
         if mass is not None and float(mass.get("value", "0")) < 0:
             raise _refuse("inertial", origin, f"{where} mass {mass.get('value')} must be >= 0")
@@ -257,6 +263,54 @@ PRECHECK_RULES: tuple[PrecheckRule, ...] = (
     PrecheckRule("tree", _tree),
 )  # fmt: skip
 """The pre-check's rules, in the order they run (the first broken one refuses the document)."""
+
+
+def _colour_problem(color: ET.Element) -> str | None:
+    """Why urdfdom cannot read a ``<color>``: ``"no rgba"`` (``rgb=`` is not URDF), ``"malformed"``, or None."""
+    raw = color.get("rgba")
+    if raw is None:
+        return "no rgba"
+    pieces = [number_text(p) for p in raw.split()]
+    if not all(0.0 <= v <= 1.0 for v in pieces):  # NaN fails too: urdfdom throws and says so
+        return "malformed"
+    return None if len(pieces) == 4 else "no rgba"  # a wrong count: read as no colour, silently
+
+
+def urdfdom_ignores(root: ET.Element) -> list[str]:
+    """Remove from ``root`` the colours urdfdom reads, ignores and complains about on its C-level stderr; say which.
+
+    urdfdom keeps such a document (so does the pre-check: what Pinocchio loads, loads) but writes lines to file
+    descriptor 2. It drops: a global ``<material>`` without a name, or whose colour it cannot read and that has
+    no texture file (the visuals naming it keep their own empty material); a ``<color>`` whose ``rgba`` has
+    a component that is not a number in [0, 1] (malformed). An inline colour without ``rgba`` (``rgb=``, a
+    common slip) it drops quietly. Removing them first changes nothing in the model and keeps the terminal
+    clean; the loader warns once instead, naming them.
+
+    Returns:
+        One phrase per element removed (``material 'grey' (no rgba)``), in document order.
+    """
+    out = []
+    for material in root.findall("material"):  # global: a readable colour or a texture file
+        name, color, texture = material.get("name"), material.find("color"), material.find("texture")
+        textured = texture is not None and bool(texture.get("filename"))
+        problem = "no name" if not name else (_colour_problem(color) if color is not None else "no <color>")
+        if problem == "malformed" and color is not None:  # complained about, texture or not
+            material.remove(color)
+        elif problem in ("no rgba", "no <color>") and textured:  # the texture is its definition
+            problem = None
+        if problem is not None:
+            if not (name and textured):
+                root.remove(material)
+            out.append(f"material {name!r} ({problem})" if name else "a nameless <material>")
+    for visual in root.iter("visual"):  # inline: ignored quietly without rgba, with a complaint when malformed
+        for material in visual.findall("material"):
+            for color in material.findall("color"):
+                problem = _colour_problem(color)
+                if problem is not None:
+                    material.remove(color)
+                    written = " ".join(f"{k}={v[:40]!r}" for k, v in color.attrib.items()) or "nothing"
+                    out.append(f"material {material.get('name')!r}'s <color {written}> ({problem})")
+    return out
 
 
 def check_urdf_tree(root: ET.Element, origin: str) -> None:

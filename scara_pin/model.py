@@ -113,11 +113,15 @@ def pose_from_placement(aMb: pin.SE3) -> np.ndarray:
     return np.array([p[0], p[1], p[2], math.atan2(R[1, 0], R[0, 0])])
 
 
-def _parse_urdf(urdf: str, origin: str) -> pin.Model:
-    """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
+def _parse_urdf(urdf: str, origin: str) -> tuple[pin.Model, str]:
+    """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`.
+
+    Returns:
+        (the model, the text Pinocchio was given: the file's, less what urdfdom ignores noisily, mimics composed).
+    """
     import xml.etree.ElementTree as ET
 
-    from ._urdf_checks import check_root, check_urdf_tree, xacro_leftovers
+    from ._urdf_checks import check_root, check_urdf_tree, urdfdom_ignores, xacro_leftovers
 
     try:
         root = ET.fromstring(urdf)
@@ -134,6 +138,12 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
             raise UrdfError(f"{origin}: {leftover[1]}")
         logging.getLogger("scara_pin").warning("%s: %s", origin, leftover[1])
     check_urdf_tree(root, origin)
+    ignored = urdfdom_ignores(root)  # colours urdfdom drops: said here once, not by urdfdom on fd 2
+    if ignored:
+        shown = ", ".join(ignored[:6]) + (f" and {len(ignored) - 6} more" if len(ignored) > 6 else "")
+        logging.getLogger("scara_pin").warning("%s: colours URDF cannot read, ignored (as urdfdom does; a colour is "
+                                               "<color rgba=\"r g b a\"/>, each in [0, 1]): %s", origin, shown)
+        urdf = ET.tostring(root, encoding="unicode")
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
     mimic = root.find("joint/mimic") is not None
     if mimic:  # Pinocchio takes one level of mimic: a mimic of a mimic is handed to it composed
@@ -147,7 +157,7 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
             f"{origin}: the URDF has no movable joint connected to its root link "
             f"({model.nbodies - 1} bodies, nq = 0): the kinematic tree is empty or disconnected"
         )
-    return model
+    return model, urdf
 
 
 def _composed_mimics(root: Any, urdf: str, origin: str) -> str:
@@ -209,7 +219,8 @@ class Robot:
     Attributes:
         model: the Pinocchio model (``nv = 4``; ``nq = 4`` plus one per continuous joint).
         data: its Pinocchio data (the methods below overwrite it).
-        urdf: the URDF text the model was built from.
+        urdf: the URDF text the model was built from, as written (Pinocchio got it less the colours urdfdom
+            ignores, with chains of mimics composed: ``_pinocchio_urdf``).
         name: the robot's name.
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
@@ -243,6 +254,7 @@ class Robot:
     locked: tuple[LockedJoint, ...]
     lock_note: str | None
     package_path: PackagePath
+    _pinocchio_urdf: str
 
     def __init__(
         self,
@@ -282,7 +294,7 @@ class Robot:
         from .chain import geared_joints, reduce_to_chain
         from .description.packages import PackagePath
 
-        model = _parse_urdf(urdf, origin)
+        model, self._pinocchio_urdf = _parse_urdf(urdf, origin)
         links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
         frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
         base_frame, tool_frame = frames.base, frames.tool
@@ -421,14 +433,15 @@ class Robot:
         """
         from .description.placeholders import placeholder_urdf
 
-        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.VISUAL)
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self._pinocchio_urdf), pin.GeometryType.VISUAL)
 
     @cached_property
     def collision_model(self) -> pin.GeometryModel:
         """Collision geometry of the URDF, built on first use (meshes as placeholder boxes, as above)."""
         from .description.placeholders import placeholder_urdf
 
-        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self._pinocchio_urdf),
+                                           pin.GeometryType.COLLISION)  # fmt: skip
 
     # ----------------------------------------------------------------- a summary for people (repr, notebooks)
     def summary(self) -> tuple[str, list[list[str]]]:

@@ -253,3 +253,12 @@ def _round_trips(robot, n: int, seed: int) -> None:  # type: ignore[no-untyped-d
         assert robot.branch_of(q) == res.nearest(q).branch
         batch = robot.ik_batch(target[None, :], q)
         assert np.abs(batch.q[0] - q).max() <= 1e-7
+
+
+def test_named_tool_and_locks_every_ik_answer_reaches_its_target() -> None:
+    """Must hold: with the tool named and a joint locked, IK answers reproduce their targets on the model."""
+    robot = load_robot(urdf=MAGICIAN, tool="magician_link_gripper_core", lock={"magician_joint_prismatic_l": 0.01})
+    assert robot.frame_note is None and robot.kind == "palletizer"
+    _round_trips(robot, 100, 9)
+    mg400 = load_robot(urdf=MG400, tool="mg400_end_effector_shaft")
+    _round_trips(mg400, 100, 10)

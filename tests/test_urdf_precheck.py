@@ -17,7 +17,7 @@ import pinocchio as pin
 import pytest
 from quirks import run
 
-from scara_pin import load_robot
+from scara_pin import load_robot, robot_from_urdf
 from scara_pin._urdf_checks import PRECHECK_RULES, PrecheckError, check_urdf_tree
 from scara_pin.limits import MAX_URDF_ELEMENTS
 from scara_pin.lint import check_urdf_file
@@ -69,6 +69,7 @@ MUTATIONS = [
     ("inertial", "mass_negative", '<mass value="1"/>', '<mass value="-1"/>'),
     ("inertial", "mass_text", '<mass value="1"/>', '<mass value="one"/>'),
     ("inertial", "no_inertia", '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>', ""),
+    ("inertial", "inertia_attribute_missing", 'ixx="0.01" ixy="0"', 'ixy="0"'),
     ("inertial", "inertial_origin_nan", '<origin xyz="0 0 0.1" rpy="0 0 0"/><mass', '<origin xyz="0 0 nan"/><mass'),
     ("geometry", "unknown_shape", '<sphere radius="0.1"/>', '<capsule radius="0.1" length="1"/>'),
     ("geometry", "box_without_size", '<box size="0.2 0.2 0.2"/>', "<box/>"),
@@ -106,7 +107,6 @@ ACCEPTED = [
     ("global_material_empty", '<material name="logo"><texture filename="logo.png"/></material>',
      '<material name="logo"/>'),
     ("global_material_nameless", '<material name="logo">', "<material>"),
-    ("inertia_attribute_missing", 'ixx="0.01" ixy="0"', 'ixy="0"'),
 ]
 
 
@@ -154,6 +154,19 @@ def test_the_precheck_refuses_what_pinocchio_refuses(rule: str, old: str, new: s
 @pytest.mark.parametrize(("old", "new"), [(o, n) for _, o, n in ACCEPTED], ids=[a[0] for a in ACCEPTED])
 def test_what_urdfdom_ignores_loads(old: str, new: str, capfd: pytest.CaptureFixture[str]) -> None:
     assert verdicts(mutate(old, new)) == (None, False)
+
+
+@pytest.mark.parametrize(("old", "new"), [(o, n) for _, o, n in ACCEPTED], ids=[a[0] for a in ACCEPTED])
+def test_the_loader_takes_them_quietly_and_says_what_urdfdom_ignores(
+    old: str, new: str, capfd: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
+) -> None:
+    """No line of urdfdom's on fd 2 (it is given the document less what it would drop); one warning instead."""
+    text = mutate(old, new)
+    with caplog.at_level("WARNING", logger="scara_pin"):
+        robot_from_urdf(text)
+    assert capfd.readouterr() == ("", "")
+    quiet = new == '<material name="red"/>'  # an inline material reduced to its name: nothing to say
+    assert ("colours URDF cannot read, ignored" in caplog.text) is not quiet, caplog.text
 
 
 def test_every_rule_is_exercised_and_a_stricter_rule_says_why() -> None:

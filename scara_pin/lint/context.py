@@ -372,8 +372,9 @@ class Context:
         for j in self.chain.joints:
             lo, hi = (j.numbers("lower") or (0.0,))[0], (j.numbers("upper") or (0.0,))[0]
             ranges.append((-math.pi, math.pi) if j.type == "continuous" or not math.isfinite(lo + hi) else (lo, hi))
-        grid = np.array(list(itertools.product(*[(lo, (lo + hi) / 2.0, hi) for lo, hi in ranges]))).reshape(
-            -1, len(ranges))  # fmt: skip
+        if not ranges:
+            return np.zeros((1, 0))
+        grid = np.array(list(itertools.product(*[(lo, (lo + hi) / 2.0, hi) for lo, hi in ranges])))
         rng = np.random.default_rng(0)
         return np.vstack([grid, rng.uniform([r[0] for r in ranges], [r[1] for r in ranges], (SAMPLES, len(ranges)))])
 

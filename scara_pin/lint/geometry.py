@@ -12,7 +12,7 @@ from .._checks import number_text
 from .context import Context
 from .report import Severity
 
-__all__ = ["bad_inertial", "mesh_missing"]
+__all__ = ["bad_inertial", "colour_ignored", "mesh_missing"]
 
 _INERTIAL = (("mass", ("value",)), ("inertia", ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")))
 
@@ -62,3 +62,16 @@ def mesh_missing(ctx: Context) -> None:
             shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
             ctx.add(Severity.WARNING, "mesh-missing", f"{exc}: the viewer draws link {shown} as a placeholder box",
                     first[filename])  # fmt: skip
+
+
+def colour_ignored(ctx: Context) -> None:
+    """Colours urdfdom cannot read and ignores (``rgb=``, a malformed ``rgba``): the loader's rule, said once."""
+    import copy
+
+    from .._urdf_checks import urdfdom_ignores
+
+    ignored = urdfdom_ignores(copy.deepcopy(ctx.parsed[0]))
+    if ignored:
+        shown = ", ".join(ignored[:6]) + (f" and {len(ignored) - 6} more" if len(ignored) > 6 else "")
+        ctx.add(Severity.WARNING, "colour-ignored", f"colours URDF cannot read, ignored by urdfdom and the toolkit "
+                f"(a colour is <color rgba=\"r g b a\"/>, each in [0, 1]): {shown}")  # fmt: skip

@@ -73,6 +73,8 @@ RULES: tuple[Rule, ...] = (
     Rule("missing-link", "tree", E, "a joint's parent or child is no link of the file", tree.missing_link),
     Rule("bad-number", "joints", E, "an origin, axis or limit that is not finite numbers, or a zero axis",
          joints.bad_number),
+    Rule("colour-ignored", "geometry", W, "a colour urdfdom cannot read (rgb=, a malformed rgba): ignored",
+         geometry.colour_ignored),
     Rule("bad-inertial", "geometry", E, "a mass or inertia that is not finite, or a negative mass",
          geometry.bad_inertial, gate=True),
     Rule("two-parents", "tree", E, "a link that is the child of two joints", tree.two_parents, gate=True),
