@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..description import JOINT_NAMES
 from ..units import SI, DisplayUnits
 from .plots import finish, new_figure
 
@@ -116,7 +115,7 @@ def plot_cycle(
     for k, (name, ratio) in enumerate(quantities):
         ax = fig.add_subplot(grid[1 + k, :])
         for j in range(4):
-            ax.plot(t, ratio[:, j], color=_COLORS[j], label=JOINT_NAMES[j])
+            ax.plot(t, ratio[:, j], color=_COLORS[j], label=robot.joint_names[j])
         ax.axhline(1.0, color="k", ls="--", lw=1)
         for leg in move.legs:
             ax.axvline(leg.t_start, color="0.85", lw=0.8, zorder=0)
