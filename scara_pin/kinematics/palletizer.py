@@ -285,7 +285,7 @@ def _branches(
                         q2, q3, t2 = edge, g2, nearest_turn(edge, lo[1], hi[1], ref[1])
             if t2 is None:
                 failed(PalletizerIKStatus.J2_LIMIT, f"q2 = {wrap(q2):.9g} rad ({label}) (+2 pi k) is outside "
-                       f"[{lo[1]:.9g}, {hi[1]:.9g}]")  # fmt: skip
+                       f"[{lo[1]:.9g}, {hi[1]:.9g}] rad")  # fmt: skip
                 continue
             t3 = q2 + q3
             tt3 = nearest_turn(t3, lo[2], hi[2], ref[2], cont[2])
@@ -298,18 +298,18 @@ def _branches(
                         t2, tt3 = t2b, nearest_turn(edge, lo[2], hi[2], ref[2])
             if tt3 is None:
                 failed(PalletizerIKStatus.J3_LIMIT, f"theta3 = {wrap(t3):.9g} rad ({label}) (+2 pi k) is outside "
-                       f"[{lo[2]:.9g}, {hi[2]:.9g}]")  # fmt: skip
+                       f"[{lo[2]:.9g}, {hi[2]:.9g}] rad")  # fmt: skip
                 continue
             t1 = nearest_turn(phi, lo[0], hi[0], ref[0], cont[0])
             if t1 is None:
                 failed(PalletizerIKStatus.J1_LIMIT, f"q1 = {wrap(phi):.9g} rad (+2 pi k) is outside "
-                       f"[{lo[0]:.9g}, {hi[0]:.9g}]")  # fmt: skip
+                       f"[{lo[0]:.9g}, {hi[0]:.9g}] rad")  # fmt: skip
                 continue
             q4 = yaw - geo.tool_yaw - t1[0]
             t4 = nearest_turn(q4, lo[3], hi[3], ref[3], cont[3])
             if t4 is None:
                 failed(PalletizerIKStatus.J4_LIMIT, f"q4 = {wrap(q4):.9g} rad (+2 pi k) is outside "
-                       f"[{lo[3]:.9g}, {hi[3]:.9g}]")  # fmt: skip
+                       f"[{lo[3]:.9g}, {hi[3]:.9g}] rad")  # fmt: skip
                 continue
             ts = (t1, t2, tt3, t4)
             found.append((label, singular, [t[0] for t in ts],
