@@ -373,10 +373,11 @@
   // Hold-to-jog: the server moves while it hears "still held" (a keep-alive) within its watchdog; the page says
   // "released" at once. The keep-alive is posted by a Worker, on a thread of its own: a slow frame on the page's
   // thread (software WebGL at full HD on a busy PC) cannot delay it. And while a button is held, a frame slower
-  // than a keep-alive period is not drawn: the page's thread stays free for the button going up (a frame under
-  // way would delay the release by what is left of it). The readouts keep up; the view is drawn on release.
+  // than a control period (the server's step, 50 ms) is not drawn: the page's thread stays free for the button
+  // going up (a frame under way would delay the release by what is left of it). The readouts keep up; the view
+  // is drawn on release.
   var hold = null, holds = 0;
-  function slowFrames() { return renderCost > teach.keepalive * 1000; }
+  function slowFrames() { return renderCost > teach.control_period * 1000; }
   var WORKER = [
     "var timer = null;",
     "onmessage = function (e) {",
@@ -393,7 +394,7 @@
     "  timer = setInterval(alive, m.every);",
     "};",
   ].join("\n");
-  var renderCost = 0;  // [ms] the last frame's time on the page's thread
+  var renderCost = 0;  // [ms] the last frame drawn: from its drawing to the next animation frame
   var keepAlive = null;  // made with the page, not at the first hold: a worker can take long to start on a busy PC
   function makeKeepAlive() {
     try {
@@ -483,12 +484,14 @@
   }
   if (teach) {
     makeKeepAlive();
+    // a frame's cost as the page's thread sees it: from the drawing to the next animation frame (the WebGL
+    // calls return at once; with software WebGL the wait for the drawn frame falls on the next one)
     var renderFrame = viewer.render.bind(viewer);
     viewer.render = function () {
       if (hold && slowFrames()) return;  // needs_render stays set: drawn on release
       var start = performance.now();
       renderFrame();
-      renderCost = performance.now() - start;
+      requestAnimationFrame(function () { renderCost = performance.now() - start; });
     };
     for (var row = 0; row < 4; row++) {
       [["-", -1], ["+", 1]].forEach(function (pair) {
