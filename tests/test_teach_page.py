@@ -507,6 +507,11 @@ def test_the_pendants_words(server: Server, page: Any, robot_s1: Robot) -> None:
     click_and_wait(page, "#goto-submit")
     seen.append(status_in_view(page, VIEWPORTS[0]))
     assert seen[-1].startswith("refused: out of reach: ") and "l1 + l2 = 200 mm" in seen[-1], seen[-1]
+    page.fill("#goto-x", "100")
+    page.fill("#goto-z", "500")  # above the stroke: an interval, in mm too
+    click_and_wait(page, "#goto-submit")
+    seen.append(status_in_view(page, VIEWPORTS[0]))
+    assert seen[-1].endswith("needs joint3 = -400 mm, outside its stroke [0, 100] mm"), seen[-1]
 
     # a recorded point: its name and pose (Pinocchio's FK here) in the status line, its row marked and in view
     page.evaluate("() => { document.getElementById('pendant').scrollTop = 0; }")

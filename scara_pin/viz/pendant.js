@@ -438,7 +438,7 @@
     }
   }
   function ended(h, r) {
-    if (r.reason && r.reason.kind === "released") return ["released " + h.name + " \u2014 moved " + travel(r), "ok"];
+    if (!r.reason || r.reason.kind === "released") return ["released " + h.name + " \u2014 moved " + travel(r), "ok"];
     return stopped(r, false);
   }
   function holding(h) {

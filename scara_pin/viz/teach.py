@@ -400,7 +400,7 @@ class TeachSession:
 
         A tick more than two periods after the previous one (this process did not run: a busy PC) neither
         judges nor moves: the page's keep-alives may be waiting unread in the server's socket. The next tick,
-        once they are read, does both (by the time since the last move: a late tick loses no distance).
+        once they are read, does both (by the time since the last move, at most :data:`WATCHDOG`).
         """
         hold = self._hold
         if hold is None:
