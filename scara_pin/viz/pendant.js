@@ -319,11 +319,9 @@
       $("jog-" + i + "-").disabled = $("jog-" + i + "+").disabled = jogFrame() === "joint" && !data.sliders[i];
     }
   }
-  // what a jog moves, in words: "joint2 +", "x \u2212 (tool frame)"
-  function jogName(row, sign) {
-    var frame = jogFrame();
-    return rowLabel(row) + " " + (sign > 0 ? "+" : "\u2212") + (frame === "tool" ? " (tool frame)" : "");
-  }
+  // what a jog moves, in words: "joint2 +", "x \u2212"; and " in the tool frame" for a jog along the tool's axes
+  function jogName(row, sign) { return rowLabel(row) + " " + (sign > 0 ? "+" : "\u2212"); }
+  function frameWords() { return jogFrame() === "tool" ? " in the tool frame" : ""; }
   // the step of a row's kind, in SI, or null after saying why in the status line (nothing is sent)
   function stepFor(kind) {
     var input = kind === "angle" ? $("jog-step-angle") : $("jog-step");
@@ -362,10 +360,10 @@
     var kind = rowKind(row), step = stepFor(kind);
     if (step === null) return;
     if (hold) endHold(true);
-    var body = motionBody(row, sign), name = jogName(row, sign);
+    var body = motionBody(row, sign), name = jogName(row, sign), frame = frameWords();
     body.step = step;
     post("/jog", body, function (r) {
-      if (r.status === "OK" && r.moved) return ["jogged " + name + " " + travel(r), "ok"];
+      if (r.status === "OK" && r.moved) return ["jogged " + name + " " + travel(r) + frame, "ok"];
       return stopped(r, true);
     }).then(function () { window.scaraJogs = (window.scaraJogs || 0) + 1; });
   }
@@ -451,7 +449,7 @@
     if (hold) endHold(true);
     var body = motionBody(row, sign);
     body.speed = Number($("speed").value);
-    var mine = hold = { id: ++holds, button: button, started: false, name: jogName(row, sign), speed: body.speed,
+    var mine = hold = { id: ++holds, button: button, started: false, name: jogName(row, sign) + frameWords(), speed: body.speed,
                         last: null };
     button.classList.add("held");
     status = function () { return holding(mine); };
