@@ -6,6 +6,8 @@ are imported only by the functions that need them.
 """
 
 import logging
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ._version import __version__
 from .description import (
@@ -31,6 +33,9 @@ from .errors import (
 from .model import Kinematics, Robot, pose_from_placement
 from .robots import kinematics_for, load_robot, load_urdf, robot_from_urdf
 
+if TYPE_CHECKING:
+    from .cell import Cell
+
 __all__ = [
     "JOINT_NAMES",
     "PARAMETER_NAMES",
@@ -50,6 +55,7 @@ __all__ = [
     "available_robots",
     "generate_urdf",
     "kinematics_for",
+    "load_cell",
     "load_parameters",
     "load_robot",
     "load_urdf",
@@ -57,5 +63,14 @@ __all__ = [
     "robot_from_urdf",
     "urdf_dir",
 ]
+
+
+
+def load_cell(path: str | Path, **kwargs: Any) -> "Cell":
+    """Read a cell file (obstacles, carried part, margin): :func:`scara_pin.cell.load_cell` (imported on first use)."""
+    from .cell import load_cell as _load_cell
+
+    return _load_cell(path, **kwargs)
+
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

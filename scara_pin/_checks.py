@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import math
-import re
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .description import JOINT_COUNTS, JOINT_NAMES
 from .errors import ParameterError
+from .units import NUMBER_TEXT, number_text  # noqa: F401 - re-exported: the grammar lives in units.py (below description)
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -18,17 +18,6 @@ MAGNITUDE_MAX = 1e6
 """[m or rad] the largest joint value or target coordinate taken as such: beyond it an angle has no
 precision left (its ulp exceeds 1e-10 rad) and no SCARA is that large."""
 
-
-NUMBER_TEXT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
-"""The one grammar of a number as text (typed by a user, or in a URDF): ASCII digits, optional sign,
-decimal point and exponent. No ``_`` separators, no other digits, no hex, no nan/inf words: what
-a robotics user types, and what urdfdom's parser accepts."""
-
-
-def number_text(text: str) -> float:
-    """``text`` (surrounding blanks allowed) as a float if it follows :data:`NUMBER_TEXT`, else NaN."""
-    stripped = text.strip(" \t\n\r")
-    return float(stripped) if NUMBER_TEXT.fullmatch(stripped) else math.nan
 
 
 def _floats(name: str, value: object, rule: str) -> np.ndarray:

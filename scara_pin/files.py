@@ -11,9 +11,15 @@ Rules:
   (``/dev/null``), block device, FIFO, socket or folder is refused with an
   :class:`~scara_pin.errors.InvalidInputError` (exit code 2), never replaced;
 - a symbolic link is replaced by the new file (its target is never written through);
-- the temporary file is created with mode ``0o666`` filtered by the process umask, as ``open()`` would;
+- the temporary file is created with mode ``0o666`` (or the ``mode`` asked) filtered by the process umask, as
+  ``open()`` would;
   the umask is never read or changed (no process-wide state is touched, so threads may write at once);
 - the data is ``fsync``-ed before the rename, and the folder after it (where the system allows).
+
+Before any work, a command checks all its outputs together with :func:`check_outputs`: each name as above
+(and a plot's ending), at most one of them on standard output, and no output the same file as one of the
+command's inputs or as another output (after resolving links: a measurements file named as ``--out`` would
+be replaced by the URDF; ``--out X --overlay X`` would keep one of two outputs).
 """
 
 from __future__ import annotations
@@ -21,7 +27,7 @@ from __future__ import annotations
 import os
 import stat
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
@@ -34,6 +40,8 @@ __all__ = [
     "STDOUT",
     "atomic_output",
     "check_output_path",
+    "check_outputs",
+    "figure_format",
     "save_figure",
     "write_atomic_with",
     "write_text_atomic",
@@ -77,8 +85,70 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     return path
 
 
-def _new_temp(folder: Path, name: str, created: list[Path]) -> Path:
-    """Create an empty temporary file in ``folder`` with mode 0o666 & ~umask (exclusive, never reused).
+PathLike = str | os.PathLike[str]
+
+
+def _identity(path: PathLike) -> tuple[int, int] | str:
+    """What ``path`` names: the (device, inode) of an existing file (links followed; hard links too).
+
+    A file that does not exist (yet): its absolute path, the links of its existing part resolved.
+    """
+    try:
+        st = os.stat(path)
+    except OSError:
+        return str(Path(path).resolve())
+    return (st.st_dev, st.st_ino)
+
+
+def check_outputs(
+    outputs: Mapping[str, PathLike | None],
+    inputs: Mapping[str, PathLike | Iterable[PathLike] | None] | None = None,
+    *,
+    figures: Collection[str] = (),
+    stdout: str | None = None,
+) -> None:
+    """Refuse, before any work, outputs that cannot be written as named or that would destroy something.
+
+    Args:
+        outputs: option -> file name, e.g. ``{"--out": "c.urdf", "--plot": None}`` (None: not given; ``-``:
+            standard output).
+        inputs: option -> the file (or files) it reads, e.g. ``{"--measurements": "m.csv"}``.
+        figures: the options of ``outputs`` that are plots: their names end in .png, .svg or .pdf (or nothing).
+        stdout: what else prints on standard output (e.g. ``"--json"``), or None.
+
+    Raises:
+        InvalidInputError: an output that :func:`check_output_path` refuses, a plot named for another format,
+            two outputs on standard output, an output that is one of the inputs or another output (the same
+            file after resolving links), naming the options.
+    """
+    named = {option: str(path) for option, path in outputs.items() if path is not None and str(path) != ""}
+    for option, path in named.items():
+        check_output_path(path)
+        if option in figures:
+            figure_format(path)
+    on_stdout = [option for option, path in named.items() if path == STDOUT] + ([stdout] if stdout else [])
+    if len(on_stdout) > 1:
+        raise InvalidInputError(f"{', '.join(on_stdout[:-1])} and {on_stdout[-1]} would print on standard output: "
+                                "only one output can go there (-)")  # fmt: skip
+    files = {option: _identity(path) for option, path in named.items() if path != STDOUT}
+    for option, given in (inputs or {}).items():
+        items = [] if given is None else [given] if isinstance(given, (str, os.PathLike)) else list(given)
+        for item in items:
+            key = _identity(item)
+            for out, out_key in files.items():
+                if out_key == key:
+                    raise InvalidInputError(f"{out} {named[out]} is the file {option} {item} reads: it would be "
+                                            "replaced; write the output elsewhere")  # fmt: skip
+    seen: dict[tuple[int, int] | str, str] = {}
+    for option, key in files.items():
+        if key in seen:
+            raise InvalidInputError(f"{seen[key]} {named[seen[key]]} and {option} {named[option]} are the same file: "
+                                    "one output would replace the other; give each its own file")  # fmt: skip
+        seen[key] = option
+
+
+def _new_temp(folder: Path, name: str, created: list[Path], mode: int = 0o666) -> Path:
+    """Create an empty temporary file in ``folder`` with ``mode`` & ~umask (exclusive, never reused).
 
     Its name is put in ``created`` BEFORE it exists, so that a Ctrl-C or SIGTERM arriving at any point
     after its creation finds it there and removes it.
@@ -88,7 +158,7 @@ def _new_temp(folder: Path, name: str, created: list[Path]) -> Path:
         tmp = folder / f".{name[:64]}.{os.urandom(6).hex()}.tmp"  # as secrets.token_hex(6)
         created.append(tmp)
         try:
-            fd = os.open(tmp, flags, 0o666)
+            fd = os.open(tmp, flags, mode)
         except FileExistsError:  # someone else's: never ours to delete
             created.remove(tmp)
             continue
@@ -109,11 +179,12 @@ def _fsync(path: Path, flags: int) -> None:
 
 
 @contextmanager
-def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
+def atomic_output(path: str | os.PathLike[str], mode: int = 0o666) -> Iterator[Path]:
     """Yield a temporary file's path; on success move it onto ``path`` (``-``: copy it to stdout), else delete it.
 
     Write to the yielded path (``open(tmp, "w")``, ``figure.savefig(tmp, format="png")``...). An error,
-    Ctrl-C or SIGTERM (under the command line) leaves the old file or none, never a partial one.
+    Ctrl-C or SIGTERM (under the command line) leaves the old file or none, never a partial one. The new
+    file's mode is ``mode`` & ~umask (``0o600``: for its owner only).
 
     Raises:
         InvalidInputError: the folder does not exist or cannot be written, ``path`` is not a regular file
@@ -129,7 +200,7 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
         folder = path.parent if str(path.parent) else Path(".")
     created: list[Path] = []
     try:
-        tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created)
+        tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created, mode)
         yield tmp
         raise_pending()  # a Ctrl-C or SIGTERM that a library swallowed meanwhile: nothing is written
         if to_stdout:
@@ -160,10 +231,10 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
             name.unlink(missing_ok=True)
 
 
-def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically (``-``: standard output); return the path."""
+def write_text_atomic(path: str | os.PathLike[str], text: str, mode: int = 0o666) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically (``-``: standard output), a new file of ``mode`` & ~umask."""
     path = Path(path)
-    with atomic_output(path) as tmp:
+    with atomic_output(path, mode) as tmp:
         tmp.write_text(text, encoding="utf-8", newline="")
     return path
 
@@ -180,6 +251,20 @@ FIGURE_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 """What a plot's file name may end with, and the format written."""
 
 
+def figure_format(path: str | os.PathLike[str]) -> str:
+    """The format a plot named ``path`` is written in: its ending's (.png, .svg, .pdf), PNG without one.
+
+    Raises:
+        InvalidInputError: another ending (the file would not be what its name says).
+    """
+    path = Path(path)
+    fmt = FIGURE_FORMATS.get(path.suffix.lower()) if path.suffix else "png"  # "-" (stdout) too
+    if fmt is None:
+        raise InvalidInputError(f"cannot write {path}: a plot is written as {', '.join(FIGURE_FORMATS)}; "
+                                "name the file with one of these endings")  # fmt: skip
+    return fmt
+
+
 def save_figure(figure: Any, path: str | os.PathLike[str], **kwargs: Any) -> Path:
     """Write a matplotlib figure atomically, in the format its name says (.png, .svg, .pdf; PNG without one).
 
@@ -187,10 +272,7 @@ def save_figure(figure: Any, path: str | os.PathLike[str], **kwargs: Any) -> Pat
         InvalidInputError: another ending (the file would not be what its name says), or an unwritable path.
     """
     path = Path(path)
-    fmt = FIGURE_FORMATS.get(path.suffix.lower()) if path.suffix else "png"  # "-" (stdout) too
-    if fmt is None:
-        raise InvalidInputError(f"cannot write {path}: a plot is written as {', '.join(FIGURE_FORMATS)}; "
-                                "name the file with one of these endings")  # fmt: skip
+    fmt = figure_format(path)
     with atomic_output(path) as tmp:
         figure.savefig(tmp, format=fmt, **kwargs)
     return path

@@ -29,9 +29,15 @@ from .errors import InvalidInputError
 
 __all__ = [
     "MAX_CALIBRATION_ROWS",
+    "MAX_CELL_BYTES",
+    "MAX_CELL_OBSTACLES",
+    "MAX_CELL_TRIANGLES",
     "MAX_CHECK_ELEMENTS",
     "MAX_DOCUMENT_BYTES",
     "MAX_FRAMES",
+    "MAX_JOB_BYTES",
+    "MAX_JOB_DEPTH",
+    "MAX_JOB_STEPS",
     "MAX_LINE_CHARS",
     "MAX_MESH_BYTES",
     "MAX_NUMBER",
@@ -48,6 +54,8 @@ __all__ = [
     "MAX_WALK_DEPTH",
     "MAX_WALK_ENTRIES",
     "MAX_XACRO_FILES",
+    "MAX_YAML_DEPTH",
+    "MAX_YAML_NODES",
     "UnreadableFileError",
     "check_count",
     "check_input_file",
@@ -84,8 +92,30 @@ MAX_POINTS = 10_000
 """Taught points of one points file (``teach --points``, ``traj --points``): a cell has tens."""
 MAX_POINTS_BYTES = 4 * 1024 * 1024
 """Bytes of one points file (10,000 points at full precision take about 1.5 MB)."""
+MAX_JOB_BYTES = 2 * 1024 * 1024
+"""Bytes of one job file (``scara-pin job``): a job is a page of steps; its pallets and loops make it long."""
+MAX_JOB_DEPTH = 4
+"""``for`` loops nested in one another in a job (a pallet's layers, rows and columns are one loop)."""
+MAX_JOB_STEPS = 10_000
+"""Moves and dwells one job expands to, its loops unrolled (counted before any is built; each new jump is a
+solve of about 0.1-0.5 s)."""
+MAX_YAML_NODES = 500_000
+"""Values (scalars, lists, mappings) of one yaml document, an alias counted at the size of all it stands for
+(a points file of 10,000 points holds about 150,000; 520 bytes of nested aliases stand for 9^9)."""
+MAX_YAML_DEPTH = 64
+"""Levels of nesting of one yaml document (a points file has 4)."""
 MAX_CHECK_ELEMENTS = 50_000
 """Links plus joints of one URDF that ``check`` lints (pure Python, linear; larger than what loads)."""
+
+# ----------------------------------------------------------------------- cells (obstacles around the robot)
+MAX_CELL_BYTES = 4 * 1024 * 1024
+"""Bytes of one cell file (YAML, URDF or xacro; meshes are read under their own caps)."""
+MAX_CELL_OBSTACLES = 500
+"""Obstacles of one cell, placed boxes of a job included (every one is checked against every link at each of
+the 10 kHz samples of a motion: 500 obstacles and 6 links take about 3 ms a sample)."""
+MAX_CELL_TRIANGLES = 200_000
+"""Mesh triangles of one cell, all its meshes together (coal's bounding-volume tree keeps a distance query
+near a few microseconds up to there)."""
 
 # ----------------------------------------------------------------------- files named by packages and meshes
 MAX_MESH_BYTES = 200 * 1024 * 1024

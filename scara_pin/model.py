@@ -36,6 +36,7 @@ from .urdf_rules import choose_frames, read_tree
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
+    from .cell import Cell, Distances
     from .chain import GearedJoint, JointAxis, LockedJoint
     from .description.packages import PackagePath
     from .kinematics.results import BatchIKResult, IKResult
@@ -397,7 +398,7 @@ class Robot:
     def visual_model(self) -> pin.GeometryModel:
         """Visual geometry of the URDF, built on first use; each mesh is a placeholder box.
 
-        Pinocchio never reads a mesh file: :func:`scara_pin.viz.meshes.visual_meshes` reads them (found
+        Pinocchio never reads a mesh file: :func:`scara_pin.cell.meshes.visual_meshes` reads them (found
         and checked as that module says) under the same geometry names.
         """
         from .description.placeholders import placeholder_urdf
@@ -667,6 +668,17 @@ class Robot:
                 raise InvalidInputError(f"reference {reference!r} must be one of {', '.join(_REFERENCES)}")
             reference = _REFERENCES[reference.lower()]
         return pin.computeFrameJacobian(self.model, self.data, q, fid, reference)
+
+    def distances(self, q: ArrayLike, cell: Cell) -> Distances:
+        """Every checked pair's distance at ``q`` in ``cell`` (:class:`scara_pin.cell.Distances`), closest first.
+
+        The robot's links (its URDF ``<collision>`` elements) and the cell's carried part against the cell's
+        obstacles, and the robot's self-collision pairs (:mod:`scara_pin.cell`); coal's signed distances, witness
+        points and normals in the base frame.
+        """
+        from .cell import scene
+
+        return scene(self, cell).distances(q)
 
     def manipulability(self, q: np.ndarray) -> float:
         """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4).

@@ -1,4 +1,6 @@
-"""Units for people: which units a person reads and types, and the one way numbers are printed for them.
+"""Units for people: the units a person reads and types, how numbers are printed and typed for them.
+
+The one grammar of a number as text is :data:`NUMBER_TEXT` (typed values, URDF attributes, yaml and CSV).
 
 Inside the package everything is SI (m, rad, s). People type and read millimetres and degrees too:
 :class:`DisplayUnits` names the unit chosen for lengths and for angles, and scales SI values to it.
@@ -13,6 +15,7 @@ CSV) keep every bit; only text for people is rounded.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
@@ -22,13 +25,27 @@ __all__ = [
     "ANGLE_UNITS",
     "HUMAN",
     "LENGTH_UNITS",
+    "NUMBER_TEXT",
     "RESOLUTION",
     "SI",
     "DisplayUnits",
     "decimals_for",
     "format_number",
     "format_vector",
+    "number_text",
 ]
+
+NUMBER_TEXT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+"""The one grammar of a number as text (typed by a user, or in a URDF, a yaml or a CSV file): ASCII digits,
+optional sign, decimal point and exponent. No ``_`` separators, no other digits, no hex, no nan/inf words:
+what a robotics user types, and what urdfdom's parser accepts."""
+
+
+def number_text(text: str) -> float:
+    """``text`` (surrounding blanks allowed) as a float if it follows :data:`NUMBER_TEXT`, else NaN."""
+    stripped = text.strip(" \t\n\r")
+    return float(stripped) if NUMBER_TEXT.fullmatch(stripped) else math.nan
+
 
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "mm": 1000.0}
 """Length units a person may choose, with their size in metres^-1 (multiply SI by it)."""

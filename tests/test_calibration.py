@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from calibration_truth import write_csv
 from scipy.spatial.transform import Rotation
 
 from scara_pin import InvalidInputError, load_robot, robot_from_urdf
@@ -93,13 +94,6 @@ def simulate(truth, n: int, rng: np.random.Generator, noise: float = 0.0, q3: fl
     readings = q.copy()
     readings[:, 2] /= SCALE
     return readings, p, yaw, q
-
-
-def write_csv(path: Path, q: np.ndarray, p: np.ndarray, yaw: np.ndarray | None = None) -> Path:
-    cols = [f"q{i + 1}" for i in range(q.shape[1])] + ["x", "y", "z"] + (["yaw"] if yaw is not None else [])
-    rows = np.column_stack([q, p] + ([yaw] if yaw is not None else []))
-    path.write_text(",".join(cols) + "\n" + "\n".join(",".join(repr(float(v)) for v in r) for r in rows) + "\n")
-    return path
 
 
 @pytest.fixture(scope="module")
@@ -232,12 +226,15 @@ def test_unexcited_scale_is_reported_not_fitted(nominal, truth) -> None:
 
 
 def test_outliers_are_found_with_the_robust_loss(nominal, truth) -> None:
+    """The default loss is robust (soft_l1): outliers listed and left out; linear keeps them, with a warning."""
     readings, p, _, _ = simulate(truth, 50, np.random.default_rng(21), NOISE)
     bad = [4, 17, 33]
     p = p.copy()
     p[bad] += [0.004, -0.003, 0.002]  # millimetres off: a slipped target
-    plain = calibrate(nominal, Measurements(readings, p), CalibrationOptions(folds=0))
-    robust = calibrate(nominal, Measurements(readings, p), CalibrationOptions(loss=Loss.SOFT_L1, folds=0))
+    plain = calibrate(nominal, Measurements(readings, p), CalibrationOptions(loss=Loss.LINEAR, folds=0))
+    robust = calibrate(nominal, Measurements(readings, p), CalibrationOptions(folds=0))
+    assert robust.loss is Loss.SOFT_L1 and not plain.outliers
+    assert any("row 5 (" in w and "row 18 (" in w and "row 34 (" in w for w in plain.warnings), plain.warnings
     assert [o.row for o in robust.outliers] == bad
     assert [o.where for o in robust.outliers] == ["row 5", "row 18", "row 34"]
     assert all(o.distance > 1e-3 for o in robust.outliers)

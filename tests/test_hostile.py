@@ -586,6 +586,20 @@ def test_caps_are_what_the_docs_say() -> None:
     assert not missing, missing
 
 
+def test_the_caps_table_of_hostile_inputs_is_limits_py() -> None:
+    """docs/hostile-inputs.md names each cap's constant: its value there is the constant's (issue 30)."""
+    import re
+
+    import scara_pin.limits as caps
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "hostile-inputs.md").read_text()
+    rows = re.findall(r"^\|[^|\n]+\| `(MAX_\w+)` \| ([\d,]+)(?: (KiB|MiB|GiB))? \|$", text, re.MULTILINE)
+    assert {"MAX_YAML_NODES", "MAX_YAML_DEPTH", "MAX_MESH_BYTES"} <= {name for name, _, _ in rows}, rows
+    unit = {"": 1, "KiB": 1 << 10, "MiB": 1 << 20, "GiB": 1 << 30}
+    for name, value, scale in rows:
+        assert int(value.replace(",", "")) * unit[scale] == getattr(caps, name), name
+
+
 def test_urdf_elements_cap_in_the_library() -> None:
     with pytest.raises(UrdfError, match="cap"):
         Robot(many_links(MAX_URDF_ELEMENTS))

@@ -33,12 +33,12 @@ import pytest
 from test_hostile import _env, _limited
 
 from scara_pin import load_robot
+from scara_pin.cell import meshes
+from scara_pin.cell.meshes import visual_meshes
 from scara_pin.cli import main
 from scara_pin.description import generate_urdf
 from scara_pin.limits import MAX_MESH_BYTES, MAX_VISUALS
 from scara_pin.model import Robot
-from scara_pin.viz import meshes
-from scara_pin.viz.meshes import visual_meshes
 
 PKG = "hostile_meshes"
 TIMEOUT = 60.0

@@ -415,18 +415,20 @@ def test_q1_on_its_limit_with_a_nearly_stretched_elbow_is_solved() -> None:
         assert min(s.distance(q) for s in res.solutions) <= singular_tol(g, q), (q.tolist(), res.solutions)
 
 
-# the layers, lowest first (STYLE.md: description -> model -> kinematics -> workspace -> motion -> viz -> cli);
+# the layers, lowest first (STYLE.md: description -> model -> kinematics -> workspace -> motion -> job -> viz -> cli);
 # a module may import its own layer and those below, never one above
 LAYERS = (
     ("_typing", "_version", "errors", "signals", "units"),
     ("limits", "files", "urdf_rules"),
     ("description",),
     ("_checks", "tables", "_urdf_checks"),
+    ("cell",),  # the robot's collision model and the obstacles: it takes a Robot (types only); model reaches it
     ("model", "chain"),
     ("kinematics",),
     ("calibration",),  # beside kinematics: imports description, model, kinematics; nothing lower imports it
     ("robots", "workspace", "lint"),
     ("motion",),
+    ("job",),  # a program of moves: above motion, below the pictures and the command line
     ("viz",),
     ("cli",),
     ("__init__",),

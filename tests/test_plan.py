@@ -108,3 +108,21 @@ def test_refusals() -> None:
         MotionRequest(start_pose=np.zeros(4), end_pose=np.ones(4), arch=True, vias=(Q0,))
     with pytest.raises(ParameterError, match="duration"):
         MotionRequest(start_q=Q0, end_q=Q1, duration=-1.0)
+
+
+def test_limits_of_a_request(robot_default: Robot) -> None:
+    """``limits`` time a joint move under other limits (a job's speed override); refused where they cannot act."""
+    from dataclasses import replace
+
+    lim = robot_default.limits
+    half = replace(lim, velocity=tuple(v / 2 for v in lim.velocity))
+    d = np.abs(Q1 - Q0)
+    v, a = np.array(half.velocity), np.array(half.acceleration)
+    one = np.where(d >= v * v / a, d / v + v / a, 2 * np.sqrt(d / a))  # each joint alone, rest to rest
+    plan = plan_motion(robot_default, MotionRequest(start_q=Q0, end_q=Q1, limits=half))
+    assert plan.method is Method.JOINT_TRAPEZOID
+    assert plan.trajectory.duration == pytest.approx(float(np.max(one)), abs=1e-12)
+    with pytest.raises(InvalidInputError, match="time-optimal"):
+        MotionRequest(start_q=Q0, end_q=Q1, duration=1.0, limits=half)
+    with pytest.raises(InvalidInputError, match="straight-leg arch"):
+        MotionRequest(start_pose=np.zeros(4), end_pose=np.ones(4), arch=True, path="lines", limits=half)

@@ -64,6 +64,9 @@ BAD = [
     ("cell.yaml", "points:\n- {name: P1, q: [0, .nan, 0, 0]}\n", "finite"),
     ("cell.yaml", "points:\n- {name: P1, q: [0, true, 0, 0]}\n", "numbers"),
     ("cell.yaml", "points:\n- {name: P1, q: [0, !degrees ten, 0, 0]}\n", "numbers"),
+    ("cell.yaml", "points:\n- {name: P1, q: [0, !degrees 1_0, 0, 0]}\n", "not a plain number"),
+    ("cell.yaml", "points:\n- {name: [" + ", ".join(["1"] * 10_000) + "], q: [0, 0, 0, 0]}\n",
+     r"line 2: point name \[1, 1, 1, 1, 1, 1, \.\.\.\] must"),  # a big value: shown briefly
     ("cell.yaml", "points:\n- {name: P1}\n", "name and q"),
     ("cell.yaml", "points:\n- {name: P1, q: [0, 0, 0, 0], speed: 3}\n", "unknown key"),
     ("cell.yaml", "format: other 2\npoints: []\n", "format"),
@@ -183,3 +186,25 @@ def test_cycle_between_two_taught_points(robot_s1: Robot, tmp_path: Path, capsys
         assert main(["cycle", "--robot", "s1", "--points", str(path), *argv]) == 2
         err = capsys.readouterr().err
         assert match in err and err.count("\n") == 1, err
+
+
+# ------------------------------------------------------------------------------------ issue 30 item 7: numbers
+def test_values_in_exponent_notation_read_back(robot_s1: Robot, tmp_path: Path) -> None:
+    """repr() writes 1e-05 and -2.5e-07; YAML 1.1 reads those as text (no decimal point), so such a file did not
+    read back. The points file's numbers follow the command line's grammar, where they are numbers."""
+    q = np.array([1e-05, -2.5e-07, 0.02, 1e-300])
+    points = PointSet((TaughtPoint.at(robot_s1, "P1", q),))
+    path = write_points(tmp_path / "cell.yaml", points)
+    assert "1e-05" in path.read_text()
+    back = read_points(path, robot_s1)
+    np.testing.assert_array_equal(back["P1"].q, q)
+    np.testing.assert_array_equal(back["P1"].pose, points["P1"].pose)
+
+
+@pytest.mark.parametrize("text", ["0x1", "0b0", "0_1", "0:0.5", "0o7", "1_000.5", "'0.5'", "\uff11", "0.5.1"])
+def test_yaml_numbers_outside_the_grammar_are_refused(robot_s1: Robot, tmp_path: Path, text: str) -> None:
+    path = tmp_path / "cell.yaml"
+    path.write_text(f"points:\n- name: P1\n  q: [0.3, {text}, 0.02, -0.5]\n", encoding="utf-8")
+    with pytest.raises(InvalidInputError, match=r"line 3: point P1: q must be a list of finite numbers; value 2 is "
+                       r".*not a plain number"):  # fmt: skip
+        read_points(path, robot_s1)

@@ -24,12 +24,12 @@ import trimesh
 from browser import next_frames, orange_pixels
 
 from scara_pin import Robot, load_robot
+from scara_pin.cell.meshes import MeshProblem, resolve_mesh, visual_meshes
 from scara_pin.cli import main
 from scara_pin.description.packages import PackagePath
 from scara_pin.description.placeholders import PLACEHOLDER_SIZE
 from scara_pin.errors import UrdfError
 from scara_pin.lint import check_urdf_file
-from scara_pin.viz.meshes import MeshProblem, resolve_mesh, visual_meshes
 
 DATA = Path(__file__).resolve().parent / "data"
 PACKAGE = "quirky_scara_description"

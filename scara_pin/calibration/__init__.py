@@ -4,11 +4,14 @@ Beside :mod:`scara_pin.kinematics` in the layers (it imports the description, th
 nothing below imports it). The loop, for any serial chain the toolkit loads (no per-robot code):
 
 - :func:`plan_experiment`: the joint configurations to measure (D- or E-optimal);
-- :class:`Measurements`: the joint readings and the measured tool positions (CSV, or arrays);
-- :func:`calibrate`: the identifiable errors (:mod:`~scara_pin.calibration.identify`) of the error model
-  (:mod:`~scara_pin.calibration.chain`), fitted by nonlinear least squares on Pinocchio's forward kinematics
-  (:mod:`~scara_pin.calibration.fit`), with their covariance, the residuals before and after, a
-  cross-validation and the calibrated URDF (:class:`CalibrationResult`);
+- :class:`Measurements`: the joint readings and the measured tool positions (CSV, or arrays); without a
+  tracker, :func:`simulate` measures them on a perturbed copy of the robot;
+- :func:`calibrate`: the data checked against the nominal model (:mod:`~scara_pin.calibration.screen`), the
+  identifiable errors (:mod:`~scara_pin.calibration.identify`, at the nominal model and at the estimate) of
+  the error model (:mod:`~scara_pin.calibration.chain`), fitted by nonlinear least squares on Pinocchio's
+  forward kinematics (:mod:`~scara_pin.calibration.fit`; robust to outliers by default), with their
+  covariance, the residuals before and after, a cross-validation by pose and the calibrated URDF
+  (:class:`CalibrationResult`);
 - :func:`yaml_overlay`: a configured robot's changed yaml parameters; :func:`plot_residuals`: a picture.
 """
 
@@ -28,6 +31,7 @@ from .results import (
     ParameterStatus,
     ResidualStats,
 )
+from .simulate import Simulation, simulate
 
 __all__ = [
     "ALL_GROUPS",
@@ -48,12 +52,14 @@ __all__ = [
     "ParameterKind",
     "ParameterStatus",
     "ResidualStats",
+    "Simulation",
     "YamlOverlay",
     "calibrate",
     "identify",
     "measurement_columns",
     "plan_experiment",
     "plot_residuals",
+    "simulate",
     "structural_count",
     "yaml_overlay",
 ]

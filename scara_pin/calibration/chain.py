@@ -57,6 +57,7 @@ __all__ = [
     "ParameterKind",
     "kabsch",
     "read_triple",
+    "rotation_basis",
 ]
 
 
@@ -157,7 +158,7 @@ class Origin:
 _AXIS_LETTERS = "xyz"
 
 
-def _basis(axis: np.ndarray) -> tuple[np.ndarray, tuple[str, str, str]]:
+def rotation_basis(axis: np.ndarray) -> tuple[np.ndarray, tuple[str, str, str]]:
     """An orthonormal basis whose last column is ``axis`` (a unit vector), and the rotations' suffixes.
 
     For an axis along a coordinate axis (+ or -), the other two columns are the other coordinate axes (in
@@ -285,7 +286,7 @@ class ChainModel:
             axis = read_triple(axis_el, "xyz") if axis_el is not None else np.array([1.0, 0.0, 0.0])
             axis = axis / np.linalg.norm(axis)
             prismatic = el.get("type") == "prismatic"
-            basis = np.eye(3) if prismatic else _basis(axis)[0]
+            basis = np.eye(3) if prismatic else rotation_basis(axis)[0]
             pre = model.jointPlacements[j] * pin.SE3(R0, xyz).inverse()
             origins.append(Origin(model.names[j], model.names[j], j, -1, pre, xyz, R0, rpy, basis, axis, prismatic))
         notes: list[str] = []
@@ -308,6 +309,23 @@ class ChainModel:
         return cls(robot, frame, yaw, groups, tuple(origins), params, tuple(notes), slots, bMo, scaled)
 
     # ------------------------------------------------------------------------------ parameters
+    @property
+    def length(self) -> float:
+        """[m] the chain's length: no tool point of the nominal chain is farther than this from the base.
+
+        The rigid offsets from the base to each joint and to the tool, and the prismatic strokes, added up.
+        """
+        model = self.robot.model
+        joints = [o.joint for o in self.origins if o.frame < 0]
+        total = float(np.linalg.norm(self._bMo.act(model.jointPlacements[joints[0]].translation))) if joints else 0.0
+        total += sum(float(np.linalg.norm(model.jointPlacements[j].translation)) for j in joints[1:])
+        total += float(np.linalg.norm(model.frames[self.robot.tool_id].placement.translation))
+        for o in self.origins:
+            if o.prismatic:
+                iq = int(model.joints[o.joint].idx_q)
+                total += max(abs(float(model.lowerPositionLimit[iq])), abs(float(model.upperPositionLimit[iq])))
+        return total
+
     @property
     def size(self) -> int:
         """The number of candidate errors."""
@@ -512,7 +530,7 @@ def _parameters(
                 add(f"{o.name}.r", 3, 2, ErrorParameter(f"{o.label}.offset", Group.OFFSETS, o.name, Rt, 2))
     if Group.ORIGINS in groups:
         for o in moving:
-            suffixes = ("rx", "ry", "rz") if o.prismatic else _basis(o.axis)[1]
+            suffixes = ("rx", "ry", "rz") if o.prismatic else rotation_basis(o.axis)[1]
             for c in range(3):
                 add(f"{o.name}.t", 3, c, ErrorParameter(f"{o.label}.{'xyz'[c]}", Group.ORIGINS, o.name, T, c))
             for c in range(3 if o.prismatic else 2):

@@ -6,20 +6,32 @@ yaw [rad], wrapped to (-pi, pi], times ``yaw_weight`` [m/rad]), ``f`` the chain'
 
 The steps of :func:`calibrate`:
 
-1. the error model of the robot's chain; in the device frame, the device's nominal placement is the rigid
-   alignment (:func:`~scara_pin.calibration.chain.kabsch`) of the nominal predictions with the measurements;
-2. the structural count: how many errors a rich set of poses separates (:func:`identify` on random poses
-   inside the limits); fewer measured poses than that is refused;
-3. the identifiable errors of these poses (:func:`identify` at the nominal model: first-order
-   identifiability), fitted by scipy's ``least_squares`` (trust-region reflective, analytic Jacobian), the
-   others fixed at zero. An error without first-order effect (J4's tilt when the target is on J4's axis)
-   is fixed even if the errors of the real robot give it a second-order one: it is never fitted to noise;
-4. with a robust loss: the rows whose position error exceeds ``outlier_sigmas`` robust standard deviations
-   (1.4826 times the median absolute coordinate residual) are outliers, listed and left out of a final
-   linear fit;
+1. the error model of the robot's chain, and the structural count: how many errors a rich set of poses
+   separates at the nominal model (:func:`identify` on random poses inside the limits);
+2. the data checked against the nominal model (:func:`~scara_pin.calibration.screen.screen`: units, degrees,
+   limits, distinct poses); in the device frame, the device's nominal placement is the rigid alignment
+   (:func:`~scara_pin.calibration.chain.kabsch`) of the nominal predictions with the measurements;
+3. the identified errors, judged where the model is (:func:`_solve`): first at the nominal model, on the
+   DISTINCT poses (a repeated pose adds rows, not rank), fitted by scipy's ``least_squares`` (trust-region
+   reflective, analytic Jacobian), the others fixed at zero; then again at the estimate, the errors already
+   identified first: an error without first-order effect at the nominal model may act at the estimate (J4's
+   tilts move the target once the fit has found a tool offset the nominal model lacks). Such second-order
+   errors (separated from the identified ones by a sine of at least ``SECOND_ORDER_SINE``) join the fit
+   when the data are not yet explained to working precision (``EXPLAINED``), the fit with them lowers the
+   residual significantly (an F-test at ``SIGNIFICANCE`` on the inlying rows) and each is determined to
+   better than ``SECOND_ORDER_STD``; else they stay fixed, never fitted to noise. Repeated until no error
+   joins (at most ``MAX_PASSES``);
+4. with a robust loss (the default, soft_l1): the rows whose weighted residual exceeds ``outlier_sigmas``
+   robust standard deviations (the median norm of a row's residual over the median of a chi distribution
+   with as many degrees of freedom as the row has coordinates) are outliers, listed and left out; the final
+   fit is the linear one of step 3 on the other rows, and the outliers are judged again against it (its
+   inlying rows give the standard deviation; a soft_l1 fit still leans towards gross rows) until they stay
+   the same. With the linear loss they are kept, and named in a warning;
 5. the covariance ``sigma^2 (J^T J)^-1`` of the identified errors, ``sigma^2`` the residual sum of squares over
-   the redundancy (rows x coordinates minus identified errors);
-6. a k-fold cross-validation: each fold's rows predicted by a fit (from the nominal model) on the others;
+   the redundancy (rows x coordinates minus identified errors), and each row's standardised residual
+   ``sqrt(r^T (I - H)^-1 r) / sigma`` (``H``: the row's block of the hat matrix; ``I + H`` for a row left out);
+6. a k-fold cross-validation by pose: each fold's poses (all their rows) predicted by a fit on the others
+   (step 3 on them, started from the fit on all the rows: the same minimum, sooner);
 7. the calibrated URDF (:mod:`scara_pin.calibration.urdf_edit`), loaded back and checked against the fit's
    predictions.
 """
@@ -35,7 +47,7 @@ import pinocchio as pin
 from ..errors import InvalidInputError, ParameterError
 from ..kinematics.planar2r import wrap
 from ..model import Robot
-from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame, kabsch
+from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame
 from .identify import IDENTIFY_TOL, Identifiability, identify
 from .measurements import Measurements
 from .results import (
@@ -47,6 +59,7 @@ from .results import (
     ParameterStatus,
     ResidualStats,
 )
+from .screen import screen
 from .urdf_edit import edit_origins
 
 __all__ = ["CalibrationOptions", "calibrate", "structural_count"]
@@ -56,11 +69,24 @@ FIT_TOL = 1e-15
 MAX_NFEV = 200
 """The most model evaluations of one fit."""
 OUTLIER_FLOOR = 1e-9
-"""[m] a position error below this is never an outlier (noise-free data)."""
+"""[m] a row's weighted residual below this is never an outlier (noise-free data)."""
 URDF_CHECK_TOL = 1e-9
 """[m] the calibrated URDF, loaded back, must reproduce the fit's predictions to this (else: a bug)."""
 STRUCTURAL_POSES = 60
 """The fewest random poses the structural count is computed on (at least 3 per candidate error)."""
+MAX_PASSES = 4
+"""The most re-identifications at the estimate (each adds the second-order errors that act there)."""
+EXPLAINED = 1e-12
+"""[m] data whose weighted residual RMS is at most this are explained (working precision): no error joins."""
+SIGNIFICANCE = 0.01
+"""The F-test's level: second-order errors join when the residual they remove would be this unlikely by chance."""
+SECOND_ORDER_SINE = 1e-3
+"""The smallest sine between a second-order error's unit column and the span of the identified ones for it to
+join (theirs are near 1; a gauge the estimate's small errors break shows sines near their product, 1e-6)."""
+SECOND_ORDER_STD = {"m": 1e-3, "rad": 1e-2, "1": 1e-3}
+"""Per unit: a second-order error joins only when the data determine it to better than this (1 mm, 0.57 deg)."""
+LARGE_ERROR = {"m": 0.05, "rad": math.radians(5.0), "1": 0.01}
+"""Per unit: an identified error above this (a fraction of the chain's length for "m") is warned about."""
 
 
 @dataclass(frozen=True)
@@ -71,25 +97,30 @@ class CalibrationOptions:
         groups: the error groups fitted (:class:`~scara_pin.calibration.chain.Group`; ``device`` follows
             from ``frame``).
         frame: the frame the positions are measured in.
-        loss: the fit's loss; a robust one (soft_l1, huber, cauchy, arctan) finds and leaves out outliers.
+        loss: the first fit's loss; a robust one (soft_l1, the default; huber, cauchy, arctan) finds the
+            outliers, which are listed and left out of the final (linear) fit; linear keeps every row.
         f_scale: the robust loss's inlier scale [m] (residuals well below it count as with the linear loss).
-        outlier_sigmas: a row whose position error exceeds this many robust standard deviations is an outlier.
+        outlier_sigmas: a row whose weighted residual exceeds this many robust standard deviations is an
+            outlier.
         yaw_weight: [m/rad] the weight of a yaw residual against a position one (the ratio of the position's
             measurement noise to the yaw's).
         folds: the cross-validation's folds (0: none).
-        seed: the seed of the random poses of the structural count and of the folds' rows.
+        seed: the seed of the random poses of the structural count and of the folds' poses.
         tol: the identification's tolerance (:data:`~scara_pin.calibration.identify.IDENTIFY_TOL`).
+        accept_outside_limits: use readings outside the joint limits (with a warning) instead of refusing
+            them (for a URDF whose limits are narrower than the controller's).
     """
 
     groups: frozenset[Group] = ALL_GROUPS
     frame: MeasurementFrame = MeasurementFrame.BASE
-    loss: Loss = Loss.LINEAR
+    loss: Loss = Loss.SOFT_L1
     f_scale: float = 1e-4
     outlier_sigmas: float = 5.0
     yaw_weight: float = 0.1
     folds: int = 5
     seed: int = 0
     tol: float = IDENTIFY_TOL
+    accept_outside_limits: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "groups", frozenset(self.groups) - {Group.DEVICE})
@@ -115,10 +146,14 @@ class _Problem:
     yaw_weight: float
     qpin: np.ndarray = field(init=False)
     target: np.ndarray = field(init=False)
+    pose: np.ndarray = field(init=False)
+    distinct: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self.qpin = self.chain.pinocchio_q(self.measurements.q)
         self.target = self.measurements.values()
+        self.pose, _ = self.measurements.poses()
+        self.distinct = np.unique(self.pose, return_index=True)[1]  # the first row of each pose, in pose order
 
     def residuals(self, theta: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """(n, k) residuals (model minus measurement, yaw wrapped, unweighted) and the weighted Jacobian."""
@@ -132,17 +167,22 @@ class _Problem:
         return r, J
 
     def weighted(self, r: np.ndarray) -> np.ndarray:
-        """The residual vector the fit minimises (the yaw times ``yaw_weight``)."""
+        """The (n, k) residuals the fit minimises (the yaw times ``yaw_weight``)."""
         if self.chain.yaw:
             r = r.copy()
             r[:, 3] *= self.yaw_weight
-        return r.ravel()
+        return r
+
+    def design(self, J: np.ndarray) -> np.ndarray:
+        """The Jacobian's rows of the distinct poses (one row block per pose: the identification's design)."""
+        k = self.chain.rows_per_pose
+        return J.reshape(len(self.qpin), k, -1)[self.distinct].reshape(len(self.distinct) * k, -1)
 
     def subset(self, rows: np.ndarray) -> _Problem:
         return _Problem(self.chain, self.measurements.subset(rows), self.device0, self.yaw_weight)
 
 
-def _fit(problem: _Problem, kept: tuple[int, ...], theta0: np.ndarray, loss: Loss,
+def _fit(problem: _Problem, kept: tuple[int, ...] | list[int], theta0: np.ndarray, loss: Loss,
          f_scale: float) -> tuple[np.ndarray, int]:  # fmt: skip
     """The errors ``kept`` fitted from ``theta0`` (the others kept at their ``theta0`` value)."""
     from scipy.optimize import least_squares
@@ -158,7 +198,7 @@ def _fit(problem: _Problem, kept: tuple[int, ...], theta0: np.ndarray, loss: Los
     def fun(x: np.ndarray) -> np.ndarray:
         r, J = problem.residuals(full(x))
         cache["x"], cache["J"] = x.copy(), J[:, idx]  # type: ignore[index]
-        return problem.weighted(r)
+        return problem.weighted(r).ravel()
 
     def jac(x: np.ndarray) -> np.ndarray:
         if "x" not in cache or not np.array_equal(cache["x"], x):
@@ -173,20 +213,129 @@ def _fit(problem: _Problem, kept: tuple[int, ...], theta0: np.ndarray, loss: Los
     return full(sol.x), int(sol.nfev)
 
 
-def _identify_at(problem: _Problem, theta: np.ndarray, tol: float) -> tuple[Identifiability, list[int]]:
-    """The identifiability at ``theta`` (errors in the model's order of preference), and that order."""
-    _, J = problem.residuals(theta)
-    order = list(range(problem.chain.size))
-    return identify(J, tol), order  # type: ignore[arg-type]
+def _robust_sigma(w: np.ndarray) -> float:
+    """The noise per coordinate, robustly, from the (n, k) weighted residuals.
+
+    The median norm of the rows over the median of a chi distribution with k degrees of freedom (1.538 for
+    k = 3: the norm of k coordinates of Gaussian noise).
+    """
+    from scipy.stats import chi2
+
+    return float(np.median(np.linalg.norm(w, axis=1))) / math.sqrt(float(chi2.ppf(0.5, w.shape[1]))) if w.size else 0.0
 
 
-def _fit_identified(problem: _Problem, theta0: np.ndarray, loss: Loss, f_scale: float,
-                    tol: float) -> tuple[np.ndarray, tuple[int, ...], int]:  # fmt: skip
-    """The errors these poses separate at the nominal model, fitted from ``theta0``."""
-    idf, order = _identify_at(problem, np.zeros(problem.chain.size), tol)
-    kept = tuple(sorted(order[i] for i in idf.kept))
-    theta, nfev = _fit(problem, kept, theta0, loss, f_scale)
-    return theta, kept, nfev
+def _inliers(w: np.ndarray, sigmas: float, among: np.ndarray | None = None) -> np.ndarray:
+    """The rows of the (n, k) weighted residuals within ``sigmas`` robust standard deviations (or the floor).
+
+    The standard deviation from the rows ``among`` (a mask; default all).
+    """
+    sigma = _robust_sigma(w if among is None else w[among])
+    return np.linalg.norm(w, axis=1) <= max(sigmas * sigma, OUTLIER_FLOOR)
+
+
+@dataclass(frozen=True)
+class _Solution:
+    """A fit with its identification.
+
+    Attributes:
+        theta: the errors. kept: the identified ones (ascending). second: those among them identified at the
+        estimate only. weak: per second-order error left fixed, why. nominal: the identification at the
+        nominal model on these poses. nfev: the last fit's model evaluations.
+    """
+
+    theta: np.ndarray
+    kept: tuple[int, ...]
+    second: tuple[int, ...]
+    weak: dict[int, str]
+    nominal: Identifiability
+    nfev: int
+
+
+def _solve(problem: _Problem, loss: Loss, opt: CalibrationOptions, start: _Solution | None = None, *,
+           keep_weak: bool = True) -> _Solution:  # fmt: skip
+    """The identified errors fitted, identifiability judged at the nominal model, then at each estimate.
+
+    ``start``: a solution on other rows of the same chain: its second-order errors are kept (if these poses
+    identify them at its estimate), those it left fixed stay fixed (with ``keep_weak``; else they are tested
+    again), and the fit starts from its estimate (the same minimum, sooner).
+    """
+    size = problem.chain.size
+    zero = np.zeros(size)
+    _, J0 = problem.residuals(zero)
+    nominal = identify(problem.design(J0), opt.tol)  # type: ignore[arg-type]
+    kept = list(nominal.kept)
+    second: list[int] = []
+    weak: dict[int, str] = {}
+    theta = zero
+    if start is not None:
+        weak = dict(start.weak) if keep_weak else {}
+        if start.second:
+            _, Js = problem.residuals(start.theta)
+            order = kept + list(start.second) + [k for k in range(size) if k not in kept and k not in start.second]
+            at = identify(problem.design(Js), opt.tol, order)  # type: ignore[arg-type]
+            second = [k for k in start.second if k in at.kept]
+            kept = sorted(kept + second)
+        theta = np.where(np.isin(np.arange(size), kept), start.theta, 0.0)
+    theta, nfev = _fit(problem, kept, theta, loss, opt.f_scale)
+    for _ in range(MAX_PASSES):
+        r, J = problem.residuals(theta)
+        w = problem.weighted(r)
+        rows = _inliers(w, opt.outlier_sigmas) if loss is not Loss.LINEAR else np.ones(len(w), dtype=bool)
+        if math.sqrt(float(np.mean(w[rows] ** 2))) <= EXPLAINED:
+            break
+        order = kept + [k for k in range(size) if k not in kept]
+        idf = identify(problem.design(J), opt.tol, order)  # type: ignore[arg-type]
+        new = [k for k in idf.kept if k not in kept and k not in weak and idf.sines[k] >= SECOND_ORDER_SINE]
+        if not new:
+            break
+        trial, trial_nfev = _fit(problem, kept + new, theta, loss, opt.f_scale)
+        accepted = _second_order(problem, theta, trial, kept, new, rows, weak)
+        if not accepted:
+            break
+        if accepted != new:
+            trial, trial_nfev = _fit(problem, kept + accepted, theta, loss, opt.f_scale)
+        kept = sorted(kept + accepted)
+        second += accepted
+        theta, nfev = trial, trial_nfev
+    return _Solution(theta, tuple(kept), tuple(sorted(second)), weak, nominal, nfev)
+
+
+def _second_order(problem: _Problem, theta: np.ndarray, trial: np.ndarray, kept: list[int], new: list[int],
+                  rows: np.ndarray, weak: dict[int, str]) -> list[int]:  # fmt: skip
+    """Which of the errors ``new`` (acting at the estimate only) join the fit; why the others do not, in ``weak``.
+
+    ``theta``: the fit without them; ``trial``: with them. Tested on the rows ``rows`` (the inlying ones).
+    """
+    from scipy.stats import f as fisher
+
+    params = problem.chain.parameters
+    r0, _ = problem.residuals(theta, jacobian=False)
+    r1, J1 = problem.residuals(trial)
+    w0, w1 = problem.weighted(r0)[rows], problem.weighted(r1)[rows]
+    rss0, rss1 = float(np.sum(w0**2)), float(np.sum(w1**2))
+    cols = kept + new
+    k = problem.chain.rows_per_pose
+    Jr = J1.reshape(len(r1), k, -1)[rows].reshape(-1, problem.chain.size)[:, cols]  # type: ignore[union-attr]
+    dof = Jr.shape[0] - len(cols)
+    if dof <= 0:
+        for i in new:
+            weak[i] = "acts only through the other errors here (second order); no redundancy left to test it"
+        return []
+    _, sv, Vt = np.linalg.svd(Jr, full_matrices=False)
+    std = np.sqrt(rss1 / dof * np.sum((Vt / sv[:, None]) ** 2, axis=0))[len(kept):]
+    p_value = float(fisher.sf((rss0 - rss1) / len(new) / (rss1 / dof), len(new), dof)) if rss1 > 0 else 0.0
+    accepted = []
+    for i, s in zip(new, std):
+        unit = params[i].unit
+        if p_value > SIGNIFICANCE:
+            weak[i] = (f"acts only through the other errors here (second order); not significant in these "
+                       f"measurements (F-test p = {p_value:.2g})")  # fmt: skip
+        elif not s <= SECOND_ORDER_STD[unit]:
+            weak[i] = (f"acts only through the other errors here (second order); these measurements determine it "
+                       f"to +/- {s:.2g} {unit} only")  # fmt: skip
+        else:
+            accepted.append(i)
+    return accepted
 
 
 def _random_poses(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -219,8 +368,36 @@ def _covariance(problem: _Problem, theta: np.ndarray, kept: tuple[int, ...]) -> 
     inv = (Vt.T / s**2) @ Vt
     if dof <= 0:
         return np.full_like(inv, math.nan), math.nan
-    sigma2 = float(problem.weighted(r) @ problem.weighted(r)) / dof
+    w = problem.weighted(r).ravel()
+    sigma2 = float(w @ w) / dof
     return sigma2 * inv, math.sqrt(sigma2)
+
+
+def _standardised(problem: _Problem, used: np.ndarray, theta: np.ndarray, kept: tuple[int, ...],
+                  sigma: float) -> np.ndarray:  # fmt: skip
+    """Per row, its standardised residual ``sqrt(r^T (I -/+ H)^-1 r) / sigma`` (NaN when it cannot be said).
+
+    ``r``: the row's weighted residual; ``H``: its block of the hat matrix of the rows used (``I - H``), or
+    of its prediction (``I + H``) for a row left out.
+    """
+    n, k = len(problem.qpin), problem.chain.rows_per_pose
+    out = np.full(n, math.nan)
+    if not (math.isfinite(sigma) and sigma > 0) or not kept:
+        return out
+    r, J = problem.residuals(theta)
+    w = problem.weighted(r)
+    Jk = J[:, list(kept)].reshape(n, k, len(kept))  # type: ignore[index]
+    _, s, Vt = np.linalg.svd(Jk[used].reshape(-1, len(kept)), full_matrices=False)
+    A = Jk @ (Vt.T / s)  # (n, k, kept): each row's hat block is A A^T
+    H = A @ np.transpose(A, (0, 2, 1))
+    sign = np.where(used, -1.0, 1.0)[:, None, None]
+    M = np.eye(k)[None] + sign * H
+    for i in range(n):
+        try:
+            out[i] = math.sqrt(max(float(w[i] @ np.linalg.solve(M[i], w[i])), 0.0)) / sigma
+        except np.linalg.LinAlgError:  # a row the fit meets exactly whatever its value (no redundancy)
+            pass
+    return out
 
 
 def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOptions | None = None) -> CalibrationResult:
@@ -233,58 +410,60 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
 
     Raises:
         InvalidInputError: (exit code 2) a robot the error model refuses (mimic joints), readings that do not
-            fit the robot, fewer poses than identifiable errors (naming both counts), too many outliers.
+            fit the robot, data the nominal model says cannot be a calibration's (units, degrees, readings
+            outside the limits, another robot: :func:`~scara_pin.calibration.screen.screen`), fewer distinct
+            poses than identifiable errors (naming both counts), too many outliers.
     """
     opt = options if options is not None else CalibrationOptions()
-    notes: list[str] = []
-    outside = measurements.check(robot)
-    if outside:
-        notes.append(f"{len(outside)} pose(s) outside the joint limits (used): " + "; ".join(outside[:5])
-                     + ("; ..." if len(outside) > 5 else ""))  # fmt: skip
+    measurements.check(robot)
     chain = ChainModel.from_robot(robot, frame=opt.frame, yaw=measurements.yaw is not None, groups=opt.groups)
-    notes.extend(chain.notes)
+    notes: list[str] = list(chain.notes)
     count = structural_count(chain, opt.seed, opt.tol, opt.yaw_weight)
+    screening = screen(chain, measurements, count, accept_outside_limits=opt.accept_outside_limits)
+    warnings = list(screening.warnings)
     n = len(measurements)
-    if n < count:
-        raise InvalidInputError(
-            f"{measurements.source}: {n} measured poses for {count} identifiable parameters: at least {count} "
-            f"poses are needed, a few times more to average the noise (scara-pin calibrate --plan {3 * count} "
-            "proposes poses)"
-        )
     zero = np.zeros(chain.size)
-    device0 = pin.SE3.Identity()
-    if opt.frame is MeasurementFrame.DEVICE:
-        nominal = ChainModel.from_robot(robot, yaw=False, groups=())
-        p_base, _ = nominal.predict(np.zeros(0), nominal.pinocchio_q(measurements.q), device0, jacobian=False)
-        device0 = kabsch(p_base, measurements.position)
-    problem = _Problem(chain, measurements, device0, opt.yaw_weight)
-    theta, kept, nfev = _fit_identified(problem, zero, opt.loss, opt.f_scale, opt.tol)
+    problem = _Problem(chain, measurements, screening.device0, opt.yaw_weight)
     used = np.ones(n, dtype=bool)
-    outliers: tuple[Outlier, ...] = ()
-    if opt.loss is not Loss.LINEAR:
-        r, _ = problem.residuals(theta, jacobian=False)
-        dist = np.linalg.norm(r[:, :3], axis=1)
-        robust_sigma = 1.4826 * float(np.median(np.abs(r[:, :3])))
-        used = dist <= max(opt.outlier_sigmas * robust_sigma, OUTLIER_FLOOR)
-        if int(used.sum()) < count:
-            raise InvalidInputError(f"{measurements.source}: {int((~used).sum())} of {n} poses are outliers: "
-                                    f"{int(used.sum())} remain for {count} identifiable parameters")  # fmt: skip
-        if not used.all():
-            theta, kept, nfev = _fit_identified(problem.subset(used), theta, Loss.LINEAR, opt.f_scale, opt.tol)
-    final = problem.subset(used)
+    start: _Solution | None = None
+    if opt.loss is not Loss.LINEAR:  # the robust fit's outliers, then each linear fit's, until they stay the same
+        start = _solve(problem, opt.loss, opt)
+        r, _ = problem.residuals(start.theta, jacobian=False)
+        used = _inliers(problem.weighted(r), opt.outlier_sigmas)
+    for attempt in range(MAX_PASSES):
+        left = len(np.unique(problem.pose[used]))
+        if left < count:
+            raise InvalidInputError(f"{measurements.source}: {int((~used).sum())} of {n} rows are outliers: "
+                                    f"{left} distinct poses remain for {count} identifiable parameters")  # fmt: skip
+        final = problem.subset(used)
+        sol = _solve(final, Loss.LINEAR, opt, start, keep_weak=False)
+        if opt.loss is Loss.LINEAR:
+            break
+        r, _ = problem.residuals(sol.theta, jacobian=False)
+        again = _inliers(problem.weighted(r), opt.outlier_sigmas, used)
+        if np.array_equal(again, used) or attempt == MAX_PASSES - 1:
+            break
+        used, start = again, sol
+    theta, kept = sol.theta, sol.kept
     covariance, sigma = _covariance(final, theta, kept)
-    if len(kept) < count:
-        notes.append(f"these poses identify {len(kept)} of the {count} errors a richer set of poses would: add "
-                     "poses (scara-pin calibrate --plan proposes well-conditioned ones)")  # fmt: skip
+    if len(sol.nominal.kept) < count:
+        notes.append(f"these poses identify {len(sol.nominal.kept)} of the {count} errors a richer set of poses "
+                     "would: add poses (scara-pin calibrate --plan proposes well-conditioned ones)")  # fmt: skip
     r_before, _ = problem.residuals(zero, jacobian=False)
     r_after, _ = problem.residuals(theta, jacobian=False)
-    if not used.all():
-        dist = np.linalg.norm(r_after[:, :3], axis=1)
-        outliers = tuple(Outlier(int(i), measurements.where(int(i)), float(dist[i])) for i in np.flatnonzero(~used))
+    standardised = _standardised(problem, used, theta, kept, sigma)
+    dist = np.linalg.norm(r_after[:, :3], axis=1)
+    outliers = tuple(Outlier(int(i), measurements.where(int(i)), float(dist[i]), float(standardised[i]))
+                     for i in np.flatnonzero(~used))  # fmt: skip
+    if opt.loss is Loss.LINEAR:
+        gross = np.flatnonzero(~_inliers(problem.weighted(r_after), opt.outlier_sigmas))
+        if len(gross):
+            shown = ", ".join(f"{measurements.where(int(i))} ({dist[i] * 1e3:.3g} mm)" for i in gross[:5])
+            warnings.append(f"{len(gross)} row(s) are off by more than {opt.outlier_sigmas:g} robust standard "
+                            f"deviations: {shown}{', ...' if len(gross) > 5 else ''}: outliers kept by the linear "
+                            "loss; the default loss (soft_l1) leaves them out")  # fmt: skip
     names = chain.names()
-    # why each fixed error is fixed: said at the nominal model, where it was decided
-    idf, order = _identify_at(final, zero, opt.tol)
-    reasons = {order[i]: why for i, why in idf.reasons([names[k] for k in order]).items()}
+    reasons = {**sol.nominal.reasons(names), **sol.weak}
     stds = np.sqrt(np.clip(np.diag(covariance), 0.0, None)) if len(kept) else np.zeros(0)
     std_of = dict(zip(kept, stds))
     estimates = tuple(
@@ -293,38 +472,65 @@ def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOpti
         ParameterEstimate(p.name, p.group, p.unit, 0.0, 0.0, ParameterStatus.FIXED, reasons.get(k, "fixed"))
         for k, p in enumerate(chain.parameters)
     )  # fmt: skip
-    cv = _cross_validation(final, opt, count, notes)
+    warnings.extend(_large_errors(estimates, chain.length))
+    cv = _cross_validation(final, opt, count, notes, sol)
     urdf = _calibrated_urdf(chain, theta)
     _check_urdf(problem, theta, urdf)
+    _, J_final = final.residuals(theta)
     return CalibrationResult(
         chain=chain, measurements=measurements, theta=theta, parameters=estimates,
-        identified=tuple(names[k] for k in kept), covariance=covariance, sigma=sigma, device0=device0, used=used,
-        residuals_before=r_before, residuals_after=r_after, before=ResidualStats.of(r_before[used]),
+        identified=tuple(names[k] for k in kept), covariance=covariance, sigma=sigma, device0=screening.device0,
+        used=used, residuals_before=r_before, residuals_after=r_after, before=ResidualStats.of(r_before[used]),
         after=ResidualStats.of(r_after[used]), outliers=outliers, cross_validation=cv, structural_count=count,
-        condition=idf.condition, loss=opt.loss, nfev=nfev, notes=tuple(notes), urdf=urdf,
+        condition=_condition(final.design(J_final)[:, list(kept)]), loss=opt.loss,  # type: ignore[arg-type]
+        nfev=sol.nfev, notes=tuple(notes), urdf=urdf, warnings=tuple(warnings), distinct=screening.distinct,
+        second_order=tuple(names[k] for k in sol.second), standardised=standardised,
     )  # fmt: skip
 
 
-def _cross_validation(problem: _Problem, opt: CalibrationOptions, count: int,
-                      notes: list[str]) -> CrossValidation | None:  # fmt: skip
-    """Each fold's rows predicted by a fit on the other rows (from the nominal model)."""
-    n = len(problem.measurements)
+def _condition(W: np.ndarray) -> float:
+    """The condition number of the unit-scaled columns of ``W`` (inf when empty or singular)."""
+    if W.shape[1] == 0:
+        return math.inf
+    sv = np.linalg.svd(W / np.linalg.norm(W, axis=0), compute_uv=False)
+    return float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+
+
+def _large_errors(estimates: tuple[ParameterEstimate, ...], length: float) -> list[str]:
+    """A warning naming the identified errors too large for a calibration (see LARGE_ERROR), or none."""
+    big = []
+    for p in estimates:
+        bound = LARGE_ERROR[p.unit] * (length if p.unit == "m" else 1.0)
+        if p.status is ParameterStatus.IDENTIFIED and abs(p.value) > bound:
+            shown = f"{math.degrees(p.value):.3g} deg" if p.unit == "rad" else f"{p.value:.3g} {p.unit}"
+            big.append(f"{p.name} = {shown}")
+    if not big:
+        return []
+    return [f"large errors for a calibration: {', '.join(big)}: check the joints' zeros, the readings' units and "
+            "the tool offset; the calibrated URDF takes them as real"]  # fmt: skip
+
+
+def _cross_validation(problem: _Problem, opt: CalibrationOptions, count: int, notes: list[str],
+                      whole: _Solution) -> CrossValidation | None:  # fmt: skip
+    """Each fold's poses (all their rows) predicted by a fit on the other poses.
+
+    The fit: :func:`_solve`, started from the fit on all of them (``whole``).
+    """
     if opt.folds == 0:
         return None
-    folds = min(opt.folds, n)
-    perm = np.random.default_rng(opt.seed).permutation(n)
-    if n - math.ceil(n / folds) < count:
-        notes.append(f"no cross-validation: {opt.folds} folds of {n} poses leave fewer than {count} poses to fit")
+    poses = len(problem.distinct)
+    folds = min(opt.folds, poses)
+    if poses - math.ceil(poses / folds) < count:
+        notes.append(f"no cross-validation: {opt.folds} folds of {poses} distinct poses leave fewer than {count} "
+                     "poses to fit")  # fmt: skip
         return None
-    held = []
+    perm = np.random.default_rng(opt.seed).permutation(poses)
+    held = np.empty_like(problem.target)
     for f in range(folds):
-        test = np.zeros(n, dtype=bool)
-        test[perm[f::folds]] = True
-        theta, _, _ = _fit_identified(problem.subset(~test), np.zeros(problem.chain.size), Loss.LINEAR, opt.f_scale,
-                                  opt.tol)  # fmt: skip
-        r, _ = problem.subset(test).residuals(theta, jacobian=False)
-        held.append(r)
-    return CrossValidation(folds, ResidualStats.of(np.vstack(held)))
+        test = np.isin(problem.pose, perm[f::folds])
+        theta = _solve(problem.subset(~test), Loss.LINEAR, opt, whole).theta
+        held[test], _ = problem.subset(test).residuals(theta, jacobian=False)
+    return CrossValidation(folds, ResidualStats.of(held), held)
 
 
 def _calibrated_urdf(chain: ChainModel, theta: np.ndarray) -> str:

@@ -1,13 +1,13 @@
 """Which errors the measurements can separate: the base parameters of an identification Jacobian.
 
 The identification Jacobian ``W`` (one row per measured coordinate, one column per candidate error, at the
-nominal description) tells what each error does to the measurements. Two errors whose columns are
+nominal description or at an estimate) tells what each error does to the measurements. Two errors whose columns are
 proportional, or a column in the span of others, cannot be told apart by any fit: such a column is fixed
 at its nominal value (zero error) and the errors it depends on absorb it (FIGAROH's base parameters, from
 a QR decomposition of the regressor).
 
-The columns are taken in the error model's order of preference
-(:mod:`scara_pin.calibration.chain`), each scaled to unit norm (so that metres, radians and scales
+The columns are taken in an order of preference (the error model's, :mod:`scara_pin.calibration.chain`; at
+an estimate, the errors already identified first), each scaled to unit norm (so that metres, radians and scales
 compare), by a QR decomposition without pivoting kept column by column (Gram-Schmidt, orthogonalised
 twice): a column is kept when the part of it outside the span of the columns kept before is at least
 ``IDENTIFY_TOL`` of its norm (``|R_ii|`` of the unit column, the sine of its angle to that span); below,
@@ -40,7 +40,7 @@ class Identifiability:
     """The errors the measurements separate, and what each of the others depends on.
 
     Attributes:
-        kept: indices of the identified (base) errors, in the model's order.
+        kept: indices of the identified (base) errors, in the model's order (ascending).
         fixed: indices of the others (fixed at zero error).
         depends: per fixed error (same order as ``fixed``), the indices of the kept errors it cannot be
             separated from; empty when it has no effect on the measurements.
@@ -66,20 +66,26 @@ class Identifiability:
         return out
 
 
-def identify(W: np.ndarray, tol: float = IDENTIFY_TOL) -> Identifiability:
+def identify(W: np.ndarray, tol: float = IDENTIFY_TOL, order: Sequence[int] | None = None) -> Identifiability:
     """The base errors of the identification Jacobian ``W`` (m x p), columns in order of preference.
 
     Args:
-        W: the Jacobian of the measurements with respect to the candidate errors, at the nominal model.
+        W: the Jacobian of the measurements with respect to the candidate errors (at the nominal model, or at
+            an estimate).
         tol: the smallest sine kept (:data:`IDENTIFY_TOL`).
+        order: the order of preference, a permutation of the column indices (default: the columns' order).
+            The indices returned are the columns' own, ``kept`` sorted.
     """
     m, p = W.shape
+    order = list(range(p)) if order is None else [int(k) for k in order]
+    if sorted(order) != list(range(p)):
+        raise ValueError(f"order must be a permutation of 0 .. {p - 1}")
     norms = np.linalg.norm(W, axis=0)
     big = float(norms.max()) if p else 0.0
     basis = np.zeros((m, 0))
     kept: list[int] = []
     sines = np.zeros(p)
-    for k in range(p):
+    for k in order:
         if norms[k] <= _ZERO * big or norms[k] == 0.0:
             continue
         v = W[:, k] / norms[k]
@@ -90,6 +96,7 @@ def identify(W: np.ndarray, tol: float = IDENTIFY_TOL) -> Identifiability:
         if s >= tol:
             kept.append(k)
             basis = np.column_stack([basis, v / s])
+    kept.sort()
     fixed = [k for k in range(p) if k not in kept]
     depends: list[tuple[int, ...]] = []
     if kept:

@@ -4,11 +4,16 @@ A measurement file is CSV read by the package's one reader (:mod:`scara_pin.tabl
 ``#`` lines skipped, plain numbers only, the line named in every error): the columns ``q1 .. qN`` (the
 robot's joint readings in URDF joint order, N = ``robot.dof``, [rad] or [m]), ``x, y, z`` (the measured
 tool position [m], in the robot's base frame or in the measuring device's frame) and, optionally, ``yaw``
-(the tool's measured yaw [rad], ``atan2(R[1, 0], R[0, 0])`` of its rotation). Other columns are ignored.
+(the tool's measured yaw [rad], ``atan2(R[1, 0], R[0, 0])`` of its rotation). Other columns are ignored, but
+a column ``q{N+1}`` (a joint reading the robot has no joint for: another robot's data) is refused.
+
+Rows whose readings agree to ``DISTINCT_TOL`` are one pose measured again (:meth:`Measurements.poses`): they
+repeat a measurement (averaging its noise) but identify nothing more.
 """
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 
@@ -17,7 +22,10 @@ import numpy as np
 from ..errors import InvalidInputError, ParameterError
 from ..model import Robot
 
-__all__ = ["Measurements", "measurement_columns"]
+__all__ = ["DISTINCT_TOL", "Measurements", "measurement_columns"]
+
+DISTINCT_TOL = 1e-6
+"""[rad or m] rows whose readings, rounded to this grid, are equal are one pose (measured again)."""
 
 
 def measurement_columns(dof: int) -> tuple[str, ...]:
@@ -83,8 +91,19 @@ class Measurements:
         """How messages name row ``row`` (0-based): its line in the file, or its row number."""
         return _where(self.source, self.lines[row])
 
-    def check(self, robot: Robot) -> list[str]:
-        """Refuse readings the robot cannot take; return the readings outside the joint limits, in words.
+    def poses(self) -> tuple[np.ndarray, int]:
+        """Per row, the index of its distinct pose (in order of first appearance), and how many there are.
+
+        Two rows are the same pose when their readings, rounded to :data:`DISTINCT_TOL`, are equal.
+        """
+        grid = np.round(self.q / DISTINCT_TOL)
+        _, first, inverse = np.unique(grid, axis=0, return_index=True, return_inverse=True)
+        rank = np.empty(len(first), dtype=int)
+        rank[np.argsort(first)] = np.arange(len(first))  # number the poses in the rows' order
+        return rank[inverse.reshape(-1)], len(first)
+
+    def check(self, robot: Robot) -> None:
+        """Refuse readings the robot cannot take (the limits: :func:`~scara_pin.calibration.screen.screen`).
 
         Raises:
             InvalidInputError: not ``robot.dof`` readings per row, or a reading beyond +/-1e6 (naming the row).
@@ -92,16 +111,11 @@ class Measurements:
         if self.q.shape[1] != robot.dof:
             raise InvalidInputError(f"{self.source}: {self.q.shape[1]} joint readings per row; robot "
                                     f"{robot.name!r} has {robot.dof} joints")  # fmt: skip
-        outside = []
         for k, q in enumerate(self.q):
             try:
                 robot.check_q(q)
             except ParameterError as exc:
                 raise InvalidInputError(f"{self.source}, {self.where(k)}: {exc}") from None
-            bad = robot.outside_limits(q, tol=1e-9)
-            if bad:
-                outside.append(f"{self.where(k)}: {'; '.join(bad)}")
-        return outside
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str], dof: int) -> Measurements:
@@ -116,10 +130,18 @@ class Measurements:
 
         columns = measurement_columns(dof)
         lines, rows = [], []
+        extra = f"q{dof + 1}"
         with open_csv(path) as handle:
-            for line, values in csv_rows(handle, str(path), columns, max_rows=MAX_CALIBRATION_ROWS, optional=("yaw",)):
+            for line, values in csv_rows(handle, str(path), columns, max_rows=MAX_CALIBRATION_ROWS,
+                                         optional=("yaw", extra)):  # fmt: skip
+                if not math.isnan(values[-1]):
+                    raise InvalidInputError(
+                        f"{path}: column {extra}: the file has readings of more joints than the robot's {dof} "
+                        f"({', '.join(columns[:dof])}): measurements of another robot? (give the robot they were "
+                        "measured on)"
+                    )
                 lines.append(line)
-                rows.append(values)
+                rows.append(values[:-1])
         if not rows:
             raise InvalidInputError(f"{path}: no data row after the header")
         table = np.array(rows, dtype=float)

@@ -15,7 +15,9 @@ __all__ = ["plot_residuals"]
 def plot_residuals(result: CalibrationResult, path: str | os.PathLike[str]) -> Path:
     """Each measured pose's position error before and after the calibration (log scale), outliers marked.
 
-    Written atomically (:func:`scara_pin.files.save_figure`); the format follows the name (.png, .svg, .pdf).
+    The x axis is each row's line in the measurement file (its row number for arrays), as the report and the
+    outlier list name it. Written atomically (:func:`scara_pin.files.save_figure`); the format follows the
+    name (.png, .svg, .pdf).
     """
     import matplotlib
 
@@ -26,7 +28,7 @@ def plot_residuals(result: CalibrationResult, path: str | os.PathLike[str]) -> P
 
     before = np.linalg.norm(result.residuals_before[:, :3], axis=1) * 1e3
     after = np.linalg.norm(result.residuals_after[:, :3], axis=1) * 1e3
-    rows = np.arange(1, len(before) + 1)
+    rows = np.array(result.measurements.lines, dtype=float)  # as messages name the rows: line (or row) numbers
     fig, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
     ax.bar(rows - 0.2, before, width=0.4, color="0.6", label=f"nominal (rms {result.before.rms * 1e3:.3g} mm)")
     ax.bar(rows + 0.2, after, width=0.4, color="tab:blue", label=f"calibrated (rms {result.after.rms * 1e3:.3g} mm)")
@@ -40,7 +42,8 @@ def plot_residuals(result: CalibrationResult, path: str | os.PathLike[str]) -> P
     positive = positive[positive > 0]
     if len(positive) and positive.max() / positive.min() > 100:
         ax.set_yscale("log")
-    ax.set_xlabel("measured pose (row)")
+    from_file = result.measurements.where(0).startswith("line") if len(before) else False
+    ax.set_xlabel("measured pose (line in the measurement file)" if from_file else "measured pose (row)")
     ax.set_ylabel("position error [mm]")
     ax.set_title(f"calibration of {result.chain.robot.name}: {len(result.identified)} errors identified")
     ax.legend(loc="best", fontsize=8)

@@ -107,23 +107,32 @@ class Outlier:
     Attributes:
         row: its index in the measurements (0-based). where: its line in the file (or row number), in words.
         distance: its position error under the final model [m].
+        standardised: its standardised residual under the final model (a prediction's: see
+            :attr:`CalibrationResult.standardised`).
     """
 
     row: int
     where: str
     distance: float
+    standardised: float = math.nan
 
 
 @dataclass(frozen=True)
 class CrossValidation:
     """Held-out prediction: each of ``folds`` groups of rows predicted by a fit on the other rows.
 
+    The groups are made of distinct poses: a pose measured again is in one group with all its rows (a fit that
+    saw the pose would predict it too well).
+
     Attributes:
         folds: the number of groups. held_out: the statistics of the held-out predictions' residuals.
+        residuals: (n, 3) or (n, 4) per row used by the final fit (in order), its residual (model minus
+            measurement) as predicted by the fit without its pose [m, rad].
     """
 
     folds: int
     held_out: ResidualStats
+    residuals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,8 +157,17 @@ class CalibrationResult:
         structural_count: how many errors a rich set of poses identifies for this model.
         condition: the condition number of the identified errors' unit columns.
         loss: the loss of the fit. nfev: the model evaluations of the final fit.
-        notes: what the user should know (unexcited errors, readings outside the limits, ...).
+        notes: what the user should know (unexcited errors, no cross-validation, ...).
         urdf: the calibrated URDF (the input's text, with the changed ``<origin>`` elements only).
+        warnings: what may make the result wrong (readings outside the limits used, a large nominal error,
+            outliers kept by the linear loss, errors too large for a calibration).
+        distinct: the number of distinct poses (rows with the same readings are one pose).
+        second_order: the identified errors without first-order effect at the nominal model, identified at the
+            estimate (where the other errors make them act).
+        standardised: per row, its standardised residual ``sqrt(r^T (I - H)^-1 r) / sigma`` (``r``: its
+            weighted residual, ``H``: its block of the hat matrix; ``I + H`` for a row left out): about
+            ``sqrt(coordinates)`` for a row as noisy as the others, far more for a gross error (NaN when
+            ``sigma`` is not known).
     """
 
     chain: ChainModel
@@ -173,6 +191,10 @@ class CalibrationResult:
     nfev: int
     notes: tuple[str, ...]
     urdf: str = field(repr=False)
+    warnings: tuple[str, ...] = ()
+    distinct: int = 0
+    second_order: tuple[str, ...] = ()
+    standardised: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
     # ------------------------------------------------------------------------------ queries
     def parameter(self, name: str) -> ParameterEstimate:
@@ -191,6 +213,16 @@ class CalibrationResult:
     def scales(self) -> dict[str, float]:
         """Per prismatic joint: the factor from its reading to its true stroke (1: no scale error)."""
         return self.chain.scales(self.theta)
+
+    @property
+    def largest_standardised(self) -> Outlier | None:
+        """The used row with the largest standardised residual (as an :class:`Outlier` record), or None."""
+        values = np.where(self.used, self.standardised, -np.inf) if len(self.standardised) else np.zeros(0)
+        if not len(values) or not np.isfinite(values).any():
+            return None
+        i = int(np.nanargmax(np.where(np.isfinite(values), values, -np.inf)))
+        return Outlier(i, self.measurements.where(i), float(np.linalg.norm(self.residuals_after[i, :3])),
+                       float(self.standardised[i]))  # fmt: skip
 
     @property
     def device(self) -> pin.SE3 | None:
@@ -226,9 +258,11 @@ class CalibrationResult:
             "yaw": self.chain.yaw,
             "loss": self.loss.value,
             "rows": len(self.measurements),
+            "distinct_poses": self.distinct,
             "rows_used": int(self.used.sum()),
             "structural_count": self.structural_count,
             "identified_count": len(self.identified),
+            "second_order": list(self.second_order),
             "condition": _json(self.condition),
             "sigma": _json(self.sigma),
             "before": self.before.to_dict(),
@@ -241,14 +275,24 @@ class CalibrationResult:
             "scales": self.scales,
             "device": None if dev is None else {"xyz": dev.translation.tolist(),
                                                 "rpy": _rpy(dev.rotation).tolist()},
-            "outliers": [{"row": o.row, "where": o.where, "distance": o.distance} for o in self.outliers],
+            "outliers": [{"row": o.row, "where": o.where, "distance": o.distance,
+                          "standardised": _json(o.standardised)} for o in self.outliers],
+            "largest_standardised": None if (big := self.largest_standardised) is None else
+            {"row": big.row, "where": big.where, "value": big.standardised, "distance": big.distance},
+            "warnings": list(self.warnings),
             "notes": list(self.notes),
             "identified": list(self.identified),
             "covariance": self.covariance.tolist(),
         }  # fmt: skip
 
-    def report(self, length_unit: str = "m", angle_unit: str = "rad") -> str:
-        """The report in words: residuals, identified errors with their deviations, fixed ones and why."""
+    def report(self, length_unit: str = "m", angle_unit: str = "rad", *, warnings: bool = True) -> str:
+        """The report in words: residuals, identified errors with their deviations, fixed ones and why.
+
+        Args:
+            length_unit: ``"m"`` or ``"mm"``.
+            angle_unit: ``"rad"`` or ``"deg"``.
+            warnings: begin with the warnings (the command line prints them on stderr instead).
+        """
         L = 1000.0 if length_unit == "mm" else 1.0
         A = 180.0 / math.pi if angle_unit == "deg" else 1.0
 
@@ -266,15 +310,24 @@ class CalibrationResult:
             return text
 
         c = self.chain
-        lines = [
-            f"calibration of {c.robot.name!r}: {len(self.measurements)} poses ({int(self.used.sum())} used), "
-            f"measured in the {c.frame.value} frame{' with the yaw' if c.yaw else ''}; model "
+        n = len(self.measurements)
+        second = (f"; {len(self.second_order)} more act at the calibrated model: {', '.join(self.second_order)}"
+                  if self.second_order else "")  # fmt: skip
+        lines = [f"warning: {w}" for w in self.warnings] if warnings else []
+        lines += [
+            f"calibration of {c.robot.name!r}: {n} rows ({self.distinct} distinct poses, {int(self.used.sum())} rows "
+            f"used), measured in the {c.frame.value} frame{' with the yaw' if c.yaw else ''}; model "
             f"{', '.join(sorted(g.value for g in c.groups))}; loss {self.loss.value}",
             f"identified {len(self.identified)} of {c.size} candidate errors (a rich set of poses identifies "
-            f"{self.structural_count}); condition number {self.condition:.4g}",
+            f"{self.structural_count} at the nominal model{second}); condition number {self.condition:.4g}",
             f"residual before: {stats(self.before)}",
             f"residual after:  {stats(self.after)}",
         ]
+        big = self.largest_standardised
+        if big is not None:
+            lines.append(f"largest standardised residual: {big.standardised:.3g} at {big.where} "
+                         f"({big.distance * L:.4g} {length_unit} off; about {math.sqrt(c.rows_per_pose):.2g} for a "
+                         "row as noisy as the others)")  # fmt: skip
         if self.cross_validation is not None:
             cv = self.cross_validation
             lines.append(f"held out ({cv.folds}-fold cross-validation): {stats(cv.held_out)}")
@@ -290,7 +343,7 @@ class CalibrationResult:
             for p in self.fixed:
                 lines.append(f"  {p.name:<22} {p.reason}")
         for joint, s in self.scales.items():
-            if s != 1.0:
+            if abs(s - 1.0) > 1e-12:  # (below: rounding)
                 lines.append(f"{joint}: scale {s:.9g}: URDF has no joint scale; the calibrated URDF's {joint} is "
                              f"{s:.9g} x the reading (scale the readings in the controller)")  # fmt: skip
         dev = self.device
@@ -299,7 +352,8 @@ class CalibrationResult:
             rpy = " ".join(f"{v * A:.6g}" for v in _rpy(dev.rotation))
             lines.append(f"base in the device frame: xyz {xyz} {length_unit}, rpy {rpy} {angle_unit}")
         for o in self.outliers:
-            lines.append(f"outlier: {o.where}: {o.distance * L:.4g} {length_unit} off (left out of the fit)")
+            lines.append(f"outlier: {o.where}: {o.distance * L:.4g} {length_unit} off, standardised residual "
+                         f"{o.standardised:.3g} (left out of the fit)")  # fmt: skip
         lines.extend(f"note: {n}" for n in self.notes)
         return "\n".join(lines)
 

@@ -28,7 +28,7 @@ from typing import Any
 
 from ..errors import ScaraError
 from ..signals import Terminated, kept, raise_pending
-from . import calibrate, cycle, describe, kinematics, motion, teach, view, workspace
+from . import calibrate, cycle, describe, job, kinematics, motion, teach, view, workspace
 from ._common import _Parser, _UsageError, log
 
 __all__ = ["build_parser", "main"]
@@ -55,7 +55,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     target: Any = sub if command is None else _OneCommand(sub, command)
-    for module in (describe, kinematics, motion, cycle, workspace, view, teach, calibrate):
+    for module in (describe, kinematics, motion, cycle, job, workspace, view, teach, calibrate):
         module.register(target)
     if command is not None and not target.found:
         return build_parser(None)

@@ -195,13 +195,21 @@ def _jerk(args: argparse.Namespace) -> list[float] | None:
 
 def _parse_sets(items: Sequence[str] | None, option: str = "--set", form: str = "key=value (e.g. l1=0.25)"
                 ) -> dict[str, float]:  # fmt: skip
-    """``--set KEY=VALUE`` items (or ``option``'s); each value through :func:`_number` (never to xacro as text)."""
+    """``--set KEY=VALUE`` items (or ``option``'s); each value through :func:`_number` (never to xacro as text).
+
+    A key given twice is refused (which one was meant? the last silently winning hid the other).
+    """
     overrides: dict[str, float] = {}
     for item in items or ():
         key, sep, value = item.partition("=")
-        if not sep or not key.strip():
+        key = key.strip()
+        if not sep or not key:
             raise InvalidInputError(f"{option} {item[:80]!r} must have the form {form}")
-        overrides[key.strip()] = _number(f"{option} {key.strip()[:80]}", value)
+        number = _number(f"{option} {key[:80]}", value)
+        if key in overrides:
+            raise InvalidInputError(f"{option} {key[:80]} is given twice ({_num(overrides[key])} and {_num(number)}); "
+                                    "give each once")  # fmt: skip
+        overrides[key] = number
     return overrides
 
 
@@ -341,6 +349,39 @@ def _joint_arg(robot: Robot, texts: Sequence[str], units: Units, what: str) -> n
     return q
 
 
+_INPUT_OPTIONS = ("urdf", "dh", "points", "measurements", "input", "traj", "simulate", "cell", "file")
+"""The options that name a file a command reads (those it has)."""
+
+
+def _input_files(args: argparse.Namespace) -> dict[str, list[str]]:
+    """The files a command reads, by option: its input options, and the yaml files of a configured ``--robot``."""
+    from ..description import config_files
+    from ..errors import UnknownRobotError
+
+    found = {f"--{name}": [value] for name in _INPUT_OPTIONS
+             if isinstance(value := getattr(args, name, None), str) and value not in ("", "-")}  # fmt: skip
+    robot = getattr(args, "robot", None)
+    if "--urdf" not in found and "--dh" not in found and (robot is None or len(robot) <= _MAX_NAME):
+        try:
+            found["--robot"] = [str(f) for f in config_files(robot or "default")]
+        except (UnknownRobotError, ValueError, OSError):  # refused when the robot is loaded
+            pass
+    return found
+
+
+def check_command_outputs(args: argparse.Namespace, outputs: dict[str, str | None], figures: Sequence[str] = ()
+                          ) -> None:  # fmt: skip
+    """The command's outputs, checked BEFORE any work by :func:`scara_pin.files.check_outputs`.
+
+    Each name (no device, folder or missing folder; a plot's ending), at most one on standard output (with
+    ``--json``), none the same file as an input of the command (:func:`_input_files`) or as another output.
+    """
+    from ..files import check_outputs
+
+    stdout = "--json" if getattr(args, "json", False) else None
+    check_outputs(outputs, _input_files(args), figures=figures, stdout=stdout)
+
+
 def write_atomic(path: Path, text: str) -> None:
     """Write a text file atomically (see :mod:`scara_pin.files`)."""
     write_text_atomic(path, text)
@@ -391,6 +432,33 @@ def _add_frame_options(g: Any) -> None:
                    help="a folder holding ROS packages (folders with package.xml), for $(find pkg) and "
                    "package://pkg/ in --urdf; repeatable; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are "
                    "searched too")  # fmt: skip
+
+
+def add_cell_options(p: argparse.ArgumentParser, *, margin: bool = True) -> None:
+    """``--cell FILE`` (obstacles, the carried part, the margin: docs/cell.md) and ``--margin M``."""
+    g = p.add_argument_group("cell")
+    g.add_argument("--cell", metavar="FILE", help="the robot's cell: obstacles in its base frame, what the tool "
+                   "carries, the margin (YAML, or a URDF/xacro of fixed links; docs/cell.md)")  # fmt: skip
+    if margin:
+        g.add_argument("--margin", type=number_type("--margin"), metavar="M",
+                       help="the smallest distance kept to any obstacle [m, or mm with --mm], instead of the "
+                       "cell file's")  # fmt: skip
+
+
+def cell_from_args(args: argparse.Namespace, units: Units | None = None) -> Any:
+    """The cell named by ``--cell`` (with ``--margin``), or None; the margin in the typed length unit."""
+    path = getattr(args, "cell", None)
+    margin = getattr(args, "margin", None)
+    if path is None:
+        if margin is not None:
+            raise _UsageError("--margin needs --cell")
+        return None
+    from ..cell import load_cell
+
+    if margin is not None and units is not None:
+        margin = margin / units.length
+    packages = tuple(getattr(args, "package_path", None) or ())
+    return load_cell(path, margin=margin, package_dirs=packages)
 
 
 def _add_q(p: argparse.ArgumentParser) -> None:

@@ -17,7 +17,7 @@ import argparse
 import math
 from typing import TYPE_CHECKING
 
-from ..errors import InvalidInputError
+from ..errors import InfeasibleError, InvalidInputError
 from ._common import MIN_NUMBER, Units
 
 if TYPE_CHECKING:
@@ -47,11 +47,23 @@ def add_points_options(p: argparse.ArgumentParser, command: str) -> None:
 
 
 def _load(args: argparse.Namespace, robot: Robot, names: list[str]) -> PointSet:
+    """The points file, each named point checked HERE, so that a message names the point and the file.
+
+    The points become option values (--from, ...) afterwards, whose checks would name the options instead.
+
+    Raises:
+        InvalidInputError: an unknown name; a file that does not fit the robot (joint count, a value beyond
+            +/-1e6, a pose that is not the FK of its q).
+        InfeasibleError: a named point outside the joint limits (as a --from outside them, exit 3).
+    """
     from ..motion.points import read_points
 
     points = read_points(args.points, robot)
     for name in names:
-        points[name]  # noqa: B018 - refused (exit 2) naming the file's points when there is none
+        outside = robot.outside_limits(points[name].q, tol=1e-12)  # an unknown name: exit 2 naming the known ones
+        if outside:
+            raise InfeasibleError(f"points file {args.points}: point {name} is outside the joint limits: "
+                                  + "; ".join(outside))  # fmt: skip
     return points
 
 

@@ -20,6 +20,9 @@ from ._common import (
     _num,
     _number,
     _read_pose,
+    add_cell_options,
+    cell_from_args,
+    check_command_outputs,
     number_type,
 )
 from ._points import add_points_options, use_points
@@ -46,6 +49,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units.from_args(args)
+    check_command_outputs(args, {"--out": args.out, "--plot": args.plot}, figures=("--plot",))  # before any work
     path = CyclePath(args.path)
     if path is CyclePath.JUMP:
         for flag, given in (("--arch", args.arch is not None), ("--no-blend", args.no_blend)):
@@ -76,8 +80,9 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     _acceleration(robot, args.acceleration, units)  # a URDF file has none: given, or refused
     limits = robot.limits
     jerk = _jerk(args)
+    cell = cell_from_args(args, units)
     common = {"start": start, "direction": direction, "span": span, "rise": rise, "payload": _payload(args, units),
-              "jerk": jerk, "limits": limits, "max_height": ceiling}  # fmt: skip
+              "jerk": jerk, "limits": limits, "max_height": ceiling, "cell": cell}  # fmt: skip
     if path is CyclePath.JUMP:
         result = standard_cycle(robot, path=path, clearance_radius=radius, **common)  # type: ignore[arg-type]
     else:
@@ -114,6 +119,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             "outputs": outputs,
             "units": {"length": "m", "angle": "rad", "time": "s"},
         }  # fmt: skip
+        if cell is not None:
+            summary["cell"] = cell_summary(cell, move.distance)
         if path is CyclePath.JUMP:
             summary["solver"] = move.stats.to_dict()  # type: ignore[union-attr]
             summary["arch"] = {"peak_above_clearance": move.peak, "bulge": move.bulge,  # type: ignore[union-attr]
@@ -148,8 +155,10 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     for leg in move.legs:
         binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in leg.binding)
         print(f"  {'out ' if leg.move == 0 else 'back'} {leg.name:<11} {leg.duration:9.6f} s   "
-              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit" + (f"; binding: {binding}" if binding
-                                                                                else ""))  # fmt: skip
+              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
+              + (f"; binding: {binding}" if binding else "") + closest_text(leg, units))  # fmt: skip
+    if cell is not None:
+        print(cell_text(cell, move.distance, units))
     if path is CyclePath.LINES:
         if compare is not None:
             slower = 100.0 * (result.cycle_time / compare[0] - 1.0)
@@ -160,6 +169,33 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     for kind, where in outputs.items():
         print(f"wrote       {kind}: {where}")
     return 0
+
+
+def cell_summary(cell: Any, distance: Any) -> dict[str, Any]:
+    """The ``cell`` object of a command's ``--json``: the file, the margin, the obstacles, the closest pair."""
+    return {"file": cell.origin, "margin": cell.margin, "obstacles": [o.name for o in cell.obstacles],
+            "carried": None if cell.carried is None else cell.carried.to_dict(),
+            "closest": None if distance is None else distance.to_dict()}  # fmt: skip
+
+
+def cell_text(cell: Any, distance: Any, units: Units) -> str:
+    """The ``cell`` line of a command's text: the cell, its margin, and the closest pair of the motion."""
+    Ln = units.length_name
+    head = (f"cell        {cell.origin}: {len(cell.obstacles)} obstacle(s)"
+            + (", carrying a part" if cell.carried is not None else "")
+            + f", margin {units.num(cell.margin, 'length')} {Ln}")  # fmt: skip
+    if distance is None:
+        return head + "; no pair checked"
+    return (head + f"; closest {distance.pair} at {units.num(distance.distance, 'length')} {Ln} "
+            f"(t = {distance.time:.4f} s)")  # fmt: skip
+
+
+def closest_text(leg: Any, units: Units) -> str:
+    """``; closest link2 - post 2.1 mm`` for a leg planned in a cell, else ""."""
+    if getattr(leg, "closest", None) is None:
+        return ""
+    pair, d = leg.closest
+    return f"; closest {pair} {units.num(d, 'length')} {units.length_name}"
 
 
 def _jump_for_comparison(robot: Any, result: Any, common: dict[str, Any], radius: float) -> tuple[float] | None:
@@ -204,5 +240,6 @@ def register(sub: Any) -> None:
     g.add_argument("--plot", metavar="PNG", help="side and plan view of the tool path; joint rates against limits")
     _add_units(p, inputs=True, json_help='print one JSON object {"cycle_time", "legs", "limits", ...}')
     _add_robot_options(p)
+    add_cell_options(p)
     add_points_options(p, "cycle")
     p.set_defaults(func=cmd_cycle)

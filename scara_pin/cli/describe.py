@@ -9,8 +9,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
-from ..files import check_output_path
-from ._common import _add_frame_options, _add_robot_options, _parse_locks, _parse_sets, write_atomic
+from ._common import (
+    _add_frame_options,
+    _add_robot_options,
+    _parse_locks,
+    _parse_sets,
+    check_command_outputs,
+    write_atomic,
+)
 
 if TYPE_CHECKING:
 
@@ -31,8 +37,7 @@ def cmd_robots(args: argparse.Namespace) -> int:
 
 def cmd_urdf(args: argparse.Namespace) -> int:
     """Write the generated URDF (of a configured robot, or of a D-H table) to stdout or, atomically, a file."""
-    if args.output not in (None, "-"):  # refused before any work
-        check_output_path(args.output)
+    check_command_outputs(args, {"--output": args.output})  # before any work: not --dh nor the robot's yaml
     if args.dh:
         from ..description.dh import dh_to_urdf
 

@@ -25,6 +25,9 @@ from ._common import (
     _read_pose,
     _read_q,
     _scaled,
+    add_cell_options,
+    cell_from_args,
+    check_command_outputs,
     integer_type,
     log,
 )
@@ -157,6 +160,8 @@ def _geared_text(robot: Robot, q: ArrayLike, units: Units) -> str:
 def cmd_ik(args: argparse.Namespace) -> int:
     """Inverse kinematics: every joint solution for a tool pose (closed form, or numeric)."""
     units = Units.from_args(args)
+    if args.input:  # refused before any work: --output must not be --input (nor a device)
+        check_command_outputs(args, {"--output": args.output})
     robot = _load(args, units)
     if args.input:
         if args.numeric:
@@ -202,6 +207,13 @@ def cmd_ik(args: argparse.Namespace) -> int:
             message = f"no {args.branch} solution ({len(result.solutions)} of the other branch)"
         qs, branches = [s.q for s in sols], [s.branch for s in sols]
         turns = [[list(t) if t is not None else None for t in s.turns] for s in sols]
+    refused: list[dict[str, Any]] = []
+    cell = cell_from_args(args, units)
+    if cell is not None:
+        qs, branches, turns, refused = _clear_solutions(robot, cell, qs, branches, turns)
+        if refused and not qs:
+            status = "COLLISION"
+            message = "every solution collides: " + "; ".join(f"{r['branch']}: {r['reason']}" for r in refused)
     code = 0 if status == "OK" else 3
     if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         si = Units(False, False)
@@ -211,9 +223,12 @@ def cmd_ik(args: argparse.Namespace) -> int:
         if robot.geared:  # the joints that follow (not degrees of freedom): their values at each solution
             for sol, q in zip(solutions, qs):
                 sol["geared"] = _geared(robot, q)
-        print(json.dumps({"robot": robot.name, "target": dict(zip(("x", "y", "z", "yaw"), map(float, target))),
-                          "solutions": solutions, "status": status, "message": message,
-                          "method": "numeric" if numeric else "closed-form", "units": _SI_UNITS}))  # fmt: skip
+        out = {"robot": robot.name, "target": dict(zip(("x", "y", "z", "yaw"), map(float, target))),
+               "solutions": solutions, "status": status, "message": message,
+               "method": "numeric" if numeric else "closed-form", "units": _SI_UNITS}  # fmt: skip
+        if cell is not None:
+            out["cell"] = {"file": cell.origin, "margin": cell.margin, "refused": refused}
+        print(json.dumps(out))
         return code
     if code:
         raise InfeasibleError(f"{status}: {message}")
@@ -230,7 +245,38 @@ def cmd_ik(args: argparse.Namespace) -> int:
         print(f"{b:<9} {units.fmt(q, units.q)}{extra}")
         if robot.geared:
             print(f"  geared  {_geared_text(robot, q, units)}")
+    for r in refused:
+        print(f"{r['branch']:<9} {units.fmt(r['q'], units.q)}  refused: COLLISION, {r['reason']}")
     return 0
+
+
+def _clear_solutions(robot: Robot, cell: Any, qs: list[Any], branches: list[str], turns: list[Any]
+                     ) -> tuple[list[Any], list[str], list[Any], list[dict[str, Any]]]:  # fmt: skip
+    """The solutions clear of ``cell`` (every checked pair at least the margin apart), and the others refused.
+
+    Each refused one: its q, branch, the reason code ``COLLISION``, the closest pair and its distance [m].
+    """
+    import numpy as np
+
+    from ..cell import describe, scene
+
+    sc = scene(robot, cell)
+    keep_q: list[Any] = []
+    keep_b: list[str] = []
+    keep_t: list[Any] = []
+    refused: list[dict[str, Any]] = []
+    for i, (q, b) in enumerate(zip(qs, branches)):
+        closest = sc.distances(q).closest
+        if closest is not None and closest.distance < sc.margin:
+            refused.append({"q": np.asarray(q, dtype=float).tolist(), "branch": b, "status": "COLLISION",
+                            "pair": [closest.pair.a, closest.pair.b], "distance": closest.distance,
+                            "reason": describe(closest, sc.margin)})  # fmt: skip
+            continue
+        keep_q.append(q)
+        keep_b.append(b)
+        if turns:
+            keep_t.append(turns[i])
+    return keep_q, keep_b, keep_t, refused
 
 
 def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
@@ -332,6 +378,7 @@ def register(sub: Any) -> None:
     p.add_argument("--output", metavar="CSV", help="batch: joints written here (atomically), with a status column")
     _add_units(p)
     _add_robot_options(p)
+    add_cell_options(p)
     p.set_defaults(func=cmd_ik)
     p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
     p.add_argument("--samples", type=integer_type("--samples", 1, MAX_VALIDATION_SAMPLES), default=1000,

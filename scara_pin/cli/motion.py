@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..files import check_output_path
 from ._common import (
     _POSE_KINDS,
     Units,
@@ -26,25 +25,19 @@ from ._common import (
     _num,
     _number,
     _read_pose,
+    add_cell_options,
+    cell_from_args,
+    check_command_outputs,
     log,
     number_type,
     write_atomic,
 )
 from ._points import add_points_options, use_points
-from .cycle import _payload
+from .cycle import _payload, cell_summary, cell_text, closest_text
 
 if TYPE_CHECKING:
 
     pass
-
-
-def _check_outputs(args: argparse.Namespace, outputs: tuple[str | None, ...]) -> None:
-    """Refuse bad output names before any work: devices, folders, and two outputs on stdout."""
-    named = [out for out in outputs if out]
-    for out in named:
-        check_output_path(out)
-    if named.count("-") + bool(args.json) > 1:
-        raise InvalidInputError("only one output can go to standard output (-), and --json prints there too")
 
 
 def cmd_traj(args: argparse.Namespace) -> int:
@@ -55,7 +48,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
 
     logging.getLogger("toppra").setLevel(logging.WARNING)
     units = Units.from_args(args)
-    _check_outputs(args, (args.out, args.setpoints, args.plot))
+    check_command_outputs(args, {"--out": args.out, "--setpoints": args.setpoints, "--plot": args.plot},
+                          figures=("--plot",))  # before any work  # fmt: skip
     robot = _load(args, units)
     use_points(args, robot, units, "traj")  # --points FILE --through P1 .. Pn: their q as --from, --via, --to
     for flag in ("linear", "arch", "plot", "payload"):
@@ -104,10 +98,11 @@ def cmd_traj(args: argparse.Namespace) -> int:
         clearance_radius=None if args.clearance_radius is None else units.value("--clearance-radius",
                                                                                  args.clearance_radius, "length"),
         max_height=None if args.max_height is None else units.value("--max-height", args.max_height, "length"),
+        cell=cell_from_args(args, units),
     )
     plan = plan_motion(robot, request)
     if plan.arch is not None:
-        return _print_arch(args, plan.robot, plan.arch, units, plan.method, tool_speed)
+        return _print_arch(args, plan.robot, plan.arch, units, plan.method, tool_speed, request.cell)
     robot, traj, method = plan.robot, plan.trajectory, plan.method.value
     from ..motion.timing import limit_ratios
 
@@ -143,6 +138,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
         "outputs": outputs,
         "units": {"length": "m", "angle": "rad", "time": "s"},
     }
+    if request.cell is not None:
+        summary["cell"] = cell_summary(request.cell, plan.clearance)
     if args.json:
         if not args.out:
             summary["samples"] = traj.resample(args.rate).to_dict()
@@ -156,6 +153,8 @@ def cmd_traj(args: argparse.Namespace) -> int:
     print(f"to        {units.fmt(traj.q_end, units.q)}  [{q_units}]", file=text)
     print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} "
           "(exact for joint-line laws, else sampled)", file=text)  # fmt: skip
+    if request.cell is not None:
+        print(cell_text(request.cell, plan.clearance, units).replace("cell        ", "cell      ", 1), file=text)
     for kind, where in outputs.items():
         print(f"wrote     {kind}: {where}", file=text)
     return 0
@@ -211,7 +210,7 @@ def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Uni
 
 
 def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any,
-                tool_speed: float | None) -> int:
+                tool_speed: float | None, cell: Any = None) -> int:
     """``traj --arch``: write and print the arch move (the jump, or the straight-leg arch with ``--path lines``)."""
     from ..motion.plan import Method
 
@@ -243,6 +242,8 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
                                      "clearance_error": move.clearance}})  # fmt: skip
         else:
             summary["jump_duration"] = faster
+        if cell is not None:
+            summary["cell"] = cell_summary(cell, move.distance)
         if not args.out:
             summary["samples"] = traj.resample(args.rate).to_dict()
         print(json.dumps(summary))
@@ -259,7 +260,9 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
     for leg in move.legs:
         binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in getattr(leg, "binding", ()))
         print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
-              + (f"; binding: {binding}" if binding else ""), file=text)  # fmt: skip
+              + (f"; binding: {binding}" if binding else "") + closest_text(leg, units), file=text)  # fmt: skip
+    if cell is not None:
+        print(cell_text(cell, move.distance, units).replace("cell        ", "cell      ", 1), file=text)
     if not jump:
         print("note      the straight-leg arch is slower than the jump (--path jump, the default)"
               + (f", which takes {_num(faster, 6)} s" if faster is not None else ""), file=text)  # fmt: skip
@@ -290,7 +293,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     from ..motion.jog import jog_to_edge
 
     units = Units.from_args(args)
-    _check_outputs(args, (args.out, args.plot))
+    check_command_outputs(args, {"--out": args.out, "--plot": args.plot}, figures=("--plot",))  # before any work
     robot = _load(args, units)
     if robot.kind != "scara":
         raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
@@ -378,6 +381,7 @@ def register(sub: Any) -> None:
     g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")
     _add_units(p, inputs=True, json_help="print one JSON object (with the samples unless --out)")
     _add_robot_options(p)
+    add_cell_options(p)
     add_points_options(p, "traj")
     p.set_defaults(func=cmd_traj)
     p = sub.add_parser("jog", help="jog to the edge: straight tool move ending at rest on the workspace edge")

@@ -7,9 +7,8 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
-from ..files import check_output_path
 from ..signals import Terminated, handled
-from ._common import Units, _add_robot_options, _add_units, _load, _q_values, log
+from ._common import Units, _add_robot_options, _add_units, _load, _q_values, check_command_outputs, log
 
 if TYPE_CHECKING:
 
@@ -23,8 +22,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     from ..viz import meshcat as viz
 
     units = Units.from_args(args)
-    if args.html:  # refused before any work
-        check_output_path(args.html)
+    check_command_outputs(args, {"--html": args.html})  # before any work: not --traj, --urdf, ...
     robot = _load(args, units)
     q = None
     if args.q:

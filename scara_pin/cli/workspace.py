@@ -8,9 +8,8 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
-from ..files import check_output_path
 from ..units import decimals_for, format_number
-from ._common import Units, _add_robot_options, _add_units, _fmt, _load, _number
+from ._common import Units, _add_robot_options, _add_units, _fmt, _load, _number, check_command_outputs
 
 _TABLE_RESOLUTION = 1e-6
 """The arc table of ``workspace`` prints centres and radii to 1 um (a summary; --json gives every bit)."""
@@ -31,8 +30,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
     units = Units.from_args(args)
     L = units.length
-    if args.plot:  # refused before any work
-        check_output_path(args.plot)
+    check_command_outputs(args, {"--plot": args.plot}, figures=("--plot",))  # before any work
     robot = _load(args, units)
     if robot.kind == "palletizer":
         return _palletizer_workspace(args, robot, units)

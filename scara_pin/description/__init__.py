@@ -44,6 +44,7 @@ __all__ = [
     "JointLimits",
     "RobotParameters",
     "available_robots",
+    "config_files",
     "configured",
     "generate_urdf",
     "load_parameters",
@@ -286,12 +287,15 @@ def _check_finite(name: str, value: object) -> None:
 
 
 def _to_float(name: str, raw: object) -> float:
-    """A finite float from a number or the text of one; anything else is refused."""
+    """A finite float from a number or the text of one (the grammar of :data:`scara_pin.units.NUMBER_TEXT`)."""
     if isinstance(raw, str):
-        try:
-            value = float(raw.strip())
-        except ValueError:
-            raise ParameterError(name, raw, "must be a number") from None
+        from ..units import number_text
+
+        value = number_text(raw)
+        if math.isnan(value):
+            if raw.strip().lower().lstrip("+-") in ("nan", "inf", "infinity"):
+                raise ParameterError(name, raw, "must be finite")
+            raise ParameterError(name, raw, "must be a number such as 0.25, -3, 1.5e-3 (ASCII digits, no _)")
     elif isinstance(raw, bool) or not isinstance(raw, numbers.Real):
         raise ParameterError(name, raw, "must be a number")
     else:
@@ -328,8 +332,7 @@ def _config_texts(folder: Path) -> dict[str, str]:
 
 def _read_config(folder: Path, texts: Mapping[str, str] | None = None) -> tuple[str, dict[str, float]]:
     """(kind, flat values) of a config folder (or of its files' ``texts``); the kind is kinematics.yaml's ``kind:``."""
-    import yaml
-
+    from ..errors import YamlError
     from .yaml_units import load_yaml
 
     texts = _config_texts(folder) if texts is None else texts
@@ -338,11 +341,11 @@ def _read_config(folder: Path, texts: Mapping[str, str] | None = None) -> tuple[
     for filename in _CONFIG_FILES:
         path = folder / filename
         try:
-            tree = load_yaml(texts[filename])
-        except yaml.YAMLError as exc:
-            mark = getattr(exc, "problem_mark", None)
-            where = f" line {mark.line + 1}" if mark is not None else ""
-            raise ParameterError(f"{path}{where}", ParameterError.NOTHING, f"must be valid yaml ({exc})") from None
+            tree = load_yaml(texts[filename], str(path))  # bounded: an alias bomb is refused
+        except YamlError as exc:
+            where = f" line {exc.line}" if exc.line is not None else ""
+            rule = f"is refused: {exc.problem}" if exc.refused else f"must be valid yaml ({exc.problem})"
+            raise ParameterError(f"{path}{where}", ParameterError.NOTHING, rule) from None
         flat: dict[str, object] = {}
         if filename == "kinematics.yaml" and isinstance(tree, dict) and "kind" in tree:
             tree = dict(tree)
@@ -381,6 +384,15 @@ def _config_folder(robot: str | Path) -> tuple[str, Path]:
         if (folder / "kinematics.yaml").is_file():
             return text, folder
     raise UnknownRobotError(text, available_robots())
+
+
+def config_files(robot: str | Path) -> tuple[Path, ...]:
+    """The yaml files of a shipped robot's name or of a config folder (the files its parameters are read from).
+
+    Raises:
+        UnknownRobotError: no such robot or folder.
+    """
+    return tuple(_config_folder(robot)[1] / name for name in _CONFIG_FILES)
 
 
 def load_parameters(

@@ -10,22 +10,34 @@ kept in a file named by their SHA-256 digest:
 - the bytes of xacro's own module (an upgrade of xacro is a new key) and this package's version.
 
 A change to any of them is a new key: the robot is made again and the new result kept. The file holds
-JSON (the kind, the parameters by flat name, the URDF text); on a hit the parameters are validated again
-(:class:`~scara_pin.description.RobotParameters`), and a file that cannot be read, is not what it should
-be, or fails that validation is ignored (the robot is made again and the file replaced). Nothing is ever
-fatal: a folder that cannot be written only means no caching.
+a header line with the SHA-256 digest of the key and of the body, then the body, JSON (the kind, the
+parameters by flat name, the URDF text).
+
+An entry is trusted only as far as it is checked, on every read:
+
+- it is opened without following a link (``O_NOFOLLOW``): a link in the cache folder is never read
+  through; it must be a regular file of the user's, of at most :data:`MAX_ENTRY_BYTES`;
+- its digest is computed again: an entry changed since it was written (a flipped bit, an edited length,
+  an entry renamed to another key) does not match; it is ignored with ONE warning, the robot is made
+  again and the entry replaced (so the next run finds a good one);
+- the parameters are validated again (:class:`~scara_pin.description.RobotParameters`).
+
+Entries are written atomically, mode 0600, in a folder of mode 0700 (created so, or narrowed when it is the
+user's); a folder that is another user's is not used. Nothing is ever fatal: a folder that cannot be used
+only means no caching.
 
 Where: ``$SCARA_PIN_CACHE_DIR``, else ``$XDG_CACHE_HOME/scara-pin``, else ``~/.cache/scara-pin``;
-``SCARA_PIN_NO_CACHE=1`` turns it off (every run then makes the robot). Files are written atomically and
-read only if they are regular files of at most :data:`MAX_ENTRY_BYTES`.
+``SCARA_PIN_NO_CACHE=1`` turns it off (every run then makes the robot).
 """
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import logging
 import os
+import stat
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,8 +47,9 @@ __all__ = ["FORMAT", "MAX_ENTRY_BYTES", "DescriptionCache"]
 
 log = logging.getLogger(__name__)
 
-FORMAT = 1
+FORMAT = 2
 """The layout of a cache file (part of every key: a new layout never reads an old file)."""
+_HEADER = b"scara-pin description cache sha256="
 MAX_ENTRY_BYTES = 8 * 1024 * 1024
 """[bytes] a cache file larger than this is not read (a generated URDF is about 10 KB)."""
 
@@ -93,32 +106,83 @@ class DescriptionCache:
     def _path(self, key: str) -> Path | None:
         return None if self.folder is None else self.folder / f"{key}.json"
 
-    def get(self, key: str) -> dict[str, Any] | None:
-        """The entry kept under ``key``, or None (none, caching off, or a file that is not one of ours)."""
-        from ..limits import read_bytes
+    @staticmethod
+    def _digest(key: str, body: bytes) -> str:
+        """The digest an entry's header holds: of its key (an entry renamed to another key fails) and body."""
+        return hashlib.sha256(key.encode() + b"\0" + body).hexdigest()
 
+    def _read(self, path: Path) -> bytes | None:
+        """The bytes of the entry ``path`` (None: there is none), opened without following a link.
+
+        Raises:
+            OSError: a link (ELOOP), or unreadable.
+            ValueError: not a regular file of the user's of at most :data:`MAX_ENTRY_BYTES`.
+        """
+        flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+        try:
+            fd = os.open(path, flags)
+        except FileNotFoundError:
+            return None
+        with os.fdopen(fd, "rb") as handle:
+            st = os.fstat(fd)
+            if not stat.S_ISREG(st.st_mode) or st.st_uid != os.getuid() or st.st_size > MAX_ENTRY_BYTES:
+                raise ValueError("not a regular file of the user's of at most MAX_ENTRY_BYTES")
+            return handle.read(MAX_ENTRY_BYTES + 1)
+
+    def get(self, key: str) -> dict[str, Any] | None:
+        """The entry kept under ``key``, verified (module docstring), or None (none, caching off, or a bad entry).
+
+        A bad entry (a link, not a regular file, a digest that does not match, not the JSON it should be) is
+        logged as a warning, once: the caller makes the robot again and :meth:`put` replaces it.
+        """
         path = self._path(key)
-        if path is None or not path.exists():
+        if path is None:
             return None
         try:
-            entry = json.loads(read_bytes(path, "cache file", MAX_ENTRY_BYTES).decode("utf-8"))
-        except Exception as exc:  # unreadable, too large, not JSON: made again and replaced
-            log.debug("description cache: %s ignored (%s)", path, exc)
-            return None
-        if not (isinstance(entry, dict) and isinstance(entry.get("urdf"), str) and isinstance(entry.get("values"), dict)
-                and isinstance(entry.get("kind"), str)):  # fmt: skip
+            data = self._read(path)
+            if data is None:
+                return None
+            header, _, body = data.partition(b"\n")
+            if not header.startswith(_HEADER) or header[len(_HEADER) :].decode("ascii") != self._digest(key, body):
+                raise ValueError("its content does not match its digest")
+            entry = json.loads(body.decode("utf-8"))
+            if not (isinstance(entry, dict) and isinstance(entry.get("urdf"), str)
+                    and isinstance(entry.get("values"), dict) and isinstance(entry.get("kind"), str)):  # fmt: skip
+                raise ValueError("it does not hold a robot")
+        except (OSError, ValueError, UnicodeDecodeError) as exc:  # json.JSONDecodeError is a ValueError
+            if isinstance(exc, OSError):
+                reason = "a symbolic link: never followed" if exc.errno == errno.ELOOP else exc.strerror or str(exc)
+            else:
+                reason = str(exc)
+            log.warning("description cache entry %s ignored (%s): the robot is made again and the entry replaced",
+                        path, reason)  # fmt: skip
             return None
         return entry
 
+    def _folder(self) -> Path | None:
+        """The cache folder, created with mode 0700 (narrowed to it when it is the user's); None: not usable."""
+        folder = self.folder
+        if folder is None:
+            return None
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+        st = os.stat(folder)
+        if st.st_uid != os.getuid():
+            log.warning("description cache folder %s is not the user's: not used", folder)
+            return None
+        if stat.S_IMODE(st.st_mode) & 0o077:
+            os.chmod(folder, 0o700)
+        return folder
+
     def put(self, key: str, entry: Mapping[str, Any]) -> None:
-        """Keep ``entry`` under ``key`` (atomically); a folder that cannot be written is only logged."""
+        """Keep ``entry`` under ``key``: atomically, mode 0600, with its digest (a folder not usable: logged)."""
         from ..files import write_text_atomic
 
-        path = self._path(key)
-        if path is None:
-            return
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            write_text_atomic(path, json.dumps(entry))
+            folder = self._folder()
+            if folder is None:
+                return
+            body = json.dumps(entry).encode("utf-8")
+            text = (_HEADER + self._digest(key, body).encode("ascii") + b"\n" + body).decode("utf-8")
+            write_text_atomic(folder / f"{key}.json", text, mode=0o600)
         except Exception as exc:  # a read-only home, a full disk: no caching, never an error
-            log.debug("description cache: %s not written (%s)", path, exc)
+            log.debug("description cache: %s not written (%s)", self._path(key), exc)

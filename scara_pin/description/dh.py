@@ -176,13 +176,11 @@ def load_dh_table(path: str | Path) -> DHTable:
     Raises:
         DHTableError: unreadable file, invalid yaml, or a field that breaks a rule.
     """
-    import yaml
-
     path = Path(path)
     origin = str(path)
-    from ..errors import InvalidInputError
+    from ..errors import InvalidInputError, YamlError
     from ..limits import read_text
-    from .yaml_units import load_yaml, yaml_problem
+    from .yaml_units import load_yaml
 
     try:
         text = read_text(path, "D-H table")  # bounded: /dev/zero or a huge file is refused, not read whole
@@ -190,12 +188,12 @@ def load_dh_table(path: str | Path) -> DHTable:
         raise DHTableError(origin, None, None, "file", ParameterError.NOTHING,
                            f"cannot be read ({exc})") from None  # fmt: skip
     try:
-        data = load_yaml(text)
-    except yaml.YAMLError as exc:
-        line, problem = yaml_problem(exc)
-        where = f" (line {line})" if line is not None else ""
+        data = load_yaml(text, origin)  # bounded: an alias bomb is refused
+    except YamlError as exc:
+        where = f" (line {exc.line})" if exc.line is not None else ""
+        rule = "is refused" if exc.refused else "must be valid yaml"  # refused: over a cap of the loader
         raise DHTableError(origin, None, None, "yaml", ParameterError.NOTHING,
-                           f"must be valid yaml{where}: {problem}") from None  # fmt: skip
+                           f"{rule}{where}: {exc.problem}") from None  # fmt: skip
     return parse_dh_table(data, origin=origin)
 
 

@@ -8,7 +8,7 @@ A mesh's name is ``package://pkg/path`` (looked up as :mod:`scara_pin.descriptio
 - no escape: the resolved file (symbolic links followed) must lie inside the package it names, or for other
   names inside one of the package folders searched or the robot file's folder.
 
-The viewer reads the meshes (:mod:`scara_pin.viz.meshes`); ``check`` only says which are missing or refused
+The viewer reads the meshes (:mod:`scara_pin.cell.meshes`); ``check`` only says which are missing or refused
 (:func:`mesh_file`), from this same module, below the viewer's layer.
 """
 

@@ -22,8 +22,10 @@ A package folder is input like any other (it may come from a stranger), so the s
 The xacro expansion is xacro's, driven by xacrodoc (no ROS installation needed). Every file it reads (an
 ``<xacro:include>``, a ``load_yaml``) follows the same rules: regular files only, at most
 :data:`~scara_pin.limits.MAX_XACRO_FILES` files and :data:`~scara_pin.limits.MAX_DOCUMENT_BYTES` bytes in
-all. A relative include is resolved against the folder of the file that includes it (as ROS's xacro does),
-never against the current folder.
+all; a yaml file that xacro's ``load_yaml`` reads is first read by the package's bounded loader
+(:func:`~scara_pin.description.yaml_units.load_yaml`: an alias bomb is refused). A relative include is
+resolved against the folder of the file that includes it (as ROS's xacro does), never against the current
+folder.
 
 Security: expanding a xacro file runs the expressions written in it (``${...}``, ``$(eval ...)``): only
 the user's own files are expanded, never text from the command line (no ``--set`` into a user's xacro).
@@ -36,6 +38,7 @@ import io
 import os
 import re
 import stat
+import sys
 import threading
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
@@ -358,9 +361,27 @@ class _XacroFiles:
             raise _Refused(f"the files read by the expansion (includes, yaml) exceed {MAX_DOCUMENT_BYTES:,} "
                            f"bytes, the cap; {file} was the last")  # fmt: skip
         self.bytes += len(data)
+        caller = sys._getframe(1)
+        if caller.f_code.co_name == "load_yaml" and caller.f_globals.get("__name__") == "xacro":
+            _check_yaml(data, file)
         if "b" in mode:
             return io.BytesIO(data)
         return io.TextIOWrapper(io.BytesIO(data), encoding="utf-8")
+
+
+def _check_yaml(data: bytes, file: object) -> None:
+    """Refuse a yaml file for xacro's ``load_yaml`` that the bounded loader refuses (an alias bomb, too deep).
+
+    xacro parses it again (its values, its tags); an invalid file is left to xacro's own error.
+    """
+    from ..errors import YamlError
+    from .yaml_units import load_yaml
+
+    try:
+        load_yaml(data.decode("utf-8", errors="replace"), f"yaml file {file}")
+    except YamlError as exc:
+        if exc.refused:
+            raise _Refused(str(exc)) from None
 
 
 @contextmanager

@@ -2,7 +2,7 @@
 
 Pinocchio would otherwise read mesh files itself (through assimp, with none of the checks a file from a
 stranger needs). The robot's geometry models (``robot.visual_model``, ``robot.collision_model``) are
-built from :func:`placeholder_urdf`, so Pinocchio never reads a mesh; :mod:`scara_pin.viz.meshes` reads
+built from :func:`placeholder_urdf`, so Pinocchio never reads a mesh; :mod:`scara_pin.cell.meshes` reads
 the real shapes, checked, under the same geometry names, and draws this box where it cannot.
 """
 

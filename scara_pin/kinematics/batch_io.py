@@ -21,7 +21,7 @@ from typing import IO, TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidInputError
-from ..files import check_output_path, write_atomic_with
+from ..files import check_outputs, write_atomic_with
 from ..limits import MAX_ROWS
 from ..tables import csv_rows, open_csv
 
@@ -92,7 +92,8 @@ def solve_csv(
     if pose_unit.shape != (4,) or q_unit.shape != (4,) or not (np.isfinite(pose_unit).all() and (pose_unit > 0).all()
                                                                  and np.isfinite(q_unit).all() and (q_unit > 0).all()):
         raise InvalidInputError("pose_scale and q_scale must be 4 finite numbers > 0 each")  # fmt: skip
-    out_path = check_output_path(destination)
+    check_outputs({"destination": destination}, {"source": source})  # never the source itself (links resolved)
+    out_path = Path(destination)
     src = Path(source)
     names = {int(c): c.name for c in kin.status}
     labels = {1: kin.branches[0], -1: kin.branches[1], 0: ""}

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -57,8 +57,10 @@ from .verify import state_ratios, trajectory_jerk
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
+    from ..cell import Cell
     from ..description import JointLimits
     from ..model import Robot
+    from .verify import Clearance
 
 __all__ = [
     "STANDARD_CLEARANCE",
@@ -343,6 +345,7 @@ class ArchMove:
         ratios: worst ratio per quantity ("velocity", "acceleration", "torque", "jerk"; None if not limited).
         payload: the payload carried.
         jerk: the jerk limits per joint, or None.
+        distance: with a cell, the smallest verified distance of its checked pairs, which and when.
     """
 
     trajectory: Trajectory
@@ -351,6 +354,7 @@ class ArchMove:
     ratios: dict[str, float | None]
     payload: Payload
     jerk: tuple[float, ...] | None
+    distance: Clearance | None = None
 
     @property
     def duration(self) -> float:
@@ -612,6 +616,7 @@ def standard_cycle(
     clearance_radius: float = STANDARD_CLEARANCE,
     max_height: float | None = None,
     jump_options: JumpOptions | None = None,
+    cell: Cell | None = None,
 ) -> CycleResult:
     """The standard cycle: up ``rise``, across ``span``, down, and back the same way (rest at both ends).
 
@@ -634,6 +639,9 @@ def standard_cycle(
         clearance_radius: [m] R of the jump (JUMP).
         max_height: [m] a ceiling for the tool's z (JUMP; LINES: refused below the traverse height).
         jump_options: the jump's grid and solver options (JUMP).
+        cell: obstacles, the carried part and the margin (:mod:`scara_pin.cell`): the jump plans around and over
+            them; the straight-leg arch (LINES) is verified against them and refused if it comes closer than
+            the margin (naming the pair, when and where).
 
     Raises:
         ParameterError: bad input (exit 2); so is InvalidInputError.
@@ -667,7 +675,7 @@ def standard_cycle(
     if path is CyclePath.JUMP:
         out = jump_move(robot, a, b, rise=rise, clearance_radius=clearance_radius, max_height=max_height,
                         payload=payload, jerk=jerk, torque=True, limits=limits, branch=branch,
-                        options=jump_options)  # fmt: skip
+                        options=jump_options, cell=cell)  # fmt: skip
         move: ArchMove | JumpMove = out.and_back()
         bound = LowerBound(2.0 * out.lower_bound.duration, out.lower_bound.joint,
                            out.lower_bound.reason + ", out and back")  # fmt: skip
@@ -680,6 +688,10 @@ def standard_cycle(
                          limits=limits, branch=branch, options=options)  # fmt: skip
         used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
         bound = _lines_bound(robot, move, a, b, rise, limits, jerk)
+        if cell is not None:
+            from .plan import clear_of
+
+            move = replace(move, distance=clear_of(robot, move.trajectory, cell))
     if wmin != wmin:  # the smallest manipulability along the traverse of the given placement
         q0 = move.trajectory.q_start
         pts = [np.array([*(a[:2] + f * (b[:2] - a[:2])), a[2], a[3]]) for f in np.linspace(0.0, 1.0, 41)]

@@ -35,13 +35,20 @@ the robot's tool position and inverse dynamics written from its Pinocchio model,
   q0 + 2 v0 h / 3 + a0 h^2 / 6, q(h). Slightly conservative where the polynomial peaks inside (0.004 % on
   the jerk-limited s1 cycle);
 - the clearance, the ceiling and the tool speed are constraints at the nodes (the clearance of each
-  node's phase or phases); the torque, costly to differentiate and seldom binding, is left out at first;
+  node's phase or phases); the torque, costly to differentiate and seldom binding, is left out of the
+  first solve; once it comes within 2 % of a limit anywhere, it is a constraint at every node from then
+  on (on both sides of each node under acceleration control, where the control steps);
 - then every interval is checked at 33 points and at the polynomial extrema: where the clearance or the
-  ceiling is missed by more than 2e-7 m, or the tool speed exceeded by more than 1e-7 relative, a
-  constraint is added at that point of that interval (its state is the polynomial of the interval's node
-  and control); where the torque comes within 2 % of a limit, constraints on both sides of the interval's
-  nodes (and at the point, if exceeded); and the problem is solved again, warm-started, at most
-  ``JumpOptions.refinements`` times.
+  ceiling is missed by more than 2e-7 m, or the tool speed or the torque exceeded by more than 1e-7
+  relative, a constraint is added at that point of that interval (its state is the polynomial of the
+  interval's node and control); and the problem is solved again, warm-started, at most
+  ``JumpOptions.refinements`` times;
+- the torque may still bulge over its limit between two constraint points (a 1e-5 excess 1 ms from the
+  nearest point was seen with a 14 kg payload). The rigid-body torque of the motion played ``k`` times
+  slower is tau_k(t) = (tau(t/k) - g(q)) / k^2 + g(q) (the velocity enters squared, the acceleration
+  once), so the smallest ``k >= 1`` that brings every torque, sampled at 256 points of every interval, to
+  its limit is found in closed form and the motion slowed by it (:func:`_torque_stretch`: a few 1e-6
+  relative at most after the refinement; every other ratio only drops, the path is the same).
 
 Among the minimum-time motions (the time is unique, the path is not: the joints that do not bind can
 move in many ways) the objective's tie-breaking terms pick the calmest (:data:`_TIE_VELOCITY`,
@@ -70,7 +77,11 @@ move takes at least the slowest joint's 1-DOF minimum time from rest to rest (th
 :func:`~scara_pin.motion.trajectory.line_optimal_duration`; with a jerk limit, ruckig's time-optimal
 jerk-limited profile). On a SCARA the quill must also rise to z_top and come back: its up and its down,
 each at least the 1-DOF rest-to-rest time (velocity and acceleration limits: at the top of its stroke the
-quill is at rest; a jerk limit only adds time).
+quill is at rest; a jerk limit only adds time). With a tool-speed limit v, the tool must travel from A to B
+through the height z_top: at least the length of the straight path A -> X -> B with X on the plane
+z = z_top (by reflection, |A - B'| with B' the mirror image of B in that plane), at most v fast. The bound
+also sizes the work before any solve (the samples of the verification: a tool speed of 1e-9 m/s is
+refused at once, exit 2, instead of running the solver to its iteration limit).
 """
 
 from __future__ import annotations
@@ -96,6 +107,7 @@ from .verify import (
     ENDPOINT_TOL,
     TOLERANCE,
     VERIFY_RATE,
+    Clearance,
     LimitViolation,
     _limits,
     jerk_vector,
@@ -107,8 +119,10 @@ from .verify import (
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
+    from ..cell import Cell, Scene
     from ..description import JointLimits
     from ..model import Robot
+    from .avoid import DistanceRow, Rows
     from .symbolic import SymbolicModel
 
 __all__ = [
@@ -152,8 +166,14 @@ _TIE_SMOOTH = 1e-6
 """Weight of the mean squared scaled control: then the smoothest controls of the joints that do not bind."""
 _LAZY = ("torque",)
 """Constraint families left out of the first solve (the torque is costly to differentiate and rarely binds):
-added on both sides of every interval where they come within _NEAR of their limit, and re-solved."""
+once one comes within _NEAR of its limit anywhere, it is constrained at every node (both sides) and re-solved.
+(Only on the intervals near the limit, as before, the solutions moved the excess from interval to interval
+until the refinements ran out: 1.06 to 3.6 times the torque limit with large acceleration limits.)"""
 _NEAR = 0.02
+_NODES = -1
+"""The interval index of a :class:`_Point` that stands for every node (both sides) of its family."""
+_STRETCH_POINTS = 256
+"""Points per interval where :func:`_torque_stretch` samples the torque."""
 _QUANTITIES = ("velocity", "acceleration", "jerk", "torque", "tool speed")
 
 
@@ -191,12 +211,15 @@ class JumpOptions:
         tolerance: IPOPT's convergence tolerance (scaled problem).
         max_iterations: per solve.
         refinements: at most this many re-solves with constraints added inside intervals.
+        avoid_iterations: with a cell, at most this many more re-solves for the obstacle distances
+            (re-linearised each time, :mod:`~scara_pin.motion.avoid`).
     """
 
     intervals: tuple[int, int, int] | None = None
     tolerance: float = 1e-10
     max_iterations: int = 3000
     refinements: int = 6
+    avoid_iterations: int = 40
 
     def __post_init__(self) -> None:
         if self.intervals is not None:
@@ -206,7 +229,7 @@ class JumpOptions:
                 raise ParameterError("intervals", self.intervals, "must be 3 integers in [1, 500]")
             object.__setattr__(self, "intervals", tuple(int(v) for v in n))
         _positive("tolerance", self.tolerance)
-        for name in ("max_iterations", "refinements"):
+        for name in ("max_iterations", "refinements", "avoid_iterations"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v <= 100_000:
                 raise ParameterError(name, v, "must be an integer in [0, 100000]")
@@ -293,6 +316,7 @@ class Leg:
         joint: the joint where that ratio is reached.
         ratio: |value| / limit there (1.0: on the limit).
         binding: every limit at >= :data:`BINDING` on the leg, with its share of the leg's time.
+        closest: with a cell, the pair that comes closest on the leg and its distance [m].
     """
 
     name: str
@@ -303,6 +327,7 @@ class Leg:
     joint: str
     ratio: float
     binding: tuple[Binding, ...] = ()
+    closest: tuple[str, float] | None = None
 
     @property
     def duration(self) -> float:
@@ -311,9 +336,12 @@ class Leg:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
-        return {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
-                "duration": self.duration, "active_limit": self.active, "joint": self.joint, "ratio": self.ratio,
-                "binding": [b.to_dict() for b in self.binding]}  # fmt: skip
+        out = {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
+               "duration": self.duration, "active_limit": self.active, "joint": self.joint, "ratio": self.ratio,
+               "binding": [b.to_dict() for b in self.binding]}  # fmt: skip
+        if self.closest is not None:
+            out["closest"] = {"pair": self.closest[0], "distance": self.closest[1]}
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -337,6 +365,9 @@ class JumpMove:
         payload: the payload carried; jerk: the jerk limits per joint, or None; tool_speed: [m/s] or None.
         lower_bound: what no motion can beat (per move; the cycle's is twice it).
         stats: how the solver got there.
+        moves: 1 (A -> B) or 2 (and back).
+        cell: the cell the move was planned in, or None.
+        distance: with a cell, the smallest verified distance of its checked pairs, which and when.
     """
 
     trajectory: Trajectory
@@ -360,6 +391,8 @@ class JumpMove:
     lower_bound: LowerBound
     stats: SolverStats
     moves: int = 1
+    cell: Cell | None = None
+    distance: Clearance | None = None
 
     @property
     def duration(self) -> float:
@@ -380,7 +413,7 @@ class JumpMove:
             raise InvalidInputError("and_back needs a jump move")
         T = self.trajectory.duration
         back = [Leg(leg.name if leg.name == Phase.TRAVERSE.value else _MIRROR[leg.name], 1, 2 * T - leg.t_end,
-                    2 * T - leg.t_start, leg.active, leg.joint, leg.ratio, leg.binding)
+                    2 * T - leg.t_start, leg.active, leg.joint, leg.ratio, leg.binding, leg.closest)
                 for leg in reversed(self.legs)]  # fmt: skip
         traj = Trajectory((piece, piece.reversed()))
         return replace(self, trajectory=traj, legs=self.legs + tuple(back), moves=2)
@@ -417,6 +450,7 @@ class _Problem:
     tool_speed: float | None
     N: tuple[int, int, int]
     t_scale: float
+    scene: Scene | None = None
 
     @property
     def order(self) -> int:
@@ -439,7 +473,10 @@ class _Problem:
 
 @dataclass(frozen=True)
 class _Point:
-    """A constraint point inside interval ``k`` at fraction ``sigma`` of it, for one family of constraints."""
+    """A constraint point inside interval ``k`` at fraction ``sigma`` of it, for one family of constraints.
+
+    ``k`` = :data:`_NODES`: the family at every node instead (both sides; a lazy family, :data:`_LAZY`).
+    """
 
     k: int
     sigma: float
@@ -468,7 +505,9 @@ class _Transcription:
     intervals).
     """
 
-    def __init__(self, prob: _Problem, points: tuple[_Point, ...], options: JumpOptions) -> None:
+    def __init__(self, prob: _Problem, points: tuple[_Point, ...], options: JumpOptions,
+                 distance_rows: tuple[DistanceRow, ...] = (), avoid: Rows | None = None,
+                 resolve: bool = False) -> None:  # fmt: skip
         import casadi as ca
 
         self.prob = P = prob
@@ -478,10 +517,7 @@ class _Transcription:
         T = ca.SX.sym("T", 3)
         X = ca.SX.sym("X", order * dof, Nt + 1)
         U = ca.SX.sym("U", dof, Nt)
-        Xp = ca.repmat(ca.DM(sx.ravel()), 1, Nt + 1) * X
-        Up = ca.repmat(ca.DM(P.control_limit), 1, Nt) * U
-        h = ca.horzcat(*[ca.repmat(T[p] * (P.t_scale / N[p]), 1, N[p]) for p in range(3)])  # 1 x Nt
-        rows = [Xp[i * dof : (i + 1) * dof, :] for i in range(order)]
+        h, rows, Up = self._physical(T, X, U)
         g: list[Any] = []
         lb: list[np.ndarray] = []
         ub: list[np.ndarray] = []
@@ -533,9 +569,16 @@ class _Transcription:
         if P.tool_speed is not None:
             v = P.sym.tool_velocity.map(Nt + 1)(rows[0], rows[1])
             add(ca.sum1(v * v) / P.tool_speed**2, -np.inf, 1.0)
+        if P.effort is not None and _Point(_NODES, 0.0, "torque") in points:  # at every node
+            # acceleration control: both sides (each interval's start and end with its own control); jerk: once
+            sides = [(slice(0, Nt), Up), (slice(1, Nt + 1), Up)] if order == 2 else [(slice(0, Nt + 1), rows[2])]
+            for cols, acc in sides:
+                m = cols.stop - cols.start
+                tau_ = P.sym.inverse_dynamics.map(m)(rows[0][:, cols], rows[1][:, cols], acc)
+                add(tau_ / ca.repmat(ca.DM(P.effort), 1, m), -1.0, 1.0)
         phase_of = P.phase_of()
         for family in ("geometry", "torque", "tool speed"):
-            pts = [pt for pt in points if pt.family == family]
+            pts = [pt for pt in points if pt.family == family and pt.k != _NODES]
             if not pts:
                 continue
             ks = [pt.k for pt in pts]
@@ -551,11 +594,18 @@ class _Transcription:
             elif family == "tool speed" and P.tool_speed is not None:
                 v = P.sym.tool_velocity.map(n)(st[0], st[1])
                 add(ca.sum1(v * v) / P.tool_speed**2, -np.inf, 1.0)
+        self.n_rows = len(distance_rows)
         w = ca.vertcat(T, ca.vec(X), ca.vec(U))
         G = ca.vertcat(*g)
         # minimum time; then, as tie-breakers among the minimum-time motions, the lowest arch and smooth controls
         f = (ca.sum1(T) + _TIE_VELOCITY * ca.sumsqr(X[dof : 2 * dof, :]) / (dof * (Nt + 1))
              + _TIE_SMOOTH * ca.sumsqr(U) / (dof * Nt))  # fmt: skip
+        nlp = {"x": w, "f": f, "g": G}
+        if distance_rows and avoid is not None:
+            nlp = self._with_rows(nlp, distance_rows, avoid)
+            lb.append(np.zeros(len(distance_rows)))
+            ub.append(np.full(len(distance_rows), np.inf))
+            G = nlp["g"]
         self.n_x, self.n_g = int(w.shape[0]), int(G.shape[0])
         self.lbg, self.ubg = np.concatenate(lb), np.concatenate(ub)
         lbx_X = np.empty((order * dof, Nt + 1))
@@ -572,12 +622,67 @@ class _Transcription:
         opts: dict[str, Any] = {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False,
                                 "ipopt.tol": options.tolerance, "ipopt.constr_viol_tol": options.tolerance,
                                 "ipopt.max_iter": options.max_iterations, "ipopt.mu_strategy": "adaptive"}  # fmt: skip
-        self.solver = ca.nlpsol("jump", "ipopt", {"x": w, "f": f, "g": G}, opts)
+        if resolve:  # a re-solve from the last solution (obstacle rows re-set): it converges fast or not at all
+            from .avoid import RESOLVE_ITERATIONS
+
+            opts["ipopt.max_iter"] = min(options.max_iterations, RESOLVE_ITERATIONS)
+        self.solver = ca.nlpsol("jump", "ipopt", nlp, opts)
         self.shape = (order, dof, Nt)
 
-    def solve(self, x0: np.ndarray, lam_x: np.ndarray | None, lam_g: np.ndarray | None) -> dict[str, Any]:
-        """One IPOPT solve from x0 (and multipliers, when warm-starting)."""
-        kwargs: dict[str, Any] = {"x0": x0, "lbx": self.lbx, "ubx": self.ubx, "lbg": self.lbg, "ubg": self.ubg}
+    def _physical(self, T: Any, X: Any, U: Any) -> tuple[Any, list[Any], Any]:
+        """(interval lengths (1, Nt), state rows [q, qd(, qdd)] (dof, Nt + 1), controls (dof, Nt)) in SI units."""
+        import casadi as ca
+
+        P = self.prob
+        order, dof, N = P.order, P.robot.dof, P.N
+        Nt = sum(N)
+        Xp = ca.repmat(ca.DM(P.state_scale.ravel()), 1, Nt + 1) * X
+        Up = ca.repmat(ca.DM(P.control_limit), 1, Nt) * U
+        h = ca.horzcat(*[ca.repmat(T[p] * (P.t_scale / N[p]), 1, N[p]) for p in range(3)])  # 1 x Nt
+        return h, [Xp[i * dof : (i + 1) * dof, :] for i in range(order)], Up
+
+    def _with_rows(self, nlp: dict[str, Any], distance_rows: tuple[DistanceRow, ...], avoid: Rows) -> dict[str, Any]:
+        """The NLP with the obstacle rows (:mod:`~scara_pin.motion.avoid`) appended to its constraints.
+
+        Each row keeps its pair's first shape beyond a separating plane taken from the last solution: the
+        planes are parameters (9 per row), re-set after every solve without rebuilding the problem. The forward
+        kinematics of each row's point is written once (mapped over the points), and each pair's separation
+        function is called on it.
+        """
+        import casadi as ca
+
+        from .avoid import BUFFER, DISTANCE_SCALE
+
+        P = self.prob
+        order, dof = P.order, P.robot.dof
+        Nt = sum(P.N)
+        w = nlp["x"]
+        Pd = ca.SX.sym("Pd", len(distance_rows) * avoid.PARAMETERS)
+        nX = order * dof * (Nt + 1)
+        h, rows, Up = self._physical(w[:3], ca.reshape(w[3 : 3 + nX], order * dof, Nt + 1),
+                                     ca.reshape(w[3 + nX :], dof, Nt))  # fmt: skip
+        par = ca.reshape(Pd, avoid.PARAMETERS, len(distance_rows))
+        keys = sorted({(r.k, r.sigma) for r in distance_rows})
+        where = {key: c for c, key in enumerate(keys)}
+        ks = [k for k, _ in keys]
+        tau = ca.repmat(h[0, ks] * ca.DM([sg for _, sg in keys]).T, dof, 1)
+        qs = _propagate(order, [r[:, ks] for r in rows], Up[:, ks], tau)[0]  # dof x points
+        frames = P.sym.joint_frames.map(len(keys))(qs)  # 12 x (njoints * points)
+        nj = frames.shape[1] // len(keys)
+        seps = []
+        for i, r in enumerate(distance_rows):
+            ja, jb = avoid.joints(r.pair)
+            c = where[(r.k, r.sigma)]
+            seps.append(avoid.function(r.pair)(frames[:, c * nj + ja], frames[:, c * nj + jb], par[0:3, i],
+                                               par[3:6, i], par[6:9, i]))  # fmt: skip
+        g_rows = (ca.vertcat(*seps) - (avoid.margin + BUFFER)) / DISTANCE_SCALE
+        return {"x": w, "f": nlp["f"], "g": ca.vertcat(nlp["g"], g_rows), "p": Pd}
+
+    def solve(self, x0: np.ndarray, lam_x: np.ndarray | None, lam_g: np.ndarray | None,
+              params: np.ndarray | None = None) -> dict[str, Any]:  # fmt: skip
+        """One IPOPT solve from x0 (and multipliers, when warm-starting); ``params``: the distance rows' (g, c)."""
+        kwargs: dict[str, Any] = {"x0": x0, "lbx": self.lbx, "ubx": self.ubx, "lbg": self.lbg, "ubg": self.ubg,
+                                  "p": np.zeros(0) if params is None else params}  # fmt: skip
         if lam_x is not None:
             kwargs["lam_x0"] = lam_x
         if lam_g is not None:
@@ -621,6 +726,7 @@ def jump_move(
     end: ArrayLike | None = None,
     branch: str | None = None,
     options: JumpOptions | None = None,
+    cell: Cell | None = None,
 ) -> JumpMove:
     """The time-optimal jump from rest at ``pose_from`` to rest at ``pose_to`` (module docstring), verified.
 
@@ -641,9 +747,13 @@ def jump_move(
         branch: the IK branch of both ends ("right"/"left" for a SCARA; default: the start's, or the
             solution nearest the middle of the joint ranges).
         options: grid and solver options.
+        cell: obstacles, the carried part and the margin (:class:`~scara_pin.cell.Cell`): every checked pair
+            stays at least the margin apart (:mod:`~scara_pin.motion.avoid`), the joint path free to go
+            around or over.
 
     Raises:
-        ParameterError, InvalidInputError: bad input (exit 2), e.g. poses closer than 2 R horizontally.
+        ParameterError, InvalidInputError: bad input (exit 2), e.g. poses closer than 2 R horizontally; a start
+            or goal in collision (:class:`~scara_pin.cell.InCollisionError`, naming the pair).
         InfeasibleError: a pose or the traverse height out of reach, a ceiling below the needed height
             (exit 3); :class:`JumpError` (exit 3): the solver failed, with its reason.
     """
@@ -669,14 +779,22 @@ def jump_move(
         raise InfeasibleError(f"max_height {ceiling:.6g} m is below the height the clearance needs: z_top = "
                               f"{z_top:.6g} m (rise {rise:.6g} m above the higher pose)")  # fmt: skip
     qA, qB = _endpoints(robot, A, B, start, end, branch)
+    scene = None
+    if cell is not None:
+        from ..cell import scene as make_scene
+
+        scene = make_scene(robot, cell)
+        scene.check(qA, "the start (pose_from)")
+        scene.check(qB, "the goal (pose_to)")
     tops = (_top(robot, A, z_top, qA, "pose_from", rise), _top(robot, B, z_top, qB, "pose_to", rise))
     # size the work before doing it: the cheap bound (no ruckig) already says how many samples it will take
-    cheap = lower_bound(robot, qA, qB, tops, lim.velocity, lim.acceleration, jv, exact_jerk=False)
+    cheap = lower_bound(robot, qA, qB, tops, lim.velocity, lim.acceleration, jv, exact_jerk=False,
+                        tool_speed=lim.tool_speed)  # fmt: skip
     check_count(f"verified samples (at least {cheap.duration:.6g} s at {VERIFY_RATE:g} Hz)",
                 2.0 * cheap.duration * VERIFY_RATE, MAX_SAMPLES,
-                "the move takes at least that long under these limits: check the velocity, acceleration and jerk "
-                "limits")  # fmt: skip
-    bound = lower_bound(robot, qA, qB, tops, lim.velocity, lim.acceleration, jv)
+                f"the move takes at least that long under these limits ({cheap.reason}): check the velocity, "
+                "acceleration, jerk and tool-speed limits")  # fmt: skip
+    bound = lower_bound(robot, qA, qB, tops, lim.velocity, lim.acceleration, jv, tool_speed=lim.tool_speed)
     loaded = with_payload(robot, payload) if torque else robot
     if lim.effort is not None:
         _holds_still(loaded, (qA, qB, *tops), lim.effort)
@@ -686,15 +804,58 @@ def jump_move(
     lim_all = robot.limits if limits is None else limits
     prob = _Problem(loaded, symbolic_model(loaded), robot, payload, limits, A, B, qA, qB, tops, z_top, R, ceiling,
                     np.array(lim_all.lower), np.array(lim_all.upper), ~np.array(robot.continuous), lim.velocity,
-                    lim.acceleration, jv, lim.effort, lim.tool_speed, N, max(bound.duration / 3.0, 1e-3))  # fmt: skip
-    piece, T, stats = _solve(prob, options)
-    traj = Trajectory((piece,))
-    check = _verify(prob, traj)
+                    lim.acceleration, jv, lim.effort, lim.tool_speed, N, max(bound.duration / 3.0, 1e-3),
+                    scene)  # fmt: skip
+    if scene is None:
+        piece, T, stats = _solve(prob, options)
+        traj = Trajectory((piece,))
+        check = _verify(prob, traj)
+    else:
+        piece, T, stats, traj, check = _solve_in_cell(prob, options, scene, ceiling)
     legs = _legs(prob, check, T)
     stats = replace(stats, seconds=time.perf_counter() - t0)
     return JumpMove(traj, A, B, qA, qB, rise, R, z_top, ceiling, (float(T[0]), float(T[1]), float(T[2])), legs,
                     check.ratios, check.clearance_error, check.peak, check.bulge, payload,
-                    None if jv is None else tuple(jv.tolist()), lim.tool_speed, bound, stats)  # fmt: skip
+                    None if jv is None else tuple(jv.tolist()), lim.tool_speed, bound, stats,
+                    cell=cell, distance=check.distance)  # fmt: skip
+
+
+def _solve_in_cell(prob: _Problem, options: JumpOptions, scene: Scene, ceiling: float | None
+                   ) -> tuple[PolynomialPiece, np.ndarray, SolverStats, Trajectory, _Check]:  # fmt: skip
+    """The best warm starts around or over the obstacles, each solved and verified; the fastest wins."""
+    from .avoid import RESOLVE_ITERATIONS, SECOND_WITHIN, blocked, candidates, solve_avoiding
+
+    found = candidates(scene, prob.qA, prob.qB, prob.q_tops, prob.A, prob.B, prob.z_top, ceiling, prob.velocity,
+                       prob.acceleration)  # fmt: skip
+    if found[0].clearance < 0.0:  # no way tried clears: one attempt from the least colliding, on a short budget
+        short = replace(options, max_iterations=min(options.max_iterations, RESOLVE_ITERATIONS))
+        try:
+            piece, T, stats = solve_avoiding(prob, short, found[0].waypoints)
+            traj = Trajectory((piece,))
+            return piece, T, stats, traj, _verify(prob, traj)
+        except JumpError as exc:
+            raise blocked(scene, found, exc.status) from None
+    tries = found[:1] + [c for c in found[1:2] if c.way != found[0].way and c.duration <= SECOND_WITHIN
+                         * found[0].duration]  # fmt: skip
+    best = None
+    error: Exception | None = None
+    iterations = 0
+    for cand in tries:
+        logger.debug("jump in a cell: warm start %s (%.4g s, clearance %.3g m)", cand.way, cand.duration,
+                     cand.clearance)  # fmt: skip
+        try:
+            piece, T, stats = solve_avoiding(prob, options, cand.waypoints)
+            traj = Trajectory((piece,))
+            check = _verify(prob, traj)
+        except JumpError as exc:
+            error = exc
+            continue
+        iterations += stats.iterations
+        if best is None or traj.duration < best[3].duration:
+            best = (piece, T, stats, traj, check)
+    if best is None:
+        raise error if error is not None else JumpError("Not_Solved", "no warm start")
+    return best[0], best[1], replace(best[2], iterations=iterations), best[3], best[4]
 
 
 def _given(robot: Robot, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarray:
@@ -813,6 +974,7 @@ def lower_bound(
     jerk: np.ndarray | None = None,
     *,
     exact_jerk: bool = True,
+    tool_speed: float | None = None,
 ) -> LowerBound:
     """The slowest joint's own minimum time for what it must do (module docstring, "Lower bound").
 
@@ -825,6 +987,7 @@ def lower_bound(
         acceleration: per-joint limits [rad/s^2, m/s^2].
         jerk: per-joint limits [rad/s^3, m/s^3], or None.
         exact_jerk: the jerk-limited 1-DOF times from ruckig (False: a cheaper, lower bound of them).
+        tool_speed: [m/s] a limit of the tool origin's speed, or None (module docstring, "Lower bound").
     """
     quill = _quill(robot, q_from)
     best = LowerBound(0.0, JOINT_NAMES[0], "no joint moves")
@@ -843,38 +1006,63 @@ def lower_bound(
             why = f"{JOINT_NAMES[j]} alone, {abs(d):.6g} {unit} from rest to rest, {kind} limits"
         if t > best.duration:
             best = LowerBound(t, JOINT_NAMES[j], why)
+    if tool_speed is not None:
+        a, b = robot.tool_pose(q_from)[:3], robot.tool_pose(q_to)[:3]
+        z_top = max(float(np.asarray(robot.tool_pose(q))[2]) for q in q_tops)
+        length = math.hypot(float(np.hypot(*(b[:2] - a[:2]))), max(0.0, z_top - a[2]) + max(0.0, z_top - b[2]))
+        t = length / tool_speed
+        if t > best.duration:
+            best = LowerBound(t, "tool", f"the tool alone, at least {length:.6g} m (up to the clearance height and "
+                              f"down, straight) at {tool_speed:.6g} m/s")  # fmt: skip
     return best
 
 
 # ---------------------------------------------------------------------------------------------- solving
-def _warm_start(prob: _Problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Joint lines A -> above A -> above B -> B, each with the quintic law over its fastest duration."""
+def _warm_start(prob: _Problem, waypoints: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Joint lines A -> above A -> [via points] -> above B -> B, each with the quintic law over its fastest duration.
+
+    The lift is the first line, the descent the last, the traverse the lines between (its nodes evenly spaced
+    in time over them).
+    """
     order = prob.order
-    ends = (prob.qA, prob.q_tops[0], prob.q_tops[1], prob.qB)
+    ends = np.array((prob.qA, prob.q_tops[0], prob.q_tops[1], prob.qB)) if waypoints is None else waypoints
+    groups = [ends[:2], ends[1:-1], ends[-2:]]
     T = np.empty(3)
     states: list[np.ndarray] = []
     for p in range(3):
-        q0, q1 = ends[p], ends[p + 1]
-        moving = not np.array_equal(q0, q1)
-        T[p] = line_optimal_duration(q0, q1, prob.velocity, prob.acceleration) * 1.2 if moving else 0.1 * prob.t_scale
-        x = np.linspace(0.0, 1.0, prob.N[p] + 1)
-        s = x**3 * (10.0 - 15.0 * x + 6.0 * x * x)
-        sd = 30.0 * x * x * (1.0 - x) ** 2 / T[p]
-        sdd = 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / T[p] ** 2
-        dq = q1 - q0
-        rows = [q0 + s[:, None] * dq, sd[:, None] * dq, sdd[:, None] * dq][:order]
-        states.append(np.stack(rows, axis=1)[(1 if p else 0) :])
+        lines = list(zip(groups[p][:-1], groups[p][1:]))
+        durations = np.array([line_optimal_duration(q0, q1, prob.velocity, prob.acceleration) * 1.2
+                              if not np.array_equal(q0, q1) else 0.0 for q0, q1 in lines])  # fmt: skip
+        T[p] = durations.sum() if durations.sum() > 0.0 else 0.1 * prob.t_scale
+        t = np.linspace(0.0, T[p], prob.N[p] + 1)
+        starts = np.concatenate([[0.0], np.cumsum(durations)[:-1]])
+        rows = [np.zeros((len(t), len(prob.qA))) for _ in range(3)]
+        for (q0, q1), t0, d in zip(lines, starts, durations):
+            sel = (t >= t0) & (t <= t0 + d) if d > 0.0 else np.zeros(len(t), dtype=bool)
+            x = (t[sel] - t0) / d if d > 0.0 else t[sel]
+            dq = q1 - q0
+            rows[0][sel] = q0 + (x**3 * (10.0 - 15.0 * x + 6.0 * x * x))[:, None] * dq
+            if d > 0.0:
+                rows[1][sel] = (30.0 * x * x * (1.0 - x) ** 2 / d)[:, None] * dq
+                rows[2][sel] = (60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / d**2)[:, None] * dq
+        if not lines or durations.sum() == 0.0:
+            rows[0][:] = groups[p][0]
+        states.append(np.stack(rows[:order], axis=1)[(1 if p else 0) :])
     X = np.concatenate(states)
     h = np.repeat(T / np.array(prob.N), prob.N)
     U = np.diff(X[:, order - 1], axis=0) / h[:, None]
     return T, X, U
 
 
-def _solve(prob: _Problem, options: JumpOptions) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:
-    """Solve, rebuild exactly, refine where a constraint fails between nodes (module docstring)."""
+def _solve(prob: _Problem, options: JumpOptions, waypoints: np.ndarray | None = None
+           ) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:  # fmt: skip
+    """Solve, rebuild exactly, refine where a constraint fails between nodes (module docstring).
+
+    ``waypoints``: the warm start's joint path (default: A, above A, above B, B; :func:`_warm_start`).
+    """
     points: tuple[_Point, ...] = ()
     tr = _Transcription(prob, points, options)
-    x0 = tr.pack(*_warm_start(prob))
+    x0 = tr.pack(*_warm_start(prob, waypoints))
     lam_x: np.ndarray | None = None
     lam_g: np.ndarray | None = None
     iterations = solves = 0
@@ -886,7 +1074,7 @@ def _solve(prob: _Problem, options: JumpOptions) -> tuple[PolynomialPiece, np.nd
             raise JumpError(sol["status"], _failure(sol["status"], options))
         T, X, U = tr.unpack(sol["x"])
         piece = _rebuild(prob, T, U)
-        new = [p for p in _violations(prob, piece, T) if p not in points]
+        new = [p for p in _violations(prob, piece, T, points) if p not in points]
         if not new or solves > options.refinements:
             break
         points = points + tuple(new)
@@ -894,6 +1082,10 @@ def _solve(prob: _Problem, options: JumpOptions) -> tuple[PolynomialPiece, np.nd
         tr = _Transcription(prob, points, options)
         x0, lam_x = sol["x"], sol["lam_x"]
         lam_g = np.concatenate([sol["lam_g"], np.zeros(tr.n_g - n_old)])
+    stretch = _torque_stretch(prob, piece)
+    if stretch > 1.0:  # the torque bulging over its limit between constraint points: the same motion, slower
+        logger.debug("jump: torque between the constraint points: %.9g times slower", stretch)
+        piece, T = piece.scaled(stretch), T * stretch
     stats = SolverStats(sol["status"], iterations, solves, prob.N, tr.n_x, tr.n_g, 0.0)
     logger.debug("jump: %s", stats)
     return piece, T, stats
@@ -944,8 +1136,13 @@ def _integrate(prob: _Problem, h: np.ndarray, U: np.ndarray) -> np.ndarray:
     return X
 
 
-def _violations(prob: _Problem, piece: PolynomialPiece, T: np.ndarray) -> list[_Point]:
-    """Interior points where a constraint not linear in time fails by more than _REFINE_RATIO (worst per interval)."""
+def _violations(prob: _Problem, piece: PolynomialPiece, T: np.ndarray, points: tuple[_Point, ...] = ()) -> list[_Point]:
+    """The new constraint points (``points``: those already there) of a solution.
+
+    Interior points where a constraint not linear in time fails by more than _REFINE_RATIO (the worst per
+    interval); a lazy family near its limit anywhere: at every node (and its interior points only from the
+    next round: the nodes alone may be enough).
+    """
     n = len(piece.breaks) - 1
     h = np.diff(piece.breaks)
     sigma = np.arange(_CHECK_POINTS + 1) / _CHECK_POINTS  # both ends too: the torque depends on each side's control
@@ -973,17 +1170,41 @@ def _violations(prob: _Problem, piece: PolynomialPiece, T: np.ndarray) -> list[_
         excess["tool speed"] = np.linalg.norm(v, axis=1) / prob.tool_speed - 1.0
     out: list[_Point] = []
     for family, e in excess.items():
-        lazy = family in _LAZY  # not at the nodes unless added: both sides of every interval near its limit
+        if family in _LAZY and _Point(_NODES, 0.0, family) not in points:
+            if float(np.max(e)) > -_NEAR:  # near its limit somewhere: at every node from now on
+                out.append(_Point(_NODES, 0.0, family))
+            continue
         limit = _REFINE_GEOMETRY if family == "geometry" else _REFINE_RATIO
-        bad = e > (-_NEAR if lazy else limit)
+        bad = e > limit
         for kk in np.unique(k[bad]):
             sel = np.nonzero(bad & (k == kk))[0]
-            worst = sel[int(np.argmax(e[sel]))]
-            sig = {0.0, 1.0} if lazy else set()
-            if e[worst] > limit:
-                sig.add(float(s[worst]))
-            out += [_Point(int(kk), sg, family) for sg in sorted(sig)]
+            out.append(_Point(int(kk), float(s[sel[int(np.argmax(e[sel]))]]), family))
     return out
+
+
+def _torque_stretch(prob: _Problem, piece: PolynomialPiece) -> float:
+    """The least k >= 1 with every torque of ``piece`` played k times slower within its limit (module docstring).
+
+    Sampled at :data:`_STRETCH_POINTS` + 1 points of every interval (its own acceleration at both ends).
+    With d = tau - g (the dynamic part) and g the static load at a sample, |d / k^2 + g| <= E needs
+    k^2 >= d / (E - g) if d > 0, k^2 >= -d / (E + g) if d < 0; a static load at or above the limit cannot be
+    helped (1 is returned: the verification says why).
+    """
+    if prob.effort is None:
+        return 1.0
+    n = len(piece.breaks) - 1
+    h = np.diff(piece.breaks)
+    k = np.repeat(np.arange(n), _STRETCH_POINTS + 1)
+    s = np.tile(np.arange(_STRETCH_POINTS + 1) / _STRETCH_POINTS, n) * h[k]
+    q, qd, qdd = (piece._local(k, s, i) for i in range(3))
+    tau = np.array(prob.sym.inverse_dynamics.map(len(k))(q.T, qd.T, qdd.T)).T
+    g = np.array(prob.sym.inverse_dynamics.map(len(k))(q.T, 0.0 * qd.T, 0.0 * qdd.T)).T
+    d, E = tau - g, prob.effort[None, :]
+    if not (np.abs(tau) > E).any() or (np.abs(g) >= E).any():
+        return 1.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        need = np.where(d > 0.0, d / (E - g), np.where(d < 0.0, -d / (E + g), 0.0))
+    return float(math.sqrt(max(1.0, float(np.max(need))))) * (1.0 + 1e-12)
 
 
 def _extrema(piece: PolynomialPiece) -> tuple[np.ndarray, np.ndarray]:
@@ -1020,6 +1241,7 @@ class _Check:
     clearance_error: float
     peak: float
     bulge: float
+    distance: Clearance | None = None
 
 
 def _verify(prob: _Problem, traj: Trajectory) -> _Check:
@@ -1039,7 +1261,8 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     lim = _limits(prob.base, prob.limits, prob.tool_speed, prob.effort is not None)
     try:
         found = verify(prob.base, traj, limits=prob.limits, jerk=prob.jerk, torque=prob.effort is not None,
-                       payload=prob.payload, tool_speed=prob.tool_speed, q_start=prob.qA, q_end=prob.qB).check()
+                       payload=prob.payload, tool_speed=prob.tool_speed, q_start=prob.qA, q_end=prob.qB,
+                       scene=prob.scene).check()
     except LimitViolation as exc:
         raise JumpError("VerificationFailed", exc.reason) from None
     T = traj.duration
@@ -1089,7 +1312,8 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     u = prob.B[:2] - prob.A[:2]
     u = u / np.linalg.norm(u)
     bulge = float(np.max(np.abs((poses[:, 0] - prob.A[0]) * u[1] - (poses[:, 1] - prob.A[1]) * u[0])))
-    return _Check(t, on_grid, table, worst, clearance_error, float(np.max(poses[:, 2]) - prob.z_top), bulge)
+    return _Check(t, on_grid, table, worst, clearance_error, float(np.max(poses[:, 2]) - prob.z_top), bulge,
+                  found.clearance)
 
 
 def _legs(prob: _Problem, check: _Check, T: np.ndarray) -> tuple[Leg, ...]:
@@ -1113,5 +1337,13 @@ def _legs(prob: _Problem, check: _Check, T: np.ndarray) -> tuple[Leg, ...]:
                     binding.append(Binding(name, who, top, share))
         binding.sort(key=lambda x: -x.share)
         who = "tool" if best[0] == "tool speed" else JOINT_NAMES[best[1]]
-        legs.append(Leg(phase.value, 0, float(cuts[p]), float(cuts[p + 1]), best[0], who, best[2], tuple(binding)))
+        closest = None
+        if check.distance is not None and prob.scene is not None:
+            ts, ds, ps = check.distance.samples
+            on = (ts >= cuts[p]) & (ts <= cuts[p + 1])
+            if on.any():
+                i = int(np.argmin(np.where(on, ds, np.inf)))
+                closest = (prob.scene.pairs[int(ps[i])].label, float(ds[i]))
+        legs.append(Leg(phase.value, 0, float(cuts[p]), float(cuts[p + 1]), best[0], who, best[2], tuple(binding),
+                        closest))  # fmt: skip
     return tuple(legs)

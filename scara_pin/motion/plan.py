@@ -34,12 +34,15 @@ from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from . import trajectory as tr
 
 if TYPE_CHECKING:
+    from ..cell import Cell
+    from ..description import JointLimits
     from ..model import Robot
     from .cycle import ArchMove
     from .jump import JumpMove
     from .payload import Payload
+    from .verify import Clearance
 
-__all__ = ["Method", "MotionPlan", "MotionRequest", "plan_motion"]
+__all__ = ["Method", "MotionPlan", "MotionRequest", "clear_of", "plan_motion"]
 
 class Method(enum.Enum):
     """How a move is made; the value is the sentence ``scara-pin traj`` prints."""
@@ -81,6 +84,11 @@ class MotionRequest:
         path: "jump" (the time-optimal jump, the joint path free) or "lines" (the straight-leg arch).
         clearance_radius: [m] the jump's clearance radius; None: the standard one (path "jump").
         max_height: [m] a ceiling for the tool's z during the arch, or None.
+        cell: obstacles, the carried part and the margin (:mod:`scara_pin.cell`), or None. The jump plans
+            around and over them; every other move's path is fixed: it is verified (every checked pair at every
+            10 kHz sample) and refused if it comes closer than the margin.
+        limits: joint limits instead of ``robot.limits`` for the time-optimal moves and the jump (a speed
+            override scales them); None: the robot's.
     """
 
     start_q: np.ndarray | None = None
@@ -100,6 +108,8 @@ class MotionRequest:
     path: str = "jump"
     clearance_radius: float | None = None
     max_height: float | None = None
+    cell: Cell | None = None
+    limits: JointLimits | None = None
 
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
@@ -132,6 +142,12 @@ class MotionRequest:
                                     "vertically")  # fmt: skip
         if not self.arch and (self.rise, self.blend, self.clearance_radius, self.max_height) != (None,) * 4:
             raise InvalidInputError("rise, blend, clearance radius and max height shape an arch move: set arch")
+        if self.limits is not None and self.duration is not None:
+            raise InvalidInputError("limits shape a time-optimal move: a move of a given duration is only checked "
+                                    "against the robot's")  # fmt: skip
+        if self.limits is not None and self.arch and self.path == "lines":
+            raise InvalidInputError("limits other than the robot's apply to the jump (path 'jump'), not the "
+                                    "straight-leg arch")  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,22 +159,53 @@ class MotionPlan:
         method: how it was made.
         robot: the robot it was planned for (the request's payload attached, when one was given).
         arch: the arch move (its legs, ratios and payload) for ``Method.JUMP`` and ``Method.ARCH``; else None.
+        clearance: with a cell, the smallest verified distance of its checked pairs, which and when.
     """
 
     trajectory: tr.Trajectory
     method: Method
     robot: Robot
     arch: ArchMove | JumpMove | None = None
+    clearance: Clearance | None = None
 
 
 def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
     """Choose the method for ``request`` (see the module docstring) and make the trajectory.
 
+    With a cell (``request.cell``) the jump plans around and over the obstacles; any other move is verified
+    against the cell (:func:`clear_of`) and refused if it comes closer than the margin.
+
     Raises:
         InvalidInputError: a straight line or an arch asked of a robot other than a SCARA, an arch with
-            ``linear``, a payload without ``torque``.
-        InfeasibleError: a pose out of reach, a path the robot cannot follow, or a timing failure.
+            ``linear``, a payload without ``torque``; a start or end in collision (naming the pair).
+        InfeasibleError: a pose out of reach, a path the robot cannot follow, a timing failure, or a fixed path
+            that comes closer than the cell's margin (naming the pair, when and where).
     """
+    plan = _plan(robot, request)
+    if request.cell is None or plan.method is Method.JUMP:
+        return plan
+    from dataclasses import replace
+
+    return replace(plan, clearance=clear_of(robot, plan.trajectory, request.cell))
+
+
+def clear_of(robot: Robot, trajectory: tr.Trajectory, cell: Cell) -> Clearance | None:
+    """The smallest distance of ``cell``'s checked pairs along ``trajectory`` (the 10 kHz verifier's), or an error.
+
+    Raises:
+        InCollisionError: the start or the end is closer than the margin (exit 2, naming the pair).
+        LimitViolation: the path comes closer than the margin (exit 3, naming the pair, when and where).
+    """
+    from ..cell import scene
+    from .verify import verify
+
+    sc = scene(robot, cell)
+    sc.check(trajectory.q_start, "the start")
+    sc.check(trajectory.q_end, "the end")
+    return verify(robot, trajectory, scene=sc).check_clearance().clearance
+
+
+def _plan(robot: Robot, request: MotionRequest) -> MotionPlan:
     if request.linear and robot.kind != "scara":
         raise InvalidInputError(f"a straight tool line (--linear) is SCARA-only for now; robot {robot.name!r} is a "
                                 f"{robot.kind} (joint-space --duration and TOPP-RA timing work)")  # fmt: skip
@@ -185,10 +232,13 @@ def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Traj
     if request.jerk is not None:
         from .jerk import time_optimal_jerk
 
+        if request.limits is not None:
+            raise InvalidInputError("limits other than the robot's are not supported with a jerk limit")
         return time_optimal_jerk(robot, path, request.jerk, torque=request.torque).trajectory  # type: ignore[arg-type]
     from .timing import time_optimal
 
-    return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque)  # type: ignore[arg-type]
+    return time_optimal(robot, path, tool_speed=request.tool_speed, torque=request.torque,  # type: ignore[arg-type]
+                        limits=request.limits)  # fmt: skip
 
 
 def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -217,7 +267,7 @@ def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
             return MotionPlan(tr.timed(path, request.duration), Method.JOINT_SPLINE_QUINTIC, robot)
         return MotionPlan(tr.quintic(q_from, q_to, request.duration), Method.JOINT_QUINTIC, robot)
     if not vias and request.tool_speed is None and not request.torque and request.jerk is None:
-        lim = robot.limits
+        lim = robot.limits if request.limits is None else request.limits
         return MotionPlan(tr.trapezoidal(q_from, q_to, lim.velocity, lim.acceleration), Method.JOINT_TRAPEZOID, robot)
     method = Method.JOINT_TOPPRA if request.jerk is None else Method.JOINT_JERK
     return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), method, robot)
@@ -248,8 +298,8 @@ def _jump(robot: Robot, request: MotionRequest) -> MotionPlan:
                      clearance_radius=STANDARD_CLEARANCE if request.clearance_radius is None
                      else request.clearance_radius, max_height=request.max_height, payload=request.payload,
                      torque=request.torque, tool_speed=request.tool_speed, start=request.start_q,
-                     end=request.end_q, jerk=request.jerk)  # fmt: skip
-    return MotionPlan(move.trajectory, Method.JUMP, robot, move)
+                     end=request.end_q, jerk=request.jerk, limits=request.limits, cell=request.cell)  # fmt: skip
+    return MotionPlan(move.trajectory, Method.JUMP, robot, move, move.distance)
 
 
 def _pose_to_q(robot: Robot, pose: np.ndarray | None, near: np.ndarray, what: str) -> np.ndarray:

@@ -48,9 +48,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import number_text
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, brief
 from ..limits import MAX_POINTS, MAX_POINTS_BYTES, check_input_file, read_text
+from ..units import number_text
 
 if TYPE_CHECKING:
     from ..model import Robot
@@ -81,9 +81,8 @@ _POSE_NAMES = ("x", "y", "z", "yaw")
 def check_point_name(name: object) -> str:
     """``name`` if it is a valid point name (see the module docstring), else an :class:`InvalidInputError`."""
     if not isinstance(name, str) or not _NAME.fullmatch(name):
-        shown = repr(name) if not isinstance(name, str) or len(name) <= 40 else repr(name[:40] + "...")
-        raise InvalidInputError(f"point name {shown} must be a letter then up to 31 letters, digits, _, - or . "
-                                "(e.g. P1, pick_2)")  # fmt: skip
+        raise InvalidInputError(f"point name {brief(name, 44)} must be a letter then up to 31 letters, digits, _, - "
+                                "or . (e.g. P1, pick_2)")  # fmt: skip
     return name
 
 
@@ -196,19 +195,27 @@ class PointSet:
     def check(self, robot: Robot, origin: str = "points") -> None:
         """Refuse points that do not fit ``robot``.
 
-        Another joint count, or a written pose that is not the FK of its q on this robot (beyond
-        :data:`POSE_TOL`; the yaw compared modulo 2 pi).
+        Another joint count, a joint value the robot cannot take (beyond +/-1e6 rad or m:
+        :meth:`~scara_pin.model.Robot.check_q`), or a written pose that is not the FK of its q on this robot
+        (beyond :data:`POSE_TOL`; the yaw compared modulo 2 pi). The joint limits are not checked here: a
+        pendant shows such a point; a command that moves to it refuses it.
 
         Raises:
             InvalidInputError: naming the point and what differs.
         """
+        from ..errors import ParameterError
+
         for p in self.points:
             if p.q.shape != (robot.dof,):
                 raise InvalidInputError(f"{origin}: point {p.name} has {p.q.size} joint values; robot "
                                         f"{robot.name!r} has {robot.dof}")  # fmt: skip
+            try:
+                q = robot.check_q(p.q)
+            except ParameterError as exc:
+                raise InvalidInputError(f"{origin}: point {p.name}: {exc}") from None
             if p.pose is None:
                 continue
-            fk = robot.tool_pose(robot.check_q(p.q))
+            fk = robot.tool_pose(q)
             error = np.abs(fk - p.pose)
             error[3] = abs(math.remainder(float(fk[3] - p.pose[3]), 2 * math.pi))
             if not float(np.max(error)) <= POSE_TOL:
@@ -319,55 +326,84 @@ def parse_points(text: str, fmt: str, origin: str = "points") -> PointSet:
             return _parse_csv(text, origin)
     except InvalidInputError as exc:
         message = str(exc)
-        raise InvalidInputError(message if message.startswith(origin) else f"{origin}: {message}") from None
+        if not message.startswith(origin):
+            message = f"{origin} {message}" if message.startswith("line ") else f"{origin}: {message}"
+        raise InvalidInputError(message) from None
     raise InvalidInputError(f"points format {fmt!r} must be 'yaml' or 'csv'")
 
 
 def _parse_yaml(text: str, origin: str) -> PointSet:
-    import yaml
+    from ..description.yaml_units import load_yaml
 
-    from ..description.yaml_units import load_yaml, yaml_problem
-
-    try:
-        tree = load_yaml(text)
-    except yaml.YAMLError as exc:
-        line, problem = yaml_problem(exc)
-        where = f" line {line}" if line is not None else ""
-        raise InvalidInputError(f"{origin}{where}: not valid YAML ({problem})") from None
+    tree = load_yaml(text, origin)  # bounded (an alias bomb is refused); a YamlError names the file and line
     if not isinstance(tree, dict) or not isinstance(tree.get("points"), list):
         raise InvalidInputError("a YAML points file is a mapping with a 'points' list")
-    unknown = sorted(str(k) for k in tree if k not in ("format", "robot", "base", "tool", "points"))
+    unknown = sorted(brief(k, 40) for k in tree if k not in ("format", "robot", "base", "tool", "points"))
     if unknown:
-        raise InvalidInputError(f"unknown key(s) {', '.join(unknown)} (keys: format, robot, base, tool, points)")
+        raise InvalidInputError(f"unknown key(s) {', '.join(unknown[:10])} (keys: format, robot, base, tool, points)")
     if "format" in tree and tree["format"] != FORMAT:
-        raise InvalidInputError(f"format {tree['format']!r} is not {FORMAT!r}")
+        raise InvalidInputError(f"{_at(tree, 'format')}format {brief(tree['format'])} is not {FORMAT!r}")
     meta = {}
     for key in ("robot", "base", "tool"):
         value = tree.get(key, "")
         if not isinstance(value, str) or len(value) > 200:
-            raise InvalidInputError(f"{key} must be a name (text of at most 200 characters)")
+            raise InvalidInputError(f"{_at(tree, key)}{key} must be a name (text of at most 200 characters)")
         meta[key] = value
     items = tree["points"]
     if len(items) > MAX_POINTS:
         raise InvalidInputError(f"{len(items):,} points: above the cap of {MAX_POINTS:,} points per file")
     points = []
     for i, item in enumerate(items):
+        where = _at(items, i)
         if not isinstance(item, dict) or "name" not in item or "q" not in item:
-            raise InvalidInputError(f"point #{i + 1} must be a mapping with name and q (and optionally pose)")
-        extra = sorted(str(k) for k in item if k not in ("name", "q", "pose"))
+            raise InvalidInputError(f"{where}point #{i + 1} must be a mapping with name and q (and optionally pose)")
+        extra = sorted(brief(k, 40) for k in item if k not in ("name", "q", "pose"))
         if extra:
-            raise InvalidInputError(f"point #{i + 1}: unknown key(s) {', '.join(extra)} (keys: name, q, pose)")
-        name = check_point_name(item["name"])
-        q = np.array(_yaml_numbers(f"point {name}: q", item["q"]))
-        pose = None if item.get("pose") is None else np.array(_yaml_numbers(f"point {name}: pose", item["pose"]))
-        points.append(TaughtPoint(name, q, pose))
+            raise InvalidInputError(f"{where}point #{i + 1}: unknown key(s) {', '.join(extra[:10])} (keys: name, q, "
+                                    "pose)")  # fmt: skip
+        try:
+            name = check_point_name(item["name"])
+        except InvalidInputError as exc:
+            raise InvalidInputError(f"{_at(item, 'name')}{exc}") from None
+        q = np.array(_yaml_numbers(f"{_at(item, 'q')}point {name}: q", item["q"]))
+        pose = item.get("pose")
+        if pose is not None:
+            pose = np.array(_yaml_numbers(f"{_at(item, 'pose')}point {name}: pose", pose))
+        try:
+            points.append(TaughtPoint(name, q, pose))
+        except InvalidInputError as exc:
+            raise InvalidInputError(f"{where}{exc}") from None
     return PointSet(tuple(points), **meta)
 
 
+def _at(data: object, key: object) -> str:
+    """``"line N: "`` for the item ``key`` of yaml data (its line in the file), or ``""`` when unknown."""
+    from ..description.yaml_units import yaml_line
+
+    line = yaml_line(data, key)
+    return "" if line is None else f"line {line}: "
+
+
 def _yaml_numbers(what: str, value: object) -> list[float]:
-    """A yaml list of numbers (a unit tag left as text because it was not a number is refused here)."""
-    if not isinstance(value, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-        raise InvalidInputError(f"{what} must be a list of numbers, got {str(value)[:60]}")
+    """A yaml list of numbers, each finite and in the number grammar of the command line, else refused briefly.
+
+    The loader leaves anything outside the grammar as text (``0x1``, ``1_0``, ``0:0.5``, a unit tag on text).
+    """
+    if not isinstance(value, list):
+        raise InvalidInputError(f"{what} must be a list of finite numbers, got {brief(value)}")
+    for k, v in enumerate(value):
+        if isinstance(v, str):
+            why = "not a plain number such as 0.25, -3, 1.5e-3 (ASCII digits; no hex, _ separators or base 60)"
+        elif isinstance(v, bool) or not isinstance(v, (int, float)):
+            why = "not a number"
+        elif math.isinf(v):  # YAML's .inf, or a number beyond the float range (a 400-digit integer)
+            raise InvalidInputError(f"{what} must be a list of finite numbers; value {k + 1} is infinite or beyond the "
+                                    "float range (about 1.8e308)")  # fmt: skip
+        elif math.isnan(v):
+            why = "not finite"
+        else:
+            continue
+        raise InvalidInputError(f"{what} must be a list of finite numbers; value {k + 1} is {brief(v, 40)}: {why}")
     return [float(v) for v in value]
 
 
@@ -402,20 +438,23 @@ def _parse_csv(text: str, origin: str) -> PointSet:
         cells = [c.strip() for c in next(csv.reader([line]))]
         if len(cells) != len(header):
             raise InvalidInputError(f"line {number}: {len(cells)} cells; the header has {len(header)}")
-        name = check_point_name(cells[0])
-        q = [_cell(number, header[i], cells[i]) for i in range(1, len(expected))]
+        try:
+            name = check_point_name(cells[0])
+        except InvalidInputError as exc:
+            raise InvalidInputError(f"line {number}: {exc}") from None
+        q = [_cell(number, name, header[i], cells[i]) for i in range(1, len(expected))]
         pose = None
         if with_pose and any(cells[len(expected):]):
-            pose = [_cell(number, header[i], cells[i]) for i in range(len(expected), len(header))]
+            pose = [_cell(number, name, header[i], cells[i]) for i in range(len(expected), len(header))]
         points.append(TaughtPoint(name, np.array(q), None if pose is None else np.array(pose)))
     return PointSet(tuple(points), **meta)
 
 
-def _cell(line: int, column: str, text: str) -> float:
+def _cell(line: int, point: str, column: str, text: str) -> float:
     value = number_text(text)
     if not math.isfinite(value):
-        shown = text if len(text) <= 30 else text[:30] + "..."
-        raise InvalidInputError(f"line {line}, column {column}: {shown!r} is not a plain finite number")
+        raise InvalidInputError(f"line {line}: point {point}: {column} = {brief(text, 40)} is not a plain finite "
+                                "number such as 0.25, -3, 1.5e-3")  # fmt: skip
     return value
 
 

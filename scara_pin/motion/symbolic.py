@@ -72,12 +72,16 @@ class SymbolicModel:
         inverse_dynamics: ``tau = inverse_dynamics(q, qd, qdd)``, (dof,) joint efforts [N m or N], as
             ``pinocchio.rnea`` (gravity included).
         dof: the number of joint values in q.
+        joint_frames: ``F = joint_frames(q)``, (12, njoints): column j is Pinocchio's ``oMi[j]`` (the rotation
+            column by column, then the translation) in the model's world frame (the root link), as
+            ``pinocchio.forwardKinematics`` gives it; column 0 is the root's identity.
     """
 
     tool_position: Any
     tool_velocity: Any
     inverse_dynamics: Any
     dof: int
+    joint_frames: Any = None
 
 
 def _joints(robot: Robot) -> tuple[list[_Joint], pin.SE3]:
@@ -193,4 +197,6 @@ def symbolic_model(robot: Robot) -> SymbolicModel:
             force[joint.parent][0] = force[joint.parent][0] + F
             force[joint.parent][1] = force[joint.parent][1] + ca.cross(lp[k], F) + lR[k] @ m_
     rnea = ca.Function("inverse_dynamics", [q, qd, qdd], [ca.vertcat(*tau)], ["q", "qd", "qdd"], ["tau"])
-    return SymbolicModel(tool, tool_velocity, rnea, dof)
+    frames = ca.Function("joint_frames", [q], [ca.horzcat(*[ca.vertcat(ca.vec(oR[k]), op[k]) for k in range(n + 1)])],
+                         ["q"], ["frames"])  # fmt: skip
+    return SymbolicModel(tool, tool_velocity, rnea, dof, frames)

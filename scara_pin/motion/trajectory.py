@@ -500,10 +500,14 @@ class Trajectory:
         qdd = np.zeros((len(tt), dof))
         k = np.clip(np.searchsorted(self.starts, tt, side="right") - 1, 0, len(self.pieces) - 1)
         inside = (tt >= 0.0) & (tt <= self.duration)
-        for j, piece in enumerate(self.pieces):
-            sel = np.nonzero((k == j) & inside)[0]
-            if len(sel):
-                q[sel], qd[sel], qdd[sel] = piece.evaluate(tt[sel] - self.starts[j])
+        # the samples grouped by piece (a stable sort: O(n log n), not a pass over the samples per piece, which a
+        # job of thousands of pieces would make quadratic)
+        idx = np.nonzero(inside)[0]
+        idx = idx[np.argsort(k[idx], kind="stable")]
+        cuts = np.searchsorted(k[idx], np.arange(len(self.pieces) + 1))
+        for j in np.nonzero(np.diff(cuts))[0]:
+            sel = idx[cuts[j] : cuts[j + 1]]
+            q[sel], qd[sel], qdd[sel] = self.pieces[j].evaluate(tt[sel] - self.starts[j])
         if not inside.all():
             last = self.pieces[-1]
             q[tt < 0.0] = self.pieces[0].evaluate(np.array([0.0]))[0][0]

@@ -24,6 +24,11 @@ and forms |value| / limit per joint for
   (:func:`~scara_pin.motion.payload.with_payload`);
 - **tool speed** |J_xyz(q) qd| when limited;
 
+- **clearance**, with a cell (``scene``, :class:`~scara_pin.cell.Scene`): the exact distance (coal) of every
+  checked pair at every sample (the grid and the extra times above: both sides of every breakpoint); the
+  smallest, its pair and time are :class:`Clearance`, and a distance below the margin by more than
+  :data:`DISTANCE_TOL` fails the check;
+
 and, separately, the **endpoints** (|q(0) - q_start|, |q(T) - q_end| when given) and the **rest** at both
 ends (|qd| / vmax, and with a jerk limit |qdd| / amax too, at t = 0 and t = T).
 
@@ -61,14 +66,17 @@ from .trajectory import Motion, Trajectory
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
+    from ..cell import Scene
     from ..model import Robot
 
 __all__ = [
+    "DISTANCE_TOL",
     "ENDPOINT_TOL",
     "PIECE_POINTS",
     "REST_TOL",
     "TOLERANCE",
     "VERIFY_RATE",
+    "Clearance",
     "JointStates",
     "LimitViolation",
     "Quantity",
@@ -92,6 +100,8 @@ VERIFY_RATE = 10_000.0
 """[Hz] the default sampling rate of :func:`verify` (ten times the 1 kHz of a controller)."""
 TOLERANCE = 1e-6
 """Relative excess of a limit that :meth:`Verification.check` tolerates: a ratio up to 1 + 1e-6 passes."""
+DISTANCE_TOL = 1e-6
+"""[m] how far below the cell's margin a verified distance may be (the planners keep margin + 1e-6)."""
 REST_TOL = 1e-9
 """|qd| / vmax (and |qdd| / amax with a jerk limit) at t = 0 and t = T above which the ends are not at rest."""
 ENDPOINT_TOL = 1e-9
@@ -143,6 +153,38 @@ class Worst:
                 "joint": None if self.joint is None else JOINT_NAMES[self.joint]}  # fmt: skip
 
 
+@dataclass(frozen=True)
+class Clearance:
+    """The smallest distance between checked pairs of a cell over the verified samples.
+
+    Attributes:
+        distance: [m] the smallest (coal's signed distance; negative: penetration).
+        margin: [m] the cell's margin.
+        pair: the pair's label (``link2 - post``).
+        time: [s] where it occurs.
+        samples: (t, smallest distance at t, index of that pair) of every verified sample, time-sorted (for
+            per-leg reports).
+    """
+
+    distance: float
+    margin: float
+    pair: str
+    time: float
+    samples: tuple[np.ndarray, np.ndarray, np.ndarray] = field(repr=False, compare=False)
+    where: tuple[float, float, float] | None = None
+
+    def describe(self) -> str:
+        """``link2 - post 1.2 mm deep at t = 0.1234 s near (290, -52, 0) mm in base (margin 2 mm)``."""
+        how = f"{-self.distance * 1e3:.4g} mm deep" if self.distance < 0 else f"{self.distance * 1e3:.4g} mm apart"
+        at = "" if self.where is None else " near (" + ", ".join(f"{v * 1e3:.1f}" for v in self.where) + ") mm in base"
+        return f"{self.pair} {how} at t = {self.time:.6g} s{at} (margin {self.margin * 1e3:g} mm)"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"distance": self.distance, "margin": self.margin, "pair": self.pair, "time": self.time,
+                "where": None if self.where is None else list(self.where)}  # fmt: skip
+
+
 class LimitViolation(InfeasibleError):
     """A verified trajectory exceeds a limit, misses an endpoint or does not rest at an end (exit code 3).
 
@@ -175,6 +217,7 @@ class Verification:
         tool_speed: the worst tool-speed ratio (None when not limited).
         start_error, end_error: [rad or m] max |q(0) - q_start|, |q(T) - q_end| (None when not given).
         rest: the largest |qd| / vmax at t = 0 and T (and |qdd| / amax with a jerk limit).
+        clearance: the smallest distance of the cell's checked pairs (None without a cell).
     """
 
     duration: float
@@ -190,6 +233,7 @@ class Verification:
     start_error: float | None = None
     end_error: float | None = None
     rest: float = 0.0
+    clearance: Clearance | None = None
     quantities: tuple[Worst, ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -224,6 +268,17 @@ class Verification:
         if not self.rest <= REST_TOL:
             raise LimitViolation(f"the trajectory is not at rest at an end: {self.rest:.3g} of a limit "
                                  f"(allowed {REST_TOL:g})")  # fmt: skip
+        return self.check_clearance()
+
+    def check_clearance(self) -> Verification:
+        """Self, if no checked pair of the cell came closer than its margin (beyond :data:`DISTANCE_TOL`); else raise.
+
+        Raises:
+            LimitViolation: naming the pair, how close, when and where (exit 3).
+        """
+        c = self.clearance
+        if c is not None and not c.distance >= c.margin - DISTANCE_TOL:
+            raise LimitViolation(f"the motion comes closer than the margin: {c.describe()}")
         return self
 
 
@@ -535,6 +590,7 @@ def verify(
     rate: float = VERIFY_RATE,
     q_start: ArrayLike | None = None,
     q_end: ArrayLike | None = None,
+    scene: Scene | None = None,
 ) -> Verification:
     """Verify ``trajectory`` against the limits (module docstring); call ``.check()`` on the result to enforce.
 
@@ -549,6 +605,8 @@ def verify(
         rate: [Hz] of the verified grid.
         q_start: the configuration the trajectory must start at, optional.
         q_end: the configuration it must end at, optional.
+        scene: a robot in its cell (:func:`scara_pin.cell.scene`): every checked pair's distance at every
+            sample, against the cell's margin.
 
     Raises:
         ParameterError: a limit is NaN, zero, negative or not finite; a bad rate or jerk.
@@ -570,9 +628,15 @@ def verify(
     worst = _Worst()
     q_grid = np.empty((len(grid), dof))
     analytic = jv is not None and any(has_jerk(p) for p in trajectory.pieces)
+    nearest = np.empty(len(times)) if scene is not None else None
+    nearest_pair = np.zeros(len(times), dtype=int)
     for lo in range(0, len(times), _CHUNK):
         t = times[lo : lo + _CHUNK]
         q, qd, qdd = trajectory.sample(t)
+        if scene is not None and nearest is not None and scene.pairs:
+            D = scene.distance_array(q)
+            nearest_pair[lo : lo + len(t)] = np.argmin(D, axis=1)
+            nearest[lo : lo + len(t)] = D[np.arange(len(t)), nearest_pair[lo : lo + len(t)]]
         inside = lo < len(grid)
         if inside:
             q_grid[lo : lo + len(t)] = q[: max(0, len(grid) - lo)]
@@ -607,9 +671,19 @@ def verify(
     v, a = worst.get(Quantity.VELOCITY), worst.get(Quantity.ACCELERATION)
     if v is None or a is None:  # pragma: no cover - the grid is never empty
         raise ParameterError("trajectory", "no samples", "must have a duration > 0")
+    clearance = None
+    if scene is not None and nearest is not None and scene.pairs:
+        within = (times >= 0.0) & (times <= T)
+        order = np.argsort(times[within], kind="stable")
+        ts, ds, ps = times[within][order], nearest[within][order], nearest_pair[within][order]
+        i = int(np.argmin(ds))
+        closest = scene.distances(trajectory.sample(np.array([ts[i]]))[0][0]).closest
+        where = None if closest is None else tuple(float(v) for v in (closest.point_a + closest.point_b) / 2.0)
+        clearance = Clearance(float(ds[i]), scene.margin, scene.pairs[int(ps[i])].label, float(ts[i]), (ts, ds, ps),
+                              where)  # type: ignore[arg-type]
     return Verification(T, rate, len(times), v, a, worst.get(Quantity.JERK), worst.get(Quantity.JERK_DIFFERENCES),
                         floor, worst.get(Quantity.TORQUE), worst.get(Quantity.TOOL_SPEED), start_err, end_err,
-                        rest)  # fmt: skip
+                        rest, clearance)  # fmt: skip
 
 
 def _analytic_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:

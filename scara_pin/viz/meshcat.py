@@ -528,7 +528,7 @@ _STAND_IN = (np.eye(3, dtype=np.float32) * PLACEHOLDER_SIZE, np.array([[0, 1, 2]
 
 
 def _draw_meshes(vis: Any, robot: Robot, viz: Any, share: bool) -> None:
-    """Set each readable mesh of the robot's visuals (:func:`scara_pin.viz.meshes.visual_meshes`) on its node.
+    """Set each readable mesh of the robot's visuals (:func:`scara_pin.cell.meshes.visual_meshes`) on its node.
 
     The scene drew a placeholder box for each mesh at the geometry's node (``viz.getViewerNodeName``, under
     its joint's node); the mesh replaces the box there, in the URDF's colour, its ``scale`` as the object's
@@ -536,8 +536,8 @@ def _draw_meshes(vis: Any, robot: Robot, viz: Any, share: bool) -> None:
     (:data:`SHARE_GEOMETRY`); else (meshcat's live server) each visual gets a copy, and the copies count
     against :data:`~scara_pin.limits.MAX_PAGE_MESH_BYTES` together.
     """
+    from ..cell.meshes import visual_meshes
     from ..limits import MAX_PAGE_MESH_BYTES
-    from .meshes import visual_meshes
 
     mg = _meshcat().geometry
     scaled = _scaled_mesh_class()
@@ -583,7 +583,7 @@ class _Scene:
     """
 
     def __init__(self, robot: Robot, window: _Window) -> None:
-        from .meshes import check_visual_count
+        from ..cell.meshes import check_visual_count
         from .tree import framing, joint_nodes, node_paths
 
         check_visual_count(robot)  # sized first: each visual is a node and a geometry of the page

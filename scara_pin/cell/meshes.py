@@ -82,6 +82,8 @@ __all__ = [
     "MeshGeometry",
     "VisualMesh",
     "check_visual_count",
+    "collision_meshes",
+    "load_mesh",
     "resolve_mesh",
     "robot_size",
     "visual_meshes",
@@ -364,11 +366,11 @@ def _links(links: list[str]) -> str:
     return f"link {shown} is" if len(links) == 1 else f"links {shown} are"
 
 
-def _mesh_elements(root: ET.Element) -> list[tuple[str, int, ET.Element, ET.Element]]:
-    """(link, index of the visual in the link, the <geometry>, its <mesh>) of every mesh visual."""
+def _mesh_elements(root: ET.Element, element: str = "visual") -> list[tuple[str, int, ET.Element, ET.Element]]:
+    """(link, index in the link, the <geometry>, its <mesh>) of every mesh ``<visual>`` (or ``<collision>``)."""
     out = []
     for link in root.findall("link"):
-        for i, visual in enumerate(link.findall("visual")):
+        for i, visual in enumerate(link.findall(element)):
             geometry = visual.find("geometry")
             mesh = geometry.find("mesh") if geometry is not None else None
             if geometry is not None and mesh is not None:
@@ -394,12 +396,45 @@ def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
     file is read once (its :class:`MeshGeometry` is shared by the visuals that name it); the files of the
     robot together are bounded (module docstring). A mesh of implausible size is drawn, with a warning.
     """
+    out, problems = _robot_meshes(robot, "visual")
+    for message, (links, boxed) in problems.items():
+        if boxed:
+            log.warning("%s; %s drawn as a %g m box", message, _links(links), PLACEHOLDER_SIZE)
+        else:
+            log.warning("%s (%s drawn as it is)", message, _links(links))
+    return out
+
+
+def collision_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
+    """The meshes of the robot's ``<collision>`` elements (names as in ``robot.collision_model``), all of them.
+
+    Read as :func:`visual_meshes` reads visuals, but a collision mesh that cannot be read is an error, not
+    a box: distances computed with a stand-in would be wrong.
+
+    Raises:
+        InvalidInputError: a collision mesh is missing, refused or unreadable (the message says which and why).
+    """
+    out, problems = _robot_meshes(robot, "collision")
+    for message, (links, boxed) in problems.items():
+        if boxed:
+            raise InvalidInputError(f"{message}; {_links(links)} without collision geometry: distances to "
+                                    "it cannot be computed")  # fmt: skip
+        log.warning("%s (%s checked as it is)", message, _links(links))
+    return out
+
+
+def _robot_meshes(robot: Robot, element: str) -> tuple[tuple[VisualMesh, ...], dict[str, tuple[list[str], bool]]]:
+    """The readable meshes of the robot's ``element`` (``visual`` or ``collision``) and the problems met.
+
+    Returns:
+        (meshes, problems): problems maps each message to (the links it concerns, whether the mesh was left out).
+    """
     size = robot_size(robot)
     budget = _Budget()
     read: dict[Path, MeshGeometry | MeshProblem] = {}
-    problems: dict[str, tuple[list[str], bool]] = {}  # warning -> (links, drawn as a box)
+    problems: dict[str, tuple[list[str], bool]] = {}  # message -> (links, left out)
     out = []
-    for link, index, _geometry, mesh in _mesh_elements(ET.fromstring(robot.urdf)):
+    for link, index, _geometry, mesh in _mesh_elements(ET.fromstring(robot.urdf), element):
         filename = mesh.get("filename", "")
         try:
             if not filename:
@@ -412,7 +447,7 @@ def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
                 except MeshProblem as exc:
                     read[path] = exc
             geometry = read[path]
-            if isinstance(geometry, MeshProblem):  # the file's problem, said once for every visual naming it
+            if isinstance(geometry, MeshProblem):  # the file's problem, said once for every element naming it
                 raise MeshProblem(*geometry.args)
             warning = _checked_size(geometry, scale, filename, size)
         except MeshProblem as exc:
@@ -421,9 +456,17 @@ def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
         if warning:
             problems.setdefault(warning, ([], False))[0].append(link)
         out.append(VisualMesh(f"{link}_{index}", link, filename, path, geometry, scale))
-    for message, (links, boxed) in problems.items():
-        if boxed:
-            log.warning("%s; %s drawn as a %g m box", message, _links(links), PLACEHOLDER_SIZE)
-        else:
-            log.warning("%s (%s drawn as it is)", message, _links(links))
-    return tuple(out)
+    return tuple(out), problems
+
+
+def load_mesh(path: Path, filename: str) -> MeshGeometry:
+    """The triangles of one mesh file, read under this module's rules (one file's caps; no package lookup).
+
+    Args:
+        path: the file.
+        filename: how to name it in messages (as the user wrote it).
+
+    Raises:
+        MeshProblem: refused, missing or unreadable (the message says which and why).
+    """
+    return _load(path, filename)

@@ -1,0 +1,122 @@
+#!/usr/bin/env python
+"""Benchmark: the issue's 4 x 6 tray job (docs/examples/tray) against its moves planned alone, and the clock.
+
+Run with the project's interpreter (``.venv/bin/python benchmarks/bench_job.py``); reported, not enforced
+(the suite's tests/test_job_plan.py checks the same on a 2 x 2 tray).
+
+1. ``scara-pin job docs/examples/tray/job.yaml --json --out tray.csv --rate 10000`` in a subprocess, timed.
+2. Every jump of it planned ALONE by ``scara-pin traj --arch --from-pose A --to-pose B --json`` (in this
+   process, ``main([...])``: the command's own code), A and B the places' poses written here from the
+   corners' FK (the grid of the three taught corners); the final ``move: home`` by ``traj --linear`` between
+   the same configurations. Printed: the largest |job - alone| per kind, and the job's total against the sum
+   of the moves alone and the dwells (the issue's promise: 1e-6 s).
+3. The README's excerpt of the job's table: each of its lines (but the planning time's) in the command's text
+   output.
+4. The CSV at 10 kHz: the worst |qd| / vmax and |qdd| / amax of its rows, the same by finite differences
+   of its positions (a mean over a step, never above the maximum), and the farthest place from the nearest
+   row (the SCARA's closed-form FK: every place is passed through).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from scara_pin import load_robot
+from scara_pin.cli import main
+from scara_pin.job import Job
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "docs" / "examples" / "tray" / "job.yaml"
+RATE = 10_000.0
+
+
+def _cli(argv: list[str]) -> dict:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        code = main(argv)
+    if code != 0:
+        raise SystemExit(f"scara-pin {' '.join(argv)}: exit {code}")
+    return json.loads(out.getvalue())
+
+
+def main_() -> None:
+    robot = load_robot("default")
+    job = Job.load(EXAMPLE)
+    with tempfile.TemporaryDirectory() as tmp:
+        csv = Path(tmp) / "tray.csv"
+        t0 = time.perf_counter()
+        done = subprocess.run([sys.executable, "-c", "import sys; from scara_pin.cli import main; sys.exit(main())",
+                               "job", str(EXAMPLE), "--json", "--out", str(csv), "--rate", str(RATE)],
+                              capture_output=True, text=True, check=True)  # fmt: skip
+        wall = time.perf_counter() - t0
+        out = json.loads(done.stdout)
+        data = np.loadtxt(csv, delimiter=",", skiprows=1)
+        side = Path(tmp) / "alone.csv"
+        fk = {n: robot.tool_pose(job.points[n].q) for n in ("feeder", "T11", "T16", "T41")}
+        places = [fk["T11"] + c / 5 * (fk["T16"] - fk["T11"]) + r / 3 * (fk["T41"] - fk["T11"])
+                  for r in range(4) for c in range(6)]  # fmt: skip
+        worst = {"jump": 0.0, "move": 0.0}
+        alone_total, poses_off = 0.0, 0.0
+        previous = fk["feeder"]
+        q_prev = job.points["feeder"].q
+        t1 = time.perf_counter()
+        for step in out["steps"]:
+            if step["kind"] == "dwell":
+                alone_total += step["duration"]
+                continue
+            if step["kind"] == "jump":
+                target = places[step["place"]["index"] - 1] if step["place"] else fk["feeder"]
+                poses_off = max(poses_off, float(np.max(np.abs(np.array(step["pose"]) - target))))
+                alone = _cli(["traj", "--arch", "--from-pose", *map(repr, previous.tolist()), "--to-pose",
+                              *map(repr, target.tolist()), "--json", "--out", str(side)])  # fmt: skip
+                previous = target
+            else:
+                alone = _cli(["traj", "--linear", "--from", *(repr(float(v)) for v in q_prev), "--to",
+                              *(repr(float(v)) for v in step["q"]), "--json", "--out", str(side)])  # fmt: skip
+            worst[step["kind"]] = max(worst[step["kind"]], abs(step["duration"] - alone["duration"]))
+            alone_total += alone["duration"]
+            q_prev = np.array(step["q"])
+        alone_wall = time.perf_counter() - t1
+    text = subprocess.run([sys.executable, "-c", "import sys; from scara_pin.cli import main; sys.exit(main())",
+                           "job", "docs/examples/tray/job.yaml"], capture_output=True, text=True, check=True,
+                          cwd=ROOT).stdout.splitlines()  # fmt: skip
+    readme = (ROOT / "README.md").read_text().split("$ .venv/bin/scara-pin job docs/examples/tray/job.yaml\n")[1]
+    excerpt = [line for line in readme.split("```")[0].splitlines() if line and line != "  ..."]
+    stale = [line for line in excerpt if not line.startswith("planning") and line not in text]
+    t, q, qd, qdd = data[:, 0], data[:, 1:5], data[:, 5:9], data[:, 9:13]
+    v, a = np.array(robot.limits.velocity), np.array(robot.limits.acceleration)
+    h = 1.0 / RATE
+    a_ = q[..., 0], q[..., 0] + q[..., 1]
+    xyz = np.stack([0.2 * np.cos(a_[0]) + 0.2 * np.cos(a_[1]), 0.2 * np.sin(a_[0]) + 0.2 * np.sin(a_[1]),
+                    -0.05 - q[..., 2]], -1)  # the default robot's closed-form FK  # fmt: skip
+    miss = max(float(np.min(np.linalg.norm(xyz - p[:3], axis=1))) for p in places)
+    jumps = sum(s["kind"] == "jump" for s in out["steps"])
+    print(f"job        {EXAMPLE.relative_to(EXAMPLE.parents[3])}: {len(out['steps'])} steps, {jumps} jumps, "
+          f"{out['places']} places")  # fmt: skip
+    print(f"total      {out['total']:.6f} s, {out['parts_per_hour']:,.1f} parts per hour")
+    print(f"alone      sum of the moves planned alone and the dwells {alone_total:.6f} s: |difference| "
+          f"{abs(out['total'] - alone_total):.2e} s")  # fmt: skip
+    print(f"per move   largest |job - alone|: jumps {worst['jump']:.2e} s, straight move {worst['move']:.2e} s; "
+          f"places' poses off by {poses_off:.1e}")  # fmt: skip
+    print(f"csv        {len(t):,} rows at {RATE:g} Hz: |qd|/vmax {np.max(np.abs(qd) / v):.9f}, |qdd|/amax "
+          f"{np.max(np.abs(qdd) / a):.9f}; by differences {np.max(np.abs(np.diff(q, axis=0)) / h / v):.9f}, "
+          f"{np.max(np.abs(np.diff(q, 2, axis=0)) / h**2 / a):.9f}; farthest place from a row {miss:.1e} m")
+    print(f"README     {len(excerpt)} lines of the job's table: " + (f"STALE: {stale}" if stale else "as the command "
+          "prints them"))  # fmt: skip
+    st = out["planning"]
+    print(f"planning   `scara-pin job` {wall:.1f} s wall ({st['planned']} moves planned, {st['reversed']} jumps "
+          f"reversed, {st['seconds']:.1f} s planning); the {jumps + 1} moves alone, in one process: "
+          f"{alone_wall:.1f} s")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main_()

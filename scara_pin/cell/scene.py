@@ -1,0 +1,434 @@
+"""A robot in its cell: the pairs checked and their distances (coal, through Pinocchio's ``GeometryModel``).
+
+The scene is one Pinocchio ``GeometryModel`` on the robot's model: the robot's collision geometry
+(:mod:`~scara_pin.cell.geometry`), the carried part on the tool frame, and the obstacles on the root
+(placed at ``oMbase * baseMobstacle``). The pairs checked:
+
+- every robot geometry and the carried part against every obstacle;
+- the robot's self-collision pairs (:class:`~scara_pin.cell.geometry.SelfPairs`), and the carried part
+  against the links that are not adjacent to the tool's link and not in contact with it at every sample;
+- minus the cell's ``allow`` pairs (by name: links, obstacles, ``carried``).
+
+Distances are coal's signed distances between the exact shapes (negative: penetration depth), with
+GJK/EPA tolerances of :data:`GJK_TOLERANCE` (coal's default, 1e-6, would leave errors of about 4e-7 m).
+Witness points and normals are returned in the robot's ``base`` frame; the normal points from the first
+shape of the pair (the robot's) to the second, so moving the second shape along it increases the distance.
+
+The derivative of a pair's distance with respect to q (for the planners) is the normal's component of the
+relative velocity of the two witness points: ``dd/dq = n . (J_b(p_b) - J_a(p_a))``, where ``J_x(p)`` is the
+Jacobian of the point p fixed to shape x's joint (zero for an obstacle). It holds where the witness points
+are unique (two strictly convex shapes, or a face against a vertex), and is a subgradient elsewhere.
+
+A mesh is a coal bounding-volume tree of its triangles, a SURFACE: a robot geometry entirely inside a closed
+mesh is not in contact with it. Motions are checked densely, so crossing the surface is always seen.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import InvalidInputError
+from .cell import CARRIED, Cell
+from .geometry import SelfPairs, robot_geometry, sample_configurations
+
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+    from .._typing import ArrayLike
+    from ..model import Robot
+
+__all__ = ["GJK_TOLERANCE", "Distances", "InCollisionError", "Pair", "PairDistance", "Scene", "scene"]
+
+GJK_TOLERANCE = 1e-10
+EPA_ITERATIONS = 1000
+"""coal's EPA iterations (its default, 64, leaves penetration depths of parallel cylinders wrong)."""
+"""coal's GJK and EPA tolerances used here [m] (distances then agree with closed forms to about 4e-11 m)."""
+
+
+class InCollisionError(InvalidInputError):
+    """A configuration asked for (a start, a goal, a taught point) is closer than the margin (exit code 2).
+
+    Attributes:
+        pair: the closest pair, distance: its distance [m], margin: the margin [m].
+    """
+
+    def __init__(self, message: str, pair: Pair, distance: float, margin: float) -> None:
+        super().__init__(message)
+        self.pair = pair
+        self.distance = distance
+        self.margin = margin
+
+
+@dataclass(frozen=True)
+class Pair:
+    """A pair of shapes whose distance is checked.
+
+    Attributes:
+        index: its index in the scene's pairs.
+        a: the first shape's name: a link of the robot, or ``carried``.
+        b: the second's: an obstacle, or a link (self-collision).
+        kind: ``"obstacle"`` or ``"self"``.
+        first, second: the geometry objects' indices in the scene's ``GeometryModel``.
+    """
+
+    index: int
+    a: str
+    b: str
+    kind: str
+    first: int
+    second: int
+
+    @property
+    def label(self) -> str:
+        """``link2 - post`` (a link and an obstacle) or ``quill - link1 (self)``."""
+        return f"{self.a} - {self.b}" + (" (self)" if self.kind == "self" else "")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"a": self.a, "b": self.b, "kind": self.kind}
+
+
+@dataclass(frozen=True)
+class PairDistance:
+    """The distance of one pair at one configuration.
+
+    Attributes:
+        pair: the pair.
+        distance: [m] coal's signed distance (negative: penetration depth).
+        point_a, point_b: (3,) the witness points on each shape, in the base frame [m].
+        normal: (3,) unit vector from a to b, in the base frame.
+    """
+
+    pair: Pair
+    distance: float
+    point_a: np.ndarray
+    point_b: np.ndarray
+    normal: np.ndarray
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {**self.pair.to_dict(), "distance": self.distance, "point_a": self.point_a.tolist(),
+                "point_b": self.point_b.tolist(), "normal": self.normal.tolist()}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Distances:
+    """Every checked pair's distance at one configuration, closest first.
+
+    Attributes:
+        q: the configuration.
+        margin: [m] the cell's margin.
+        pairs: per pair, closest first.
+    """
+
+    q: np.ndarray
+    margin: float
+    pairs: tuple[PairDistance, ...]
+
+    @property
+    def closest(self) -> PairDistance | None:
+        """The closest pair (None when nothing is checked)."""
+        return self.pairs[0] if self.pairs else None
+
+    @property
+    def minimum(self) -> float:
+        """[m] the smallest distance (inf when nothing is checked)."""
+        return self.pairs[0].distance if self.pairs else math.inf
+
+    @property
+    def clear(self) -> bool:
+        """Every pair at least the margin apart."""
+        return self.minimum >= self.margin
+
+    def below(self, distance: float | None = None) -> tuple[PairDistance, ...]:
+        """The pairs closer than ``distance`` (default: the margin)."""
+        limit = self.margin if distance is None else distance
+        return tuple(p for p in self.pairs if p.distance < limit)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"q": self.q.tolist(), "margin": self.margin, "minimum": self.minimum,
+                "pairs": [p.to_dict() for p in self.pairs]}  # fmt: skip
+
+    def __repr__(self) -> str:
+        c = self.closest
+        if c is None:
+            return "Distances(no pair checked)"
+        return (f"Distances({len(self.pairs)} pairs; closest {c.pair.label} at {c.distance * 1e3:.3f} mm, margin "
+                f"{self.margin * 1e3:g} mm)")  # fmt: skip
+
+
+@dataclass(eq=False)
+class Scene:
+    """A robot and a cell: the checked pairs and their distances (module docstring).
+
+    Attributes:
+        robot: the robot.
+        cell: the cell.
+        pairs: the checked pairs.
+        self_pairs: the robot's self-collision pairs, checked and disabled.
+        margin: [m] the cell's margin.
+    """
+
+    robot: Robot
+    cell: Cell
+    pairs: tuple[Pair, ...] = field(init=False)
+    self_pairs: SelfPairs = field(init=False)
+    margin: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        import pinocchio as pin
+
+        robot, cell = self.robot, self.cell
+        geo = robot_geometry(robot)
+        gm = pin.GeometryModel(geo.model)
+        names = list(geo.links)
+        n_robot = len(names)
+        model = robot.model
+        base = robot.data.oMf[robot.base_id]  # fixed to the root (Robot keeps it from its neutral FK)
+        self._oMbase = pin.SE3(base)
+        carried_index = None
+        if cell.carried is not None:
+            frame = model.frames[robot.tool_id]
+            obj = pin.GeometryObject(CARRIED, int(frame.parentJoint), int(robot.tool_id),
+                                     frame.placement * cell.carried.placement(), cell.carried.geometry())  # fmt: skip
+            carried_index = gm.addGeometryObject(obj)
+            names.append(CARRIED)
+        first_obstacle = gm.ngeoms
+        for o in cell.obstacles:
+            gm.addGeometryObject(pin.GeometryObject(f"obstacle:{o.name}", 0, 0, base * o.shape.placement(),
+                                                    o.shape.geometry()))  # fmt: skip
+            names.append(o.name)
+        known = set(names)
+        allowed: set[frozenset[str]] = set()
+        for first, second in cell.allow:
+            for n in (first, second):
+                if n not in known:
+                    raise InvalidInputError(f"{cell.origin}: allow names {n!r}, neither a link with collision geometry "
+                                            f"nor an obstacle (known: {', '.join(sorted(known))})")  # fmt: skip
+            allowed.add(frozenset((first, second)))
+        movers = list(range(n_robot)) + ([carried_index] if carried_index is not None else [])
+        candidates = []  # (i, j, kind)
+        for i in movers:
+            for j in range(first_obstacle, gm.ngeoms):
+                candidates.append((i, j, "obstacle"))
+        self_candidates = []
+        for i in movers:
+            for j in range(n_robot):
+                if j >= i and i < n_robot:
+                    continue
+                if i < n_robot and j < n_robot:
+                    a, b = (j, i) if j < i else (i, j)
+                else:
+                    a, b = j, i  # (link, carried)
+                self_candidates.append((a, b))
+        self_candidates = sorted(set(self_candidates))
+        adjacent = set(geo.adjacent)
+        if carried_index is not None:  # the carried part is on the tool's joint: adjacent to the links there
+            tool_joint = int(model.frames[robot.tool_id].parentJoint)
+            for j in range(n_robot):
+                gj = gm.geometryObjects[j].parentJoint
+                if gj == tool_joint or model.parents[tool_joint] == gj:
+                    adjacent.add((j, carried_index))
+        disabled: list[tuple[str, str, str]] = []
+        to_sample = []
+        for a, b in self_candidates:
+            if names[a] == names[b]:
+                continue
+            if (a, b) in adjacent:
+                disabled.append((names[a], names[b], "adjacent"))
+            else:
+                to_sample.append((a, b))
+        always = self._always_in_contact(gm, to_sample)
+        checked_self = []
+        for a, b in to_sample:
+            if (a, b) in always:
+                disabled.append((names[a], names[b], "always in contact"))
+            else:
+                checked_self.append((a, b))
+        pairs: list[Pair] = []
+        for i, j, kind in candidates + [(a, b, "self") for a, b in checked_self]:
+            na, nb = names[i], names[j]
+            if kind == "self" and j == carried_index:
+                na, nb, i, j = nb, na, j, i  # carried first
+            if frozenset((na, nb)) in allowed:
+                continue
+            pairs.append(Pair(len(pairs), na, nb, kind, int(i), int(j)))
+        gm.removeAllCollisionPairs()
+        for p in pairs:
+            gm.addCollisionPair(pin.CollisionPair(p.first, p.second))
+        self._gm = gm
+        self._gd = gm.createData()
+        _fresh_guesses(self._gd)
+        for req in self._gd.distanceRequests:
+            req.gjk_tolerance = GJK_TOLERANCE
+            req.epa_tolerance = GJK_TOLERANCE
+            req.enable_signed_distance = True
+            req.epa_max_iterations = EPA_ITERATIONS
+        self._data = model.createData()
+        self.pairs = tuple(pairs)
+        checked = [(names[a], names[b]) for a, b in checked_self]
+        disabled += [(na, nb, "allowed by the cell") for na, nb in checked if frozenset((na, nb)) in allowed]
+        self.self_pairs = SelfPairs(tuple(p for p in checked if frozenset(p) not in allowed), tuple(disabled))
+        self.margin = cell.margin
+        self._names = tuple(names)
+
+    # ------------------------------------------------------------------ building
+    def _always_in_contact(self, gm: pin.GeometryModel, candidates: list[tuple[int, int]]) -> set[tuple[int, int]]:
+        """The candidate pairs in contact (distance <= 0) at every sampled configuration."""
+        import pinocchio as pin
+
+        if not candidates:
+            return set()
+        probe = pin.GeometryModel(gm)
+        probe.removeAllCollisionPairs()
+        for a, b in candidates:
+            probe.addCollisionPair(pin.CollisionPair(a, b))
+        pd = probe.createData()
+        data = self.robot.model.createData()
+        alive = set(range(len(candidates)))
+        for q in sample_configurations(self.robot):
+            pin.computeDistances(self.robot.model, data, probe, pd, self.robot.to_pinocchio_q(q))
+            alive = {k for k in alive if pd.distanceResults[k].min_distance <= 0.0}
+            if not alive:
+                break
+        return {candidates[k] for k in alive}
+
+    # ------------------------------------------------------------------ distances
+    @property
+    def geometry_model(self) -> pin.GeometryModel:
+        """The scene's Pinocchio ``GeometryModel`` (robot, carried part, obstacles; the checked pairs)."""
+        return self._gm
+
+    def distances(self, q: ArrayLike) -> Distances:
+        """Every checked pair's distance at ``q`` (witness points and normals in the base frame), closest first."""
+        import pinocchio as pin
+
+        q = self.robot.check_q(q)
+        pin.computeDistances(self.robot.model, self._data, self._gm, self._gd, self.robot.to_pinocchio_q(q))
+        inv = self._oMbase.inverse()
+        out = []
+        for p, res in zip(self.pairs, self._gd.distanceResults):
+            pa = inv.act(np.asarray(res.getNearestPoint1()))
+            pb = inv.act(np.asarray(res.getNearestPoint2()))
+            normal = inv.rotation @ np.asarray(res.normal)
+            out.append(PairDistance(p, float(res.min_distance), pa, pb, normal))
+        out.sort(key=lambda d: d.distance)
+        return Distances(q, self.margin, tuple(out))
+
+    def distance_array(self, Q: ArrayLike, pairs: ArrayLike | None = None) -> np.ndarray:
+        """(n, k) distances of pairs ``pairs`` (default: all, in the scene's order) at each row of ``Q`` [m]."""
+        import pinocchio as pin
+
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
+        convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
+        if pairs is None:
+            out = np.empty((len(Q), len(self.pairs)))
+            for i, q in enumerate(Q):
+                pin.computeDistances(model, data, gm, gd, convert(q) if convert else q)
+                out[i] = [r.min_distance for r in gd.distanceResults]
+            return out
+        idx = [int(k) for k in np.asarray(pairs, dtype=int).ravel()]
+        out = np.empty((len(Q), len(idx)))
+        for i, q in enumerate(Q):
+            pin.updateGeometryPlacements(model, data, gm, gd, convert(q) if convert else q)
+            for c, k in enumerate(idx):
+                out[i, c] = pin.computeDistance(gm, gd, k).min_distance
+        return out
+
+    def gradients(self, q: ArrayLike, pairs: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(d (k,), G (k, dof)): the distances of ``pairs`` (default all) at ``q`` and their derivatives dd/dq.
+
+        See the module docstring for the formula and where it holds.
+        """
+        import pinocchio as pin
+
+        q = np.asarray(q, dtype=float)
+        model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
+        qp = self.robot.to_pinocchio_q(q) if self.robot.has_continuous else q
+        idx = list(range(len(self.pairs))) if pairs is None else [int(k) for k in np.asarray(pairs).ravel()]
+        pin.computeJointJacobians(model, data, qp)  # also the joint placements
+        pin.updateGeometryPlacements(model, data, gm, gd)
+        d = np.empty(len(idx))
+        G = np.zeros((len(idx), self.robot.dof))
+        jac: dict[int, np.ndarray] = {}
+
+        def point_jacobian(joint: int, p: np.ndarray) -> np.ndarray:
+            if joint == 0:
+                return np.zeros((3, model.nv))
+            J = jac.get(joint)
+            if J is None:
+                J = jac[joint] = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
+            r = p - data.oMi[joint].translation
+            return J[:3] - np.cross(r[None, :], J[3:].T).T  # v_p = v_o + w x r = v_o - r x w
+
+        objs = gm.geometryObjects
+        for c, k in enumerate(idx):
+            res = pin.computeDistance(gm, gd, k)
+            pair = self.pairs[k]
+            d[c] = res.min_distance
+            n = np.asarray(res.normal)
+            ja, jb = objs[pair.first].parentJoint, objs[pair.second].parentJoint
+            g = n @ (point_jacobian(jb, np.asarray(res.getNearestPoint2()))
+                     - point_jacobian(ja, np.asarray(res.getNearestPoint1())))  # fmt: skip
+            G[c] = g[: self.robot.dof] if model.nv == self.robot.dof else g
+        return d, G
+
+    def check(self, q: ArrayLike, what: str) -> Distances:
+        """The distances at ``q``; :class:`InCollisionError` (exit 2) naming the closest pair if below the margin."""
+        found = self.distances(q)
+        c = found.closest
+        if c is not None and c.distance < self.margin:
+            raise InCollisionError(f"{what} is in collision: {describe(c, self.margin)}", c.pair, c.distance,
+                                   self.margin)  # fmt: skip
+        return found
+
+    def __repr__(self) -> str:
+        return (f"Scene({self.robot.name}: {len(self.pairs)} pairs checked, {len(self.cell.obstacles)} obstacle(s), "
+                f"margin {self.margin * 1e3:g} mm)")  # fmt: skip
+
+
+def _fresh_guesses(gd: Any) -> None:
+    """No query starts from the last one's GJK guess.
+
+    Pinocchio's requests cache it by default, and EPA started from a stale guess can stop on a wrong face (a
+    penetration 30 times too deep was seen: box against cylinder).
+    """
+    import warnings
+
+    import coal
+
+    for req in gd.distanceRequests:
+        req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
+        with warnings.catch_warnings():  # the flag is deprecated, but Pinocchio still sets it
+            warnings.simplefilter("ignore", DeprecationWarning)
+            req.enable_cached_gjk_guess = False
+
+
+def describe(found: PairDistance, margin: float) -> str:
+    """``link2 and post are 1.2 mm apart (margin 2 mm) at (x, y, z) mm``: one pair's distance, in words."""
+    at = ", ".join(f"{v * 1e3:.1f}" for v in (found.point_a + found.point_b) / 2.0)
+    a, b = found.pair.a, found.pair.b
+    if found.distance < 0:
+        how = f"{a} is {-found.distance * 1e3:.3g} mm deep in {b}"
+    else:
+        how = f"{a} and {b} are {found.distance * 1e3:.3g} mm apart"
+    return f"{how} (margin {margin * 1e3:g} mm) near ({at}) mm in base"
+
+
+def scene(robot: Robot, cell: Cell) -> Scene:
+    """The scene of ``robot`` in ``cell``, built once per (robot, cell) and kept on the robot."""
+    cache: dict[int, tuple[Cell, Scene]] = robot.__dict__.setdefault("_cell_scenes", {})
+    hit = cache.get(id(cell))
+    if hit is not None and hit[0] is cell:
+        return hit[1]
+    if len(cache) >= 8:
+        cache.clear()
+    out = Scene(robot, cell)
+    cache[id(cell)] = (cell, out)
+    return out

@@ -1,0 +1,301 @@
+"""Planning a job: every move through one function, each as fast as the limits allow, each verified at 10 kHz.
+
+:func:`plan_move` is the one function every move of a job goes through:
+
+- ``jump``: the time-optimal jump (:func:`~scara_pin.motion.jump.jump_move`: joint path free over the
+  clearance), between the two configurations themselves (their branch and J4 turn);
+- ``move``: a straight tool line, time-optimal (TOPP-RA), and ``go``: a joint move, time-optimal
+  (:func:`~scara_pin.motion.plan.plan_motion`, which chooses the method);
+
+under the robot's limits with the velocity limits times the ``speed`` fraction and the acceleration
+limits times the ``accel`` fraction (SPEL+'s ``Speed`` and ``Accel``), and the effort limits with the
+job's payload when the job asks for the torques. Each move is then verified by the package's verifier
+(:func:`~scara_pin.motion.verify.verify`: every limit at 10 kHz and at every breakpoint, the endpoints,
+rest at both ends); a move it refuses is an error (exit 3), never an output. ``placed`` is the obstacles
+placed so far (the boxes a palletizing job has put down, issue "The cell"): it is part of what makes two
+moves the same, and the cell's planners will take it; until the cell is wired no job has any.
+
+Every move is from rest to rest, so a job lasts exactly the sum of its moves and dwells: it is never slower
+than its moves planned one by one, because it IS them.
+
+**Same moves, planned once** (:class:`Planner`). A move whose kind, end configurations (bit for bit),
+limit fractions, clearance and obstacles are those of a move planned before is that move again. A jump
+whose reverse was planned is that jump played backwards: under the same symmetric limits and clearance
+the reversed motion is feasible and as fast as any (:mod:`~scara_pin.motion.jump`, "Return move"), so a
+tray job solves one jump per place, not two. The reversed move is verified like a new one.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import math
+import time
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..description import JOINT_NAMES
+from ..errors import InvalidInputError, JobFileError, ScaraError
+from ..motion.jump import BINDING, Binding, jump_move
+from ..motion.payload import Payload, with_payload
+from ..motion.polynomial import PolynomialPiece
+from ..motion.trajectory import Trajectory
+from ..motion.verify import VERIFY_RATE, _limits, state_ratios, verify
+from ..signals import raise_pending
+from .results import JobResult, PlanningStats, StepResult
+from .steps import Dwell, Move, MoveKind, located
+
+if TYPE_CHECKING:
+    from ..description import JointLimits
+    from ..model import Robot
+    from .loading import Job
+
+__all__ = ["STILL", "PlannedMove", "Planner", "Source", "plan_job", "plan_move", "scaled_limits"]
+
+log = logging.getLogger(__name__)
+
+STILL = 1e-12
+"""[rad or m] a move whose end configurations differ by no more than this is no motion (the robot is there)."""
+
+
+class Source(enum.Enum):
+    """Where a job's move came from; the value is its name in the table and the JSON."""
+
+    PLANNED = "planned"
+    SAME = "same as an earlier move"
+    REVERSED = "an earlier jump reversed"
+    STILL = "already there"
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedMove:
+    """A move of a job, planned and verified.
+
+    Attributes:
+        trajectory: the motion (one or more pieces), or None when the robot is already there.
+        method: how it was made (:class:`~scara_pin.motion.plan.Method`'s sentence), "" when still.
+        binding: the limits at >= 99.9 % of themselves on it, with their share of its time (largest first).
+        worst: the quantity and joint closest to its limit (ratio), or None when still.
+        lower_bound: [s] what no motion between the same configurations can beat (jumps), or None.
+        source: planned, the same as an earlier move, an earlier jump reversed, or still.
+        seconds: [s] the wall time its planning took (0 for a move planned before).
+    """
+
+    trajectory: Trajectory | None
+    method: str
+    binding: tuple[Binding, ...]
+    worst: Binding | None
+    lower_bound: float | None
+    source: Source
+    seconds: float = 0.0
+
+    @property
+    def duration(self) -> float:
+        """[s] (0 when the robot is already there)."""
+        return 0.0 if self.trajectory is None else self.trajectory.duration
+
+
+def scaled_limits(robot: Robot, speed: float, accel: float) -> JointLimits:
+    """The robot's limits with the velocities times ``speed`` and the accelerations times ``accel`` (in (0, 1])."""
+    for name, f in (("speed", speed), ("accel", accel)):
+        if not (isinstance(f, (int, float)) and 0.0 < f <= 1.0):
+            raise InvalidInputError(f"{name} fraction {f!r} must be in (0, 1]")
+    lim = robot.limits
+    return replace(lim, velocity=tuple(v * speed for v in lim.velocity),
+                   acceleration=tuple(a * accel for a in lim.acceleration), validate=False)  # fmt: skip
+
+
+def plan_move(
+    robot: Robot,
+    move: Move,
+    q_from: np.ndarray,
+    *,
+    torque: bool = False,
+    payload: Payload | None = None,
+    placed: tuple[Hashable, ...] = (),
+) -> PlannedMove:
+    """Plan and verify one move of a job from ``q_from`` (module docstring): the one function every move goes through.
+
+    Args:
+        robot: a robot with a wrist (4 joints).
+        move: the move: its kind, target configuration, limit fractions and (jumps) clearance.
+        q_from: where the robot is, at rest [rad, m].
+        torque: respect the effort limits too (with ``payload``).
+        payload: carried by the tool (torques); None: none.
+        placed: the obstacles placed so far (issue "The cell"); none until the cell is wired.
+
+    Raises:
+        InvalidInputError: the move cannot be made as asked (e.g. a jump between poses closer than twice its
+            clearance radius; exit 2).
+        InfeasibleError: the planner or the verifier refuses it (exit 3).
+    """
+    from ..motion.plan import Method, MotionRequest, plan_motion
+
+    if placed:
+        raise InvalidInputError("cells in jobs are not supported yet")
+    q0, q1 = np.asarray(q_from, dtype=float), np.asarray(move.q, dtype=float)
+    if float(np.max(np.abs(q1 - q0))) <= STILL:
+        return PlannedMove(None, "", (), None, None, Source.STILL)
+    t0 = time.perf_counter()
+    limits = scaled_limits(robot, move.speed, move.accel)
+    payload = Payload() if payload is None else payload
+    bound = None
+    if move.kind is MoveKind.JUMP:
+        shape = move.shape
+        if shape is None:  # pragma: no cover - the expansion gives every jump its shape
+            raise InvalidInputError("a jump needs its clearance (rise, clearance_radius)")
+        jump = jump_move(robot, robot.tool_pose(q0), move.pose, rise=shape.rise,
+                         clearance_radius=shape.clearance_radius, max_height=shape.max_height, payload=payload,
+                         torque=torque, limits=limits, start=q0, end=q1)  # fmt: skip
+        traj, method, bound = jump.trajectory, Method.JUMP.value, jump.lower_bound.duration
+    else:
+        request = MotionRequest(start_q=q0, end_q=q1, linear=move.kind is MoveKind.MOVE, torque=torque,
+                                payload=payload if torque else None, limits=limits)  # fmt: skip
+        plan = plan_motion(robot, request)
+        traj, method = plan.trajectory, plan.method.value
+    return _checked(robot, traj, method, limits, torque, payload, bound, Source.PLANNED, time.perf_counter() - t0)
+
+
+def _checked(robot: Robot, traj: Trajectory, method: str, limits: JointLimits, torque: bool, payload: Payload,
+             bound: float | None, source: Source, seconds: float) -> PlannedMove:  # fmt: skip
+    """The move verified at 10 kHz (exit 3 if it fails) with what binds on it."""
+    verify(robot, traj, limits=limits, torque=torque, payload=payload, q_start=traj.q_start,
+           q_end=traj.q_end).check()  # fmt: skip
+    binding, worst = _binding(robot, traj, limits, torque, payload)
+    return PlannedMove(traj, method, binding, worst, bound, source, seconds)
+
+
+def _binding(robot: Robot, traj: Trajectory, limits: JointLimits, torque: bool, payload: Payload
+             ) -> tuple[tuple[Binding, ...], Binding]:  # fmt: skip
+    """The limits at >= :data:`~scara_pin.motion.jump.BINDING` on the 10 kHz grid, with their share of the time."""
+    lim = _limits(robot, limits, None, torque)
+    loaded = with_payload(robot, payload) if torque else robot
+    t = np.append(np.arange(math.floor(traj.duration * VERIFY_RATE) + 1) / VERIFY_RATE, traj.duration)
+    q, qd, qdd = traj.sample(t)
+    found, worst = [], Binding("velocity", JOINT_NAMES[0], -1.0, 0.0)
+    for quantity, r in state_ratios(loaded, lim, (q, qd, qdd)).items():
+        for j in range(r.shape[1]):
+            who = "tool" if r.shape[1] == 1 else JOINT_NAMES[j]
+            top = float(np.max(r[:, j]))
+            if top > worst.ratio:
+                worst = Binding(quantity.value, who, top, float(np.mean(r[:, j] >= BINDING)))
+            if top >= BINDING:
+                found.append(Binding(quantity.value, who, top, float(np.mean(r[:, j] >= BINDING))))
+    found.sort(key=lambda b: -b.share)
+    return tuple(found), worst
+
+
+class Planner:
+    """:func:`plan_move` with the job's options, each distinct move planned once (module docstring).
+
+    Attributes:
+        robot: the robot; torque, payload: the job's.
+        stats: how many moves were planned, reused and reversed, and the planning's wall time.
+    """
+
+    def __init__(self, robot: Robot, *, torque: bool = False, payload: Payload | None = None) -> None:
+        self.robot, self.torque = robot, torque
+        self.payload = Payload() if payload is None else payload
+        self._done: dict[Hashable, PlannedMove] = {}
+        self.stats = PlanningStats()
+
+    def _key(self, move: Move, q_from: np.ndarray, q_to: np.ndarray, placed: tuple[Hashable, ...]) -> Hashable:
+        return (move.kind, q_from.tobytes(), q_to.tobytes(), move.speed, move.accel, move.shape, placed)
+
+    def plan(self, move: Move, q_from: np.ndarray, placed: tuple[Hashable, ...] = ()) -> PlannedMove:
+        """The move from ``q_from``: planned, or the same (or reversed) move planned before."""
+        q0, q1 = np.asarray(q_from, dtype=float), np.asarray(move.q, dtype=float)
+        key = self._key(move, q0, q1, placed)
+        found = self._done.get(key)
+        if found is not None:
+            self.stats = replace(self.stats, same=self.stats.same + 1)
+            return replace(found, source=Source.SAME if found.trajectory is not None else Source.STILL, seconds=0.0)
+        back = self._done.get(self._key(move, q1, q0, placed)) if move.kind is MoveKind.JUMP else None
+        t0 = time.perf_counter()
+        if back is not None and back.trajectory is not None and back.source is not Source.STILL:
+            piece = back.trajectory.pieces[0]
+            if not isinstance(piece, PolynomialPiece):  # pragma: no cover - jumps are polynomial pieces
+                raise InvalidInputError("a reversed jump needs a polynomial piece")
+            limits = scaled_limits(self.robot, move.speed, move.accel)
+            out = _checked(self.robot, Trajectory((piece.reversed(),)), back.method, limits, self.torque,
+                           self.payload, back.lower_bound, Source.REVERSED, time.perf_counter() - t0)  # fmt: skip
+            self.stats = replace(self.stats, reversed=self.stats.reversed + 1)
+        else:
+            out = plan_move(self.robot, move, q0, torque=self.torque, payload=self.payload, placed=placed)
+            if out.trajectory is not None:
+                self.stats = replace(self.stats, planned=self.stats.planned + 1)
+        self.stats = replace(self.stats, seconds=self.stats.seconds + time.perf_counter() - t0)
+        self._done[key] = out
+        return out
+
+
+def _floats(values: np.ndarray) -> tuple[float, ...]:
+    return tuple(float(v) for v in values)
+
+
+def _hold(q: np.ndarray, seconds: float) -> PolynomialPiece:
+    """At rest at ``q`` for ``seconds``: a polynomial piece of degree 0."""
+    return PolynomialPiece(np.array([0.0, seconds]), np.asarray(q, dtype=float)[None, None, :])
+
+
+def plan_job(job: Job, robot: Robot, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
+    """Plan every move of ``job`` for ``robot`` (module docstring): the table, the total, the trajectory.
+
+    Everything the job file and the robot can tell is checked first (:meth:`Job.program`); then the moves are
+    planned in order, each from where the previous one ended. A Ctrl-C (or SIGTERM) swallowed by the solver
+    stops the job after the move it interrupted.
+
+    Args:
+        job: the job.
+        robot: the robot (4 joints, acceleration limits known).
+        progress: called with (actions done, actions) after each move and dwell.
+
+    Raises:
+        JobFileError: the job cannot be run as written (exit 2), with the file and line.
+        JobStepError: a place out of reach, a move the planner or the verifier refuses (exit 3), with the line.
+    """
+    for key in ("cell", "carry"):
+        if getattr(job, key) is not None:
+            raise JobFileError(job.path, job.lines.get(key), "cells in jobs are not supported yet (the job's "
+                               f"{key}: is kept, not planned with)")  # fmt: skip
+    if robot.dof != 4:
+        raise JobFileError(job.path, None, f"a job needs a wrist (4 joints); robot {robot.name!r} has {robot.dof}")
+    program = job.program(robot)
+    planner = Planner(robot, torque=job.torque, payload=job.payload)
+    q, at, t = program.start_q, program.start, 0.0
+    pose = robot.tool_pose(q)
+    placed: tuple[Hashable, ...] = ()  # the boxes placed so far: the cell's obstacles for the moves after them
+    pieces: list[Any] = []
+    rows: list[StepResult] = []
+    n = len(program.actions)
+    for k, action in enumerate(program.actions):
+        if isinstance(action, Dwell):
+            if action.seconds > 0.0:
+                pieces.append(_hold(q, action.seconds))
+            rows.append(StepResult(k + 1, action.line, "dwell", at, at, t, t + action.seconds, q=_floats(q),
+                                   pose=_floats(pose)))  # fmt: skip
+            t += action.seconds
+        else:
+            try:
+                planned = planner.plan(action, q, placed)
+            except ScaraError as exc:
+                raise located(job.path, action.line, exc, f"{action.kind.value} {at} -> {action.target}") from None
+            if planned.trajectory is not None:
+                pieces.extend(planned.trajectory.pieces)
+            log.debug("job: line %s: %s %s -> %s: %.6f s (%s)", action.line, action.kind.value, at, action.target,
+                      planned.duration, planned.source.value)  # fmt: skip
+            rows.append(StepResult(k + 1, action.line, action.kind.value, at, action.target, t,
+                                   t + planned.duration, action.place, planned.binding, planned.worst,
+                                   action.speed, action.accel, planned.source.value, planned.method,
+                                   planned.lower_bound, _floats(action.q), _floats(action.pose)))  # fmt: skip
+            t += planned.duration
+            q, at, pose = np.asarray(action.q, dtype=float), action.target, action.pose
+        raise_pending()  # a signal the solver swallowed stops the job here
+        if progress is not None:
+            progress(k + 1, n)
+    if not pieces:
+        raise JobFileError(job.path, job.lines.get("steps"), "the job never moves nor dwells: nothing to time")
+    return JobResult(job.path, robot.name, tuple(rows), Trajectory(tuple(pieces)), len(program.places), planner.stats)
