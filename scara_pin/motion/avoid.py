@@ -347,8 +347,11 @@ def candidates(
     velocity: np.ndarray,
     acceleration: np.ndarray,
 ) -> list[Candidate]:
-    """Warm starts for the jump in the cell (module docstring): the straight one when it is clear; else the clear
-    ones, fastest first; else (none clears) every one tried, the least colliding first."""
+    """Warm starts for the jump in the cell (module docstring).
+
+    The straight one when it is clear; else the clear ones, fastest first; else (none clears) every one tried, the
+    least colliding first.
+    """
     robot = scene.robot
     straight = np.array([qA, tops[0], tops[1], qB])
     t, clear = _score(scene, straight, velocity, acceleration)
