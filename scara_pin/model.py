@@ -20,6 +20,7 @@ from __future__ import annotations
 import enum
 import logging
 import math
+import os
 from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
@@ -114,11 +115,12 @@ def pose_from_placement(aMb: pin.SE3) -> np.ndarray:
     return np.array([p[0], p[1], p[2], math.atan2(R[1, 0], R[0, 0])])
 
 
-def _parse_urdf(urdf: str, origin: str) -> pin.Model:
-    """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`."""
-    import xml.etree.ElementTree as ET
+def _parse_urdf(urdf: str, origin: str, checked: bool = False) -> pin.Model:
+    """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`.
 
-    from ._urdf_checks import check_urdf_tree, xacro_leftovers
+    ``checked``: the package generated it (its own xacro): the Python pre-checks are skipped.
+    """
+    import xml.etree.ElementTree as ET
 
     try:
         root = ET.fromstring(urdf)
@@ -127,15 +129,8 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
         raise UrdfError(f"{origin}: malformed XML at line {line}, column {column + 1}") from None
     if root.tag != "robot":
         raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
-    # urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state):
-    # its rules are checked first, in Python, so that it only sees documents it accepts.
-    # the rule `scara-pin check` applies (xacro-not-expanded / xacro-ignored); the text search spares a walk
-    leftover = xacro_leftovers(root) if "xacro" in urdf or "$" in urdf else None
-    if leftover is not None:
-        if leftover[0]:
-            raise UrdfError(f"{origin}: {leftover[1]}")
-        logging.getLogger("scara_pin").warning("%s: %s", origin, leftover[1])
-    check_urdf_tree(root, origin)
+    if not checked:
+        _check_urdf(urdf, root, origin)
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
     mimic = root.find("joint/mimic") is not None
     try:
@@ -148,6 +143,23 @@ def _parse_urdf(urdf: str, origin: str) -> pin.Model:
             f"({model.nbodies - 1} bodies, nq = 0): the kinematic tree is empty or disconnected"
         )
     return model
+
+
+def _check_urdf(urdf: str, root: Any, origin: str) -> None:
+    """The Python checks of a URDF from elsewhere, before urdfdom sees it (:mod:`scara_pin._urdf_checks`).
+
+    urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state): its
+    rules are checked first, in Python, so that it only sees documents it accepts; and the rule
+    ``scara-pin check`` applies (xacro-not-expanded / xacro-ignored; the text search spares a walk).
+    """
+    from ._urdf_checks import check_urdf_tree, xacro_leftovers
+
+    leftover = xacro_leftovers(root) if "xacro" in urdf or "$" in urdf else None
+    if leftover is not None:
+        if leftover[0]:
+            raise UrdfError(f"{origin}: {leftover[1]}")
+        logging.getLogger("scara_pin").warning("%s: %s", origin, leftover[1])
+    check_urdf_tree(root, origin)
 
 
 _CONTINUOUS = frozenset(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"))
@@ -196,7 +208,7 @@ class Robot:
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
         kind: ``"scara"`` or ``"palletizer"`` (from the parameters; a URDF file is a palletizer when it has
-            the palletizer's layout and its flange stays level, :func:`_urdf_kind`; else it counts as a SCARA).
+            the palletizer's layout and its flange stays level; else it counts as a SCARA).
         continuous: per joint of q, whether it is a continuous joint; ``has_continuous``: any of them.
         dof: the number of joint values in q, 4 or 3 (a SCARA without a wrist; :data:`JOINT_COUNTS`).
         base_frame, tool_frame: names of the reference frame and of the tool frame (links of the URDF).
@@ -224,7 +236,6 @@ class Robot:
     geared: tuple[GearedJoint, ...]
     locked: tuple[LockedJoint, ...]
     lock_note: str | None
-    package_path: PackagePath
 
     def __init__(
         self,
@@ -238,6 +249,7 @@ class Robot:
         package_path: PackagePath | None = None,
         kinematics: KinematicsFactory | None = None,
         lock: Mapping[str, float] | None = None,
+        generated: bool = False,
     ) -> None:
         """Load URDF text.
 
@@ -255,22 +267,30 @@ class Robot:
                 :func:`scara_pin.kinematics.kinds.kinematics_for`, which :func:`scara_pin.load_robot` passes).
             lock: joints to fix, with their values [rad, m] (:mod:`scara_pin.chain`); joints that are not on
                 the chain from the root to the tool (another arm) are locked anyway, at 0 by default.
+            generated: the URDF is the package's own xacro output (:meth:`from_config`): the checks that keep
+                a stranger's file from urdfdom's C-level messages are skipped (urdfdom still refuses a bad one).
 
         Raises:
             UrdfError: unreadable, invalid or disconnected URDF, not a 4-joint robot, an unusable joint
                 (inverted limits, zero axis: :func:`scara_pin.urdf_rules.joint_problem`), or a frame
                 asked for that is not a link of the file.
         """
-        from .chain import geared_joints, reduce_to_chain
-        from .description.packages import PackagePath
-
-        model = _parse_urdf(urdf, origin)
+        model = _parse_urdf(urdf, origin, checked=generated)
         links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
         frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
         base_frame, tool_frame = frames.base, frames.tool
         edges = {j.name: j for j in joints}
-        # one arm of a multi-arm tree (or with --lock): the other joints fixed, the whole robot still drawn
-        model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin)
+        # one arm of a multi-arm tree (or with --lock): the other joints fixed, the whole robot still drawn;
+        # a model that is the chain alone (every joint moves the tool, none geared: the shipped robots) needs
+        # neither (scara_pin.chain is not even imported: `scara-pin fk` starts faster)
+        tool_joint = model.frames[model.getFrameId(tool_frame, pin.FrameType.BODY)].parentJoint
+        alone = not lock and len(model.supports[tool_joint]) == model.njoints and model.nv == model.njoints - 1
+        if alone:
+            self.locked, self.geared = (), ()
+        else:
+            from .chain import geared_joints, reduce_to_chain
+
+            model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin)
         try:
             continuous = _continuous_joints(model, origin)
         except UrdfError as exc:
@@ -279,7 +299,8 @@ class Robot:
             names = ", ".join(lj.name for lj in self.locked[:12]) + (" ..." if len(self.locked) > 12 else "")
             raise UrdfError(f"{exc}, once {names} locked (not on the chain {frames.root} -> {tool_frame}, or "
                             "--lock): --tool picks the link that ends an arm") from None  # fmt: skip
-        self.geared = geared_joints(model, edges)
+        if not alone:
+            self.geared = geared_joints(model, edges)
         self.frame_note = frames.note
         off_chain = [lj for lj in self.locked if lj.reason != "asked"]
         self.lock_note = None if not off_chain else (
@@ -287,7 +308,7 @@ class Robot:
             + ", ".join(f"{lj.name} = {lj.value:.6g}" for lj in off_chain[:12])
             + (" ..." if len(off_chain) > 12 else "") + " (--lock JOINT=VALUE sets them, rad or m)"
         )  # fmt: skip
-        self.package_path = package_path if package_path is not None else PackagePath()
+        self._package_path = package_path
         self.model = model
         self.data = model.createData()
         self.urdf = urdf
@@ -340,8 +361,8 @@ class Robot:
         """``baseMtool``: the placement of the tool frame in the base frame, at ``q``.
 
         Computed on a private copy of the model re-rooted at the base frame (``robot.data`` is not updated).
-        An instance calls the closure of :func:`_per_call_paths` directly (this method is what a subclass
-        overrides, and what ``super()`` reaches).
+        An instance calls a closure made for it at load directly (this method is what a subclass overrides,
+        and what ``super()`` reaches).
         """
         return self._per_call[0](q)
 
@@ -366,7 +387,7 @@ class Robot:
         Keyword arguments (``tool_frame``, ``base_frame``) are passed to the constructor.
         """
         params, urdf = configured(robot, overrides)  # the description cache: no yaml nor xacro when unchanged
-        return cls(urdf, parameters=params, origin=f"robot {params.name!r}", **kwargs)
+        return cls(urdf, parameters=params, origin=f"robot {params.name!r}", generated=True, **kwargs)
 
     @classmethod
     def from_file(cls, path: str | Path, *, package_dirs: Sequence[str | Path] = (), **kwargs: Any) -> Robot:
@@ -394,6 +415,15 @@ class Robot:
         return cls(text, origin=str(path), package_path=packages, **kwargs)
 
     # ----------------------------------------------------------------- geometry (lazy)
+    @property
+    def package_path(self) -> PackagePath:
+        """Where ``package://`` names (meshes) are looked for (:mod:`scara_pin.description.packages`)."""
+        if self._package_path is None:  # made when first asked: `fk` never imports the package resolver
+            from .description.packages import PackagePath
+
+            self._package_path = PackagePath()
+        return self._package_path
+
     @cached_property
     def visual_model(self) -> pin.GeometryModel:
         """Visual geometry of the URDF, built on first use; each mesh is a placeholder box.
@@ -413,6 +443,16 @@ class Robot:
         return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
 
     # ----------------------------------------------------------------- a summary for people (repr, notebooks)
+    def plot(self, q: object = None, path: str | os.PathLike[str] | None = None, **kwargs: Any) -> Any:
+        """The arm at ``q`` as a matplotlib stick figure (a Figure; written to ``path`` when one is given).
+
+        ``robot.plot(q)`` is :func:`scara_pin.stick.plot_robot` (its keywords: ``units``, ``view`` ``"3d"`` /
+        ``"top"`` / ``"side"``, ``ax``, ``title``, ``dpi``). matplotlib is imported only when it draws.
+        """
+        from .stick import plot_robot
+
+        return plot_robot(self, q, path, **kwargs)
+
     def summary(self) -> tuple[str, list[list[str]]]:
         """The robot at a glance: a headline and one row per joint, in degrees and millimetres.
 

@@ -1,6 +1,6 @@
 """Identify a robot's errors from measured poses: nonlinear least squares on Pinocchio's forward kinematics.
 
-The problem (:class:`_Problem`): the residuals ``f(theta) - m`` of every measured pose (positions [m]; the
+The problem: the residuals ``f(theta) - m`` of every measured pose (positions [m]; the
 yaw [rad], wrapped to (-pi, pi], times ``yaw_weight`` [m/rad]), ``f`` the chain's prediction
 (:meth:`ChainModel.predict <scara_pin.calibration.chain.ChainModel.predict>`) with its analytic Jacobian.
 

@@ -17,7 +17,6 @@ from ._common import (
     _jerk,
     _load,
     _needs_wrist,
-    _num,
     _number,
     _read_pose,
     add_cell_options,
@@ -95,8 +94,9 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.cycle import plot_cycle
 
-        plot_cycle(robot, move, args.plot, limits=limits, title=f"{robot.name}: standard cycle ({path.value}) "
-                   f"{result.cycle_time:.4g} s, payload {move.payload.mass:g} kg")  # fmt: skip
+        plot_cycle(result, args.plot, robot=robot, units=units.display, limits=limits,
+                   title=f"{robot.name}: standard cycle ({path.value}) {result.cycle_time:.4g} s, payload "
+                   f"{move.payload.mass:g} kg")  # fmt: skip
         outputs["plot"] = args.plot
     compare = _jump_for_comparison(robot, result, common, radius) if path is CyclePath.LINES else None
     bound = result.lower_bound
@@ -110,6 +110,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             "legs": [leg.to_dict() for leg in move.legs],
             "limits": limits_dict(robot, limits, move.jerk),
             "limit_ratios": move.ratios,
+            "worst": {w.quantity.value: w.to_dict() for w in result.verification.limited()},  # type: ignore[union-attr]
             "placement": {"from": result.start.tolist(), "to": result.end.tolist(), "rule": result.placement,
                           "min_manipulability": result.min_manipulability},
             "span": result.span, "rise": result.rise, "blend": result.blend,
@@ -129,34 +130,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             summary["jump_cycle_time"] = compare[0] if compare else None
         print(json.dumps(summary))
         return 0
-    Ln = units.length_name
-    timing = "jerk-limited time-optimal timing" if move.jerk else "TOPP-RA timing"
-    what = ("jump (time-optimal, joint path free)" if path is CyclePath.JUMP
-            else f"straight-leg arch (lines and blends, {timing})")  # fmt: skip
-    print(f"robot       {robot.name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
-          + (f", jerk limit {list(move.jerk)}" if move.jerk else ""))  # fmt: skip
-    print(f"cycle time  {_num(result.cycle_time, 6)} s (up {units.num(result.rise, 'length')}, across "
-          f"{units.num(result.span, 'length')}, down and back [{Ln}]"
-          + (f"; clearance radius {units.num(radius, 'length')} {Ln})" if path is CyclePath.JUMP
-             else f"; blend {units.num(result.blend, 'length')} {Ln})"))  # fmt: skip
-    if bound is not None:
-        print(f"bound       {_num(bound.duration, 6)} s ({bound.reason}): no cycle under these limits is faster; this "
-              f"one is {100 * (result.gap or 0.0):.1f} % above it")  # fmt: skip
-    print(f"placement   from {units.fmt(result.start[:3], 'length')} to {units.fmt(result.end[:3], 'length')} {Ln}: "
-          f"{result.placement}")  # fmt: skip
-    if path is CyclePath.JUMP:
-        jm = move
-        top, peak, bulge = jm.z_top + jm.peak, jm.peak, jm.bulge  # type: ignore[union-attr]
-        print(f"arch        up to {units.num(top, 'length')} {Ln} ({units.num(peak, 'length')} {Ln} above the "
-              f"clearance height), {units.num(bulge, 'length')} {Ln} off the straight line in plan view; solved in "
-              f"{jm.stats.seconds:.3g} s ({jm.stats.iterations} IPOPT iterations, "  # type: ignore[union-attr]
-              f"{jm.stats.solves} solve(s))")  # type: ignore[union-attr]
-    print("legs        (binding limits: the share of the leg's time at >= 99.9 % of the limit)")
-    for leg in move.legs:
-        binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in leg.binding)
-        print(f"  {'out ' if leg.move == 0 else 'back'} {leg.name:<11} {leg.duration:9.6f} s   "
-              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
-              + (f"; binding: {binding}" if binding else "") + closest_text(leg, units))  # fmt: skip
+    print(result.summary(units.display))  # the cycle's text: its repr in SI (CycleResult.summary)
     if cell is not None:
         print(cell_text(cell, move.distance, units))
     if path is CyclePath.LINES:
@@ -188,14 +162,6 @@ def cell_text(cell: Any, distance: Any, units: Units) -> str:
         return head + "; no pair checked"
     return (head + f"; closest {distance.pair} at {units.num(distance.distance, 'length')} {Ln} "
             f"(t = {distance.time:.4f} s)")  # fmt: skip
-
-
-def closest_text(leg: Any, units: Units) -> str:
-    """``; closest link2 - post 2.1 mm`` for a leg planned in a cell, else ""."""
-    if getattr(leg, "closest", None) is None:
-        return ""
-    pair, d = leg.closest
-    return f"; closest {pair} {units.num(d, 'length')} {units.length_name}"
 
 
 def _jump_for_comparison(robot: Any, result: Any, common: dict[str, Any], radius: float) -> tuple[float] | None:

@@ -349,8 +349,8 @@ def candidates(
 ) -> list[Candidate]:
     """Warm starts for the jump in the cell (module docstring).
 
-    The straight one when it is clear; else the clear ones, fastest first; else (none clears) every one tried, the
-    least colliding first.
+    The straight one when it is clear; else the clear ones, fastest first; else (none clears) every one tried,
+    the least colliding first.
     """
     robot = scene.robot
     straight = np.array([qA, tops[0], tops[1], qB])

@@ -51,13 +51,14 @@ the robot's tool position and inverse dynamics written from its Pinocchio model,
   relative at most after the refinement; every other ratio only drops, the path is the same).
 
 Among the minimum-time motions (the time is unique, the path is not: the joints that do not bind can
-move in many ways) the objective's tie-breaking terms pick the calmest (:data:`_TIE_VELOCITY`,
-:data:`_TIE_SMOOTH`): the quill brakes at once after the lift and holds (the lowest single-hump arch).
+move in many ways) the objective's small tie-breaking terms (the mean squared joint velocity, then the
+smoothness of the controls) pick the calmest: the quill brakes at once after the lift and holds (the lowest
+single-hump arch).
 
 **Output.** The states are integrated again from A in floating point with the solved controls, and the
 rounding left at B (about the solver's tolerance) is removed by the least-norm change of the controls
 that ends exactly at rest at B (the end state is linear in the controls). The result is then verified
-by independent routes (:func:`_verify`): the package's verifier (:func:`~scara_pin.motion.verify.verify`:
+by independent routes: the package's verifier (:func:`~scara_pin.motion.verify.verify`:
 Pinocchio at 10 kHz and at every breakpoint on both sides, the exact jerk and the jerk by third
 differences, the torques with the payload, endpoints, rest), the same ratios inside every interval and at
 the polynomial extrema, and the clearance, ceiling,
@@ -100,7 +101,9 @@ from ..description import JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..kinematics.validate import _pose_error
 from ..limits import MAX_SAMPLES, check_count
-from .payload import Payload, with_payload
+from ..summary import Summarized
+from ..units import SI, DisplayUnits
+from .payload import Payload, PayloadLike, as_payload, with_payload
 from .polynomial import PolynomialPiece
 from .trajectory import Trajectory, line_optimal_duration
 from .verify import (
@@ -122,6 +125,7 @@ if TYPE_CHECKING:
     from ..cell import Cell, Scene
     from ..description import JointLimits
     from ..model import Robot
+    from ..units import DisplayUnits
     from .avoid import DistanceRow, Rows
     from .symbolic import SymbolicModel
 
@@ -334,6 +338,26 @@ class Leg:
         """[s]."""
         return self.t_end - self.t_start
 
+    def line(self, units: DisplayUnits | None = None) -> str:
+        """The leg in one line, as ``scara-pin cycle`` prints it.
+
+        Ratios have no unit, times are in s; in a cell, the closest pair's distance is in ``units``' length unit
+        (default m).
+        """
+        binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in self.binding)
+        return (f"  {'out ' if self.move == 0 else 'back'} {self.name:<11} {self.duration:9.6f} s   {self.active} of "
+                f"{self.joint} at {self.ratio:.4f} of its limit" + (f"; binding: {binding}" if binding else "")
+                + self.closest_words(units))  # fmt: skip
+
+    def closest_words(self, units: DisplayUnits | None = None) -> str:
+        """``; closest link2 - post 0.002006 m`` for a leg planned in a cell (in ``units``' lengths), else ""."""
+        if self.closest is None:
+            return ""
+        from ..units import SI
+
+        u = SI if units is None else units
+        return f"; closest {self.closest[0]} {u.format(self.closest[1], 'length')} {u.name('length')}"
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         out = {"name": self.name, "move": self.move, "t_start": self.t_start, "t_end": self.t_end,
@@ -344,8 +368,8 @@ class Leg:
         return out
 
 
-@dataclass(frozen=True, eq=False)
-class JumpMove:
+@dataclass(frozen=True, eq=False, repr=False)
+class JumpMove(Summarized):
     """A verified time-optimal jump (or the cycle out and back) and how its limits are used.
 
     Attributes:
@@ -403,6 +427,22 @@ class JumpMove:
     def gap(self) -> float:
         """The duration above the lower bound, relative (0.2: 20 % above)."""
         return self.duration / (self.moves * self.lower_bound.duration) - 1.0
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The move in a few lines: its time, the bound, the arch, the legs (lengths in ``units``, default SI)."""
+        u = SI if units is None else units
+        Ln = u.name("length")
+        what = "jump move" if self.moves == 1 else f"jump cycle ({self.moves} moves)"
+        return "\n".join([
+            f"{what}   {self.duration:.6f} s, {100 * self.gap:.1f} % above its lower bound "
+            f"{self.moves * self.lower_bound.duration:.6f} s ({self.lower_bound.reason})",
+            f"from {u.format_vector(self.pose_from[:3], 'length')} to {u.format_vector(self.pose_to[:3], 'length')} "
+            f"{Ln}, payload {self.payload.mass:g} kg" + (f", jerk limit {list(self.jerk)}" if self.jerk else ""),
+            f"arch   up to {u.format(self.z_top + self.peak, 'length')} {Ln} ({u.format(self.peak, 'length')} {Ln} "
+            f"above the clearance height), {u.format(self.bulge, 'length')} {Ln} off the straight line in plan view",
+            "legs   (binding limits: the share of the leg's time at >= 99.9 % of the limit)",
+            *(leg.line(u) for leg in self.legs),
+        ])  # fmt: skip
 
     def and_back(self) -> JumpMove:
         """The move followed by its time reversal (B -> A): the cycle (module docstring, "Return move")."""
@@ -717,7 +757,7 @@ def jump_move(
     rise: float = STANDARD_RISE,
     clearance_radius: float = STANDARD_CLEARANCE,
     max_height: float | None = None,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     jerk: float | ArrayLike | None = None,
     torque: bool = True,
     tool_speed: float | None = None,
@@ -737,7 +777,8 @@ def jump_move(
         rise: [m] > 0, how high above the higher pose the tool must be away from both.
         clearance_radius: [m] > 0, R: within R of a pose (horizontally) the tool may be lower.
         max_height: [m] a ceiling for the tool's z (base frame), or None.
-        payload: carried by the tool (torques); default none.
+        payload: carried by the tool (torques): a :class:`~scara_pin.motion.payload.Payload` or a mass [kg];
+            default none.
         jerk: joint jerk limit [rad/s^3, m/s^3], one or four numbers; None: not limited.
         torque: respect the effort limits (inverse dynamics with the payload).
         tool_speed: [m/s] a limit of the tool origin's speed, or None.
@@ -767,7 +808,7 @@ def jump_move(
     ceiling = None
     if max_height is not None:
         ceiling = float(_vector("max_height", [max_height], 1)[0])
-    payload = Payload() if payload is None else payload
+    payload = as_payload(payload)
     lim = _limits(robot, limits, tool_speed, torque)
     jv = None if jerk is None else jerk_vector(jerk)
     D = float(np.hypot(*(B[:2] - A[:2])))

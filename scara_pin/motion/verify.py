@@ -60,14 +60,16 @@ from .._checks import _limit_vector, _positive
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
+from ..summary import Summarized
 from .paths import GeometricPath, JointLine, third_by_differences
-from .payload import Payload, with_payload
+from .payload import PayloadLike, with_payload
 from .trajectory import Motion, Trajectory
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..cell import Scene
     from ..model import Robot
+    from ..units import DisplayUnits
 
 __all__ = [
     "DISTANCE_TOL",
@@ -90,6 +92,7 @@ __all__ = [
     "state_ratios",
     "static_load",
     "static_overload",
+    "static_payload",
     "time_scale",
     "torque_coefficients",
     "trajectory_jerk",
@@ -123,6 +126,10 @@ class Quantity(enum.Enum):
     JERK_DIFFERENCES = "jerk (third differences)"
     TORQUE = "torque"
     TOOL_SPEED = "tool speed"
+
+
+_QUANTITY_WORD = {q: "jerk" if q is Quantity.JERK_DIFFERENCES else q.value for q in Quantity}
+"""How each quantity is named in a summary (the third differences are the jerk's measure there)."""
 
 
 @dataclass(frozen=True)
@@ -199,9 +206,9 @@ class LimitViolation(InfeasibleError):
         super().__init__(reason)
 
 
-@dataclass(frozen=True)
-class Verification:
-    """What :func:`verify` found.
+@dataclass(frozen=True, repr=False)
+class Verification(Summarized):
+    """What :func:`verify` found (``repr``: one line per limit checked, its worst ratio and where).
 
     Attributes:
         duration: [s] of the trajectory.
@@ -249,6 +256,31 @@ class Verification:
         """{quantity name: worst ratio or None}, JSON-ready."""
         found = {w.quantity: w.ratio for w in self.quantities}
         return {q.value: found.get(q) for q in Quantity}
+
+    def limited(self) -> tuple[Worst, ...]:
+        """The worst ratio of each limit checked; a limit not given is left out.
+
+        Velocity, acceleration, jerk (the analytic jerk where the motions have one, else the third
+        differences), torque, tool speed.
+        """
+        jerk = self.jerk if self.jerk is not None else self.jerk_differences
+        return tuple(w for w in (self.velocity, self.acceleration, jerk, self.torque, self.tool_speed) if w is not None)
+
+    def ratio_text(self) -> str:
+        """``velocity 0.9159 (joint1), acceleration 1.0000 (joint1), torque 0.6757 (joint2)``: :meth:`limited`."""
+        return ", ".join(f"{_QUANTITY_WORD[w.quantity]} {w.ratio:.4f} ({w.where.split(' at ')[0]})"
+                         for w in self.limited())  # fmt: skip
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The verification in a few lines: each limit's worst ratio, where and when (ratios have no unit)."""
+        try:
+            self.check()
+            verdict = "within the limits"
+        except LimitViolation as exc:
+            verdict = f"NOT within the limits: {exc}"
+        lines = [f"Verification of {self.duration:.6g} s at {self.rate:g} Hz ({self.samples} samples): {verdict}"]
+        lines += [f"  {_QUANTITY_WORD[w.quantity]:<13} {w.ratio:.6f} of its limit, {w.where}" for w in self.limited()]
+        return "\n".join(lines)
 
     def check(self, tolerance: float = TOLERANCE) -> Verification:
         """Self, if every ratio is <= 1 + ``tolerance`` and the endpoints and rest hold; else raise.
@@ -410,6 +442,31 @@ def static_load(robot: Robot, q: np.ndarray) -> np.ndarray:
     """g(q) (n, dof): the joint efforts that hold the robot still (RNEA at rest, gravity and payload)."""
     zero = np.zeros_like(q)
     return _rnea(robot, q, zero, zero)
+
+
+def static_payload(robot: Robot, q: np.ndarray, limits: JointLimits | None = None) -> float:
+    """The largest point mass [kg] at the tool frame's origin that the effort limits hold at rest at every row of q.
+
+    The static load is linear in the mass: ``g(q; m) = g0(q) + m g1(q)`` (``g1`` the load of 1 kg, the
+    difference of two :func:`static_load` calls), and ``|g0 + m g1| <= effort`` per joint gives
+    ``m <= (effort - sign(g1) g0) / |g1|`` wherever ``g1 != 0``. A SCARA's only loaded joint is the vertical
+    quill (constant over q); a palletizer's depends on q: the minimum is over the rows given.
+
+    Args:
+        robot: the robot (its model: gravity and the links' masses).
+        q: (n, dof) configurations [rad, m].
+        limits: limits instead of ``robot.limits`` (their efforts).
+
+    Returns:
+        the mass [kg]; 0 when the arm alone already exceeds an effort somewhere; inf when no joint carries it.
+    """
+    effort = np.asarray((robot.limits if limits is None else limits).effort, dtype=float)
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    g0 = static_load(robot, q)
+    g1 = static_load(with_payload(robot, 1.0), q) - g0
+    carried = np.abs(g1) > 1e-12 * max(1.0, float(np.abs(g0).max()))
+    room = np.where(carried, (effort - np.sign(g1) * g0) / np.where(carried, np.abs(g1), 1.0), np.inf)
+    return max(0.0, float(room.min()))
 
 
 def torque_coefficients(robot: Robot, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -585,7 +642,7 @@ def verify(
     limits: JointLimits | None = None,
     jerk: float | ArrayLike | None = None,
     torque: bool = False,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     tool_speed: float | None = None,
     rate: float = VERIFY_RATE,
     q_start: ArrayLike | None = None,
@@ -600,7 +657,8 @@ def verify(
         limits: joint limits instead of ``robot.limits``.
         jerk: joint jerk limit(s) [rad/s^3 or m/s^3], one or one per joint; None: jerk not checked.
         torque: check the effort limits (RNEA, gravity included).
-        payload: carried by the tool for the torques (:func:`~scara_pin.motion.payload.with_payload`).
+        payload: carried by the tool for the torques: a :class:`~scara_pin.motion.payload.Payload` or a mass
+            [kg] (:func:`~scara_pin.motion.payload.with_payload`).
         tool_speed: [m/s] limit of the tool origin's speed, optional.
         rate: [Hz] of the verified grid.
         q_start: the configuration the trajectory must start at, optional.

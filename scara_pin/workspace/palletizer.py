@@ -27,6 +27,7 @@ tolerances.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -169,7 +170,7 @@ def arm_plane_envelope(geo: PalletizerGeometry) -> ArmPlaneEnvelope:
                             (float(pts[:, 1].min()), float(pts[:, 1].max())), geo)  # fmt: skip
 
 
-def plot_envelope(env: ArmPlaneEnvelope, path: str | None = None, q: np.ndarray | None = None, *,
+def plot_envelope(env: ArmPlaneEnvelope, path: str | os.PathLike[str] | None = None, *, q: np.ndarray | None = None,
                   units: DisplayUnits = SI, robot_name: str | None = None, dpi: int = 120) -> Figure:  # fmt: skip
     """The envelope in the arm plane: arcs coloured by their limit, and the arm at ``q`` (default mid-range).
 
