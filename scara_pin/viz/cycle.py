@@ -18,7 +18,6 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from ..cell import Cell
-
     from ..description import JointLimits
     from ..model import Robot
     from ..motion.cycle import ArchMove, CycleResult
@@ -130,8 +129,11 @@ def plot_cycle(
 
 
 def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarray, k: float) -> None:
-    """The obstacles of a cell: their outline in plan view (the convex hull of the shape's points: a circle's for a
-    vertical cylinder or a sphere) and, in the side view, the box they span along the traverse and in z."""
+    """The obstacles of a cell, in plan view and in the side view.
+
+    In plan view their outline (the convex hull of the shape's points: a circle's for a vertical cylinder or a
+    sphere); in the side view, the box they span along the traverse and in z.
+    """
     from matplotlib.patches import Polygon, Rectangle
 
     angle = np.linspace(0.0, 2.0 * np.pi, 73)
