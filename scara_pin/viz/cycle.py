@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..description import JOINT_NAMES
 from ..units import SI, DisplayUnits
 from .plots import finish, new_figure
 
@@ -116,7 +115,7 @@ def plot_cycle(
     for k, (name, ratio) in enumerate(quantities):
         ax = fig.add_subplot(grid[1 + k, :])
         for j in range(4):
-            ax.plot(t, ratio[:, j], color=_COLORS[j], label=JOINT_NAMES[j])
+            ax.plot(t, ratio[:, j], color=_COLORS[j], label=robot.joint_names[j])
         ax.axhline(1.0, color="k", ls="--", lw=1)
         for leg in move.legs:
             ax.axvline(leg.t_start, color="0.85", lw=0.8, zorder=0)
@@ -129,9 +128,9 @@ def plot_cycle(
 
 
 def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarray, k: float) -> None:
-    """The obstacles of a cell, in plan view and in the side view.
+    """The obstacles of a cell, drawn on the cycle's side and plan views.
 
-    In plan view their outline (the convex hull of the shape's points: a circle's for a vertical cylinder or a
+    In plan view, their outline (the convex hull of the shape's points: a circle for a vertical cylinder or a
     sphere); in the side view, the box they span along the traverse and in z.
     """
     from matplotlib.patches import Polygon, Rectangle
