@@ -133,6 +133,25 @@ def test_a_tool_frame_step_and_a_joint_step_stop_at_the_margin(robot) -> None:
     np.testing.assert_allclose(reply.q, q1 + np.array([reply.travelled, 0.0, 0.0, 0.0]), rtol=0, atol=1e-15)
 
 
+def test_a_step_from_the_stretched_arm_stops_at_the_margin(robot) -> None:
+    """On the outer edge (arm stretched) the closed form's joint rates have no bound: the move's first micrometre
+    goes through its IK solutions, the rest by the closed form, and it stops with the flange at the margin (closed
+    form), on the line. The step out to the edge ends there the same way (its last micrometre)."""
+    post = np.array([0.30, 0.01])
+    cell = Cell((Obstacle("post", Shape("cylinder", (RP, 0.23), np.array([*post, -0.185]), np.zeros(3))),), MARGIN)
+    session = TeachSession(robot, start_q(robot, 0.36, 0.01), cell=cell)
+    edge = session.jog(JogAxis.X, 0.2)
+    assert edge.status == "STOPPED" and edge.reason is not None and edge.reason.kind is StopKind.WORKSPACE
+    assert abs(np.linalg.norm(tool(robot, edge.q)[:2]) - 0.4) < 1e-9  # l1 + l2: the stretched arm
+    reply = session.jog(JogAxis.X, -0.2)
+    assert reply.status == "STOPPED" and reply.message == "stopped 0.002 m from post (flange)", reply.message
+    end = tool(robot, reply.q)
+    assert R - 1e-12 <= float(np.linalg.norm(end[:2] - post)) <= R + CONTACT_TOL + 1e-12
+    assert abs(end[1] - 0.01) < 1e-12 and abs(end[2] + 0.1) < 1e-12
+    x_edge = math.sqrt(0.4**2 - 0.01**2)  # the stretched arm at y = 0.01
+    assert reply.travelled == pytest.approx(x_edge - (post[0] + R), abs=2 * CONTACT_TOL)
+
+
 @pytest.mark.parametrize("held", ["x", "joint1"])
 def test_a_held_jog_stops_at_the_margin(robot, held: str) -> None:
     """Held at 100 %: x of the base frame from (0.25, -0.1) toward the post's axis, or J1 from (0.22, -0.25)."""

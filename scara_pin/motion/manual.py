@@ -34,7 +34,8 @@ No acceleration ramp is simulated: a hold starts and stops at once.
 In a cell (``scene=``, :func:`scara_pin.cell.scene`), every move also stops before a checked pair (a link or the
 carried part against an obstacle, or two links checked against each other) comes closer than the cell's margin:
 the move above is followed as the joint path it is (a straight joint line, or the straight tool line by the
-closed-form IK, :class:`~scara_pin.motion.paths.CartesianSegment`) by
+closed-form IK, :class:`~scara_pin.motion.paths.CartesianSegment`; its last or first micrometre through its IK
+solutions when it ends or starts on the stretched or folded arm) by
 :func:`scara_pin.cell.sweep.first_contact`, and ends where the first pair comes to the margin (clear of it by
 0 to 1e-9 m), never beyond; the reason names the obstacle and the robot's shape: ``stopped 0.002 m from post
 (flange)``. A move that would bring a pair at the margin closer does not move (``AT_EDGE``).
@@ -61,13 +62,15 @@ from ..errors import InvalidInputError, NoSolutionError, ParameterError, ScaraEr
 
 if TYPE_CHECKING:
     from ..cell import PairDistance, Scene
+    from ..cell.sweep import JointPath
     from ..model import Robot
     from ..workspace.scara import RayHit, Workspace
-    from .paths import GeometricPath
 
 __all__ = [
     "BISECT_TOL",
     "CONTACT_ROOM",
+    "MAX_POLYLINE_POINTS",
+    "POLYLINE_SPACING",
     "JUMP",
     "MANUAL_SPEED",
     "MANUAL_TURN_RATE",
@@ -108,6 +111,12 @@ BISECT_TOL = 1e-10
 """[m or rad] the bisection of the first refused sample stops this close to it."""
 CONTACT_ROOM = 1e-9
 """[m or rad] in a cell, a move shorter than this before the first contact does not move (``AT_EDGE``)."""
+POLYLINE_SPACING = 1e-4
+"""[m or rad] in a cell, the part of a Cartesian move the closed form cannot follow (next to the stretched or
+folded arm) is followed through its IK solutions this far apart (at least 16, at most
+:data:`MAX_POLYLINE_POINTS`), joined by straight joint lines."""
+MAX_POLYLINE_POINTS = 2000
+"""The IK solutions of such a move at most."""
 _EDGE = 1e-9  # [m] a ray edge this close is where the tool is (the workspace's EDGE_TOL)
 _AIM = 0.999  # a shortened hold step aims at this fraction of the speed limits (1 would converge from above)
 
@@ -339,13 +348,17 @@ def _before_contact(robot: Robot, scene: Scene, q0: np.ndarray, motion: JogMotio
     """``move`` (from ``q0``), ended where a checked pair of ``scene`` first comes to the margin, if it does."""
     from ..cell.sweep import first_contact
 
-    path, reach = _move_path(robot, q0, motion, move)
-    found = first_contact(scene, path)  # InCollisionError (exit 2) when q0 is closer than the margin
-    if found is None:
+    done = 0.0
+    for path, length in _move_paths(robot, q0, motion, move):
+        found = first_contact(scene, path)  # InCollisionError (exit 2) when q0 is closer than the margin
+        if found is not None:
+            break
+        done += length
+    else:
         return move
     c = found.closest
     pair = f"{c.pair.b} ({c.pair.a})"
-    travelled = found.s * reach
+    travelled = done + found.s * length
     if not travelled > CONTACT_ROOM:
         reason = StopReason(StopKind.OBSTACLE, f"at the margin: {c.distance:.6g} m from {pair}, and this way "
                             "comes closer", c.pair.b)  # fmt: skip
@@ -357,29 +370,90 @@ def _before_contact(robot: Robot, scene: Scene, q0: np.ndarray, motion: JogMotio
                    move.solver, c)  # fmt: skip
 
 
-def _move_path(robot: Robot, q0: np.ndarray, motion: JogMotion, move: JogMove) -> tuple[GeometricPath, float]:
-    """The joint path ``move`` follows from ``q0``, s in [0, 1], and the length [m or rad] of the move it covers.
+def _move_paths(robot: Robot, q0: np.ndarray, motion: JogMotion, move: JogMove) -> list[tuple[JointPath, float]]:
+    """The joint paths ``move`` follows from ``q0``, one after the other, each with the length [m or rad] it covers.
 
     A joint move: the straight joint line. A Cartesian one: the straight tool line followed by the closed-form IK
-    (the branch and the J4 turn of ``q0``). A line that ends on the stretched or folded arm (the workspace's
-    outer or inner edge) cannot be followed to its end (the joint rates grow without bound): it is followed to
-    :data:`~scara_pin.motion.jog.SINGULAR_EDGE_GAP` before it, as :func:`~scara_pin.motion.jog.jog_to_edge` does.
+    (the branch and the J4 turn of ``q0``). That IK's joint rates have no bound on the stretched or folded arm
+    (:func:`~scara_pin.motion.paths.cartesian_path` refuses a line that starts or ends there): the line's last (or
+    first) :data:`~scara_pin.motion.jog.SINGULAR_EDGE_GAP` is followed through its IK solutions instead
+    (:func:`_ik_polyline`), and a line that does both, or that the closed form refuses otherwise, all of it.
     """
     from .jog import SINGULAR_EDGE_GAP
     from .paths import JointLine, PathError, cartesian_path
 
     if motion.joint is not None:
-        return JointLine(q0, move.q), move.travelled
+        return [(JointLine(q0, move.q), move.travelled)]
     d = direction(robot, q0, motion)
     pose0 = np.asarray(robot.tool_pose(q0), dtype=float)
-    reach = move.travelled
+    length, gap = move.travelled, SINGULAR_EDGE_GAP
+
+    def line(a: float, b: float, start: np.ndarray) -> JointPath:
+        return cartesian_path(robot, [pose0 + a * d, pose0 + b * d], start=start).segments[0]
+
     try:
-        return cartesian_path(robot, [pose0, pose0 + reach * d], start=q0).segments[0], reach
-    except PathError:
-        if not reach > SINGULAR_EDGE_GAP:
-            raise
-        reach -= SINGULAR_EDGE_GAP
-        return cartesian_path(robot, [pose0, pose0 + reach * d], start=q0).segments[0], reach
+        return [(line(0.0, length, q0), length)]
+    except PathError as exc:
+        log.debug("the jog's line near a singular arm: %s", exc)
+    if length > 2.0 * gap:
+        try:  # it ends on the singular arm
+            head = line(0.0, length - gap, q0)
+            q_near = head.evaluate(np.ones(1), 0)[0][0]
+            tail = _ik_polyline(robot, q_near, pose0 + (length - gap) * d, d, gap, move.q)
+            return [(head, length - gap), (tail, gap)]
+        except PathError as exc:
+            log.debug("not only its end: %s", exc)
+        try:  # it starts on it
+            start = _ik_polyline(robot, q0, pose0, d, gap)
+            return [(start, gap), (line(gap, length, start.Q[-1]), length - gap)]
+        except PathError as exc:
+            log.debug("not only its start: %s", exc)
+    return [(_ik_polyline(robot, q0, pose0, d, length, move.q), length)]
+
+
+def _ik_polyline(robot: Robot, q0: np.ndarray, pose0: np.ndarray, d: np.ndarray, length: float,
+                 q_end: np.ndarray | None = None) -> _Polyline:  # fmt: skip
+    """The IK solutions of the line ``pose0 + s d``, s in [0, ``length``], joined by straight joint lines.
+
+    At least 16, at most :data:`MAX_POLYLINE_POINTS`, :data:`POLYLINE_SPACING` apart where that allows; each the
+    solution of ``q0``'s branch nearest to the one before (:func:`_continuous`); ``q_end`` is the last if given.
+
+    Raises:
+        PathError: a point of the line without such a solution.
+    """
+    from .paths import PathError
+
+    n = min(MAX_POLYLINE_POINTS - 1, max(16, math.ceil(length / POLYLINE_SPACING)))
+    s = np.linspace(0.0, 1.0, n + 1)
+    Q = np.empty((n + 1, robot.dof))
+    Q[0] = q0
+    branch = branch_of(robot, q0) or "all"
+    for k in range(1, n + 1):
+        if k == n and q_end is not None:
+            Q[k] = q_end
+            break
+        answer = _continuous(robot, pose0 + s[k] * length * d, Q[k - 1], branch)
+        if answer.q is None:
+            raise PathError(f"no IK solution on the jog's line ({answer.status}: {answer.message})", s=float(s[k]),
+                            pose=pose0 + s[k] * length * d)  # fmt: skip
+        Q[k] = answer.q
+    return _Polyline(s, Q)
+
+
+@dataclass(frozen=True, eq=False)
+class _Polyline:
+    """The joint path through ``Q`` (rows) at the parameters ``s`` (increasing, 0 to 1), straight between them."""
+
+    s: np.ndarray
+    Q: np.ndarray
+
+    def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
+        """(q, q', q'' = 0) at ``s`` (1-D), each (n, dof); q' of the piece on the right of a knot."""
+        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
+        i = np.clip(np.searchsorted(self.s, s, side="right") - 1, 0, len(self.s) - 2)
+        rate = (self.Q[i + 1] - self.Q[i]) / (self.s[i + 1] - self.s[i])[:, None]
+        out = (self.Q[i] + (s - self.s[i])[:, None] * rate, rate, np.zeros_like(rate))
+        return out[: order + 1]
 
 
 def _joint_step(robot: Robot, q0: np.ndarray, j: int, sign: int, length: float) -> JogMove:
