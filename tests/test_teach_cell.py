@@ -299,3 +299,21 @@ def test_the_pendant_page_stops_a_jog_at_the_post_and_draws_it(robot, cell_serve
     hidden = slate_pixels(page.screenshot(clip=view))
     assert drawn > 1000 and hidden < 0.01 * drawn, (drawn, hidden)
     assert page.errors == []
+
+
+def test_a_step_onto_the_stretched_arm_is_checked_in_few_steps(robot, monkeypatch) -> None:
+    """0.4 mm out onto the outer edge, the post far away: near the singularity the joint rates grow without bound
+    (and jump at each corner of the last micrometre's joint polyline), yet the far post allows long steps: the
+    search asks for few distances (4,480 configurations before it kept a step its gaps allow at either end's bound)."""
+    from scara_pin.cell import Scene
+
+    cell = Cell((Obstacle("post", Shape("cylinder", (RP, 0.23), np.array([-0.3, 0.0, -0.185]), np.zeros(3))),))
+    session = TeachSession(robot, start_q(robot, 0.3996, 0.0), cell=cell)
+    asked = []
+    real = Scene.distance_array
+    monkeypatch.setattr(Scene, "distance_array",
+                        lambda self, Q, *a, **k: asked.append(len(np.atleast_2d(Q))) or real(self, Q, *a, **k))
+    reply = session.jog(JogAxis.X, 0.1)
+    assert reply.status == "STOPPED" and reply.reason is not None and reply.reason.kind is StopKind.WORKSPACE
+    assert abs(tool(robot, reply.q)[0] - 0.4) < 1e-9
+    assert sum(asked) < 500, sum(asked)

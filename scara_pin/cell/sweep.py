@@ -26,8 +26,9 @@ the closest pair's rate of approach, :meth:`Scene.gradients <scara_pin.cell.Scen
 bisection on coal's distance until the gap at the stop is in [0, :data:`CONTACT_TOL`] m.
 
 The bound holds for the q' of the start of each step; a step after which the bound grew by more than
-:data:`BOUND_GROWTH` is taken again at half the length, so a path whose q' changes fast (near a singularity)
-is followed in small steps.
+:data:`BOUND_GROWTH` is kept only if every pair's gap also allows it at the larger of its bounds at the step's two
+ends, else taken again at half the length, so a path whose q' changes fast (near a singularity, or at the
+corners of a joint polyline) is followed in small steps where a pair is near.
 
 **Starting at the margin.** Conservative advancement cannot follow a pair that starts AT the margin and does
 not approach (a jog that stopped at a post, then moves along it or turns the flange beside it): its steps are
@@ -407,6 +408,10 @@ def first_contact(scene: Scene, path: JointPath, s_end: float = 1.0) -> Contact 
                 return _bracketed(scene, at, margin, s, s1)
             V1 = pair_speeds(q1, dq1, g1)
             if V1.max() <= BOUND_GROWTH * V.max() or step <= _MIN_STEP:
+                break
+            # the bound grew: the step holds if it holds with each pair's larger bound of its two ends (the samples
+            # of a pair at the margin are its check: the step is at most one)
+            if np.all((step * np.maximum(V, V1) <= g) | sliding):
                 break
             step *= 0.5
         s, q, dq, g, V = s1, q1, dq1, g1, V1
