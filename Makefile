@@ -1,5 +1,5 @@
 # Two commands do all the set-up on a fresh machine with Python 3.11 and make:
-#   make demo   creates .venv, installs scara-pin, runs the demo
+#   make demo   creates .venv, installs scara-pin, runs the demo (in mm and deg, the README's quick start)
 #   make test   creates .venv, installs scara-pin with its test extras, runs the whole suite (on every core:
 #               pytest-xdist's -n auto is in pyproject.toml's addopts; pass -n 0 for one process)
 PYTHON ?= python3
@@ -24,9 +24,9 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 demo: $(VENV)/.installed
 	@mkdir -p $(OUT)
 	$(BIN)/scara-pin urdf --robot default -o $(OUT)/scara.urdf
-	$(BIN)/scara-pin fk 0.1 0.2 0.05 0.3
-	$(BIN)/scara-pin jacobian 0.1 0.2 0.05 0.3
-	$(BIN)/scara-pin ik 0.3 0.1 -0.1 0.5
+	$(BIN)/scara-pin fk --mm --deg 30 45 20 10
+	$(BIN)/scara-pin jacobian --mm --deg 30 45 20 10
+	$(BIN)/scara-pin ik --mm --deg 300 100 -60 45
 	$(BIN)/scara-pin traj --robot s1 --deg --mm --from 0 0 0 0 --to 90 60 50 -180 --duration 5 \
 	    --out $(OUT)/s1_traj.csv --plot $(OUT)/s1_traj.png
 	$(BIN)/scara-pin view --robot s1 --traj $(OUT)/s1_traj.csv --workspace --html $(OUT)/s1_traj.html
@@ -71,7 +71,7 @@ bench-cell: $(VENV)/.installed-test
 
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[test,lint]'
-	$(BIN)/ruff check scara_pin tests benchmarks
+	$(BIN)/ruff check scara_pin tests benchmarks tools
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
 # the documentation site from docs/ and the docstrings, into site/; a warning fails the build

@@ -10,7 +10,7 @@ Run with the project's interpreter (``.venv/bin/python benchmarks/bench_jerk.py 
     per smooth piece, s free, 240 intervals), its own path data (finite differences of the closed-form IK),
     its own check; its duration is made FEASIBLE by that check (an upper bound of the true minimum). Both
     are then checked by the same independent dense check (q(t) by IK at 100 kHz, finite differences, RNEA):
-    the worst ratio is printed. Also: the old moving-average filter method (motion/jerk_fir.py), and for the
+    the worst ratio is printed. Also: the old moving-average filter method (benchmarks/jerk_fir.py), and for the
     one-joint move ruckig's exact time-optimal profile.
 (b) **Discretisation**: ours with 24 to 96 intervals on the standard-cycle arch (duration, compute time).
 (c) **Simpler plans** on the standard-cycle arch: the three straight lines with a stop at each corner
@@ -32,13 +32,13 @@ import numpy as np
 from scara_pin import load_robot
 from scara_pin.motion.cycle import arch_path, cycle_placement
 from scara_pin.motion.jerk import JerkOptions, time_optimal_jerk
-from scara_pin.motion.jerk_fir import fir_jerk_limited
 from scara_pin.motion.paths import cartesian_path
 from scara_pin.motion.timing import parameterize
 from scara_pin.motion.trajectory import JointLine
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import jerk_reference  # noqa: E402  (the independent reference, shared with the tests)
+from jerk_fir import fir_jerk_limited  # noqa: E402  (benchmarks/jerk_fir.py, beside this script: the old filter method)
 
 ISSUE_FROM = np.array([0.2608695652173913, -0.1525, -0.0875, 0.0])
 """The issue's placement of the standard cycle (``--from ... --direction 0 1``, 305 mm across, 25 mm up)."""

@@ -10,7 +10,7 @@ standard :mod:`csv` module (quoting). The rules, the same for every file:
 - the first other line is the header; the wanted columns are found by name (case and surrounding blanks
   ignored), other columns are ignored; with ``exact=True`` the header must be exactly the wanted names;
 - every data row has as many cells as the header, and the wanted cells are plain numbers
-  (:data:`scara_pin._checks.NUMBER_TEXT`: no ``nan``, ``inf``, ``1_000``) of magnitude at most
+  (no ``nan``, ``inf``, ``1_000``) of magnitude at most
   :data:`scara_pin.limits.MAX_NUMBER`.
 
 Errors are :class:`~scara_pin.errors.InvalidInputError` (exit code 2) naming the file and the line.

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from scara_pin import generate_urdf
+from scara_pin import available_robots, generate_urdf, load_parameters
 from scara_pin.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
@@ -405,16 +405,56 @@ def test_version_and_help_return(flag: str, capsys: pytest.CaptureFixture[str]) 
     assert capsys.readouterr().out.strip()
 
 
+# ----------------------------------------------------------------------------------------- commands
+def test_the_command_map_is_what_the_modules_register() -> None:
+    """scara_pin.cli.COMMANDS (main imports only the module of the command it runs) against each module's own
+    register(): every command is mapped to the module that registers it, and nothing else is mapped."""
+    import importlib
+
+    from scara_pin.cli import COMMANDS
+
+    class Recorder:
+        def __init__(self) -> None:
+            self.names: list[str] = []
+
+        def add_parser(self, name: str, **kwargs: object) -> object:
+            self.names.append(name)
+            return argparse.ArgumentParser().add_subparsers().add_parser(name)
+
+    registered = {}
+    for module in sorted(set(COMMANDS.values())):
+        rec = Recorder()
+        importlib.import_module(f"scara_pin.cli.{module}").register(rec)
+        registered.update({name: module for name in rec.names})
+    assert registered == COMMANDS
+    modules = {p.stem for p in (REPO / "scara_pin" / "cli").glob("*.py") if not p.stem.startswith("_")}
+    assert modules == set(COMMANDS.values())  # a new command module is in the map
+
+
 # ----------------------------------------------------------------------------------------- robots
 def test_robots_lists_default_and_s1(capsys: pytest.CaptureFixture[str]) -> None:
     rc, out, err = run(capsys, ["robots"])
     assert rc == 0 and err == ""
-    names = out.split()
+    head, *lines = out.splitlines()
+    assert head.split() == ["robot", "kind", "reach", "[mm]", "stroke", "[mm]", "payload", "[kg]"]
+    rows = {line.split()[0]: line.split() for line in lines if line.split() and line.split()[0] in available_robots()}
+    names = list(rows)
     assert {"default", "s1"} <= set(names)
     assert names == sorted(names)
     data = fk_json(capsys, ["robots", "--json"])
     assert data["robots"] == names
     assert Path(data["config_dir"]).resolve() == CONFIG.resolve()
+    # the default robot's figures from its yaml, by the closed forms (issue 31 item 8): reach l1 + l2 and
+    # |l1 + l2 e^(i q2max)|, stroke the quill's range, payload effort3 / g - the quill's and flange's masses
+    p = load_parameters("default").values
+    r_min = math.hypot(p["l1"] + p["l2"] * math.cos(p["joint2_upper"]), p["l2"] * math.sin(p["joint2_upper"]))
+    payload = p["joint3_effort"] / 9.81 - p["quill_mass"] - p["flange_mass"]
+    stroke = p["joint3_upper"] - p["joint3_lower"]
+    assert rows["default"][1:] == ["scara", f"{r_min * 1e3:.0f}", "-", f"{(p['l1'] + p['l2']) * 1e3:.0f}",
+                                   f"{stroke * 1e3:.0f}", f"{payload:.2f}"]  # fmt: skip
+    facts = {f["name"]: f for f in data["facts"]}
+    assert facts["default"]["payload"] == pytest.approx(payload, rel=1e-12)
+    assert facts["default"]["reach"] == pytest.approx([r_min, p["l1"] + p["l2"]], abs=1e-12)
 
 
 # ------------------------------------------------------------------------------------------- urdf

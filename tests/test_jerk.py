@@ -11,6 +11,8 @@ from the samples.
 from __future__ import annotations
 
 import dataclasses
+import sys
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -213,9 +215,11 @@ def test_path_derivatives_against_differences_of_ik(robot, issue_arch):
 def test_blended_arch_never_slower_than_the_simpler_plans(robot, issue_arch):
     """The issue's 'never slower than the simpler plan', same limits (jerk 2000, torques): the blended arch
     timed here <= the three lines with a stop at each corner, and <= the same arch by the old filter method."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from jerk_fir import fir_jerk_limited  # the old filter method: a benchmark's baseline, not the package's
+
     from scara_pin.motion.cycle import arch_path
     from scara_pin.motion.jerk import time_optimal_jerk
-    from scara_pin.motion.jerk_fir import fir_jerk_limited
     from scara_pin.motion.timing import parameterize
 
     path, b = issue_arch
@@ -226,6 +230,9 @@ def test_blended_arch_never_slower_than_the_simpler_plans(robot, issue_arch):
     old, _ = fir_jerk_limited(robot, parameterize(robot, path, torque=True).trajectory, JERK, torque=True)
     assert blended.duration <= corners.trajectory.duration
     assert blended.duration <= old.duration
+    import importlib.util
+
+    assert importlib.util.find_spec("scara_pin.motion.jerk_fir") is None  # a baseline: benchmarks/, not the package
 
 
 def test_arch_near_an_independent_minimum(robot, issue_arch):

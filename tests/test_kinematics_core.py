@@ -418,12 +418,12 @@ def test_q1_on_its_limit_with_a_nearly_stretched_elbow_is_solved() -> None:
 # the layers, lowest first (STYLE.md: description -> model -> kinematics -> workspace -> motion -> job -> viz -> cli);
 # a module may import its own layer and those below, never one above
 LAYERS = (
-    ("_typing", "_version", "errors", "signals", "units"),
+    ("_typing", "_version", "errors", "signals", "units", "summary"),
     ("limits", "files", "urdf_rules"),
     ("description",),
     ("_checks", "tables", "_urdf_checks"),
     ("cell",),  # the robot's collision model and the obstacles: it takes a Robot (types only); model reaches it
-    ("model", "chain"),
+    ("model", "chain", "stick"),
     ("kinematics",),
     ("calibration",),  # beside kinematics: imports description, model, kinematics; nothing lower imports it
     ("robots", "workspace", "lint"),
@@ -492,6 +492,29 @@ def test_fk_imports_no_inverse_kinematics() -> None:
     rc, loaded = done.stdout.strip().splitlines()[-1].split(" ", 1)
     assert rc == "0"
     assert loaded == "['scara_pin.kinematics.kinds']", loaded
+
+
+def test_fk_loads_neither_other_commands_nor_the_tree_tools() -> None:
+    """Issue 31 item 8: `python -X importtime` showed cli.motion, description.packages, chain and _urdf_checks
+    loaded for `fk` of a shipped robot; none is needed there (one command's module, a chain-only model, the
+    package's own URDF, no mesh to resolve)."""
+    import subprocess
+    import sys
+    import textwrap
+
+    code = textwrap.dedent("""
+        import sys
+        from scara_pin.cli import main
+        rc = main(["fk", "0.1", "0.2", "0.05", "0.3"])
+        print(rc, sorted(m for m in sys.modules if m.startswith("scara_pin")))
+    """)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    rc, loaded = done.stdout.strip().splitlines()[-1].split(" ", 1)
+    assert rc == "0"
+    for name in ("scara_pin.cli.motion", "scara_pin.cli.cycle", "scara_pin.cli.calibrate", "scara_pin.cli.describe",
+                 "scara_pin.description.packages", "scara_pin.chain", "scara_pin._urdf_checks"):  # fmt: skip
+        assert f"'{name}'" not in loaded, name
+    assert "'scara_pin.cli.kinematics'" in loaded
 
 
 def test_no_compiled_twin() -> None:

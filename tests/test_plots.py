@@ -43,7 +43,7 @@ def test_plots_leave_the_callers_matplotlib_alone(tmp_path: Path) -> None:
                         robot=robot)
         arch = plan_motion(robot, MotionRequest(start_pose=np.array([0.30, -0.10, -0.09, 0.0]),
                                                 end_pose=np.array([0.25, 0.15, -0.09, 0.3]), arch=True))
-        plot_cycle(robot, arch.arch, out / "cycle.png")
+        plot_cycle(arch.arch, out / "cycle.png", robot=robot)
         pyplot = sys.modules.get("matplotlib.pyplot")  # toppra imports it itself; we must leave no figure there
         print(matplotlib.get_backend(), pyplot.get_fignums() if pyplot else [])
     """)

@@ -450,6 +450,25 @@ def test_play_steps_in_real_time(viewer: Viewer, robot: Robot) -> None:
     np.testing.assert_allclose(M, robot.frame_placement(qs[-1], "tool0", "universe").homogeneous, rtol=0, atol=1e-12)
 
 
+def test_play_and_animate_take_a_trajectory(viewer: Viewer, robot: Robot) -> None:
+    """The live viewer as a MeshcatVisualizer user drives it: display(q), play(trajectory), animate(trajectory)."""
+    from scara_pin.motion.timing import time_optimal
+
+    traj = time_optimal(robot, [Q_A, Q_B])
+    viewer.display(Q_A)
+    M = chain_placement(page_commands(viewer.static_html()), robot, "tool0")
+    np.testing.assert_allclose(M, robot.frame_placement(Q_A, "tool0", "universe").homogeneous, rtol=0, atol=1e-12)
+    start = time.monotonic()
+    viewer.play(traj, speed=2.0)
+    elapsed = time.monotonic() - start
+    assert 0.4 * traj.duration < elapsed < 0.5 * traj.duration + 1.0, (elapsed, traj.duration)
+    M = chain_placement(page_commands(viewer.static_html()), robot, "tool0")  # it ends where the trajectory does
+    np.testing.assert_allclose(M, robot.frame_placement(Q_B, "tool0", "universe").homogeneous, rtol=0, atol=1e-9)
+    viewer.animate(traj, fps=30)  # the browser's animation: frames at 30 fps, the last one q_end
+    with pytest.raises(InvalidInputError, match="not both"):
+        viewer.play(traj, Q_A[None, :])
+
+
 # ------------------------------------------------------------------------------------------ real browser
 def test_live_page_shows_the_robot_where_pinocchio_puts_it(viewer: Viewer, robot: Robot, page: Any) -> None:
     viewer.display(Q_A)

@@ -29,6 +29,7 @@ import pinocchio as pin
 from ..errors import InvalidInputError
 from ..limits import MAX_PLAN_POSES, MAX_PLAN_WORK, check_count
 from ..model import Robot
+from ..summary import Summarized
 from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame
 from .fit import _random_poses, structural_count
 from .identify import identify
@@ -55,8 +56,8 @@ class Criterion(enum.Enum):
     """E-optimal: the smallest singular value of the scaled identification Jacobian."""
 
 
-@dataclass(frozen=True, eq=False)
-class ExperimentPlan:
+@dataclass(frozen=True, eq=False, repr=False)
+class ExperimentPlan(Summarized):
     """The configurations to measure.
 
     Attributes:
@@ -81,6 +82,13 @@ class ExperimentPlan:
     condition: float
     candidates: int
     seed: int
+
+    def summary(self, units: object = None) -> str:
+        """How many configurations, the criterion, what they identify and how well."""
+        return (f"ExperimentPlan for {self.robot!r}: {len(self.q)} configurations ({self.criterion.value}-optimal, "
+                f"from {self.candidates} candidates, seed {self.seed}); identifies {len(self.identified)} errors: "
+                f"{', '.join(self.identified)}; condition {self.condition:.4g}, smallest singular value "
+                f"{self.min_sv:.4g}")  # fmt: skip
 
     def to_csv(self) -> str:
         """A measurement file template: the configurations and the nominal positions, to replace by measured ones."""

@@ -9,11 +9,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..summary import Summarized
 from .chain import Group, MeasurementFrame
 
 if TYPE_CHECKING:
     import pinocchio as pin
 
+    from ..units import DisplayUnits
     from .chain import ChainModel
     from .measurements import Measurements
 
@@ -135,8 +137,8 @@ class CrossValidation:
     residuals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)
 
 
-@dataclass(frozen=True, eq=False)
-class CalibrationResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class CalibrationResult(Summarized):
     """A calibrated robot: the identified errors, their covariance, the residuals and the report.
 
     Attributes:
@@ -284,6 +286,10 @@ class CalibrationResult:
             "identified": list(self.identified),
             "covariance": self.covariance.tolist(),
         }  # fmt: skip
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """:meth:`report` in ``units`` (default SI): what ``scara-pin calibrate`` prints."""
+        return self.report("m", "rad") if units is None else self.report(units.length, units.angle)
 
     def report(self, length_unit: str = "m", angle_unit: str = "rad", *, warnings: bool = True) -> str:
         """The report in words: residuals, identified errors with their deviations, fixed ones and why.

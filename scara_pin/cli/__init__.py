@@ -20,6 +20,7 @@ them, so ``fk`` starts about as fast as ``import pinocchio``.
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import os
 import sys
@@ -28,10 +29,24 @@ from typing import Any
 
 from ..errors import ScaraError
 from ..signals import Terminated, kept, raise_pending
-from . import calibrate, cycle, describe, job, kinematics, motion, teach, view, workspace
 from ._common import _Parser, _UsageError, log
 
-__all__ = ["build_parser", "main"]
+__all__ = ["COMMANDS", "build_parser", "main"]
+
+COMMANDS: dict[str, str] = {
+    "robots": "describe", "urdf": "describe", "check": "describe",
+    "fk": "kinematics", "jacobian": "kinematics", "ik": "kinematics", "validate-ik": "kinematics",
+    "traj": "motion", "jog": "motion",
+    "cycle": "cycle",
+    "job": "job",
+    "workspace": "workspace",
+    "view": "view",
+    "teach": "teach",
+    "calibrate": "calibrate",
+}  # fmt: skip
+"""Each command and the module of ``scara_pin.cli`` that registers it (in ``--help``'s order): ``main`` imports
+only the module of the command it runs (``scara-pin fk`` loads neither the motion nor the calibration
+commands). tests/test_cli.py checks it against what each module registers."""
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
@@ -55,8 +70,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     target: Any = sub if command is None else _OneCommand(sub, command)
-    for module in (describe, kinematics, motion, cycle, job, workspace, view, teach, calibrate):
-        module.register(target)
+    names = list(dict.fromkeys(COMMANDS.values())) if command not in COMMANDS else [COMMANDS[command]]
+    for name in names:
+        importlib.import_module(f"{__name__}.{name}").register(target)
     if command is not None and not target.found:
         return build_parser(None)
     return parser

@@ -17,7 +17,6 @@ from ._common import (
     _jerk,
     _load,
     _needs_wrist,
-    _num,
     _number,
     _read_pose,
     add_cell_options,
@@ -82,7 +81,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     jerk = _jerk(args)
     cell = cell_from_args(args, units)
     common = {"start": start, "direction": direction, "span": span, "rise": rise, "payload": _payload(args, units),
-              "jerk": jerk, "limits": limits, "max_height": ceiling, "cell": cell}  # fmt: skip
+              "jerk": jerk, "limits": limits, "max_height": ceiling, "cell": cell,
+              "torque": not args.no_torque}  # fmt: skip
     if path is CyclePath.JUMP:
         result = standard_cycle(robot, path=path, clearance_radius=radius, **common)  # type: ignore[arg-type]
     else:
@@ -95,8 +95,9 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.cycle import plot_cycle
 
-        plot_cycle(robot, move, args.plot, limits=limits, title=f"{robot.name}: standard cycle ({path.value}) "
-                   f"{result.cycle_time:.4g} s, payload {move.payload.mass:g} kg")  # fmt: skip
+        plot_cycle(result, args.plot, robot=robot, units=units.display, limits=limits,
+                   title=f"{robot.name}: standard cycle ({path.value}) {result.cycle_time:.4g} s, payload "
+                   f"{move.payload.mass:g} kg")  # fmt: skip
         outputs["plot"] = args.plot
     compare = _jump_for_comparison(robot, result, common, radius) if path is CyclePath.LINES else None
     bound = result.lower_bound
@@ -110,11 +111,14 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             "legs": [leg.to_dict() for leg in move.legs],
             "limits": limits_dict(robot, limits, move.jerk),
             "limit_ratios": move.ratios,
+            "worst": {w.quantity.value: w.to_dict() for w in result.verification.limited()},  # type: ignore[union-attr]
             "placement": {"from": result.start.tolist(), "to": result.end.tolist(), "rule": result.placement,
                           "min_manipulability": result.min_manipulability},
             "span": result.span, "rise": result.rise, "blend": result.blend,
             "clearance_radius": result.clearance_radius, "max_height": result.max_height,
             "payload": move.payload.to_dict(),
+            "torque": result.torque,
+            "joints": list(robot.joint_names),
             "q_start": move.trajectory.q_start.tolist(),
             "outputs": outputs,
             "units": {"length": "m", "angle": "rad", "time": "s"},
@@ -129,34 +133,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             summary["jump_cycle_time"] = compare[0] if compare else None
         print(json.dumps(summary))
         return 0
-    Ln = units.length_name
-    timing = "jerk-limited time-optimal timing" if move.jerk else "TOPP-RA timing"
-    what = ("jump (time-optimal, joint path free)" if path is CyclePath.JUMP
-            else f"straight-leg arch (lines and blends, {timing})")  # fmt: skip
-    print(f"robot       {robot.name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
-          + (f", jerk limit {list(move.jerk)}" if move.jerk else ""))  # fmt: skip
-    print(f"cycle time  {_num(result.cycle_time, 6)} s (up {units.num(result.rise, 'length')}, across "
-          f"{units.num(result.span, 'length')}, down and back [{Ln}]"
-          + (f"; clearance radius {units.num(radius, 'length')} {Ln})" if path is CyclePath.JUMP
-             else f"; blend {units.num(result.blend, 'length')} {Ln})"))  # fmt: skip
-    if bound is not None:
-        print(f"bound       {_num(bound.duration, 6)} s ({bound.reason}): no cycle under these limits is faster; this "
-              f"one is {100 * (result.gap or 0.0):.1f} % above it")  # fmt: skip
-    print(f"placement   from {units.fmt(result.start[:3], 'length')} to {units.fmt(result.end[:3], 'length')} {Ln}: "
-          f"{result.placement}")  # fmt: skip
-    if path is CyclePath.JUMP:
-        jm = move
-        top, peak, bulge = jm.z_top + jm.peak, jm.peak, jm.bulge  # type: ignore[union-attr]
-        print(f"arch        up to {units.num(top, 'length')} {Ln} ({units.num(peak, 'length')} {Ln} above the "
-              f"clearance height), {units.num(bulge, 'length')} {Ln} off the straight line in plan view; solved in "
-              f"{jm.stats.seconds:.3g} s ({jm.stats.iterations} IPOPT iterations, "  # type: ignore[union-attr]
-              f"{jm.stats.solves} solve(s))")  # type: ignore[union-attr]
-    print("legs        (binding limits: the share of the leg's time at >= 99.9 % of the limit)")
-    for leg in move.legs:
-        binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in leg.binding)
-        print(f"  {'out ' if leg.move == 0 else 'back'} {leg.name:<11} {leg.duration:9.6f} s   "
-              f"{leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
-              + (f"; binding: {binding}" if binding else "") + closest_text(leg, units))  # fmt: skip
+    print(result.summary(units.display))  # the cycle's text: its repr in SI (CycleResult.summary)
     if cell is not None:
         print(cell_text(cell, move.distance, units))
     if path is CyclePath.LINES:
@@ -188,14 +165,6 @@ def cell_text(cell: Any, distance: Any, units: Units) -> str:
         return head + "; no pair checked"
     return (head + f"; closest {distance.pair} at {units.num(distance.distance, 'length')} {Ln} "
             f"(t = {distance.time:.4f} s)")  # fmt: skip
-
-
-def closest_text(leg: Any, units: Units) -> str:
-    """``; closest link2 - post 2.1 mm`` for a leg planned in a cell, else ""."""
-    if getattr(leg, "closest", None) is None:
-        return ""
-    pair, d = leg.closest
-    return f"; closest {pair} {units.num(d, 'length')} {units.length_name}"
 
 
 def _jump_for_comparison(robot: Any, result: Any, common: dict[str, Any], radius: float) -> tuple[float] | None:
@@ -232,6 +201,8 @@ def register(sub: Any) -> None:
     g.add_argument("--payload", metavar="KG", help="payload mass at the tool (default 0)")
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")
     g.add_argument("--jerk-limit", nargs="+", metavar="J", help="joint jerk limit, one or 4 (rad/s^3, m/s^3)")
+    g.add_argument("--no-torque", action="store_true",
+                   help="leave the effort limits out (a URDF's placeholder efforts); said in the output")
     _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",

@@ -23,15 +23,51 @@ if TYPE_CHECKING:
     pass
 
 
+PAYLOAD_GRID = 7
+"""Values per joint of the grid the static payload is the minimum over (7^4 = 2401 configurations)."""
+
+
+def robot_facts(name: str) -> dict[str, Any]:
+    """A shipped robot's kind, reach, stroke and payload [SI], as ``scara-pin robots`` lists them.
+
+    reach: the smallest and largest horizontal distance of the wrist axis (SCARA) or the arm's end
+    (palletizer) from the J1 axis [m]; stroke: the tool's vertical travel [m]; payload: the largest point
+    mass at the tool that the effort limits hold at rest (:func:`~scara_pin.motion.verify.static_payload`,
+    over a grid of the joint ranges; exact for a SCARA, whose only loaded joint is the vertical quill) [kg].
+    """
+    import numpy as np
+
+    from ..motion.verify import static_payload
+    from ..robots import load_robot
+    from ..workspace import Workspace, workspace_of
+
+    robot = load_robot(name)
+    ws = workspace_of(robot)
+    reach = (ws.r_min, ws.r_max) if isinstance(ws, Workspace) else tuple(ws.r_range)
+    lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
+    axes = [np.linspace(a, b, PAYLOAD_GRID) for a, b in zip(lo, hi)]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, robot.dof)
+    return {"name": name, "kind": robot.kind, "reach": [float(reach[0]), float(reach[1])],
+            "stroke": float(ws.z_range[1] - ws.z_range[0]), "payload": static_payload(robot, grid)}  # fmt: skip
+
+
 def cmd_robots(args: argparse.Namespace) -> int:
-    """List the shipped robot configurations."""
+    """List the shipped robot configurations: kind, reach, stroke and the payload their effort limits hold."""
     from ..description import available_robots, urdf_dir
 
-    names = available_robots()
+    facts = [robot_facts(name) for name in available_robots()]
     if args.json:
-        print(json.dumps({"robots": names, "config_dir": str(urdf_dir() / "config")}))
-    else:
-        print("\n".join(names))
+        units = {"length": "m", "mass": "kg"}
+        names, folder = [f["name"] for f in facts], str(urdf_dir() / "config")
+        print(json.dumps({"robots": names, "facts": facts, "config_dir": folder, "units": units}))
+        return 0
+    print(f"{'robot':<12} {'kind':<11} {'reach [mm]':>15} {'stroke [mm]':>12} {'payload [kg]':>13}")
+    for f in facts:
+        reach = f"{f['reach'][0] * 1e3:.0f} - {f['reach'][1] * 1e3:.0f}"
+        print(f"{f['name']:<12} {f['kind']:<11} {reach:>15} {f['stroke'] * 1e3:>12.0f} {f['payload']:>13.2f}")
+    print("reach: of the wrist axis from the J1 axis (palletizer: of the arm's end); stroke: the tool's vertical "
+          "travel;\npayload: the largest mass at the tool the effort limits hold at rest (static, no motion); "
+          "details: scara-pin workspace --robot NAME")  # fmt: skip
     return 0
 
 
@@ -57,7 +93,20 @@ def cmd_urdf(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable."""
+    """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable (or list the rules)."""
+    if args.list_rules:
+        from ..lint import RULES, rules_text
+
+        if args.file is not None:
+            raise InvalidInputError("--list-rules lists the rules of check: it takes no file")
+        if args.json:
+            print(json.dumps({"rules": [{"code": r.code, "severity": r.severity.value, "family": r.family,
+                                         "summary": r.summary} for r in RULES]}))  # fmt: skip
+        else:
+            print(rules_text())
+        return 0
+    if args.file is None:
+        raise InvalidInputError("check needs a FILE.urdf (or --list-rules)")
     from ..lint import check_urdf_file
 
     report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or (),
@@ -68,7 +117,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
-    p = sub.add_parser("robots", help="list the shipped robots")
+    p = sub.add_parser("robots", help="list the shipped robots: kind, reach, stroke, payload")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=cmd_robots)
     p = sub.add_parser("urdf", help="write the generated URDF of a robot")
@@ -79,7 +128,8 @@ def register(sub: Any) -> None:
     _add_robot_options(p, urdf_file=False)
     p.set_defaults(func=cmd_urdf)
     p = sub.add_parser("check", help="lint a third-party SCARA URDF: exit 0 clean, 4 warnings, 2 unusable")
-    p.add_argument("file", metavar="FILE.urdf", help="the URDF (or .xacro, expanded) to check")
+    p.add_argument("file", metavar="FILE.urdf", nargs="?", help="the URDF (or .xacro, expanded) to check")
+    p.add_argument("--list-rules", action="store_true", help="print the rules of check, one line each, and exit")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_frame_options(p.add_argument_group("robot"))
     p.set_defaults(func=cmd_check)

@@ -52,7 +52,7 @@ def cmd_job(args: argparse.Namespace) -> int:
     if args.plot:
         from ..viz.job import plot_job
 
-        plot_job(result, robot, args.plot)
+        plot_job(result, args.plot, robot=robot)
         written["plot"] = args.plot
     if args.html:
         _page(result, robot, args.html)

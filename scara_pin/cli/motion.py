@@ -33,7 +33,7 @@ from ._common import (
     write_atomic,
 )
 from ._points import add_points_options, use_points
-from .cycle import _payload, cell_summary, cell_text, closest_text
+from .cycle import _payload, cell_summary, cell_text
 
 if TYPE_CHECKING:
 
@@ -260,7 +260,7 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
     for leg in move.legs:
         binding = ", ".join(f"{bd.quantity} {bd.joint} {100 * bd.share:.0f} %" for bd in getattr(leg, "binding", ()))
         print(f"  {leg.name:<11} {leg.duration:9.6f} s   {leg.active} of {leg.joint} at {leg.ratio:.4f} of its limit"
-              + (f"; binding: {binding}" if binding else "") + closest_text(leg, units), file=text)  # fmt: skip
+              + (f"; binding: {binding}" if binding else "") + leg.closest_words(units.display), file=text)  # fmt: skip
     if cell is not None:
         print(cell_text(cell, move.distance, units).replace("cell        ", "cell      ", 1), file=text)
     if not jump:

@@ -40,7 +40,7 @@ import numpy as np
 from ..description import JOINT_NAMES
 from ..errors import InvalidInputError, JobFileError, ScaraError
 from ..motion.jump import BINDING, Binding, jump_move
-from ..motion.payload import Payload, with_payload
+from ..motion.payload import Payload, PayloadLike, as_payload, with_payload
 from ..motion.polynomial import PolynomialPiece
 from ..motion.trajectory import Trajectory
 from ..motion.verify import VERIFY_RATE, _limits, state_ratios, verify
@@ -114,7 +114,7 @@ def plan_move(
     q_from: np.ndarray,
     *,
     torque: bool = False,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     placed: tuple[Hashable, ...] = (),
 ) -> PlannedMove:
     """Plan and verify one move of a job from ``q_from`` (module docstring): the one function every move goes through.
@@ -124,7 +124,7 @@ def plan_move(
         move: the move: its kind, target configuration, limit fractions and (jumps) clearance.
         q_from: where the robot is, at rest [rad, m].
         torque: respect the effort limits too (with ``payload``).
-        payload: carried by the tool (torques); None: none.
+        payload: carried by the tool (torques): a Payload, or a mass [kg] at the tool frame's origin; None: none.
         placed: the obstacles placed so far (issue "The cell"); none until the cell is wired.
 
     Raises:
@@ -141,7 +141,7 @@ def plan_move(
         return PlannedMove(None, "", (), None, None, Source.STILL)
     t0 = time.perf_counter()
     limits = scaled_limits(robot, move.speed, move.accel)
-    payload = Payload() if payload is None else payload
+    payload = as_payload(payload)
     bound = None
     if move.kind is MoveKind.JUMP:
         shape = move.shape
@@ -196,9 +196,9 @@ class Planner:
         stats: how many moves were planned, reused and reversed, and the planning's wall time.
     """
 
-    def __init__(self, robot: Robot, *, torque: bool = False, payload: Payload | None = None) -> None:
+    def __init__(self, robot: Robot, *, torque: bool = False, payload: PayloadLike = None) -> None:
         self.robot, self.torque = robot, torque
-        self.payload = Payload() if payload is None else payload
+        self.payload = as_payload(payload)
         self._done: dict[Hashable, PlannedMove] = {}
         self.stats = PlanningStats()
 

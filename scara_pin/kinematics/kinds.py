@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..chain import AXIS_TOL
 from ..errors import InvalidInputError
 
 if TYPE_CHECKING:
@@ -66,7 +65,7 @@ def what_arm(robot: Robot) -> str | None:
     - a palletizer's layout (:func:`scara_pin.chain.palletizer_layout`) whose flange does not stay level:
       not recognised as a palletizer, with the reason (the levelling parallelogram is not modelled).
     """
-    from ..chain import LEVEL_PROBES, flange_pitch, palletizer_layout
+    from ..chain import AXIS_TOL, LEVEL_PROBES, flange_pitch, palletizer_layout
 
     axes = robot.axes
     names = [a.name for a in axes]

@@ -27,8 +27,8 @@ Tolerances (one set for every caller):
 Near the boundary circles the elbow angle is ill-conditioned: a radius known to a few ulps fixes gamma only
 to about ``sqrt(64 SNAP_TOL) (l1 + l2) / sqrt(l1 l2)`` (7e-7 rad for l1 = l2). :meth:`Planar2R.wobble`
 gives that bound for a given gamma; callers use it to land a joint exactly on its limit when rounding
-alone puts it outside (:meth:`Planar2R.with_link1`, :meth:`with_elbow`, :meth:`with_link2` re-solve the
-arm with one angle fixed).
+alone puts it outside (:meth:`Planar2R.with_link1`, :meth:`Planar2R.with_elbow`, :meth:`Planar2R.with_link2`
+re-solve the arm with one angle fixed).
 
 Joint turns. A revolute joint value v is the same joint position as v + 2 pi k. Inside limits [lo, hi]
 the turns that fit are k in [k_min, k_max] = [ceil((lo - v) / 2 pi), floor((hi - v) / 2 pi)] (limits

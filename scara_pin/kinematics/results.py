@@ -17,9 +17,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import InvalidInputError, NoSolutionError
+from ..summary import Summarized
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
+    from ..units import DisplayUnits
 
 __all__ = ["MAX_SOLUTIONS", "BatchBranch", "BatchIKResult", "IKResult", "IKSolution", "joint_distance", "result_of"]
 
@@ -84,8 +86,8 @@ def joint_distance(q: np.ndarray, reference: np.ndarray, weights: np.ndarray, co
     return float(np.dot(d * d, weights))
 
 
-@dataclass(frozen=True)
-class IKResult:
+@dataclass(frozen=True, repr=False)
+class IKResult(Summarized):
     """The solutions of one target (one per branch, see the module docstring), or the reason there is none.
 
     Attributes:
@@ -106,6 +108,13 @@ class IKResult:
     def success(self) -> bool:
         """True when at least one solution exists."""
         return int(self.status) == 0
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The target, the status and each solution in a line (q in SI: rad, and m for a prismatic joint)."""
+        head = f"IKResult {self.status.name} for target {np.round(self.target, 9).tolist()} [m, rad]: {self.message}"
+        rows = [f"  {s.branch:<6} q = {np.round(s.q, 9).tolist()}" + (" (singular)" if s.singular else "")
+                for s in self.solutions]  # fmt: skip
+        return "\n".join([head, *rows])
 
     def branch(self, branch: str) -> tuple[IKSolution, ...]:
         """The solutions of one branch (or ``"all"``)."""
@@ -247,6 +256,11 @@ class BatchIKResult:
         named = {int(m): m.name for m in self.status_enum} if self.status_enum is not None else {}
         pairs = sorted(((named.get(int(c), str(int(c))), int(k)) for c, k in zip(codes, n)), key=lambda p: -p[1])
         return dict(pairs)
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        return f"<pre>{escape(repr(self))}</pre>"
 
     def __repr__(self) -> str:
         solved = int(np.count_nonzero(self.branch))

@@ -23,9 +23,9 @@ Continuous joints take the turn nearest the reference (distances wrapped).
 
 Limits and rounding: a joint within ``LIMIT_TOL`` outside a limit is clamped onto it. Near the stretched
 and folded circles the joint angles are ill-conditioned (a target rounded to the last bit moves them by
-up to ~1e-7 rad, :meth:`Planar2R.wobble`): a joint that rounding alone puts outside its limit by less than
-that is put ON the limit and the other angles re-solved with it fixed (the position still reached to
-``REACH_TOL``), so configurations with a joint on its limit come back.
+up to ~1e-7 rad, :meth:`~scara_pin.kinematics.planar2r.Planar2R.wobble`): a joint that rounding alone puts
+outside its limit by less than that is put ON the limit and the other angles re-solved with it fixed (the
+position still reached to ``REACH_TOL``), so configurations with a joint on its limit come back.
 
 Two entry points here: :func:`solve` (the solutions of one target, as objects, with the reason when there
 is none) and :func:`solve_nearest` (the one solution nearest a reference, as a new array: what a controller

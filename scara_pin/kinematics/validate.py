@@ -7,7 +7,7 @@ For N configurations sampled inside the joint limits (seeded), with target = FK(
 
 1. every closed-form solution reproduces the target under Pinocchio FK to ``POSE_TOL`` (1e-9 m / rad);
 2. the sampled q is among the closed-form solutions (to ``Q_TOL``, 1e-9; at any of a solution's turns);
-3. the numeric IK (:mod:`scara_pin.ik_numeric`) from the default start (middle of the joint ranges)
+3. the numeric IK (:mod:`scara_pin.kinematics.numeric`) from the default start (middle of the joint ranges)
    converges to the target and coincides (to ``Q_TOL``) with a closed-form solution of the same branch.
 """
 

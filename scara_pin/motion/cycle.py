@@ -47,13 +47,25 @@ import numpy as np
 
 from .._checks import _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..summary import Summarized
+from ..units import SI, DisplayUnits, format_number
 from .jerk import time_optimal_jerk
-from .jump import STANDARD_CLEARANCE, STANDARD_RISE, JumpMove, JumpOptions, Leg, LowerBound, jump_move, lower_bound
+from .jump import (
+    BINDING,
+    STANDARD_CLEARANCE,
+    STANDARD_RISE,
+    JumpMove,
+    JumpOptions,
+    Leg,
+    LowerBound,
+    jump_move,
+    lower_bound,
+)
 from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
-from .payload import Payload, with_payload
+from .payload import Payload, PayloadLike, as_payload, with_payload
 from .timing import TimingOptions, _limits, parameterize
 from .trajectory import Motion, Trajectory
-from .verify import state_ratios, trajectory_jerk
+from .verify import Quantity, Verification, state_ratios, trajectory_jerk, verify
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -84,6 +96,9 @@ STANDARD_SPAN = 0.305
 """[m] the horizontal stroke of the standard cycle."""
 _STEP = 2e-3  # [m] checkpoint spacing along a blend (as cartesian_path's default)
 _QUANTITIES = ("velocity", "acceleration", "torque", "jerk")
+_NOT_IN_BOUND = (Quantity.TORQUE, Quantity.TOOL_SPEED)
+"""The limits the lower bound leaves out (it is the 1-DOF time of each joint under velocity, acceleration and
+jerk): the bound line says so when they apply."""
 
 # quintic Hermite basis (coefficients of tau^0..tau^5): H1 (start velocity), H4 (end velocity), H5 (end point)
 _H1 = np.array([0.0, 1.0, 0.0, -6.0, 8.0, -3.0])
@@ -334,8 +349,8 @@ def _nonneg(name: str, value: object, strict: bool = False) -> float:
 
 
 # ---------------------------------------------------------------------------------------------- results
-@dataclass(frozen=True, eq=False)
-class ArchMove:
+@dataclass(frozen=True, eq=False, repr=False)
+class ArchMove(Summarized):
     """A timed arch move (or several, joined rest to rest) and how its limits are used.
 
     Attributes:
@@ -361,6 +376,17 @@ class ArchMove:
         """[s]."""
         return self.trajectory.duration
 
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The move in a few lines: its time, the worst ratio of each limit, the legs."""
+        ratios = ", ".join(f"{k} {v:.4f}" for k, v in self.ratios.items() if v is not None)
+        return "\n".join([
+            f"straight-leg arch   {self.duration:.6f} s, {len(self.paths)} path(s), payload {self.payload.mass:g} kg"
+            + (f", jerk limit {list(self.jerk)}" if self.jerk else ""),
+            f"worst |value| / limit: {ratios}",
+            "legs   (binding limits: the share of the leg's time at >= 99.9 % of the limit)",
+            *(leg.line(units) for leg in self.legs),
+        ])  # fmt: skip
+
 
 class CyclePath(enum.Enum):
     """How the cycle's moves are made; the value is the ``--path`` word."""
@@ -369,9 +395,9 @@ class CyclePath(enum.Enum):
     LINES = "lines"
 
 
-@dataclass(frozen=True, eq=False)
-class CycleResult:
-    """The standard cycle: out and back, with its placement.
+@dataclass(frozen=True, eq=False, repr=False)
+class CycleResult(Summarized):
+    """The standard cycle: out and back, with its placement (``repr``: ``scara-pin cycle``'s text, in SI).
 
     Attributes:
         move: the timed cycle (two moves): a :class:`~scara_pin.motion.jump.JumpMove` (``path`` JUMP) or an
@@ -385,6 +411,10 @@ class CycleResult:
         max_height: [m] the ceiling, or None.
         lower_bound: what no cycle under these limits can beat (twice a move's bound, see
             :func:`~scara_pin.motion.jump.lower_bound`).
+        robot_name: the robot's name.
+        verification: the whole cycle verified (:func:`~scara_pin.motion.verify.verify`: the worst ratio of each
+            limit that applies, with its joint and time), or None.
+        torque: whether the effort limits were respected (False: left out, ``torque=False``).
     """
 
     move: ArchMove | JumpMove
@@ -399,6 +429,9 @@ class CycleResult:
     clearance_radius: float | None = None
     max_height: float | None = None
     lower_bound: LowerBound | None = None
+    robot_name: str = ""
+    verification: Verification | None = None
+    torque: bool = True
 
     @property
     def cycle_time(self) -> float:
@@ -410,6 +443,46 @@ class CycleResult:
         """The cycle time above the lower bound, relative (0.2: 20 % above)."""
         return None if self.lower_bound is None else self.cycle_time / self.lower_bound.duration - 1.0
 
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """What ``scara-pin cycle`` prints, lengths in ``units`` (default SI).
+
+        The time, the bound (and the limits it leaves out), the worst ratio of each limit that applies, the
+        placement, the arch and the legs.
+        """
+        u = SI if units is None else units
+        move, bound, Ln = self.move, self.lower_bound, u.name("length")
+        timing = "jerk-limited time-optimal timing" if move.jerk else "TOPP-RA timing"
+        what = ("jump (time-optimal, joint path free)" if self.path is CyclePath.JUMP
+                else f"straight-leg arch (lines and blends, {timing})")  # fmt: skip
+        lines = [f"robot       {self.robot_name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
+                 + (f", jerk limit {list(move.jerk)}" if move.jerk else "")
+                 + ("" if self.torque else "; effort limits left out (--no-torque): torques not checked")]  # fmt: skip
+        shape = (f"; clearance radius {u.format(self.clearance_radius or 0.0, 'length')} {Ln})"
+                 if self.path is CyclePath.JUMP else f"; blend {u.format(self.blend, 'length')} {Ln})")  # fmt: skip
+        lines.append(f"cycle time  {format_number(self.cycle_time, 6)} s (up {u.format(self.rise, 'length')}, across "
+                     f"{u.format(self.span, 'length')}, down and back [{Ln}]" + shape)  # fmt: skip
+        check = self.verification
+        if bound is not None:
+            left = [] if check is None else [w.quantity.value for w in check.limited() if w.quantity in _NOT_IN_BOUND]
+            unused = f"; not the {' and '.join(left)} limits" if left else ""
+            lines.append(f"bound       {format_number(bound.duration, 6)} s ({bound.reason}{unused}): no cycle under "
+                         f"these limits is faster; this one is {100 * (self.gap or 0.0):.1f} % above it")  # fmt: skip
+        if check is not None:
+            binding = [w.quantity.value for w in check.limited() if w.ratio >= BINDING]
+            lines.append(f"limits      worst |value| / limit: {check.ratio_text()}; "
+                         + (f"binding: {', '.join(binding)}" if binding else "none binds"))  # fmt: skip
+        lines.append(f"placement   from {u.format_vector(self.start[:3], 'length')} to "
+                     f"{u.format_vector(self.end[:3], 'length')} {Ln}: {self.placement}")  # fmt: skip
+        if isinstance(move, JumpMove):
+            st = move.stats
+            lines.append(f"arch        up to {u.format(move.z_top + move.peak, 'length')} {Ln} "
+                         f"({u.format(move.peak, 'length')} {Ln} above the clearance height), "
+                         f"{u.format(move.bulge, 'length')} {Ln} off the straight line in plan view; solved in "
+                         f"{st.seconds:.3g} s ({st.iterations} IPOPT iterations, {st.solves} solve(s))")  # fmt: skip
+        lines.append("legs        (binding limits: the share of the leg's time at >= 99.9 % of the limit)")
+        lines += [leg.line(units) for leg in move.legs]
+        return "\n".join(lines)
+
 
 # ---------------------------------------------------------------------------------------------- timing
 def arch_move(
@@ -418,7 +491,7 @@ def arch_move(
     *,
     rise: float = STANDARD_RISE,
     blend: float | None = None,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     jerk: float | ArrayLike | None = None,
     torque: bool = True,
     limits: JointLimits | None = None,
@@ -434,7 +507,8 @@ def arch_move(
         poses: (m, 4) poses, m >= 2: an arch from each to the next, the robot at rest at each.
         rise: [m] the traverse height above the higher pose (:func:`arch_path`).
         blend: [m] the largest blend distance (:func:`arch_path`; 0: stop at the corners).
-        payload: carried by the tool (torques); default none.
+        payload: carried by the tool (torques): a :class:`~scara_pin.motion.payload.Payload` or a mass [kg];
+            default none.
         jerk: joint jerk limit [rad/s^3, m/s^3], one or four numbers; None: not limited.
         torque: respect the effort limits (RNEA with the payload).
         limits: limits instead of ``robot.limits`` (a URDF file has no accelerations: give them here).
@@ -446,7 +520,7 @@ def arch_move(
     Raises:
         ParameterError, InvalidInputError: bad input (exit 2); PathError, TimingError: infeasible (exit 3).
     """
-    payload = Payload() if payload is None else payload
+    payload = as_payload(payload)
     if tool_speed is not None and jerk is not None:
         raise InvalidInputError("the straight-leg arch takes a tool-speed limit or a jerk limit, not both")
     P = np.asarray(poses, dtype=float)
@@ -499,8 +573,6 @@ def _legs(
     robot: Robot, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
 ) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
     """Legs (time spans) and, per leg, the most used limit, from a dense sampling (rate and 8 per 1/rate)."""
-    from ..description import JOINT_NAMES
-
     spans: list[tuple[str, int, float, float]] = []
     t0 = 0.0
     motions = [p for p in traj.pieces if isinstance(p, Motion)]
@@ -533,7 +605,7 @@ def _legs(
             worst[qty] = val if prev is None else max(prev, val)
             if val > best[2]:
                 best = (qty, j, val)
-        legs.append(Leg(name, move, float(ta), float(tb), best[0], JOINT_NAMES[best[1]], best[2]))
+        legs.append(Leg(name, move, float(ta), float(tb), best[0], robot.joint_names[best[1]], best[2]))
     return tuple(legs), worst
 
 
@@ -546,23 +618,30 @@ def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: 
 
 # ---------------------------------------------------------------------------------------------- the cycle
 def cycle_placement(
-    robot: Robot, span: float = STANDARD_SPAN, rise: float = STANDARD_RISE, branch: str = "right", n: int = 160
+    robot: Robot, span: float = STANDARD_SPAN, rise: float = STANDARD_RISE, branch: str | None = None, n: int = 160
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The default placement of the standard cycle (module docstring): (start pose, end pose, min |det J|).
 
     Candidates: the chords of length ``span`` perpendicular to the arm's direction at the middle of
-    J1's range (q2 = 0), centred on it, at ``n`` distances d from the J1 axis; at each, 41 points of the
-    chord at the start height are solved (closed-form IK, ``branch``, nearest the middle of the ranges)
-    and scored by the smallest manipulability |det J|. The best d wins.
+    J1's range (the elbow at 0), centred on it, at ``n`` distances d from the J1 axis; at each, 41 points of
+    the chord at the start height are solved (closed-form IK, ``branch``, default the first, nearest the
+    middle of the ranges) and scored by the smallest manipulability |det J|. The best d wins. The joints are
+    the closed form's reading of the model (:class:`~scara_pin.kinematics.scara_geometry.ScaraGeometry`):
+    the vertical stroke is that of the prismatic joint wherever it sits in q.
 
     Raises:
-        InvalidInputError: ``span`` is longer than the diameter of the reach circle (no chord fits).
+        InvalidInputError: ``span`` is longer than the diameter of the reach circle (no chord fits), or
+            ``rise`` is not below the vertical stroke.
+        UrdfError: the SCARA closed form refuses the robot (its reason: ``NotScaraError``).
         InfeasibleError: no candidate chord is reachable within the joint limits.
     """
+    geo = robot.kinematics.geometry  # the closed form's reading; its refusal names the real reason
+    branch = branch or robot.kinematics.branches[0]
+    elbow, quill = geo.revolute[1], geo.prismatic
     lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
     mid = (lo + hi) / 2.0
     q_stretched = mid.copy()
-    q_stretched[1] = 0.0 if lo[1] <= 0.0 <= hi[1] else mid[1]
+    q_stretched[elbow] = 0.0 if lo[elbow] <= 0.0 <= hi[elbow] else mid[elbow]
     centre = robot.tool_pose(q_stretched)
     reach = float(np.hypot(centre[0], centre[1]))
     if span >= 2.0 * reach:
@@ -570,10 +649,11 @@ def cycle_placement(
                                 f"axis, so no chord longer than {2 * reach:.6g} m fits")  # fmt: skip
     radial = centre[:2] / reach
     tangent = np.array([-radial[1], radial[0]])
-    z_lo = robot.tool_pose(np.where(np.arange(4) == 2, hi, mid))[2]  # the quill fully down: lowest z
-    z_hi = robot.tool_pose(np.where(np.arange(4) == 2, lo, mid))[2]
-    if rise >= abs(z_hi - z_lo):
-        raise InvalidInputError(f"rise {rise:.6g} m is beyond the vertical stroke {abs(z_hi - z_lo):.6g} m")
+    z_ends = [robot.tool_pose(np.where(np.arange(robot.dof) == quill, end, mid))[2] for end in (lo, hi)]
+    z_lo, z_hi = min(z_ends), max(z_ends)  # the quill at either end of its stroke (its axis up or down)
+    if rise >= z_hi - z_lo:
+        raise InvalidInputError(f"rise {rise:.6g} m is beyond the vertical stroke {z_hi - z_lo:.6g} m of "
+                                f"{robot.joint_names[quill]}")  # fmt: skip
     z = 0.5 * (z_lo + z_hi) - rise / 2.0
     yaw = 0.0
     u = np.linspace(-0.5, 0.5, 41) * span
@@ -607,16 +687,17 @@ def standard_cycle(
     span: float = STANDARD_SPAN,
     rise: float = STANDARD_RISE,
     blend: float | None = None,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     jerk: float | ArrayLike | None = None,
     limits: JointLimits | None = None,
-    branch: str = "right",
+    branch: str | None = None,
     options: TimingOptions | None = None,
     path: CyclePath | str = CyclePath.JUMP,
     clearance_radius: float = STANDARD_CLEARANCE,
     max_height: float | None = None,
     jump_options: JumpOptions | None = None,
     cell: Cell | None = None,
+    torque: bool = True,
 ) -> CycleResult:
     """The standard cycle: up ``rise``, across ``span``, down, and back the same way (rest at both ends).
 
@@ -629,10 +710,12 @@ def standard_cycle(
         rise: [m] > 0, the vertical stroke.
         blend: [m] >= 0, largest blend distance of the straight-leg arch (None: as large as allowed, i.e.
             the whole rise; 0: none); LINES only.
-        payload: carried by the tool (torque limits always apply, with the payload).
+        payload: carried by the tool (the torque limits apply with it, unless ``torque`` is False): a
+            :class:`~scara_pin.motion.payload.Payload` or a mass [kg].
         jerk: joint jerk limit, one or four numbers, or None.
         limits: limits instead of ``robot.limits``.
-        branch: the elbow branch.
+        branch: the elbow branch (the robot's branch names: ``right``/``left`` for a SCARA, ``up``/``down`` for
+            a palletizer); default: the default placement's first, a given start's nearest the mid-range.
         options: TOPP-RA grid and verification options (LINES).
         path: JUMP (the default: :func:`~scara_pin.motion.jump.jump_move` out, its time reversal back) or
             LINES (the straight-leg arch, :func:`arch_move`: slower).
@@ -642,6 +725,7 @@ def standard_cycle(
         cell: obstacles, the carried part and the margin (:mod:`scara_pin.cell`): the jump plans around and over
             them; the straight-leg arch (LINES) is verified against them and refused if it comes closer than
             the margin (naming the pair, when and where).
+        torque: respect the effort limits (default); False leaves them out (placeholder efforts in a URDF).
 
     Raises:
         ParameterError: bad input (exit 2); so is InvalidInputError.
@@ -674,7 +758,7 @@ def standard_cycle(
         wmin = math.nan
     if path is CyclePath.JUMP:
         out = jump_move(robot, a, b, rise=rise, clearance_radius=clearance_radius, max_height=max_height,
-                        payload=payload, jerk=jerk, torque=True, limits=limits, branch=branch,
+                        payload=payload, jerk=jerk, torque=torque, limits=limits, branch=branch,
                         options=jump_options, cell=cell)  # fmt: skip
         move: ArchMove | JumpMove = out.and_back()
         bound = LowerBound(2.0 * out.lower_bound.duration, out.lower_bound.joint,
@@ -684,8 +768,8 @@ def standard_cycle(
         if max_height is not None and max_height < max(a[2], b[2]) + rise:
             raise InfeasibleError(f"max_height {max_height:.6g} m is below the traverse height "
                                   f"{max(a[2], b[2]) + rise:.6g} m")  # fmt: skip
-        move = arch_move(robot, np.array([a, b, a]), rise=rise, blend=blend, payload=payload, jerk=jerk, torque=True,
-                         limits=limits, branch=branch, options=options)  # fmt: skip
+        move = arch_move(robot, np.array([a, b, a]), rise=rise, blend=blend, payload=payload, jerk=jerk,
+                         torque=torque, limits=limits, branch=branch, options=options)  # fmt: skip
         used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
         bound = _lines_bound(robot, move, a, b, rise, limits, jerk)
         if cell is not None:
@@ -696,8 +780,10 @@ def standard_cycle(
         q0 = move.trajectory.q_start
         pts = [np.array([*(a[:2] + f * (b[:2] - a[:2])), a[2], a[3]]) for f in np.linspace(0.0, 1.0, 41)]
         wmin = min(robot.manipulability(robot.ik_nearest(p, q0)) for p in pts)
+    check = verify(robot, move.trajectory, limits=limits, jerk=jerk, torque=torque, payload=payload)
     return CycleResult(move, a, b, span, rise, used, why, float(wmin), path,
-                       clearance_radius if path is CyclePath.JUMP else None, max_height, bound)  # fmt: skip
+                       clearance_radius if path is CyclePath.JUMP else None, max_height, bound, robot.name,
+                       check, torque)  # fmt: skip
 
 
 def _lines_bound(

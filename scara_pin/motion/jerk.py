@@ -23,8 +23,8 @@ and every inner point,
 time avoids the rest-to-rest singularity of the s-domain (a jerk-limited start has ``sd ~ s^(2/3)``, no
 polynomial in s); fixing the points in s makes the NLP's data exact and constant: ONE NLP per grid.
 
-**Grids.** The first grid puts the nodes at equal times of a feasible double-S law (:func:`_guess`); the
-second at equal times of the first solution weighted by where its jerk switches (:func:`_density`: a
+**Grids.** The first grid puts the nodes at equal times of a feasible double-S law; the
+second at equal times of the first solution weighted by where its jerk switches (a
 switch inside an interval costs to first order in its length), solved warm.
 
 **Between the points** (the promise is the :mod:`~scara_pin.motion.verify` grid, 10 kHz): the exact
@@ -58,6 +58,7 @@ import numpy as np
 from .._checks import _positive
 from ..errors import InfeasibleError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
+from ..summary import Summarized
 from .paths import CartesianPath, GeometricPath, path_segments
 from .timing import TimingError
 from .trajectory import Motion, TimeLaw, Trajectory
@@ -77,6 +78,7 @@ if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..description import JointLimits
     from ..model import Robot
+    from ..units import DisplayUnits
 
 __all__ = ["JerkLaw", "JerkOptions", "JerkRatios", "JerkResult", "minimum_duration", "time_optimal_jerk"]
 
@@ -161,8 +163,10 @@ class JerkLaw(TimeLaw):
         t: (N + 1,) node times from 0 [s].
         c: (N,) path jerks [1/s^3].
         knots: the path's knots that nodes sit on (a node within 1e-9 of one starts exactly at it).
-        s, sd, sdd: (N + 1,) node states (derived).
-        duration: t[-1] [s].
+        s: (N + 1,) node path positions (derived) [-].
+        sd: (N + 1,) node path velocities (derived) [1/s].
+        sdd: (N + 1,) node path accelerations (derived) [1/s^2].
+        duration: ``t[-1]`` [s].
     """
 
     t: np.ndarray
@@ -637,8 +641,8 @@ def _probe_times(law: JerkLaw) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------------------------- public
-@dataclass(frozen=True, eq=False)
-class JerkResult:
+@dataclass(frozen=True, eq=False, repr=False)
+class JerkResult(Summarized):
     """A jerk-limited time-optimal trajectory and how it was obtained.
 
     Attributes:
@@ -654,6 +658,14 @@ class JerkResult:
     correction: float
     nlps: int
     options: JerkOptions = field(default_factory=JerkOptions)
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The duration and the worst ratio of each limit (ratios have no unit)."""
+        r = self.ratios
+        torque = "" if r.torque is None else f", torque {r.torque:.4f}"
+        return (f"JerkResult {self.trajectory.duration:.6f} s ({len(self.trajectory.pieces)} segment(s), {self.nlps} "
+                f"NLP(s)): worst |value| / limit: velocity {r.velocity:.4f}, acceleration {r.acceleration:.4f}, "
+                f"jerk {r.jerk:.4f}{torque}")  # fmt: skip
 
 
 def time_optimal_jerk(

@@ -4,7 +4,7 @@ A straight tool move along a direction that ends exactly on the workspace edge (
 at rest, planned before moving.
 
 The edge is found with the exact workspace (:meth:`scara_pin.workspace.Workspace.ray`); the move is a
-straight Cartesian line (:func:`scara_pin.trajectory.cartesian_path`: one elbow branch, J4 continuous,
+straight Cartesian line (:func:`scara_pin.motion.paths.cartesian_path`: one elbow branch, J4 continuous,
 yaw constant) followed with the quintic time law, so that velocity AND acceleration are zero at both
 ends, stretched in time just enough to respect every joint velocity and acceleration limit. The time
 law scales exactly (velocities as 1/k, accelerations as 1/k^2 for k times slower), so the duration is

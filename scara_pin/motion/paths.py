@@ -8,7 +8,8 @@
   ``s`` and the pose, a line that leaves the workspace, reaches a joint limit or crosses the
   stretched/folded-arm singularity.
 
-Time laws and the :class:`~scara_pin.trajectory.Trajectory` they make live in :mod:`scara_pin.trajectory`,
+Time laws and the :class:`~scara_pin.motion.trajectory.Trajectory` they make live in
+:mod:`scara_pin.motion.trajectory`,
 which also re-exports these names (the public home of paths and trajectories).
 """
 
@@ -445,7 +446,7 @@ class CartesianSegment(GeometricPath):
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
         """(q, q', q'', q''') at s: ``q' = J^-1 pose'``, ``q'' = J^-1 (pose'' - (dJ/ds) q')`` (J the task Jacobian).
 
-        All the derivatives at once by :meth:`_Kinematics.derivatives` (exact, CasADi); on a robot whose
+        All the derivatives at once (exact, CasADi); on a robot whose
         axes are not exactly vertical, q' and q'' by Pinocchio's Jacobian and its time variation and q''' by
         :func:`third_by_differences`.
         """

@@ -1,5 +1,8 @@
 """A payload carried by the tool, added to a copy of the robot's Pinocchio model (for the RNEA torques).
 
+Every function that takes a payload takes a :class:`Payload` or a mass in kilograms (``payload=2.0``: 2 kg at
+the tool frame's origin), through :func:`as_payload`.
+
 The payload is a point mass ``mass`` at ``com``, a point given in the TOOL frame (``tool0``). It is added
 to the inertia of the joint that carries the tool frame (the wrist), as ``pin.Inertia(mass, com, 0)``
 moved by the tool frame's placement in that joint. The robot itself is never modified: :func:`with_payload`
@@ -21,7 +24,7 @@ from ..errors import ParameterError
 if TYPE_CHECKING:
     from ..model import Robot
 
-__all__ = ["Payload", "with_payload"]
+__all__ = ["Payload", "PayloadLike", "as_payload", "with_payload"]
 
 
 @dataclass(frozen=True)
@@ -57,12 +60,33 @@ class Payload:
         return {"mass": self.mass, "com": list(self.com), "frame": "tool0"}
 
 
-def with_payload(robot: Robot, payload: Payload | None) -> Robot:
+PayloadLike = Payload | float | int | None
+"""What a ``payload`` argument accepts: a :class:`Payload`, a mass [kg] (at the tool frame's origin), or None."""
+
+
+def as_payload(payload: PayloadLike) -> Payload:
+    """``payload`` as a :class:`Payload`: a number is a mass [kg] at the tool frame's origin; None is none.
+
+    Raises:
+        ParameterError: a mass that is not a finite number >= 0, or something else than a number or a Payload.
+    """
+    if payload is None:
+        return Payload()
+    if isinstance(payload, Payload):
+        return payload
+    if isinstance(payload, bool) or not isinstance(payload, (int, float, np.integer, np.floating)):
+        raise ParameterError("payload", payload, "must be a mass in kg or a Payload(mass, com)")
+    return Payload(float(payload))
+
+
+def with_payload(robot: Robot, payload: PayloadLike) -> Robot:
     """The robot carrying ``payload``: a shallow copy with a copied Pinocchio model (``robot`` is untouched).
 
-    Without a payload (None or zero mass) the robot itself is returned.
+    ``payload``: a :class:`Payload` or a mass [kg] (:func:`as_payload`). Without a payload (None or zero mass)
+    the robot itself is returned.
     """
-    if payload is None or payload.mass == 0.0:
+    payload = as_payload(payload)
+    if payload.mass == 0.0:
         return robot
     model = pin.Model(robot.model)  # a deep copy of the model
     frame = model.frames[robot.tool_id]

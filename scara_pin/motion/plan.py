@@ -25,21 +25,23 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from .._checks import _vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..summary import Summarized
 from . import trajectory as tr
 
 if TYPE_CHECKING:
     from ..cell import Cell
     from ..description import JointLimits
     from ..model import Robot
+    from ..units import DisplayUnits
     from .cycle import ArchMove
     from .jump import JumpMove
-    from .payload import Payload
+    from .payload import Payload, PayloadLike
     from .verify import Clearance
 
 __all__ = ["Method", "MotionPlan", "MotionRequest", "clear_of", "plan_motion"]
@@ -78,7 +80,8 @@ class MotionRequest:
         torque: respect the effort limits (time-optimal moves).
         rise: [m] the arch's clearance above the higher pose; None: the standard one.
         blend: [m] the straight-leg arch's corner blend distance; None: as large as allowed (path "lines").
-        payload: a payload at the tool (``torque`` moves and arches); None: none.
+        payload: a payload at the tool (``torque`` moves and arches): a
+            :class:`~scara_pin.motion.payload.Payload` or a mass [kg]; None: none.
         jerk: joint jerk limits [rad/s^3, m/s^3], one per joint, for a jerk-limited time-optimal move (arches
             too); None: none.
         path: "jump" (the time-optimal jump, the joint path free) or "lines" (the straight-leg arch).
@@ -103,7 +106,7 @@ class MotionRequest:
     torque: bool = False
     rise: float | None = None
     blend: float | None = None
-    payload: Payload | None = field(default=None)
+    payload: Payload | PayloadLike = field(default=None)
     jerk: tuple[float, ...] | None = None
     path: str = "jump"
     clearance_radius: float | None = None
@@ -114,6 +117,10 @@ class MotionRequest:
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
             object.__setattr__(self, name, _optional_vector(name, getattr(self, name)))
+        if self.payload is not None:  # a mass [kg] becomes a Payload
+            from .payload import as_payload
+
+            object.__setattr__(self, "payload", as_payload(self.payload))
         object.__setattr__(self, "vias", tuple(_vector(f"via {i + 1}", v, None) for i, v in enumerate(self.vias)))
         if (self.start_q is None) == (self.start_pose is None):
             raise InvalidInputError("a move needs exactly one start: start_q or start_pose")
@@ -150,9 +157,9 @@ class MotionRequest:
                                     "straight-leg arch")  # fmt: skip
 
 
-@dataclass(frozen=True, eq=False)
-class MotionPlan:
-    """A planned move.
+@dataclass(frozen=True, eq=False, repr=False)
+class MotionPlan(Summarized):
+    """A planned move (``repr``: the method and the trajectory; an arch's legs and ratios).
 
     Attributes:
         trajectory: the timed joint trajectory.
@@ -167,6 +174,11 @@ class MotionPlan:
     robot: Robot
     arch: ArchMove | JumpMove | None = None
     clearance: Clearance | None = None
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The method, the robot and the trajectory; an arch's own summary below."""
+        head = f"MotionPlan ({self.method.value}) for {self.robot.name!r}: {self.trajectory.summary(units)}"
+        return head if self.arch is None else head + "\n" + self.arch.summary(units)
 
 
 def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
@@ -209,7 +221,7 @@ def _plan(robot: Robot, request: MotionRequest) -> MotionPlan:
     if request.linear and robot.kind != "scara":
         raise InvalidInputError(f"a straight tool line (--linear) is SCARA-only for now; robot {robot.name!r} is a "
                                 f"{robot.kind} (joint-space --duration and TOPP-RA timing work)")  # fmt: skip
-    payload = request.payload
+    payload = cast("Payload | None", request.payload)  # a Payload once the request is made
     if payload is not None and payload.mass and not request.torque:
         raise InvalidInputError("--payload changes only the torques: give --torque too")
     if request.arch:

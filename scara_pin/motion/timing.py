@@ -20,7 +20,7 @@ between them. Here:
    as ONE precomputed canonical linear constraint (collocation type); sigma in {0, 1} is toppra's own
    "interpolation" discretisation, the interior sub-points shrink what is left between them ~m^2 times.
 2. **Output.** Not toppra's spline: the exact constant-path-acceleration kinematics between grid points
-   (:class:`~scara_pin.trajectory.ProfileLaw`), q, q', q'' from the path itself.
+   (:class:`~scara_pin.motion.trajectory.ProfileLaw`), q, q', q'' from the path itself.
 3. **Verification and rescaling.** The result is evaluated at ``check_subdivisions`` points of every
    segment and on the ``check_rate`` grid (1 kHz) and, for joint lines and splines (cubic between grid
    points), at every interior extremum of each joint's velocity and acceleration, found in closed form:
@@ -226,9 +226,9 @@ def parameterize(
 
     Args:
         robot: the robot (limits; Pinocchio model for the tool speed and the torques).
-        path: a path, a :class:`~scara_pin.trajectory.CartesianPath` (its segments are timed one by
+        path: a path, a :class:`~scara_pin.motion.paths.CartesianPath` (its segments are timed one by
             one: the tool stops at each via point, where the line turns), or (m, 4) joint waypoints
-            (:func:`~scara_pin.trajectory.joint_path`).
+            (:func:`~scara_pin.motion.paths.joint_path`).
         tool_speed: [m/s] limit of the tool origin's speed |J_xyz(q) qd|, optional.
         torque: also limit the joint efforts (``limits.effort``) computed with Pinocchio's RNEA from the
             model's inertias (gravity included).
@@ -415,7 +415,7 @@ def _diagnose(
     rows = len(grid)
     S = grid[:, None] + np.append(np.diff(grid), 0.0)[:, None] * (np.arange(m + 1) / m)[None, :]
     S = S.ravel()
-    bad = None if g_static is None or lim.effort is None else static_overload(g_static, lim.effort)
+    bad = None if g_static is None or lim.effort is None else static_overload(g_static, lim.effort, robot.joint_names)
     if bad is not None:
         return TimingError(code, bad.reason(), segment=segment, s=float(S[bad.index]))
     Bmin = B.reshape(rows, m + 1).min(axis=1)

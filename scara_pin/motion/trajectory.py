@@ -6,12 +6,12 @@ is ``s(t)`` for ``t`` in [0, T]; the chain rule gives the joint trajectory
     q(t) = q(s(t)),    qd = q'(s) sd,    qdd = q'(s) sdd + q''(s) sd^2,
 
 with ``'`` a derivative in ``s`` and ``d`` one in ``t``. The paths (:class:`JointLine`,
-:class:`JointSpline`, and the straight tool lines of :func:`cartesian_path`) are in :mod:`scara_pin.paths`.
+:class:`JointSpline`, and the straight tool lines of :func:`cartesian_path`) are in :mod:`scara_pin.motion.paths`.
 
 Time laws: :class:`QuinticLaw` (``jtraj``: zero velocity and acceleration at both ends),
 :class:`TrapezoidLaw` (bang-coast-bang, time-optimal on a straight joint line), :class:`ProfileLaw`
 (piecewise-constant path acceleration between grid points: the exact output of a TOPP-RA profile, see
-:mod:`scara_pin.timing`).
+:mod:`scara_pin.motion.timing`).
 
 A :class:`Trajectory` strings motions together, rest to rest. Outside [0, T] it holds its end positions
 (zero velocity and acceleration). It samples at any times, resamples at a fixed rate, exports to CSV and
@@ -39,6 +39,7 @@ from ..description import JOINT_COUNTS, JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_text_atomic
 from ..limits import MAX_SAMPLES, check_count, read_text
+from ..summary import Summarized
 from .paths import (
     SINGULAR_TOL,
     CartesianPath,
@@ -54,6 +55,7 @@ from .paths import (
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
+    from ..units import DisplayUnits
 
 __all__ = [
     "CSV_HEADER",
@@ -449,8 +451,8 @@ class _SampledPiece(Piece):
 
 
 # ---------------------------------------------------------------------------------------------- trajectory
-@dataclass(frozen=True, eq=False)
-class Trajectory:
+@dataclass(frozen=True, eq=False, repr=False)
+class Trajectory(Summarized):
     """A joint trajectory made of pieces played one after the other, from rest to rest.
 
     Attributes:
@@ -485,6 +487,15 @@ class Trajectory:
         object.__setattr__(self, "dof", int(pieces[0].evaluate(np.array([0.0]))[0].shape[1]))
 
     # --------------------------------------------------------------------------------- sampling
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """Duration, pieces (by kind) and the end configurations (q in SI: rad, and m for a prismatic joint)."""
+        kinds: dict[str, int] = {}
+        for p in self.pieces:
+            kinds[type(p).__name__] = kinds.get(type(p).__name__, 0) + 1
+        made = ", ".join(f"{n} {k}" for k, n in kinds.items())
+        return (f"Trajectory {self.duration:.6f} s, {len(self.pieces)} piece(s) ({made}), {self.dof} joints: q "
+                f"{np.round(self.q_start, 9).tolist()} -> {np.round(self.q_end, 9).tolist()}")
     def sample(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(q, qd, qdd) at times ``t`` [s]: (4,) each for a scalar, (n, 4) for an array.
 

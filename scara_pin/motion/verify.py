@@ -60,14 +60,16 @@ from .._checks import _limit_vector, _positive
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
+from ..summary import Summarized
 from .paths import GeometricPath, JointLine, third_by_differences
-from .payload import Payload, with_payload
+from .payload import PayloadLike, with_payload
 from .trajectory import Motion, Trajectory
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..cell import Scene
     from ..model import Robot
+    from ..units import DisplayUnits
 
 __all__ = [
     "DISTANCE_TOL",
@@ -90,6 +92,7 @@ __all__ = [
     "state_ratios",
     "static_load",
     "static_overload",
+    "static_payload",
     "time_scale",
     "torque_coefficients",
     "trajectory_jerk",
@@ -125,6 +128,10 @@ class Quantity(enum.Enum):
     TOOL_SPEED = "tool speed"
 
 
+_QUANTITY_WORD = {q: "jerk" if q is Quantity.JERK_DIFFERENCES else q.value for q in Quantity}
+"""How each quantity is named in a summary (the third differences are the jerk's measure there)."""
+
+
 @dataclass(frozen=True)
 class Worst:
     """The largest |value| / limit of one quantity over the verified samples.
@@ -134,23 +141,25 @@ class Worst:
         ratio: |value| / limit (1.0 = on the limit).
         time: [s] where it occurs (a closed-form peak of a law: the start of its piece).
         joint: the joint's index, or None for the tool speed.
+        names: the robot's joint names (the file's own).
     """
 
     quantity: Quantity
     ratio: float
     time: float
     joint: int | None
+    names: tuple[str, ...] = JOINT_NAMES
 
     @property
     def where(self) -> str:
         """``"joint2 at t = 0.1234 s"``."""
-        who = "the tool" if self.joint is None else JOINT_NAMES[self.joint]
+        who = "the tool" if self.joint is None else self.names[self.joint]
         return f"{who} at t = {self.time:.6g} s"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {"ratio": self.ratio, "time": self.time,
-                "joint": None if self.joint is None else JOINT_NAMES[self.joint]}  # fmt: skip
+                "joint": None if self.joint is None else self.names[self.joint]}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -199,9 +208,9 @@ class LimitViolation(InfeasibleError):
         super().__init__(reason)
 
 
-@dataclass(frozen=True)
-class Verification:
-    """What :func:`verify` found.
+@dataclass(frozen=True, repr=False)
+class Verification(Summarized):
+    """What :func:`verify` found (``repr``: one line per limit checked, its worst ratio and where).
 
     Attributes:
         duration: [s] of the trajectory.
@@ -250,6 +259,31 @@ class Verification:
         found = {w.quantity: w.ratio for w in self.quantities}
         return {q.value: found.get(q) for q in Quantity}
 
+    def limited(self) -> tuple[Worst, ...]:
+        """The worst ratio of each limit checked; a limit not given is left out.
+
+        Velocity, acceleration, jerk (the analytic jerk where the motions have one, else the third
+        differences), torque, tool speed.
+        """
+        jerk = self.jerk if self.jerk is not None else self.jerk_differences
+        return tuple(w for w in (self.velocity, self.acceleration, jerk, self.torque, self.tool_speed) if w is not None)
+
+    def ratio_text(self) -> str:
+        """``velocity 0.9159 (joint1), acceleration 1.0000 (joint1), torque 0.6757 (joint2)``: :meth:`limited`."""
+        return ", ".join(f"{_QUANTITY_WORD[w.quantity]} {w.ratio:.4f} ({w.where.split(' at ')[0]})"
+                         for w in self.limited())  # fmt: skip
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The verification in a few lines: each limit's worst ratio, where and when (ratios have no unit)."""
+        try:
+            self.check()
+            verdict = "within the limits"
+        except LimitViolation as exc:
+            verdict = f"NOT within the limits: {exc}"
+        lines = [f"Verification of {self.duration:.6g} s at {self.rate:g} Hz ({self.samples} samples): {verdict}"]
+        lines += [f"  {_QUANTITY_WORD[w.quantity]:<13} {w.ratio:.6f} of its limit, {w.where}" for w in self.limited()]
+        return "\n".join(lines)
+
     def check(self, tolerance: float = TOLERANCE) -> Verification:
         """Self, if every ratio is <= 1 + ``tolerance`` and the endpoints and rest hold; else raise.
 
@@ -294,9 +328,10 @@ class _Limits:
 def _limits(robot: Robot, limits: JointLimits | None, tool_speed: float | None, torque: bool) -> _Limits:
     """The limits in force, each refused when NaN, zero, negative or infinite."""
     lim = robot.limits if limits is None else limits
-    v = _limit_vector("velocity", lim.velocity, "rad/s or m/s")
-    a = _limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2")
-    e = _limit_vector("effort", lim.effort, "N m or N") if torque else None
+    names = robot.joint_names
+    v = _limit_vector("velocity", lim.velocity, "rad/s or m/s", names)
+    a = _limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2", names)
+    e = _limit_vector("effort", lim.effort, "N m or N", names) if torque else None
     vt = None if tool_speed is None else _positive("tool_speed", tool_speed, "m/s")
     return _Limits(v, a, e, vt)
 
@@ -380,36 +415,65 @@ class StaticOverload:
         joint: the joint's index.
         load: the static load g [N m or N] (signed).
         limit: the effort limit [N m or N].
+        names: the robot's joint names (the file's own).
     """
 
     index: int
     joint: int
     load: float
     limit: float
+    names: tuple[str, ...] = JOINT_NAMES
 
     def reason(self, where: str = "there") -> str:
         """The sentence, ``where`` saying where the robot is (``"there"``, ``"at q = [...]"``)."""
-        return (f"the static load on {JOINT_NAMES[self.joint]} ({self.load:.6g}) is not below its effort limit "
+        return (f"the static load on {self.names[self.joint]} ({self.load:.6g}) is not below its effort limit "
                 f"{self.limit:.6g}: the robot cannot even hold still {where}")  # fmt: skip
 
 
-def static_overload(g: np.ndarray, effort: np.ndarray) -> StaticOverload | None:
+def static_overload(
+    g: np.ndarray, effort: np.ndarray, names: tuple[str, ...] = JOINT_NAMES
+) -> StaticOverload | None:
     """The first row of static loads ``g`` (n, dof) with |g| >= ``effort`` on a joint, or None.
 
     Whatever its sign: a load above the limit cannot be held, and one below it leaves room on both sides
-    (E - g > 0 and E + g > 0), which :func:`time_scale` relies on.
+    (E - g > 0 and E + g > 0), which :func:`time_scale` relies on. ``names``: the robot's joint names.
     """
     over = np.abs(g) >= effort
     if not over.any():
         return None
     i, j = np.argwhere(over)[0]
-    return StaticOverload(int(i), int(j), float(g[i, j]), float(effort[j]))
+    return StaticOverload(int(i), int(j), float(g[i, j]), float(effort[j]), names)
 
 
 def static_load(robot: Robot, q: np.ndarray) -> np.ndarray:
     """g(q) (n, dof): the joint efforts that hold the robot still (RNEA at rest, gravity and payload)."""
     zero = np.zeros_like(q)
     return _rnea(robot, q, zero, zero)
+
+
+def static_payload(robot: Robot, q: np.ndarray, limits: JointLimits | None = None) -> float:
+    """The largest point mass [kg] at the tool frame's origin that the effort limits hold at rest at every row of q.
+
+    The static load is linear in the mass: ``g(q; m) = g0(q) + m g1(q)`` (``g1`` the load of 1 kg, the
+    difference of two :func:`static_load` calls), and ``|g0 + m g1| <= effort`` per joint gives
+    ``m <= (effort - sign(g1) g0) / |g1|`` wherever ``g1 != 0``. A SCARA's only loaded joint is the vertical
+    quill (constant over q); a palletizer's depends on q: the minimum is over the rows given.
+
+    Args:
+        robot: the robot (its model: gravity and the links' masses).
+        q: (n, dof) configurations [rad, m].
+        limits: limits instead of ``robot.limits`` (their efforts).
+
+    Returns:
+        the mass [kg]; 0 when the arm alone already exceeds an effort somewhere; inf when no joint carries it.
+    """
+    effort = np.asarray((robot.limits if limits is None else limits).effort, dtype=float)
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    g0 = static_load(robot, q)
+    g1 = static_load(with_payload(robot, 1.0), q) - g0
+    carried = np.abs(g1) > 1e-12 * max(1.0, float(np.abs(g0).max()))
+    room = np.where(carried, (effort - np.sign(g1) * g0) / np.where(carried, np.abs(g1), 1.0), np.inf)
+    return max(0.0, float(room.min()))
 
 
 def torque_coefficients(robot: Robot, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -449,7 +513,7 @@ def time_scale(
     if tau is not None and lim.effort is not None and len(q):
         E = lim.effort
         g = static_load(robot, q)
-        bad = static_overload(g, E)
+        bad = static_overload(g, E, robot.joint_names)
         if bad is not None:
             raise InfeasibleError(bad.reason())
         dyn = tau - g
@@ -559,8 +623,9 @@ def _extra_times(traj: Trajectory) -> np.ndarray:
 class _Worst:
     """Running maxima of |value| / limit per quantity: (ratio, time, joint)."""
 
-    def __init__(self) -> None:
+    def __init__(self, names: tuple[str, ...] = JOINT_NAMES) -> None:
         self.best: dict[Quantity, tuple[float, float, int | None]] = {}
+        self.names = names
 
     def add(self, quantity: Quantity, ratios: np.ndarray, t: np.ndarray, tool: bool = False) -> None:
         if not ratios.size:
@@ -575,7 +640,7 @@ class _Worst:
 
     def get(self, quantity: Quantity) -> Worst | None:
         got = self.best.get(quantity)
-        return None if got is None else Worst(quantity, *got)
+        return None if got is None else Worst(quantity, *got, self.names)
 
 
 def verify(
@@ -585,7 +650,7 @@ def verify(
     limits: JointLimits | None = None,
     jerk: float | ArrayLike | None = None,
     torque: bool = False,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     tool_speed: float | None = None,
     rate: float = VERIFY_RATE,
     q_start: ArrayLike | None = None,
@@ -600,7 +665,8 @@ def verify(
         limits: joint limits instead of ``robot.limits``.
         jerk: joint jerk limit(s) [rad/s^3 or m/s^3], one or one per joint; None: jerk not checked.
         torque: check the effort limits (RNEA, gravity included).
-        payload: carried by the tool for the torques (:func:`~scara_pin.motion.payload.with_payload`).
+        payload: carried by the tool for the torques: a :class:`~scara_pin.motion.payload.Payload` or a mass
+            [kg] (:func:`~scara_pin.motion.payload.with_payload`).
         tool_speed: [m/s] limit of the tool origin's speed, optional.
         rate: [Hz] of the verified grid.
         q_start: the configuration the trajectory must start at, optional.
@@ -625,7 +691,7 @@ def verify(
                 "lower the rate or shorten the motion")  # fmt: skip
     grid = np.arange(-3, n_grid + 4) * h  # three samples of rest on each side (the third differences see the ends)
     times = np.concatenate([grid, np.clip(extra, 0.0, T)])
-    worst = _Worst()
+    worst = _Worst(robot.joint_names)
     q_grid = np.empty((len(grid), dof))
     analytic = jv is not None and any(has_jerk(p) for p in trajectory.pieces)
     nearest = np.empty(len(times)) if scene is not None else None

@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..files import write_text_atomic
 from ..limits import MAX_FRAMES, check_count
+from ..summary import Summarized
 
 if TYPE_CHECKING:
     from ..model import Robot
@@ -34,9 +35,9 @@ _FPS = 30
 """Samples per second of a trajectory handed to the page's player."""
 
 
-@dataclass(frozen=True)
-class SceneView:
-    """A self-contained 3-D page of a robot, shown inline by Jupyter.
+@dataclass(frozen=True, repr=False)
+class SceneView(Summarized):
+    """A self-contained 3-D page of a robot, shown inline by Jupyter (``repr``: one line, not the page).
 
     Attributes:
         html: the page (meshcat's viewer script and the scene; about 1 MB).
@@ -47,6 +48,11 @@ class SceneView:
     html: str
     height: int = 480
     title: str = "scara-pin"
+
+    def summary(self, units: object = None) -> str:
+        """One line: the title and the page's size (the page itself is ``.html``)."""
+        return (f"SceneView {self.title!r}: a self-contained 3-D page of {len(self.html):,} characters (Jupyter shows "
+                "it; .save(path) writes it)")  # fmt: skip
 
     def _repr_html_(self) -> str:
         from html import escape

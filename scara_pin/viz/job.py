@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..description import JOINT_NAMES
+from ..units import SI, DisplayUnits
 from .plots import COLORS, LIMIT_GID, finish, new_figure
 
 if TYPE_CHECKING:
@@ -33,14 +34,15 @@ _RATE = 1000.0
 """[Hz] the drawing rate of a job short enough."""
 
 
-def plot_job(result: JobResult, robot: Robot, path: str | os.PathLike[str] | None = None, *,
-             title: str | None = None) -> Figure:  # fmt: skip
+def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, robot: Robot,
+             units: DisplayUnits = SI, title: str | None = None) -> Figure:  # fmt: skip
     """The timeline of a planned job (module docstring); written to ``path`` (PNG, SVG, PDF) when given.
 
     Args:
         result: the planned job.
-        robot: the robot it was planned for (its limits).
         path: the file to write, or None.
+        robot: the robot it was planned for (its limits).
+        units: display units (the timeline's axes are times and ratios: kept for the one plotting signature).
         title: the figure's title (default: the job's file, robot, total and parts per hour).
     """
     traj = result.trajectory

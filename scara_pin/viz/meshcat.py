@@ -166,9 +166,26 @@ def _points(name: str, value: object, dim: int) -> np.ndarray:
     return arr
 
 
-def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.ndarray]:
-    """Check a sampled motion: (N,) strictly increasing finite times [s] and (N, dof) joint values."""
+def _motion(robot: Robot, times: object, qs: object, rate: float = _DEFAULT_FPS) -> tuple[np.ndarray, np.ndarray]:
+    """Check a sampled motion: (N,) strictly increasing finite times [s] and (N, dof) joint values.
+
+    ``times`` may be a :class:`~scara_pin.motion.trajectory.Trajectory` instead (``qs`` None): it is sampled at
+    ``rate`` [Hz], both ends included (the frame count checked against :data:`~scara_pin.limits.MAX_FRAMES`
+    before any sample is made).
+    """
+    from ..motion.trajectory import Trajectory
+
     n = robot.dof
+    if isinstance(times, Trajectory):
+        if qs is not None:
+            raise InvalidInputError("give a trajectory alone, or times and qs (not both)")
+        duration = float(times.duration)
+        check_count(f"frames ({duration:.6g} s at {rate:g} fps)", duration * rate + 2.0, MAX_FRAMES)
+        t = np.linspace(0.0, duration, max(2, int(math.ceil(duration * rate)) + 1))
+        qs = times.sample(t)[0]
+        times = t
+    elif qs is None:
+        raise InvalidInputError(f"give a trajectory, or (N,) times [s] and (N, {n}) joint values qs")
     try:
         t = np.array(times, dtype=float)
         q = np.array(qs, dtype=float)
@@ -192,7 +209,7 @@ def _motion(robot: Robot, times: object, qs: object) -> tuple[np.ndarray, np.nda
 def read_trajectory_csv(path: str | os.PathLike[str], dof: int = 4) -> tuple[np.ndarray, np.ndarray]:
     """Read the times and joint values of a trajectory CSV (columns ``t,q1..q{dof}``; others ignored).
 
-    Reads the files of :meth:`scara_pin.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``)
+    Reads the files of :meth:`scara_pin.motion.trajectory.Trajectory.to_csv` (header ``t,q1..q4,qd1..,qdd1..``)
     with the package's one CSV reader (:func:`scara_pin.tables.read_csv`: bounded, blank lines and lines
     starting with ``#`` skipped).
 
@@ -617,7 +634,7 @@ class _Scene:
         self.tool_r0 = pin.utils.rotate("z", -yaw0) @ zero.rotation
         self._floor()
         self._camera()
-        self.display(np.zeros(robot.dof))
+        self.display(robot.default_q)
 
     def _load_geometry(self, geometry: pin.GeometryObject) -> None:
         """Load one visual geometry (primitive or mesh, by Pinocchio's loader) under its joint's node."""
@@ -799,7 +816,7 @@ def _scene(
     if (times is None) != (qs is None):
         raise InvalidInputError("times and qs go together: give both or neither")
     data = scene.page_data()
-    shown = np.zeros(robot.dof) if q is None else robot.check_q(q)
+    shown = robot.default_q if q is None else robot.check_q(q)
     if polylines is not None:
         scene.draw_polylines(polylines, "workspace", None, _WORKSPACE_COLOR)
     if path_points is not None:
@@ -916,7 +933,8 @@ class Viewer:
         with Viewer(robot) as viewer:
             print(viewer.url)
             viewer.display([0.1, 0.2, 0.05, 0.3])
-            viewer.animate(times, qs)
+            viewer.play(trajectory)         # Python steps it in real time
+            viewer.animate(trajectory)      # the browser plays it (play / pause / time slider)
 
     Attributes:
         robot: the robot shown.
@@ -995,12 +1013,13 @@ class Viewer:
         self._live().display(q)
 
     def animate(
-        self, times: object, qs: object, *, fps: int = _DEFAULT_FPS, loop: bool = False, play: bool = True
+        self, times: object, qs: object = None, *, fps: int = _DEFAULT_FPS, loop: bool = False, play: bool = True
     ) -> None:
         """Send the motion to the browser, which plays it in real time (play / pause / time controls).
 
         Args:
-            times: (N,) strictly increasing sample times [s], N >= 2.
+            times: (N,) strictly increasing sample times [s], N >= 2; or a
+                :class:`~scara_pin.motion.trajectory.Trajectory` (``qs`` None), sampled at ``fps``.
             qs: (N, 4) joint values [rad or m].
             fps: animation frames per second (joint values are interpolated linearly between samples).
             loop: repeat forever (else play once and hold the last frame).
@@ -1008,21 +1027,24 @@ class Viewer:
                 has been played: press play, then pause).
         """
         scene = self._live()
-        t, q = _motion(self.robot, times, qs)
+        t, q = _motion(self.robot, times, qs, fps)
         if len(t) < 2:
             raise InvalidInputError("an animation needs at least 2 samples; use display() for one")
         scene.vis.set_animation(scene.animation(t, q, fps), play=play, repetitions=math.inf if loop else 1)
 
-    def play(self, times: object, qs: object, *, speed: float = 1.0) -> None:
+    def play(self, times: object, qs: object = None, *, speed: float = 1.0, rate: float = _DEFAULT_FPS) -> None:
         """Step the robot through the motion from Python, in real time (blocks until the end).
 
-        Samples whose time has passed while the previous one was sent are skipped, so the motion keeps
-        to the clock. ``speed`` > 1 plays faster.
+        ``viewer.play(trajectory)`` plays a :class:`~scara_pin.motion.trajectory.Trajectory` (sampled at
+        ``rate`` [Hz]); ``viewer.play(times, qs)`` plays samples. Samples whose time has passed while the
+        previous one was sent are skipped, so the motion keeps to the clock. ``speed`` > 1 plays faster.
         """
         if not (math.isfinite(speed) and speed > 0):
             raise InvalidInputError(f"speed is {speed}; it must be > 0")
+        if not (math.isfinite(rate) and rate > 0):
+            raise InvalidInputError(f"rate is {rate} Hz; it must be > 0")
         scene = self._live()
-        t, q = _motion(self.robot, times, qs)
+        t, q = _motion(self.robot, times, qs, rate)
         start = time.monotonic()
         k = 0
         while k < len(t):

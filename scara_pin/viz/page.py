@@ -177,7 +177,7 @@ def render(title: str, viewer_js: str, commands: list[bytes], data: dict[str, An
         viewer_js: meshcat's viewer script (``</script`` already escaped).
         commands: the scene's msgpack commands, applied in order at load (no fetch); meshcat's, and
             :data:`SHARE_GEOMETRY` (a mesh embedded once, shown by several visuals).
-        data: the panel's data (:meth:`scara_pin.viz.meshcat._Scene.page_data`, plus ``q``, and ``motion``
+        data: the panel's data (the scene's joints, tool and limits, plus ``q``, and ``motion``
             or ``teach``); None for a page without a panel.
     """
     share = SHARE_GEOMETRY

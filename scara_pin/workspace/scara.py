@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import enum
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
@@ -67,6 +68,7 @@ import numpy as np
 from ..errors import InvalidInputError, ParameterError
 from ..kinematics.planar2r import LIMIT_TOL
 from ..kinematics.scara import NEAR_PARALLEL_TOL, ScaraGeometry
+from ..summary import Summarized
 from ..units import SI, DisplayUnits, decimals_for, format_number
 from .arcs import SIDE_OFFSET, ArmBox, JointRange, Role, box_region
 
@@ -235,8 +237,8 @@ def _box(geo: ScaraGeometry) -> ArmBox:
     return ArmBox(geo.a1, geo.arm, t, g, relative=True)
 
 
-@dataclass(frozen=True)
-class Workspace:
+@dataclass(frozen=True, repr=False)
+class Workspace(Summarized):
     """The exact plan-view region of the wrist axis point (or, with ``yaw``, the tool point at that yaw).
 
     Attributes:
@@ -279,6 +281,19 @@ class Workspace:
                            if rows else tuple(np.zeros(0) for _ in range(6)))  # fmt: skip
 
     # --------------------------------------------------------------------------------- membership
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """Area, reach, stroke and boundary, lengths in ``units`` (default SI)."""
+        u = SI if units is None else units
+        L = u.name("length")
+        of = ("the wrist axis" if self.yaw is None
+              else f"the tool at yaw {u.format(self.yaw, 'angle')} {u.name('angle')}")  # fmt: skip
+        return (f"Workspace of {of}: area {u.format(self.area, 'area')} {u.name('area')}, reach "
+                f"{u.format(self.r_min, 'length')} to {u.format(self.r_max, 'length')} {L} from the J1 axis, z "
+                f"{u.format(self.z_range[0], 'length')} to {u.format(self.z_range[1], 'length')} {L}; "
+                f"{len(self.arcs)} boundary arcs in {len(self.loops)} loop(s)"
+                + (f"\n  {self.note}" if self.note else ""))  # fmt: skip
+
     def contains(self, points: Sequence[float] | np.ndarray, *, tol: float = LIMIT_TOL) -> bool | np.ndarray:
         """Whether plan points (x, y) are reachable (the closed-form IK's test).
 
@@ -431,7 +446,8 @@ class Workspace:
             z = S[:, 2]
             if ((z < z_lo - EDGE_TOL) | (z > z_hi + EDGE_TOL)).any():
                 i = int(np.argmax((z < z_lo - EDGE_TOL) | (z > z_hi + EDGE_TOL)))
-                raise OutsideWorkspaceError(S[i], f"z = {z[i]:.9g} m is outside the J3 stroke "
+                quill = self.geometry.names[self.geometry.prismatic]
+                raise OutsideWorkspaceError(S[i], f"z = {z[i]:.9g} m is outside {quill}'s stroke "
                                                   f"[{z_lo:.9g}, {z_hi:.9g}] m")  # fmt: skip
             dz = D[:, 2]
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -615,10 +631,10 @@ def _labels(geo: ScaraGeometry) -> dict[Role, tuple[tuple[Limit, str], int]]:
 # ------------------------------------------------------------------------------------------ picture
 def plot_workspace(
     ws: Workspace,
-    path: str | None = None,
+    path: str | os.PathLike[str] | None = None,
+    *,
     q: Sequence[float] | None = None,
     ray: tuple[Sequence[float], Sequence[float]] | None = None,
-    *,
     units: DisplayUnits = SI,
     robot_name: str | None = None,
     dpi: int = 120,

@@ -1,6 +1,9 @@
 """The old jerk-BOUNDED timing: a moving-average (FIR) filter of the TOPP-RA profile, then a global slow-down.
 
-A baseline (never faster than :mod:`~scara_pin.motion.jerk`), and that module's initial guess.
+A baseline for benchmarks/bench_jerk.py and tests/test_jerk.py (never faster than :mod:`scara_pin.motion.jerk`,
+the package's jerk-limited timing); it lived in the package as ``scara_pin/motion/jerk_fir.py`` until issue 31.
+It uses a few of the package's private helpers (the limits in force, a positive-number check): it is the
+package's own baseline, kept beside the benchmarks that run it.
 
 TOPP-RA's output (:class:`~scara_pin.motion.trajectory.ProfileLaw`) has a piecewise-constant path
 acceleration: its jerk is infinite at every grid point. Here the path parameter law is filtered by a
@@ -35,17 +38,25 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._checks import _positive
-from ..errors import ParameterError
-from .jerk import JerkRatios
-from .timing import TimingError, TimingOptions
-from .trajectory import GeometricPath, Motion, ProfileLaw, TimeLaw, Trajectory
-from .verify import Quantity, _Limits, _limits, jerk_vector, joint_jerk, path_third_derivative, time_scale
+from scara_pin._checks import _positive
+from scara_pin.errors import ParameterError
+from scara_pin.motion.jerk import JerkRatios
+from scara_pin.motion.timing import TimingError, TimingOptions
+from scara_pin.motion.trajectory import GeometricPath, Motion, ProfileLaw, TimeLaw, Trajectory
+from scara_pin.motion.verify import (
+    Quantity,
+    _Limits,
+    _limits,
+    jerk_vector,
+    joint_jerk,
+    path_third_derivative,
+    time_scale,
+)
 
 if TYPE_CHECKING:
-    from .._typing import ArrayLike
-    from ..description import JointLimits
-    from ..model import Robot
+    from scara_pin._typing import ArrayLike
+    from scara_pin.description import JointLimits
+    from scara_pin.model import Robot
 
 __all__ = ["FilteredLaw", "JerkRatios", "fir_jerk_limited"]
 
