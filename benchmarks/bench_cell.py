@@ -2,7 +2,7 @@
 """Benchmark: the jump in a cell (issue 27) against independent minima, the clock, and a sampling planner.
 
 How to run. ``make bench-cell`` makes ``.venv-bench-cell`` (pyroboplan 1.3.1 from PyPI on top of ``-e .``:
-see the Makefile for why it is installed without its pins) and runs the whole script there, about 6-10
+see the Makefile for why it is installed without its pins) and runs the whole script there, about 4-6
 minutes on the 2-core machine. With the project's interpreter (``.venv/bin/python benchmarks/bench_cell.py``)
 parts 1 and 2 run and part 3 is skipped with a note. Options: ``--quick`` (3 seeds, 2 rounds), ``--seeds N``,
 ``--runs N``. Reported, not enforced (exit 0 unless something breaks). The machine is shared: every time is
