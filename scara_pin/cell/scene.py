@@ -376,7 +376,7 @@ class Scene:
         return out
 
     def _bounded(self, k: int) -> float:
-        """Pair k's distance (placements up to date): its bounding spheres' when farther than :data:`FAR`, else coal's."""
+        """Pair k's distance (placements current): its bounding spheres' beyond :data:`FAR`, else coal's."""
         import pinocchio as pin
 
         pr = self.pairs[k]
