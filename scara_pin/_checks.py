@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -72,12 +73,12 @@ def _rows(name: str, value: object) -> np.ndarray:
     return arr
 
 
-def _limit_vector(name: str, values: ArrayLike, unit: str) -> np.ndarray:
-    """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0."""
+def _limit_vector(name: str, values: ArrayLike, unit: str, names: Sequence[str] = JOINT_NAMES) -> np.ndarray:
+    """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0 (``names``: the joints')."""
     arr = np.array(values, dtype=float)
     if arr.ndim != 1 or len(arr) not in JOINT_COUNTS:
         raise ParameterError(name, values, "must hold one value per joint (4, or 3 without a wrist)")
-    for joint, v in zip(JOINT_NAMES, arr.tolist()):
+    for joint, v in zip(names, arr.tolist()):
         if math.isnan(v):
             raise ParameterError(f"{joint}_{name}", v, "must be given (a URDF file has no acceleration limits)")
         if not (math.isfinite(v) and v > 0.0):

@@ -9,7 +9,9 @@ only the joints that move the tool freely:
   arm of a two-arm robot, a gripper's fingers), and any joint the user locks, is fixed at a value
   (default 0, or the nearest limit when 0 is outside them; ``lock={"joint": value}`` sets it) by
   Pinocchio's ``buildReducedModel``. The locked parts stay in the model as fixed bodies: the viewer still
-  draws the whole robot, at the locked values. A geared joint whose source is locked is locked with it.
+  draws the whole robot, at the locked values. A geared joint whose source is locked is locked with it;
+  one whose source stays free keeps following it, on the chain or off it (a parallelogram's rods beside
+  the arm: drawn, and their frames placed, where the arm puts them).
 
 Lock values are SI (rad, m), as the rest of the robot's description (the CLI's ``--set`` likewise).
 """
@@ -24,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import ParameterError, UrdfError
-from .urdf_rules import JointEdge
+from .urdf_rules import JointEdge, zero_within
 
 __all__ = [
     "AXIS_TOL",
@@ -169,8 +171,8 @@ def reduce_to_chain(
             reasons[j] = "asked"
         elif j not in chain and j not in sources:
             reasons[j] = "off-chain"
-    for j, src in sources.items():  # a geared joint goes with its source
-        if src in reasons or j not in chain:
+    for j, src in sources.items():  # a geared joint goes with its source: locked with it, else it follows it
+        if src in reasons:
             reasons[j] = "geared"
     if not reasons:
         return model, ()
@@ -190,9 +192,7 @@ def reduce_to_chain(
                 raise ParameterError(f"--lock {name}", value,
                                      f"must be within the joint's limits [{lower:g}, {upper:g}]")  # fmt: skip
         else:
-            value = 0.0
-            if kind != "continuous" and lower is not None and upper is not None:
-                value = min(max(0.0, lower), upper)
+            value = 0.0 if kind == "continuous" else zero_within(lower, upper)
         values[j] = value
         jm = model.joints[j]
         if jm.nq == 2:  # continuous: (cos, sin)

@@ -17,7 +17,7 @@ def brief(value: object, chars: int = _BRIEF_CHARS) -> str:
     """``value`` as text for a message, at most about ``chars`` characters, whatever its size.
 
     A string is quoted (``repr``); a number or a NumPy array as ``str`` shows it; a list, dict or other
-    container is walked only as far as the text needs (:mod:`reprlib`: at most 6 items per level, 3 levels),
+    container is walked only as far as the text needs (``reprlib``: at most 6 items per level, 3 levels),
     never whole: a value read from a file may stand for billions of items (a yaml alias bomb).
     """
     import reprlib

@@ -32,8 +32,8 @@ import pinocchio as pin
 from ._checks import MAGNITUDE_MAX
 from .description import JOINT_COUNTS, JointLimits, RobotParameters, configured
 from .errors import InvalidInputError, ParameterError, UrdfError
-from .units import HUMAN, format_number
-from .urdf_rules import choose_frames, read_tree
+from .units import HUMAN, DisplayUnits, format_number
+from .urdf_rules import choose_frames, edges_of, read_tree, resolve_mimics
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -115,10 +115,13 @@ def pose_from_placement(aMb: pin.SE3) -> np.ndarray:
     return np.array([p[0], p[1], p[2], math.atan2(R[1, 0], R[0, 0])])
 
 
-def _parse_urdf(urdf: str, origin: str, checked: bool = False) -> pin.Model:
+def _parse_urdf(urdf: str, origin: str, checked: bool = False) -> tuple[pin.Model, str]:
     """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`.
 
     ``checked``: the package generated it (its own xacro): the Python pre-checks are skipped.
+
+    Returns:
+        (the model, the text Pinocchio was given: the file's, less what urdfdom ignores noisily, mimics composed).
     """
     import xml.etree.ElementTree as ET
 
@@ -130,9 +133,11 @@ def _parse_urdf(urdf: str, origin: str, checked: bool = False) -> pin.Model:
     if root.tag != "robot":
         raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
     if not checked:
-        _check_urdf(urdf, root, origin)
+        urdf = _check_urdf(urdf, root, origin)
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
     mimic = root.find("joint/mimic") is not None
+    if mimic:  # Pinocchio takes one level of mimic: a mimic of a mimic is handed to it composed
+        urdf = _composed_mimics(root, urdf, origin)
     try:
         model = pin.buildModelFromXML(urdf, mimic=True) if mimic else pin.buildModelFromXML(urdf)
     except (ValueError, RuntimeError) as exc:
@@ -142,24 +147,55 @@ def _parse_urdf(urdf: str, origin: str, checked: bool = False) -> pin.Model:
             f"{origin}: the URDF has no movable joint connected to its root link "
             f"({model.nbodies - 1} bodies, nq = 0): the kinematic tree is empty or disconnected"
         )
-    return model
+    return model, urdf
 
 
-def _check_urdf(urdf: str, root: Any, origin: str) -> None:
+def _composed_mimics(root: Any, urdf: str, origin: str) -> str:
+    """The URDF text with each chain of ``<mimic>`` joints composed down to its free joint (the text when none).
+
+    Raises:
+        UrdfError: a mimic that cannot be resolved (:func:`scara_pin.urdf_rules.resolve_mimics` names it).
+    """
+    import xml.etree.ElementTree as ET
+
+    resolved = resolve_mimics(edges_of(root)[1], origin)
+    if not any(m.via for m in resolved.values()):
+        return urdf
+    for el in root.findall("joint"):
+        m = resolved.get(el.get("name", ""))
+        if m is not None and m.via:
+            el.find("mimic").attrib.update(joint=m.source, multiplier=repr(m.multiplier), offset=repr(m.offset))
+    return ET.tostring(root, encoding="unicode")
+
+
+def _check_urdf(urdf: str, root: Any, origin: str) -> str:
     """The Python checks of a URDF from elsewhere, before urdfdom sees it (:mod:`scara_pin._urdf_checks`).
 
     urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state): its
     rules are checked first, in Python, so that it only sees documents it accepts; and the rule
     ``scara-pin check`` applies (xacro-not-expanded / xacro-ignored; the text search spares a walk).
-    """
-    from ._urdf_checks import check_urdf_tree, xacro_leftovers
 
+    Returns:
+        the text for Pinocchio: the file's, less the colours urdfdom would ignore noisily (said once here).
+    """
+    import xml.etree.ElementTree as ET
+
+    from ._urdf_checks import check_root, check_urdf_tree, urdfdom_ignores, xacro_leftovers
+
+    check_root(root, origin)
     leftover = xacro_leftovers(root) if "xacro" in urdf or "$" in urdf else None
     if leftover is not None:
         if leftover[0]:
             raise UrdfError(f"{origin}: {leftover[1]}")
         logging.getLogger("scara_pin").warning("%s: %s", origin, leftover[1])
     check_urdf_tree(root, origin)
+    ignored = urdfdom_ignores(root)  # colours urdfdom drops: said here once, not by urdfdom on fd 2
+    if ignored:
+        shown = ", ".join(ignored[:6]) + (f" and {len(ignored) - 6} more" if len(ignored) > 6 else "")
+        logging.getLogger("scara_pin").warning("%s: colours URDF cannot read, ignored (as urdfdom does; a colour is "
+                                               "<color rgba=\"r g b a\"/>, each in [0, 1]): %s", origin, shown)
+        return ET.tostring(root, encoding="unicode")
+    return urdf
 
 
 _CONTINUOUS = frozenset(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"))
@@ -203,7 +239,8 @@ class Robot:
     Attributes:
         model: the Pinocchio model (``nv = 4``; ``nq = 4`` plus one per continuous joint).
         data: its Pinocchio data (the methods below overwrite it).
-        urdf: the URDF text the model was built from.
+        urdf: the URDF text the model was built from, as written (Pinocchio got it less the colours urdfdom
+            ignores, with chains of mimics composed: ``_pinocchio_urdf``).
         name: the robot's name.
         limits: the joint limits; accelerations come from ``joint_limits.yaml`` (URDF has none).
         parameters: the yaml parameters, when the robot was generated from them.
@@ -236,6 +273,7 @@ class Robot:
     geared: tuple[GearedJoint, ...]
     locked: tuple[LockedJoint, ...]
     lock_note: str | None
+    _pinocchio_urdf: str
 
     def __init__(
         self,
@@ -275,7 +313,7 @@ class Robot:
                 (inverted limits, zero axis: :func:`scara_pin.urdf_rules.joint_problem`), or a frame
                 asked for that is not a link of the file.
         """
-        model = _parse_urdf(urdf, origin, checked=generated)
+        model, self._pinocchio_urdf = _parse_urdf(urdf, origin, checked=generated)
         links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
         frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
         base_frame, tool_frame = frames.base, frames.tool
@@ -433,14 +471,15 @@ class Robot:
         """
         from .description.placeholders import placeholder_urdf
 
-        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.VISUAL)
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self._pinocchio_urdf), pin.GeometryType.VISUAL)
 
     @cached_property
     def collision_model(self) -> pin.GeometryModel:
         """Collision geometry of the URDF, built on first use (meshes as placeholder boxes, as above)."""
         from .description.placeholders import placeholder_urdf
 
-        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self.urdf), pin.GeometryType.COLLISION)
+        return pin.buildGeomFromUrdfString(self.model, placeholder_urdf(self._pinocchio_urdf),
+                                           pin.GeometryType.COLLISION)  # fmt: skip
 
     # ----------------------------------------------------------------- a summary for people (repr, notebooks)
     def plot(self, q: object = None, path: str | os.PathLike[str] | None = None, **kwargs: Any) -> Any:
@@ -610,15 +649,35 @@ class Robot:
         """The URDF names of the joints of q, in q order (mimic joints are not in q)."""
         return tuple(self.model.names[j] for j in range(1, self.model.njoints) if self.model.joints[j].nv > 0)
 
-    def outside_limits(self, q: np.ndarray, tol: float = 0.0) -> list[str]:
-        """The joints of ``q`` outside their position limits (by more than ``tol``), with values."""
+    @property
+    def default_q(self) -> np.ndarray:
+        """Where the robot rests by default (a page's first pose, the pendant's start), a new array.
+
+        q = 0, each joint whose limits exclude 0 at its nearest limit (:func:`scara_pin.urdf_rules.zero_within`).
+        """
+        from .urdf_rules import zero_within
+
+        return np.array([0.0 if c else zero_within(lo, hi)
+                         for c, lo, hi in zip(self.continuous, self.limits.lower, self.limits.upper)])  # fmt: skip
+
+    def outside_limits(self, q: np.ndarray, tol: float = 0.0, units: DisplayUnits | None = None) -> list[str]:
+        """The joints of ``q`` outside their position limits (by more than ``tol``), with values.
+
+        ``units``: the values in these units, named (``joint3 = 0 deg outside [10, 150] deg``); default SI
+        without unit names.
+        """
         out = []
         for i, joint in enumerate(self.joint_names):
             if self.continuous[i]:  # no position limit
                 continue
             lo, hi = self.limits.lower[i], self.limits.upper[i]
             if not lo - tol <= q[i] <= hi + tol:
-                out.append(f"{joint} = {q[i]:.9g} outside [{lo:.9g}, {hi:.9g}]")
+                if units is None:
+                    out.append(f"{joint} = {q[i]:.9g} outside [{lo:.9g}, {hi:.9g}]")
+                else:
+                    kind = self.joint_kinds[i]
+                    out.append(f"{joint} = {units.format(q[i], kind)} {units.name(kind)} outside "
+                               f"[{units.format(lo, kind)}, {units.format(hi, kind)}] {units.name(kind)}")  # fmt: skip
         return out
 
     # ----------------------------------------------------------------- kinematics
@@ -739,8 +798,10 @@ def _urdf_kind(robot: Robot) -> str:
 
     The layout (:func:`scara_pin.chain.palletizer_layout`): a vertical waist, two parallel horizontal arm
     joints, a vertical flange. Level: the tool's z axis keeps its direction at
-    :data:`~scara_pin.chain.LEVEL_PROBES` (the levelling parallelogram, modelled by ``<mimic>`` joints).
-    Whether the palletizer's closed form then fits the model is its kinematics' check (FK at sampled q).
+    :data:`~scara_pin.chain.LEVEL_PROBES` (the levelling parallelogram, modelled by ``<mimic>`` joints). Both
+    are read from the geometry, whatever the order of the joints and their zero pose; the palletizer's
+    geometry is then read the same way (:mod:`scara_pin.kinematics.palletizer_model`), which says where a
+    model departs from its closed form.
     """
     from .chain import AXIS_TOL, LEVEL_PROBES, flange_pitch, palletizer_layout
 

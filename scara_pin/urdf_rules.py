@@ -3,8 +3,11 @@
 One place for what both must agree on, so that whatever ``scara-pin check`` says the toolkit will do, it
 does:
 
-- :func:`choose_frames`: the tool and base frames (``tool0`` if present, else the chain's last link;
-  ``base`` if present, else the root link; a named frame that does not exist is an error);
+- :func:`choose_frames`: the tool and base frames (``tool0`` if present, else the link the arm ends in:
+  the end of the chain through the most free joints; ``base`` if present, else the root link; a named
+  frame that does not exist is an error);
+- :func:`resolve_mimics`: each ``<mimic>`` joint's free joint, through chains of mimics (a mimic of a
+  mimic: multipliers and offsets composed), or why Pinocchio cannot take it;
 - :func:`joint_problem`: a joint the toolkit cannot use (zero axis, non-finite or inverted limits, a range
   of zero width).
 """
@@ -12,22 +15,42 @@ does:
 from __future__ import annotations
 
 import math
+import re
+import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from .errors import UrdfError
 
-__all__ = ["MOVABLE", "FrameChoice", "JointEdge", "choose_frames", "joint_problem", "read_tree"]
+__all__ = [
+    "MOVABLE",
+    "TOOL_NAMES",
+    "FrameChoice",
+    "JointEdge",
+    "Mimic",
+    "ToolCandidate",
+    "choose_frames",
+    "edges_of",
+    "joint_problem",
+    "read_tree",
+    "resolve_mimics",
+    "zero_within",
+]
 
 MOVABLE = ("revolute", "continuous", "prismatic")
 """URDF joint types that move (each one value of q)."""
+TOOL_NAMES = ("tool0", "flange", "tcp", "ee", "end_effector")
+"""Names of a tool link, preferred in this order among links that end equally long chains (a name matches
+when its words, split at ``_``, ``-``, ``.`` and between letters and digits, contain them: ``mg400_flange``,
+``magician_link_ee``, ``end_effector_shaft``)."""
 
 
 @dataclass(frozen=True)
 class JointEdge:
     """A URDF joint as the tree sees it: name, type, parent link, child link; its limits and mimic as written.
 
-    ``lower``/``upper``: the position limits (None when absent); ``mimic``: the joint it follows, if any.
+    ``lower``/``upper``: the position limits (None when absent); ``mimic``: the joint it follows, if any
+    (a movable joint's ``<mimic>``), with ``multiplier`` and ``offset`` as written.
     """
 
     name: str
@@ -37,6 +60,42 @@ class JointEdge:
     lower: float | None = None
     upper: float | None = None
     mimic: str | None = None
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+    @property
+    def free(self) -> bool:
+        """A movable joint that follows no other: a degree of freedom."""
+        return self.type in MOVABLE and self.mimic is None
+
+
+@dataclass(frozen=True)
+class Mimic:
+    """A ``<mimic>`` joint resolved down to the free joint it follows: ``value = multiplier * source + offset``.
+
+    ``via``: the mimic joints between it and ``source`` (empty when it follows a free joint directly).
+    """
+
+    joint: str
+    source: str
+    multiplier: float
+    offset: float
+    via: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class ToolCandidate:
+    """A link that ends the arm: a leaf of the tree, or the hand its fingers hang from.
+
+    Attributes:
+        link: its name. free: the free joints between the root and it, root first. depth: all joints on the way.
+        hand: the fingers hanging from it (sibling movable joints ending the tree), when it is a hand.
+    """
+
+    link: str
+    free: tuple[str, ...]
+    depth: int
+    hand: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -47,14 +106,18 @@ class FrameChoice:
         base: the reference frame of poses (a link).
         tool: the tool frame (a link).
         note: when the tool was chosen by default without a ``tool0``: the one-line notice saying which
-            link is the tool (the CLI prints it as ``info:``); else None.
+            link is the tool and why (the CLI prints it as ``info:``); else None.
         root: the root link of the tree.
+        alternatives: the other links that end the arm (best first), when the tool was chosen by default.
+        ambiguous: when chosen by default: another link ends an equally long chain and no name decides.
     """
 
     base: str
     tool: str
     note: str | None = None
     root: str = ""
+    alternatives: tuple[ToolCandidate, ...] = ()
+    ambiguous: bool = False
 
 
 def _dfs(links: Sequence[str], joints: Sequence[JointEdge]) -> tuple[str, list[JointEdge], dict[str, list[JointEdge]]]:
@@ -99,8 +162,9 @@ def choose_frames(
     Args:
         links: the link names, in file order.
         joints: the joints, in file order.
-        tool: the tool frame asked for (``--tool``); default: ``tool0`` if present, else the chain's last
-            link (the deepest link below the last movable joint, the first in file order at each level).
+        tool: the tool frame asked for (``--tool``); default: ``tool0`` if present, else the link the arm
+            ends in: the first of :func:`tool_candidates` (the end of the chain through the most free joints;
+            among equals, a name of :data:`TOOL_NAMES`), with a note saying why and the alternatives.
         base: the base frame asked for (``--base``), a link fixed to the root; default: ``base`` if present,
             else the root link.
         origin: how to name the source in error messages.
@@ -126,19 +190,82 @@ def choose_frames(
                                 f"{parent_of[link].name}: the base must be fixed to the root link; "
                                 f"fixed links: {fixed}")  # fmt: skip
             link = parent_of[link].parent
-    note = None
-    if tool is None:
-        if "tool0" in links:
-            tool = "tool0"
-        else:
-            chain = [j for j in order if j.type in MOVABLE]
-            tool = root
-            level = [chain[-1].child] if chain else []
-            while level:
-                tool = level[0]
-                level = [j.child for link in level for j in children.get(link, [])]
-            note = f"no tool0 frame: {tool} (the chain's last link) is taken as the tool; --tool FRAME picks another"
-    return FrameChoice(base=base, tool=tool, note=note, root=root)
+    if tool is not None or "tool0" in links:
+        return FrameChoice(base=base, tool=tool or "tool0", root=root)
+    candidates = tool_candidates(root, order, children)
+    if not candidates:
+        return FrameChoice(base=base, tool=root, root=root)
+    best = candidates[0]
+    ambiguous = len(candidates) > 1 and len(candidates[1].free) == len(best.free) \
+        and _name_rank(candidates[1].link) == _name_rank(best.link)  # fmt: skip
+    why = f"it ends the chain through the most free joints, {len(best.free)}"
+    if _name_rank(best.link) < len(TOOL_NAMES):
+        why += f", and its name says {TOOL_NAMES[_name_rank(best.link)]}"
+    elif best.hand:
+        why += f"; the hand of the fingers {', '.join(best.hand)}"
+    note = f"no tool0 frame: {best.link} is taken as the tool ({why})"
+    if ambiguous:
+        note += f"; {candidates[1].link} ends as many and no name tells them apart"
+    note += "; --tool FRAME picks another"
+    return FrameChoice(base=base, tool=best.link, note=note, root=root, alternatives=tuple(candidates[1:]),
+                       ambiguous=ambiguous)  # fmt: skip
+
+
+def _words(name: str) -> list[str]:
+    """A name's words: split at ``_``, ``-``, ``.``, and between letters and digits; lower case."""
+    return [w for w in re.split(r"[_\-.]+|(?<=[a-z])(?=\d)|(?<=\d)(?=[a-z])", name.lower()) if w]
+
+
+def _name_rank(link: str) -> int:
+    """The index in :data:`TOOL_NAMES` of the first name whose words the link's words contain (else its length)."""
+    words = _words(link)
+    for i, name in enumerate(TOOL_NAMES):
+        parts = _words(name)
+        if any(words[k : k + len(parts)] == parts for k in range(len(words) - len(parts) + 1)):
+            return i
+    return len(TOOL_NAMES)
+
+
+def tool_candidates(root: str, order: Sequence[JointEdge], children: dict[str, list[JointEdge]]
+                    ) -> list[ToolCandidate]:  # fmt: skip
+    """The links the arm may end in, best first (the default tool is the first, :func:`choose_frames`).
+
+    The leaves of the tree, except that the fingers of a hand are not the arm: where a link carries two or
+    more movable joints with nothing movable below them (a gripper's jaws, one usually a ``<mimic>`` of the
+    other), the link itself (the hand) stands for the leaves below them. Ranked by the free joints between
+    the root and them (most first: the arm, not a parallelogram's rod, which only ``<mimic>`` joints move),
+    then by :data:`TOOL_NAMES`, then the deeper first, then file order.
+    """
+    moving_below: set[str] = set()
+    for j in reversed(order):
+        if j.type in MOVABLE or j.child in moving_below:
+            moving_below.add(j.parent)
+    out: list[ToolCandidate] = []
+    stack: list[tuple[str, tuple[str, ...], int]] = [(root, (), 0)]
+    while stack:
+        link, free, depth = stack.pop()
+        kids = children.get(link, [])
+        movable = [j for j in kids if j.type in MOVABLE]
+        fingers = tuple(j.name for j in movable) if len(movable) >= 2 and any(j.mimic is None for j in movable) \
+            and not any(j.child in moving_below for j in movable) else ()  # fmt: skip
+        if not kids or fingers:
+            out.append(ToolCandidate(link, free, depth, fingers))
+        for j in reversed(kids):  # the first child popped first: file order
+            if j.name not in fingers:
+                stack.append((j.child, free + ((j.name,) if j.free else ()), depth + 1))
+    index = {c.link: i for i, c in enumerate(out)}
+    return sorted(out, key=lambda c: (-len(c.free), _name_rank(c.link), -c.depth, index[c.link]))
+
+
+
+
+def zero_within(lower: float | None, upper: float | None) -> float:
+    """0, or the nearest limit when 0 is outside [lower, upper] (None: no limit) [rad or m].
+
+    Where a joint rests by default: a locked joint, a page's first pose, the pendant's start.
+    """
+    value = 0.0 if lower is None else max(0.0, lower)
+    return value if upper is None else min(value, upper)
 
 
 def joint_problem(
@@ -171,6 +298,7 @@ def joint_problem(
 
 
 def _float(text: str | None) -> float | None:
+    """A number as written (NaN when malformed), None when absent."""
     if text is None:
         return None
     try:
@@ -179,33 +307,108 @@ def _float(text: str | None) -> float | None:
         return math.nan
 
 
+def edges_of(root: ET.Element) -> tuple[list[str], list[JointEdge]]:
+    """The link names and the joints of a parsed URDF, in file order (nothing checked; NaN for bad numbers)."""
+    links = [el.get("name", "") for el in root.findall("link")]
+    joints = []
+    for el in root.findall("joint"):
+        parent, child, limit, mimic = el.find("parent"), el.find("child"), el.find("limit"), el.find("mimic")
+        lo = _float(limit.get("lower")) if limit is not None else None
+        hi = _float(limit.get("upper")) if limit is not None else None
+        joints.append(JointEdge(
+            el.get("name", ""), el.get("type", ""), parent.get("link", "") if parent is not None else "",
+            child.get("link", "") if child is not None else "", lo, hi,
+            None if mimic is None else mimic.get("joint", ""),
+            1.0 if mimic is None else float(_float(mimic.get("multiplier", "1"))),  # type: ignore[arg-type]
+            0.0 if mimic is None else float(_float(mimic.get("offset", "0"))),  # type: ignore[arg-type]
+        ))  # fmt: skip
+    return links, joints
+
+
 def read_tree(urdf: str, origin: str) -> tuple[list[str], list[JointEdge]]:
     """Read the links and joints of URDF text (file order), and check every movable joint (:func:`joint_problem`).
 
     Raises:
         UrdfError: the first unusable joint (one line naming the joint and the rule).
     """
-    import xml.etree.ElementTree as ET
-
     root = ET.fromstring(urdf)  # the caller has parsed it once already: it is well-formed
-    links = [el.get("name", "") for el in root.findall("link")]
-    joints = []
-    for el in root.findall("joint"):
-        name, kind = el.get("name", ""), el.get("type", "")
-        parent, child = el.find("parent"), el.find("child")
-        axis_el, limit, mimic = el.find("axis"), el.find("limit"), el.find("mimic")
-        lo = _float(limit.get("lower")) if limit is not None else None
-        hi = _float(limit.get("upper")) if limit is not None else None
-        joints.append(JointEdge(name, kind, parent.get("link", "") if parent is not None else "",
-                                child.get("link", "") if child is not None else "", lo, hi,
-                                None if mimic is None else mimic.get("joint", "")))  # fmt: skip
-        if kind not in MOVABLE or mimic is not None:  # a mimic joint follows another: not in q
+    links, joints = edges_of(root)
+    for el, j in zip(root.findall("joint"), joints):
+        if not j.free:  # a mimic joint follows another: not in q
             continue
+        axis_el = el.find("axis")
         try:
             axis = [float(v) for v in (axis_el.get("xyz", "1 0 0") if axis_el is not None else "1 0 0").split()]
         except ValueError:
             axis = [math.nan]
-        problem = joint_problem(name, kind, axis, lo, hi)
+        problem = joint_problem(j.name, j.type, axis, j.lower, j.upper)
         if problem is not None:
             raise UrdfError(f"{origin}: {problem[1]} [{problem[0]}]")
     return links, joints
+
+
+def _pinocchio_order(joints: Sequence[JointEdge]) -> dict[str, int]:
+    """Each joint's place in the order Pinocchio builds the tree: depth-first, a link's children by name.
+
+    (urdfdom keeps the joints in a map sorted by name and lists each link's child joints in that order.)
+    """
+    children: dict[str, list[JointEdge]] = {}
+    for j in sorted(joints, key=lambda e: e.name.encode()):
+        children.setdefault(j.parent, []).append(j)
+    has_parent = {j.child for j in joints}
+    stack = [j for link in children if link not in has_parent for j in reversed(children[link])]
+    out: dict[str, int] = {}
+    while stack:
+        j = stack.pop()
+        if j.name in out:
+            continue
+        out[j.name] = len(out)
+        stack.extend(reversed(children.get(j.child, [])))
+    return out
+
+
+def resolve_mimics(joints: Sequence[JointEdge], origin: str) -> dict[str, Mimic]:
+    """Each movable ``<mimic>`` joint's free joint, multiplier and offset, through chains of mimics.
+
+    A joint following a joint that itself follows another (a parallelogram's plate following its rod) is
+    the composition: ``a = m1 b + c1``, ``b = m2 f + c2`` give ``a = (m1 m2) f + (m1 c2 + c1)``. Pinocchio
+    takes one level only: the loader hands it the composed ``<mimic>`` (:class:`scara_pin.model.Robot`).
+
+    Raises:
+        UrdfError: what cannot be resolved, naming the joints: a loop of mimics; a source that is no joint of
+            the file, or not a movable one; a continuous joint following a bounded one or the reverse
+            (Pinocchio's configurations differ: (cos, sin) against an angle); a source that Pinocchio builds
+            after its mimic (it builds each link's child joints in name order, and needs the source first).
+    """
+    by_name = {j.name: j for j in joints}
+    out: dict[str, Mimic] = {}
+    order: dict[str, int] | None = None
+    for j in joints:
+        if j.type not in MOVABLE or j.mimic is None:
+            continue
+        m, c, path, name = j.multiplier, j.offset, [j.name], j.mimic
+        while True:
+            src = by_name.get(name)
+            if src is None or src.type not in MOVABLE:
+                what = "which is no joint of the file" if src is None else f"a {src.type} joint"
+                raise UrdfError(f"{origin}: joint {path[-1]} follows {name!r} (<mimic>), {what}: a <mimic> follows a "
+                                "revolute, continuous or prismatic joint")  # fmt: skip
+            if src.name in path:
+                loop = " -> ".join([*path[path.index(src.name) :], src.name])
+                raise UrdfError(f"{origin}: the <mimic> joints {loop} follow one another in a loop: none of them is "
+                                "free, so none has a value")  # fmt: skip
+            if src.mimic is None:
+                break
+            path.append(src.name)
+            m, c, name = m * src.multiplier, m * src.offset + c, src.mimic
+        if (j.type == "continuous") != (src.type == "continuous"):
+            raise UrdfError(f"{origin}: joint {j.name} ({j.type}) follows {src.name} ({src.type}) (<mimic>): "
+                            "Pinocchio takes a mimic of a continuous joint only as a continuous joint, and the "
+                            "reverse")  # fmt: skip
+        order = _pinocchio_order(joints) if order is None else order
+        if order.get(src.name, -1) > order.get(j.name, -1):
+            raise UrdfError(f"{origin}: joint {j.name} follows {src.name} (<mimic>), but Pinocchio builds {src.name} "
+                            "after it (depth-first, each link's child joints in name order) and needs the followed "
+                            f"joint first: rename the branches so that {src.name}'s comes first")  # fmt: skip
+        out[j.name] = Mimic(j.name, src.name, m, c, tuple(path[1:]))
+    return out

@@ -95,9 +95,10 @@ def plain(robot, cli_corners):
     assert kwargs["blend"] == 0.0 and kwargs["span"] == STANDARD_SPAN and kwargs["rise"] == STANDARD_RISE
     assert kwargs["start"] is None and kwargs["direction"] is None and kwargs["jerk"] is None
     assert kwargs["payload"] == Payload() and kwargs["limits"] == robot.limits and kwargs["max_height"] is None
-    assert kwargs["path"].value == "lines" and kwargs["cell"] is None
+    assert kwargs["path"].value == "lines"
+    assert kwargs["torque"] is True and kwargs["cell"] is None  # efforts apply unless --no-torque; no --cell
     assert kwargs.keys() == {"start", "direction", "span", "rise", "blend", "payload", "jerk", "limits", "path",
-                             "max_height", "cell"}  # fmt: skip
+                             "max_height", "cell", "torque"}  # fmt: skip
     assert cli_corners.planned[1][0]["path"].value == "jump"
     return standard_cycle(robot, path="lines"), corners
 

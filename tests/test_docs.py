@@ -37,6 +37,7 @@ def test_every_python_block_of_a_page_runs(page: Path, tmp_path: Path, monkeypat
     from sybil.parsers.markdown import PythonCodeBlockParser
 
     monkeypatch.chdir(tmp_path)
+    (tmp_path / "docs").symlink_to(ROOT / "docs")  # the pages name their example files from the repository's root
     monkeypatch.setattr("scara_pin.viz.meshcat.Viewer.DEFAULT_TIMEOUT", 30.0)
     document = Sybil(parsers=[PythonCodeBlockParser()]).parse(page)
     examples = list(document.examples())

@@ -192,7 +192,7 @@ def test_the_timeline_plot(robot_default: Robot, tmp_path: Path) -> None:
 
     job = write_job(tmp_path, "start: feeder\nsteps:\n  - jump: T22\n  - dwell: 0.1\n  - go: feeder\n", robot_default)
     result = Job.load(job).plan(robot_default)
-    fig = plot_job(result, robot_default)
+    fig = plot_job(result, robot=robot_default)
     band, ax_v, ax_a = fig.axes[:3]
     assert [p.get_gid() for p in band.patches] == ["step-jump", "step-go"]  # the dwell left blank
     for ax in (ax_v, ax_a):

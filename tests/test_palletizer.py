@@ -319,10 +319,10 @@ def _geo(robot: Robot, **limits: tuple[float, float]) -> PalletizerGeometry:
     ("target", "limits", "branch", "status", "words"),
     [
         ([5.0, 0.0, 1.0, 0.0], {}, "all", PalletizerIKStatus.OUT_OF_REACH, "beyond a2 + a3 = 1.95"),
-        ("q", {"j2": (0.3, 0.35)}, "up", PalletizerIKStatus.J2_LIMIT, "q2 = 0.2"),
-        ("q", {"j3": (1.5, 2.0)}, "up", PalletizerIKStatus.J3_LIMIT, "theta3 = 1.4"),
-        ("q", {"j1": (0.5, 1.0)}, "up", PalletizerIKStatus.J1_LIMIT, "q1 = 0"),
-        ("q", {"j4": (0.5, 1.0)}, "up", PalletizerIKStatus.J4_LIMIT, "q4 = 0.1"),
+        ("q", {"j2": (0.3, 0.35)}, "up", PalletizerIKStatus.J2_LIMIT, "joint2 = 0.2 rad (up)"),
+        ("q", {"j3": (1.5, 2.0)}, "up", PalletizerIKStatus.J3_LIMIT, "joint3 = 1.4 rad (up)"),
+        ("q", {"j1": (0.5, 1.0)}, "up", PalletizerIKStatus.J1_LIMIT, "joint1 = 0 rad"),
+        ("q", {"j4": (0.5, 1.0)}, "up", PalletizerIKStatus.J4_LIMIT, "joint4 = 0.1 rad"),
     ],
 )
 def test_reason_codes(robot: Robot, target: Any, limits: dict, branch: str, status: PalletizerIKStatus,

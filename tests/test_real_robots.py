@@ -162,7 +162,8 @@ def test_cli_fk_on_a_xacro_says_the_tool_once(xacro: Path, capsys: pytest.Captur
     code, out, err = run(capsys, "fk", "--urdf", str(xacro), "--json", *map(repr, q.tolist()))
     assert code == 0, err
     assert [ln for ln in err.splitlines()] == [
-        "info: no tool0 frame: Hand_Base (the chain's last link) is taken as the tool; --tool FRAME picks another"
+        "info: no tool0 frame: Hand_Base is taken as the tool (it ends the chain through the most free joints, 4); "
+        "--tool FRAME picks another"
     ]
     import json
 

@@ -212,27 +212,38 @@ def test_tilt_below_one_microradian_is_not_reported() -> None:
     assert "axis-tilted" not in check_urdf(text).codes()
 
 
+def _moved(text: str, written: str, exact: str, qs: list[list[float]]) -> float:
+    """[mm] the most the tool point moves between the file as written and with the exact value (Pinocchio's FK)."""
+    a, b = robot_from_urdf(text), robot_from_urdf(text.replace(written, exact))
+    return 1000.0 * max(float(np.linalg.norm(a.tool_pose(np.array(q))[:3] - b.tool_pose(np.array(q))[:3]))
+                        for q in qs)  # fmt: skip
+
+
 def test_rpy_3_14_error_in_mm_at_full_reach() -> None:
-    """ROS tutorial: rpy 3.14 on the quill: 0.0016 rad times 0.5 m (quill origin to the tool) = 0.80 mm."""
+    """ROS tutorial: rpy 3.14 on the quill tilts it by 0.0016 rad: the tool moves most at the quill's full stroke
+    (issue 29 item 8: measured over the configurations, not only at q = 0, where it was 0.80 mm)."""
     text = text_of("ros_rrp_tutorial.urdf")
     (f,) = only(check_urdf(text), "rpy-approximate")
     err = math.pi - 3.14
-    dist = 0.5  # tool0 at xyz 0 0 0.5 in link3: the quill's frame origin to the tool, rotation-invariant
     assert f.joint == "joint3" and f.severity is Severity.WARNING
     assert f.line == line_of(text, 'rpy="3.14 0 0"', after='<joint name="joint3"')
-    assert f"{err * dist * 1000:.3g} mm" in f.message  # 0.796 mm
+    lo, hi = robot_from_urdf(text).limits.lower[2], robot_from_urdf(text).limits.upper[2]
+    mm = _moved(text, 'rpy="3.14 0 0"', f'rpy="{math.pi!r} 0 0"', [[0.0, 0.0, lo], [0.0, 0.0, hi]])
+    assert mm > err * 0.5 * 1000  # more than at q = 0 (tool0 0.5 m from the quill's origin there)
+    assert f"up to {mm:.3g} mm" in f.message
     assert f"{math.degrees(err):.3g} deg" in f.message  # 0.0912 deg
     assert "approximates pi" in f.message
 
 
 def test_rpy_1_5708_error_in_mm() -> None:
+    """j1's origin turned by 1.5708: everything turns about j1's axis, the tool most with the arm stretched."""
     text = text_of("yk400xe_rpy_1_5708.urdf")
     (f,) = only(check_urdf(text), "rpy-approximate")
     err = 1.5708 - math.pi / 2
-    # j1's origin (0, 0, 0.140) to the tool at q = 0: (0.225 + 0.175 along the arm, z 0.0478 - 0.068)
-    dist = math.hypot(0.400, 0.0478 - 0.068)
+    mm = _moved(text, 'rpy="0 0 1.5708"', f'rpy="0 0 {math.pi / 2!r}"', [[0.0, 0.0, 0.0, 0.0]])  # stretched
+    assert mm == pytest.approx(err * 0.400 * 1000, rel=1e-6)  # arms 0.225 + 0.175 m from j1's axis
     assert f.joint == "j1" and f.line == line_of(text, 'rpy="0 0 1.5708"')
-    assert f"{err * dist * 1000:.3g} mm" in f.message and "pi/2" in f.message
+    assert f"up to {mm:.3g} mm" in f.message and "pi/2" in f.message
 
 
 @pytest.mark.parametrize(("value", "exact", "reported"), [

@@ -494,7 +494,7 @@ def test_ray_errors() -> None:
         ws.ray([0.7, 0.0], [1.0, 0.0])
     with pytest.raises(OutsideWorkspaceError, match="joint1/joint2"):
         ws.ray([-0.5, 0.0], [1.0, 0.0])  # behind the robot, between the J1 limits
-    with pytest.raises(OutsideWorkspaceError, match="J3 stroke"):
+    with pytest.raises(OutsideWorkspaceError, match="joint3's stroke"):
         ws.ray([0.5, 0.0, 0.3], [1.0, 0.0, 0.0])
     with pytest.raises(ParameterError, match="must not be zero"):
         ws.ray([0.5, 0.0], [0.0, 0.0])

@@ -11,7 +11,7 @@ The steps of :func:`calibrate`:
 2. the data checked against the nominal model (:func:`~scara_pin.calibration.screen.screen`: units, degrees,
    limits, distinct poses); in the device frame, the device's nominal placement is the rigid alignment
    (:func:`~scara_pin.calibration.chain.kabsch`) of the nominal predictions with the measurements;
-3. the identified errors, judged where the model is (:func:`_solve`): first at the nominal model, on the
+3. the identified errors, judged where the model is (``_solve``): first at the nominal model, on the
    DISTINCT poses (a repeated pose adds rows, not rank), fitted by scipy's ``least_squares`` (trust-region
    reflective, analytic Jacobian), the others fixed at zero; then again at the estimate, the errors already
    identified first: an error without first-order effect at the nominal model may act at the estimate (J4's
@@ -514,7 +514,7 @@ def _cross_validation(problem: _Problem, opt: CalibrationOptions, count: int, no
                       whole: _Solution) -> CrossValidation | None:  # fmt: skip
     """Each fold's poses (all their rows) predicted by a fit on the other poses.
 
-    The fit: :func:`_solve`, started from the fit on all of them (``whole``).
+    The fit: ``_solve``, started from the fit on all of them (``whole``).
     """
     if opt.folds == 0:
         return None

@@ -35,7 +35,7 @@ no margin, carried part or allowed pairs: :func:`load_cell` takes them as argume
 
 Every file is sized before it is read (:data:`~scara_pin.limits.MAX_CELL_BYTES`); obstacles and
 triangles are capped (:data:`~scara_pin.limits.MAX_CELL_OBSTACLES`, :data:`~scara_pin.limits.MAX_CELL_TRIANGLES`)
-before any geometry is built; meshes are read by :func:`scara_pin.description.meshes.load_mesh` (its caps).
+before any geometry is built; meshes are read by :func:`scara_pin.cell.meshes.load_mesh` (its caps).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The robot's own collision geometry: its links' ``<collision>`` elements, and which pairs of them are checked.
 
 The shapes are the URDF's (Pinocchio's ``GeometryModel`` of the collision elements, coal primitives; meshes
-read by :func:`scara_pin.description.meshes.collision_meshes` and checked as coal's bounding-volume trees).
+read by :func:`scara_pin.cell.meshes.collision_meshes` and checked as coal's bounding-volume trees).
 Each geometry belongs to a link (its name in messages) and moves with a joint.
 
 **Self-collision pairs** are chosen as MoveIt's setup assistant does, automatically:

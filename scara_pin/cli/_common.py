@@ -304,9 +304,9 @@ def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]
     return [_number(prefix + n, t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
 
 
-def _check_limits(robot: Robot, q: np.ndarray, strict: bool) -> None:
+def _check_limits(robot: Robot, q: np.ndarray, strict: bool, units: Units) -> None:
     robot.check_q(q)  # a q that cannot be computed is an error, never first a "computed anyway" warning
-    outside = robot.outside_limits(q)
+    outside = robot.outside_limits(q, units=units.display)
     if outside and strict:
         raise InfeasibleError("q outside the joint limits (--strict): " + "; ".join(outside))
     for item in outside:
@@ -343,7 +343,7 @@ def _read_pose(texts: Sequence[str], units: Units, what: str = "target", dof: in
 
 def _joint_arg(robot: Robot, texts: Sequence[str], units: Units, what: str) -> np.ndarray:
     q = robot.check_q(_q_values(texts, units, what))
-    outside = robot.outside_limits(q, tol=1e-12)
+    outside = robot.outside_limits(q, tol=1e-12, units=units.display)
     if outside:
         raise InfeasibleError(f"{what} is outside the joint limits: " + "; ".join(outside))
     return q

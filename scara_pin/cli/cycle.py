@@ -81,7 +81,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     jerk = _jerk(args)
     cell = cell_from_args(args, units)
     common = {"start": start, "direction": direction, "span": span, "rise": rise, "payload": _payload(args, units),
-              "jerk": jerk, "limits": limits, "max_height": ceiling, "cell": cell}  # fmt: skip
+              "jerk": jerk, "limits": limits, "max_height": ceiling, "cell": cell,
+              "torque": not args.no_torque}  # fmt: skip
     if path is CyclePath.JUMP:
         result = standard_cycle(robot, path=path, clearance_radius=radius, **common)  # type: ignore[arg-type]
     else:
@@ -116,6 +117,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
             "span": result.span, "rise": result.rise, "blend": result.blend,
             "clearance_radius": result.clearance_radius, "max_height": result.max_height,
             "payload": move.payload.to_dict(),
+            "torque": result.torque,
+            "joints": list(robot.joint_names),
             "q_start": move.trajectory.q_start.tolist(),
             "outputs": outputs,
             "units": {"length": "m", "angle": "rad", "time": "s"},
@@ -198,6 +201,8 @@ def register(sub: Any) -> None:
     g.add_argument("--payload", metavar="KG", help="payload mass at the tool (default 0)")
     g.add_argument("--payload-com", nargs=3, metavar="C", help="payload centre of mass X Y Z in the tool frame")
     g.add_argument("--jerk-limit", nargs="+", metavar="J", help="joint jerk limit, one or 4 (rad/s^3, m/s^3)")
+    g.add_argument("--no-torque", action="store_true",
+                   help="leave the effort limits out (a URDF's placeholder efforts); said in the output")
     _add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",

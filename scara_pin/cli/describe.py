@@ -93,7 +93,20 @@ def cmd_urdf(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable."""
+    """Lint a SCARA URDF: findings with line numbers; exit 0 clean, 4 warnings, 2 unusable (or list the rules)."""
+    if args.list_rules:
+        from ..lint import RULES, rules_text
+
+        if args.file is not None:
+            raise InvalidInputError("--list-rules lists the rules of check: it takes no file")
+        if args.json:
+            print(json.dumps({"rules": [{"code": r.code, "severity": r.severity.value, "family": r.family,
+                                         "summary": r.summary} for r in RULES]}))  # fmt: skip
+        else:
+            print(rules_text())
+        return 0
+    if args.file is None:
+        raise InvalidInputError("check needs a FILE.urdf (or --list-rules)")
     from ..lint import check_urdf_file
 
     report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or (),
@@ -115,7 +128,8 @@ def register(sub: Any) -> None:
     _add_robot_options(p, urdf_file=False)
     p.set_defaults(func=cmd_urdf)
     p = sub.add_parser("check", help="lint a third-party SCARA URDF: exit 0 clean, 4 warnings, 2 unusable")
-    p.add_argument("file", metavar="FILE.urdf", help="the URDF (or .xacro, expanded) to check")
+    p.add_argument("file", metavar="FILE.urdf", nargs="?", help="the URDF (or .xacro, expanded) to check")
+    p.add_argument("--list-rules", action="store_true", help="print the rules of check, one line each, and exit")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_frame_options(p.add_argument_group("robot"))
     p.set_defaults(func=cmd_check)

@@ -48,7 +48,7 @@ def cmd_fk(args: argparse.Namespace) -> int:
     units = Units.from_args(args)
     robot = _load(args, units)
     q = _read_q(args, units)
-    _check_limits(robot, q, args.strict)
+    _check_limits(robot, q, args.strict, units)
     M = robot.tool_placement(q)
     from ..model import pose_from_placement
 
@@ -91,7 +91,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     units = Units.from_args(args)
     robot = _load(args, units)
     q = _read_q(args, units)
-    _check_limits(robot, q, args.strict)
+    _check_limits(robot, q, args.strict, units)
     if args.reference == "task":
         if args.frame is not None:
             raise InvalidInputError("--frame goes with --reference world|local|local_world_aligned")
@@ -303,7 +303,7 @@ def _near(robot: Robot, texts: Sequence[str], units: Units) -> np.ndarray:
     if len(texts) != robot.dof:
         raise ParameterError("--near", " ".join(texts), f"must be {robot.dof} joint values")
     near = robot.check_q(_q_values(texts, units))
-    for item in robot.outside_limits(near):
+    for item in robot.outside_limits(near, units=units.display):
         log.warning("--near: %s (used as given: the solutions nearest to it are returned)", item)
     return near
 

@@ -17,8 +17,6 @@ if TYPE_CHECKING:
 
 def cmd_view(args: argparse.Namespace) -> int:
     """Show the robot in the browser (meshcat): a configuration, a trajectory, the workspace boundary."""
-    import numpy as np
-
     from ..viz import meshcat as viz
 
     units = Units.from_args(args)
@@ -27,7 +25,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     q = None
     if args.q:
         q = robot.check_q(_q_values(args.q, units))
-        for item in robot.outside_limits(q):
+        for item in robot.outside_limits(q, units=units.display):
             log.warning("%s (shown anyway)", item)
     times = qs = None
     if args.traj and args.traj.lower().endswith(".json"):  # as `traj --out` writes it
@@ -57,7 +55,7 @@ def cmd_view(args: argparse.Namespace) -> int:
             viewer.draw_tool_path(qs)
             viewer.animate(times, qs, loop=True)
         else:
-            viewer.display(q if q is not None else np.zeros(robot.dof))
+            viewer.display(q if q is not None else robot.default_q)
         try:  # from the line that says so on, Ctrl-C stops the server
             print(f"meshcat viewer: {viewer.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
             viewer.serve()

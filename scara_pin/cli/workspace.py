@@ -40,7 +40,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         start = [units.value(n, t, "length") for n, t in zip(("x", "y"), args.ray[:2])]
         direction = [_number(n, t) for n, t in zip(("dx", "dy"), args.ray[2:])]
         if (args.z is None) != (args.dz is None):
-            raise InvalidInputError("--z and --dz go together (a 3-D ray also meets the J3 stroke)")
+            raise InvalidInputError("--z and --dz go together (a 3-D ray also meets the vertical stroke)")
         if args.z is not None:
             start.append(units.value("--z", args.z, "length"))
             direction.append(_number("--dz", args.dz))
@@ -71,7 +71,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         print(f"robot     {robot.name}: reachable region of the wrist axis (= tool point without tool offset)")
         print(f"area      {units.num(ws.area, 'area')} {n}^2")
         print(f"radius    {units.num(ws.r_min, 'length')} .. {units.num(ws.r_max, 'length')} {n} (from the J1 axis)")
-        print(f"z         {units.num(z0, 'length')} .. {units.num(z1, 'length')} {n} (J3 stroke)")
+        quill = ws.geometry.names[ws.geometry.prismatic]
+        print(f"z         {units.num(z0, 'length')} .. {units.num(z1, 'length')} {n} ({quill}'s stroke)")
         if ws.note is not None:
             print(f"note      {ws.note}")
         # the arc table to 1 um and 0.001 deg (--json gives every bit)
@@ -101,7 +102,7 @@ def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) 
         raise InvalidInputError("--ray/--z/--dz are SCARA-only for now; a palletizer gets its arm-plane envelope")
     env = arm_plane_envelope(robot.kinematics.geometry)
     if args.plot:
-        plot_envelope(env, args.plot, units=units.display, robot_name=robot.name)
+        plot_envelope(env, args.plot, units=units.display, robot_name=robot.name, tool_frame=robot.tool_frame)
     if args.json:
         out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"},
                                "envelope": env.to_dict()}  # fmt: skip
@@ -127,7 +128,7 @@ def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
     p = sub.add_parser("workspace", help="exact reachable region (arcs, area, radii); --ray: the edge along a ray")
     p.add_argument("--ray", nargs=4, metavar=("X", "Y", "DX", "DY"), help="start inside the region and plan direction")
-    p.add_argument("--z", metavar="Z", help="with --ray: start height (a 3-D ray also meets the J3 stroke)")
+    p.add_argument("--z", metavar="Z", help="with --ray: start height (a 3-D ray also meets the vertical stroke)")
     p.add_argument("--dz", metavar="DZ", help="with --ray: vertical direction component")
     p.add_argument("--plot", metavar="PNG", help="picture of the region (arcs coloured by limit; the ray)")
     _add_units(p, deg=False)

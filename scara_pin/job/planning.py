@@ -48,7 +48,7 @@ import numpy as np
 from ..description import JOINT_NAMES
 from ..errors import InvalidInputError, JobFileError, ScaraError
 from ..motion.jump import BINDING, Binding, jump_move
-from ..motion.payload import Payload, with_payload
+from ..motion.payload import Payload, PayloadLike, as_payload, with_payload
 from ..motion.polynomial import PolynomialPiece
 from ..motion.trajectory import Trajectory
 from ..motion.verify import VERIFY_RATE, _limits, state_ratios, verify
@@ -128,7 +128,7 @@ def plan_move(
     q_from: np.ndarray,
     *,
     torque: bool = False,
-    payload: Payload | None = None,
+    payload: PayloadLike = None,
     cell: Cell | None = None,
 ) -> PlannedMove:
     """Plan and verify one move of a job from ``q_from`` (module docstring): the one function every move goes through.
@@ -138,7 +138,7 @@ def plan_move(
         move: the move: its kind, target configuration, limit fractions and (jumps) clearance.
         q_from: where the robot is, at rest [rad, m].
         torque: respect the effort limits too (with ``payload``).
-        payload: carried by the tool (torques); None: none.
+        payload: carried by the tool (torques): a Payload, or a mass [kg] at the tool frame's origin; None: none.
         cell: the obstacles in force (the cell file's, the boxes placed so far) and the part in the tool, or
             None: every checked pair kept the cell's margin apart.
 
@@ -154,7 +154,7 @@ def plan_move(
         return PlannedMove(None, "", (), None, None, Source.STILL)
     t0 = time.perf_counter()
     limits = scaled_limits(robot, move.speed, move.accel)
-    payload = Payload() if payload is None else payload
+    payload = as_payload(payload)
     bound = None
     if move.kind is MoveKind.JUMP:
         shape = move.shape
@@ -226,10 +226,10 @@ class Planner:
         stats: how many moves were planned, reused and reversed, and the planning's wall time.
     """
 
-    def __init__(self, robot: Robot, *, torque: bool = False, payload: Payload | None = None, cell: Cell | None = None,
+    def __init__(self, robot: Robot, *, torque: bool = False, payload: PayloadLike = None, cell: Cell | None = None,
                  carry: Shape | None = None) -> None:  # fmt: skip
         self.robot, self.torque = robot, torque
-        self.payload = Payload() if payload is None else payload
+        self.payload = as_payload(payload)
         self.cell, self.carry = cell, carry
         if carry is not None and self.cell is None:
             from ..cell import Cell

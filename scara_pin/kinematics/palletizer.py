@@ -17,9 +17,18 @@ Forward kinematics (S2, in ``q``; tool0 on the flange axis, its yaw turned by ``
     r = a1 + a2 sin q2 + a3 sin theta3 + a4,   x = r cos q1,   y = r sin q1,
     z = d1 + d2 + a2 cos q2 + a3 cos theta3 + d5,   yaw = q1 + q4 + tool_yaw.
 
-The geometry is read from the loaded Pinocchio model (:meth:`PalletizerGeometry.from_robot`), as the
-SCARA's is: its forward kinematics at three configurations gives r0 = a1 + a4, h0 = d1 + d2 + d5, a2, a3
-and the tool's yaw, and the closed form above is then checked against the model at random configurations.
+**A file's own joints.** Descriptions order and zero their joints their own way: the levelling joint
+before or after the small arm's, a small arm horizontal at q = 0 (the Dobot MG400, Magician), its angle
+measured from the big arm (relative) rather than from the vertical, an axis along -y. The closed form works
+in S2's coordinates, the *canonical* ``t = (phi, q2, theta3, q4)`` (``theta3`` replaced by the elbow angle
+``q3 = theta3 - q2`` when the file's third joint is relative, ``relative``), each one joint of the file's
+``q`` turned and shifted: ``t_i = s_i q_i + c_i`` (``signs`` +/-1, ``offsets``; q4's offset is in
+``tool_yaw``). Limits, turns and references map the same way, so every formula below is S2's.
+
+The geometry is read from the loaded Pinocchio model (:mod:`scara_pin.kinematics.palletizer_model`), as
+the SCARA's is: the tool's path in the arm plane as each arm joint turns gives r0 = a1 + a4,
+h0 = d1 + d2 + d5, a2, a3, the signs and zero offsets, and whether the third joint is relative; the closed
+form is then checked against the model at random configurations.
 
 Inverse (S2): ``q1 = atan2(y, x)`` (and ``q1 + pi`` with the arm reaching backwards, ``r < 0``);
 the shoulder-to-wrist vector in the arm plane ``(h, v) = (r - r0, z - h0)`` is a planar two-link arm
@@ -129,6 +138,11 @@ class PalletizerGeometry:
         lower, upper: position limits of ``q`` (q1, q2, theta3, q4) [rad]; -inf/inf for a continuous joint.
         continuous: per joint, whether it is continuous.
         R0: tool0's rotation in the base frame at q = 0.
+        signs, offsets: the file's q in canonical coordinates, ``t_i = signs[i] q_i + offsets[i]`` (module
+            docstring); ``lower``/``upper`` are the canonical limits (the file's, mapped).
+        relative: the canonical third coordinate is the elbow angle theta3 - q2 (the file's third joint is
+            measured from the big arm), not theta3.
+        names: the file's joint names (messages).
         arm: the planar two-link arm (a2, a3).
     """
 
@@ -142,9 +156,15 @@ class PalletizerGeometry:
     shoulder: tuple[float, float] = (0.0, 0.0)
     continuous: tuple[bool, ...] = (False, False, False, False)
     R0: np.ndarray = field(default_factory=lambda: np.diag([1.0, -1.0, -1.0]))
+    signs: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)
+    offsets: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    relative: bool = False
+    names: tuple[str, str, str, str] = ("joint1", "joint2", "joint3", "joint4")
     arm: Planar2R = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        if any(abs(v) != 1.0 for v in self.signs) or not all(math.isfinite(c) for c in self.offsets):
+            raise ParameterError("signs, offsets", (self.signs, self.offsets), "must be +/-1 and finite")
         for name in ("r0", "h0", "a2", "a3", "tool_yaw"):
             value = getattr(self, name)
             if not math.isfinite(value):
@@ -156,44 +176,35 @@ class PalletizerGeometry:
 
     @classmethod
     def from_robot(cls, robot: Robot) -> PalletizerGeometry:
-        """Read the geometry from the robot's Pinocchio model (forward kinematics at three configurations).
+        """Read the geometry from the robot's Pinocchio model (:func:`scara_pin.kinematics.palletizer_model.read`).
 
         Raises:
             NotPalletizerError: the model does not follow the closed form (checked at 8 seeded random
-                configurations to FK_TOL), or its arms have no length.
+                configurations to FK_TOL), or one of its arms has no length.
         """
-        fk = robot.tool_pose
-        x0, y0, z0, yaw0 = fk(np.zeros(4)).tolist()
-        x2, _, z2, _ = fk(np.array([0.0, 0.5 * math.pi, 0.0, 0.0])).tolist()
-        x3, _, _, _ = fk(np.array([0.0, 0.0, 0.5 * math.pi, 0.0])).tolist()
-        a2, a3 = x2 - x0, x3 - x0
-        if not (a2 > 1e-9 and a3 > 1e-9 and abs(y0) < FK_TOL):
-            raise NotPalletizerError(f"robot {robot.name!r}: turning joint2 or joint3 by 90 deg does not move the "
-                                     "tool forwards: not a palletizer's arm (q = q1, q2, theta3, q4)")  # fmt: skip
-        model = robot.model
-        data = model.createData()
-        pin.framesForwardKinematics(model, data, pin.neutral(model))
-        bMs = data.oMf[robot.base_id].actInv(data.oMi[model.getJointId(robot.joint_names[1])])
-        limits = robot.limits
-        cont = tuple(robot.continuous)
-        geo = cls(
-            r0=x0, h0=z0 - a2 - a3, a2=a2, a3=a3, tool_yaw=yaw0,
-            lower=tuple(-math.inf if c else v for c, v in zip(cont, limits.lower)),  # type: ignore[arg-type]
-            upper=tuple(math.inf if c else v for c, v in zip(cont, limits.upper)),  # type: ignore[arg-type]
-            shoulder=(float(bMs.translation[0]), float(bMs.translation[2])),
-            continuous=cont,
-            R0=robot.tool_placement(np.zeros(4)).rotation.copy(),
-        )  # fmt: skip
-        rng = np.random.default_rng(0)
-        for q in rng.uniform(-math.pi, math.pi, (8, 4)):
-            err = np.abs(forward(geo, q) - fk(q))
-            err[3] = abs(wrap(float(err[3])))
-            if err.max() > FK_TOL:
-                raise NotPalletizerError(
-                    f"robot {robot.name!r}: the palletizer's closed form departs from the model by {err.max():.3g} "
-                    f"at q = {np.round(q, 6).tolist()} (a2 = {a2:.9g}, a3 = {a3:.9g} m read from the model)"
-                )
-        return geo
+        from .palletizer_model import read
+
+        return read(robot)
+
+    def canonical(self, q: Sequence[float] | np.ndarray) -> list[float]:
+        """The file's ``q`` in canonical coordinates ``t`` (module docstring)."""
+        return [s * float(v) + c for s, v, c in zip(self.signs, q, self.offsets)]
+
+    def user(self, t: Sequence[float] | np.ndarray) -> list[float]:
+        """Canonical ``t`` as the file's ``q`` (the inverse of :meth:`canonical`)."""
+        return [s * (float(v) - c) for s, v, c in zip(self.signs, t, self.offsets)]
+
+    def user_limits(self, i: int) -> tuple[float, float]:
+        """The file's limits of joint ``i`` [rad] (-inf/inf for a continuous joint)."""
+        a, b = (self.signs[i] * (v - self.offsets[i]) for v in (self.lower[i], self.upper[i]))
+        return (a, b) if a <= b else (b, a)
+
+    def outside(self, i: int, t: float, label: str = "") -> str:
+        """``joint3 = 1.2 rad (up) (+2 pi k) is outside [lo, hi]``: canonical ``t`` as the file's joint ``i``."""
+        lo, hi = self.user_limits(i)
+        value = wrap(self.signs[i] * (t - self.offsets[i]))
+        return (f"{self.names[i]} = {value:.9g} rad{f' ({label})' if label else ''} (+2 pi k) is outside "
+                f"[{lo:.9g}, {hi:.9g}]")  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------ conventions
@@ -217,15 +228,23 @@ def wrist_pitch(q: Sequence[float]) -> float:
 # ------------------------------------------------------------------------------------ kinematics
 def forward(geo: PalletizerGeometry, q: ArrayLike) -> np.ndarray:
     """S2's closed-form FK: (x, y, z, yaw) of tool0 in ``base`` at ``q`` (motor side) [m, rad]."""
-    q1, q2, t3, q4 = _vector("q", q)
+    q1, q2, t3, q4 = geo.canonical(_vector("q", q))
+    if geo.relative:
+        t3 += q2
     r = geo.r0 + geo.a2 * math.sin(q2) + geo.a3 * math.sin(t3)
     z = geo.h0 + geo.a2 * math.cos(q2) + geo.a3 * math.cos(t3)
     return np.array([r * math.cos(q1), r * math.sin(q1), z, q1 + q4 + geo.tool_yaw])
 
 
-def branch_of(q: ArrayLike) -> str:
-    """``"up"`` when sin(q3) >= 0 (q3 = theta3 - q2, S2's small-arm angle), else ``"down"``."""
+def branch_of(q: ArrayLike, geo: PalletizerGeometry | None = None) -> str:
+    """``"up"`` when sin(q3) >= 0 (q3 = theta3 - q2, S2's small-arm angle), else ``"down"``.
+
+    ``geo``: the palletizer whose joints ``q`` are (default: S2's own, ``q = (q1, q2, theta3, q4)``).
+    """
     a = _vector("q", q)
+    if geo is not None:
+        t = geo.canonical(a)
+        return "up" if math.sin(t[2] if geo.relative else t[2] - t[1]) >= 0.0 else "down"
     return "up" if math.sin(a[2] - a[1]) >= 0.0 else "down"
 
 
@@ -267,7 +286,9 @@ def _branches(
         singular = arm.singular(g) and abs(math.sin(lean)) < 1e-9  # equal arms folded: two configurations
         wob = arm.wobble(g)
         if D <= FREE_R:  # a2 = a3 and the wrist on the shoulder axis, folded: the big arm is free
-            free = free_angle(lo[1], hi[1], lo[2], hi[2], 1.0, math.pi, ref[1], cont[2])  # theta3 = q2 + pi
+            free: float | None = ref[1] if cont[1] else min(max(ref[1], lo[1]), hi[1])
+            if not geo.relative:  # theta3 = q2 + pi inside its limits too (relative: the elbow alone, at pi)
+                free = free_angle(lo[1], hi[1], lo[2], hi[2], 1.0, math.pi, ref[1], cont[2])  # theta3 = q2 + pi
             elbows: list[tuple[float, float, str]] = [(math.pi, ref[1] if free is None else free, "down")]
         elif singular:
             elbows = [(g, heading - lean, "up" if g < 1.0 else "down")]
@@ -284,36 +305,33 @@ def _branches(
                     if miss <= REACH_TOL:
                         q2, q3, t2 = edge, g2, nearest_turn(edge, lo[1], hi[1], ref[1])
             if t2 is None:
-                failed(PalletizerIKStatus.J2_LIMIT, f"q2 = {wrap(q2):.9g} rad ({label}) (+2 pi k) is outside "
-                       f"[{lo[1]:.9g}, {hi[1]:.9g}]")  # fmt: skip
+                failed(PalletizerIKStatus.J2_LIMIT, geo.outside(1, q2, label))
                 continue
-            t3 = q2 + q3
+            t3 = q3 if geo.relative else q2 + q3  # the elbow angle, or the small arm's from the vertical
             tt3 = nearest_turn(t3, lo[2], hi[2], ref[2], cont[2])
             if tt3 is None:
                 edge = turn_edge(t3, lo[2], hi[2], wob)
                 if edge is not None:
-                    q2b, miss = arm.with_link2(v, r - geo.r0, edge)
+                    q2b, miss = (arm.with_elbow if geo.relative else arm.with_link2)(v, r - geo.r0, edge)
                     t2b = nearest_turn(q2b, lo[1], hi[1], ref[1], cont[1])
                     if miss <= REACH_TOL and t2b is not None:
                         t2, tt3 = t2b, nearest_turn(edge, lo[2], hi[2], ref[2])
             if tt3 is None:
-                failed(PalletizerIKStatus.J3_LIMIT, f"theta3 = {wrap(t3):.9g} rad ({label}) (+2 pi k) is outside "
-                       f"[{lo[2]:.9g}, {hi[2]:.9g}]")  # fmt: skip
+                failed(PalletizerIKStatus.J3_LIMIT, geo.outside(2, t3, label))
                 continue
             t1 = nearest_turn(phi, lo[0], hi[0], ref[0], cont[0])
             if t1 is None:
-                failed(PalletizerIKStatus.J1_LIMIT, f"q1 = {wrap(phi):.9g} rad (+2 pi k) is outside "
-                       f"[{lo[0]:.9g}, {hi[0]:.9g}]")  # fmt: skip
+                failed(PalletizerIKStatus.J1_LIMIT, geo.outside(0, phi))
                 continue
             q4 = yaw - geo.tool_yaw - t1[0]
             t4 = nearest_turn(q4, lo[3], hi[3], ref[3], cont[3])
             if t4 is None:
-                failed(PalletizerIKStatus.J4_LIMIT, f"q4 = {wrap(q4):.9g} rad (+2 pi k) is outside "
-                       f"[{lo[3]:.9g}, {hi[3]:.9g}]")  # fmt: skip
+                failed(PalletizerIKStatus.J4_LIMIT, geo.outside(3, q4))
                 continue
-            ts = (t1, t2, tt3, t4)
-            found.append((label, singular, [t[0] for t in ts],
-                          [None if c else (t[1], t[2]) for c, t in zip(cont, ts)]))  # fmt: skip
+            ts = (t1, t2, tt3, t4)  # the file's q; its other turns (a joint turned the other way: mirrored)
+            found.append((label, singular, geo.user([t[0] for t in ts]),
+                          [None if c else ((t[1], t[2]) if sg > 0 else (-t[2], -t[1]))
+                           for c, t, sg in zip(cont, ts, geo.signs)]))  # fmt: skip
     if found:
         found.sort(key=lambda b: b[0] != "up")  # up before down (stable: forwards before backwards)
         return found, None
@@ -321,8 +339,15 @@ def _branches(
 
 
 def _pose(geo: PalletizerGeometry, target: object) -> tuple[float, float, float, float, float]:
-    x, y, z, alpha, tilt = parse_target(target, geo.tool_yaw, geo.R0)
-    return x, y, z, alpha + geo.tool_yaw, tilt
+    yaw0 = geo.tool_yaw + geo.offsets[0]  # the tool's yaw at q = 0
+    x, y, z, alpha, tilt = parse_target(target, yaw0, geo.R0)
+    return x, y, z, alpha + yaw0, tilt
+
+
+def _user_limits(geo: PalletizerGeometry) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The file's lower and upper limits, per joint."""
+    lims = [geo.user_limits(i) for i in range(4)]
+    return tuple(lo for lo, _ in lims), tuple(hi for _, hi in lims)
 
 
 def solve(
@@ -355,8 +380,8 @@ def solve(
         return IKResult(pose, (), PalletizerIKStatus.NOT_A_YAW_POSE,
                         f"the target's z axis is tilted by {tilt:.3g} rad from the vertical; the palletizer's "
                         "flange stays level", geo.continuous)  # fmt: skip
-    found, failure = _branches(geo, x, y, z, yaw, reference_floats(reference), branch)
-    return result_of(pose, found, failure, PalletizerIKStatus.OK, geo.continuous, geo.lower, geo.upper, all_turns)
+    found, failure = _branches(geo, x, y, z, yaw, geo.canonical(reference_floats(reference)), branch)
+    return result_of(pose, found, failure, PalletizerIKStatus.OK, geo.continuous, *_user_limits(geo), all_turns)
 
 
 def solve_nearest(
@@ -378,7 +403,7 @@ def solve_nearest(
     if tilt > YAW_POSE_TOL:
         raise NoSolutionError(PalletizerIKStatus.NOT_A_YAW_POSE, f"the target's z axis is tilted by {tilt:.3g} rad")
     ref = reference_floats(reference)
-    found, failure = _branches(geo, x, y, z, yaw, ref, branch)
+    found, failure = _branches(geo, x, y, z, yaw, geo.canonical(ref), branch)
     if failure is not None:
         raise NoSolutionError(*failure)
     w = [1.0] * 4 if weights is None else weight_floats(weights)
@@ -402,7 +427,9 @@ def solve_batch(
         BatchIKResult: q (NaN rows without a solution), PalletizerIKStatus codes, branch +1 up / -1 down.
     """
     T, ref = batch_inputs(targets, reference, branch, BRANCHES)
-    refs = [ref[j] if ref.ndim == 1 else ref[:, j] for j in range(4)]
+    signs, offsets = np.array(geo.signs), np.array(geo.offsets)
+    ref_t = ref * signs + offsets  # canonical
+    refs = [ref_t[j] if ref_t.ndim == 1 else ref_t[:, j] for j in range(4)]
     n = len(T)
     lo, hi, cont, arm = geo.lower, geo.upper, geo.continuous, geo.arm
     x, y, z, yaw = T[:, 0], T[:, 1], T[:, 2], T[:, 3]
@@ -422,17 +449,19 @@ def solve_batch(
             reach = (D <= arm.l12 + REACH_TOL) & (D >= arm.d12 - REACH_TOL)
             rare |= reach & (D <= FREE_R)  # a2 = a3, the wrist on the shoulder: the big arm is free (solve's)
             q2, ok2 = nearest_turn_array(heading - sg * lean, lo[1], hi[1], refs[1], cont[1])
-            t3, ok3 = nearest_turn_array(heading - sg * lean + sg * g, lo[2], hi[2], refs[2], cont[2])
+            third = sg * g if geo.relative else heading - sg * lean + sg * g  # the elbow, or theta3
+            t3, ok3 = nearest_turn_array(third, lo[2], hi[2], refs[2], cont[2])
             q1, ok1 = nearest_turn_array(phi + turn_back, lo[0], hi[0], refs[0], cont[0])
             q4, ok4 = nearest_turn_array(yaw - geo.tool_yaw - q1, lo[3], hi[3], refs[3], cont[3])
             ok = reach & ok1 & ok2 & ok3 & ok4
             # a joint-limit failure near the stretched/folded circles may be rounding: solve() decides those
             rare |= reach & ~ok & (arm.wobble_array(g) > LIMIT_TOL)
             Q = np.column_stack((q1, q2, t3, q4))
-            d = np.where(ok, ((Q - ref) ** 2).sum(axis=1), np.inf)
+            d = np.where(ok, ((Q - ref_t) ** 2).sum(axis=1), np.inf)
             take = d < best_d
             best_q[take], best_d[take], sign[take] = Q[take], d[take], int(sg)
     status = np.where(np.isfinite(best_d), 0, -1).astype(np.int64)
+    best_q = (best_q - offsets) * signs  # the file's q
     for i in np.flatnonzero(rare | (status != 0)).tolist():  # their status and reason: solve()'s
         row_ref = ref if ref.ndim == 1 else ref[i]
         res = solve(geo, T[i], branch="all" if branch == "nearest" else branch, reference=row_ref)

@@ -59,5 +59,5 @@ class PalletizerKinematics:
 
     def branch_of(self, q: ArrayLike) -> str:
         """:func:`scara_pin.kinematics.palletizer.branch_of`."""
-        return palletizer.branch_of(q)
+        return palletizer.branch_of(q, self.geometry)
 

@@ -195,20 +195,19 @@ class ScaraGeometry:
     def _read(cls, robot: Robot, wrist: bool) -> ScaraGeometry:
         model = robot.model
         data = model.createData()
-        # the joints of q (nv = 1); geared (<mimic>) joints, nv = 0, follow one of them
+        # the joints of q (nv = 1); geared (<mimic>) joints, nv = 0, follow one of them: those between the root
+        # and the tool move it; others (a parallelogram's rods beside the arm) only follow
         actuated = [j for j in range(1, model.njoints) if model.joints[j].nv > 0]
-        geared = [j for j in range(1, model.njoints) if model.joints[j].nv == 0]
+        chain = list(model.supports[model.frames[robot.tool_id].parentJoint])[1:]
+        geared = [j for j in chain if model.joints[j].nv == 0]
         names = tuple(model.names[j] for j in actuated)
         n = 4 if wrist else 3
         if len(actuated) != n:
             raise NotScaraError(f"a SCARA has {n} joints; this model has {len(actuated)}: {', '.join(names)}")
-        for j in range(2, model.njoints):
-            if model.parents[j] != j - 1:
-                raise NotScaraError(f"joint {model.names[j]} does not follow {model.names[j - 1]}: not a serial chain")
-        tool_parent = model.frames[robot.tool_id].parentJoint
-        if tool_parent != model.njoints - 1:
-            raise NotScaraError(f"the tool frame {robot.tool_frame!r} is not carried by the last joint "
-                                f"{model.names[model.njoints - 1]}")  # fmt: skip
+        off = [j for j in actuated if j not in chain]
+        if off:
+            raise NotScaraError(f"joint {model.names[off[0]]} does not carry the tool frame {robot.tool_frame!r}: "
+                                "not a serial chain")  # fmt: skip
         q0 = pin.neutral(model)  # q = 0 (a continuous joint's (cos, sin) = (1, 0))
         pin.framesForwardKinematics(model, data, q0)
         oMb = data.oMf[robot.base_id]
@@ -257,10 +256,11 @@ class ScaraGeometry:
         a1, a2, a4 = points[ra][:2], points[rb][:2], points[rc][:2]
         u1, u2, t = a2 - a1, a4 - a2, bMt.translation[:2] - a4
         wrist_name = names[rc] if wrist else f"the tool point ({robot.tool_frame})"
-        for vec, what in ((u1, f"{names[rb]}'s axis coincides with {names[ra]}'s"),
-                          (u2, f"{wrist_name} lies on {names[rb]}'s axis")):  # fmt: skip
+        for vec, what, arm in ((u1, f"{names[rb]}'s axis coincides with {names[ra]}'s", f"arm 1 ({names[ra]} to "
+                                f"{names[rb]})"), (u2, f"{wrist_name} lies on {names[rb]}'s axis",
+                                f"arm 2 ({names[rb]} to {wrist_name})")):  # fmt: skip
             if math.hypot(*vec) < 1e-9:
-                raise NotScaraError(f"{what}: the arm has no length")
+                raise NotScaraError(f"{what}: {arm} has no length in plan view")
         R0 = bMt.rotation.copy()
         if math.hypot(R0[0, 0], R0[1, 0]) < 1e-6:
             raise NotScaraError("the tool frame's x axis is vertical at q = 0: its yaw is undefined")

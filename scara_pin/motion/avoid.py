@@ -12,7 +12,7 @@ second shape's joint (an obstacle's plane is fixed in the cell). The row asks fo
     n . (p - x) >= margin + BUFFER   for every point x of the first shape, at the row's configuration,
 
 written with the shape's support function (a box, a cylinder, a sphere: closed form, |x| smoothed as
-sqrt(x^2 + eps^2), which only makes the shape look larger by at most eps times its size, :data:`_SMOOTH`; a
+sqrt(x^2 + eps^2), which only makes the shape look larger by at most eps times its size, ``_SMOOTH``; a
 mesh: its witness point) and the forward kinematics of the shape's joint written in CasADi from the model
 (:attr:`~scara_pin.motion.symbolic.SymbolicModel.joint_frames`). For a CONVEX second shape the plane
 through its witness point supports it, so a row that holds keeps the pair at least the margin apart: the
@@ -494,7 +494,7 @@ def infeasible(scene: Scene, piece: PolynomialPiece, status: str) -> InfeasibleE
 
 # ---------------------------------------------------------------------------------------------- the iterations
 def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[PolynomialPiece, np.ndarray, Any]:
-    """The jump's solve (:func:`~scara_pin.motion.jump._solve`) with the distance rows (module docstring).
+    """The jump's solve (the jump's own solve) with the distance rows (module docstring).
 
     From the warm start ``waypoints``: solve; check densely; add rows; re-set every row's plane; solve again,
     warm-started, until nothing is added, the dense check holds and the duration has settled. A re-solve the

@@ -414,6 +414,7 @@ class CycleResult(Summarized):
         robot_name: the robot's name.
         verification: the whole cycle verified (:func:`~scara_pin.motion.verify.verify`: the worst ratio of each
             limit that applies, with its joint and time), or None.
+        torque: whether the effort limits were respected (False: left out, ``torque=False``).
     """
 
     move: ArchMove | JumpMove
@@ -430,6 +431,7 @@ class CycleResult(Summarized):
     lower_bound: LowerBound | None = None
     robot_name: str = ""
     verification: Verification | None = None
+    torque: bool = True
 
     @property
     def cycle_time(self) -> float:
@@ -453,7 +455,8 @@ class CycleResult(Summarized):
         what = ("jump (time-optimal, joint path free)" if self.path is CyclePath.JUMP
                 else f"straight-leg arch (lines and blends, {timing})")  # fmt: skip
         lines = [f"robot       {self.robot_name}: standard cycle, {what}, payload {move.payload.mass:g} kg"
-                 + (f", jerk limit {list(move.jerk)}" if move.jerk else "")]  # fmt: skip
+                 + (f", jerk limit {list(move.jerk)}" if move.jerk else "")
+                 + ("" if self.torque else "; effort limits left out (--no-torque): torques not checked")]  # fmt: skip
         shape = (f"; clearance radius {u.format(self.clearance_radius or 0.0, 'length')} {Ln})"
                  if self.path is CyclePath.JUMP else f"; blend {u.format(self.blend, 'length')} {Ln})")  # fmt: skip
         lines.append(f"cycle time  {format_number(self.cycle_time, 6)} s (up {u.format(self.rise, 'length')}, across "
@@ -570,8 +573,6 @@ def _legs(
     robot: Robot, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
 ) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
     """Legs (time spans) and, per leg, the most used limit, from a dense sampling (rate and 8 per 1/rate)."""
-    from ..description import JOINT_NAMES
-
     spans: list[tuple[str, int, float, float]] = []
     t0 = 0.0
     motions = [p for p in traj.pieces if isinstance(p, Motion)]
@@ -604,7 +605,7 @@ def _legs(
             worst[qty] = val if prev is None else max(prev, val)
             if val > best[2]:
                 best = (qty, j, val)
-        legs.append(Leg(name, move, float(ta), float(tb), best[0], JOINT_NAMES[best[1]], best[2]))
+        legs.append(Leg(name, move, float(ta), float(tb), best[0], robot.joint_names[best[1]], best[2]))
     return tuple(legs), worst
 
 
@@ -617,23 +618,30 @@ def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: 
 
 # ---------------------------------------------------------------------------------------------- the cycle
 def cycle_placement(
-    robot: Robot, span: float = STANDARD_SPAN, rise: float = STANDARD_RISE, branch: str = "right", n: int = 160
+    robot: Robot, span: float = STANDARD_SPAN, rise: float = STANDARD_RISE, branch: str | None = None, n: int = 160
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The default placement of the standard cycle (module docstring): (start pose, end pose, min |det J|).
 
     Candidates: the chords of length ``span`` perpendicular to the arm's direction at the middle of
-    J1's range (q2 = 0), centred on it, at ``n`` distances d from the J1 axis; at each, 41 points of the
-    chord at the start height are solved (closed-form IK, ``branch``, nearest the middle of the ranges)
-    and scored by the smallest manipulability |det J|. The best d wins.
+    J1's range (the elbow at 0), centred on it, at ``n`` distances d from the J1 axis; at each, 41 points of
+    the chord at the start height are solved (closed-form IK, ``branch``, default the first, nearest the
+    middle of the ranges) and scored by the smallest manipulability |det J|. The best d wins. The joints are
+    the closed form's reading of the model (:class:`~scara_pin.kinematics.scara_geometry.ScaraGeometry`):
+    the vertical stroke is that of the prismatic joint wherever it sits in q.
 
     Raises:
-        InvalidInputError: ``span`` is longer than the diameter of the reach circle (no chord fits).
+        InvalidInputError: ``span`` is longer than the diameter of the reach circle (no chord fits), or
+            ``rise`` is not below the vertical stroke.
+        UrdfError: the SCARA closed form refuses the robot (its reason: ``NotScaraError``).
         InfeasibleError: no candidate chord is reachable within the joint limits.
     """
+    geo = robot.kinematics.geometry  # the closed form's reading; its refusal names the real reason
+    branch = branch or robot.kinematics.branches[0]
+    elbow, quill = geo.revolute[1], geo.prismatic
     lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
     mid = (lo + hi) / 2.0
     q_stretched = mid.copy()
-    q_stretched[1] = 0.0 if lo[1] <= 0.0 <= hi[1] else mid[1]
+    q_stretched[elbow] = 0.0 if lo[elbow] <= 0.0 <= hi[elbow] else mid[elbow]
     centre = robot.tool_pose(q_stretched)
     reach = float(np.hypot(centre[0], centre[1]))
     if span >= 2.0 * reach:
@@ -641,10 +649,11 @@ def cycle_placement(
                                 f"axis, so no chord longer than {2 * reach:.6g} m fits")  # fmt: skip
     radial = centre[:2] / reach
     tangent = np.array([-radial[1], radial[0]])
-    z_lo = robot.tool_pose(np.where(np.arange(4) == 2, hi, mid))[2]  # the quill fully down: lowest z
-    z_hi = robot.tool_pose(np.where(np.arange(4) == 2, lo, mid))[2]
-    if rise >= abs(z_hi - z_lo):
-        raise InvalidInputError(f"rise {rise:.6g} m is beyond the vertical stroke {abs(z_hi - z_lo):.6g} m")
+    z_ends = [robot.tool_pose(np.where(np.arange(robot.dof) == quill, end, mid))[2] for end in (lo, hi)]
+    z_lo, z_hi = min(z_ends), max(z_ends)  # the quill at either end of its stroke (its axis up or down)
+    if rise >= z_hi - z_lo:
+        raise InvalidInputError(f"rise {rise:.6g} m is beyond the vertical stroke {z_hi - z_lo:.6g} m of "
+                                f"{robot.joint_names[quill]}")  # fmt: skip
     z = 0.5 * (z_lo + z_hi) - rise / 2.0
     yaw = 0.0
     u = np.linspace(-0.5, 0.5, 41) * span
@@ -681,13 +690,14 @@ def standard_cycle(
     payload: PayloadLike = None,
     jerk: float | ArrayLike | None = None,
     limits: JointLimits | None = None,
-    branch: str = "right",
+    branch: str | None = None,
     options: TimingOptions | None = None,
     path: CyclePath | str = CyclePath.JUMP,
     clearance_radius: float = STANDARD_CLEARANCE,
     max_height: float | None = None,
     jump_options: JumpOptions | None = None,
     cell: Cell | None = None,
+    torque: bool = True,
 ) -> CycleResult:
     """The standard cycle: up ``rise``, across ``span``, down, and back the same way (rest at both ends).
 
@@ -700,11 +710,12 @@ def standard_cycle(
         rise: [m] > 0, the vertical stroke.
         blend: [m] >= 0, largest blend distance of the straight-leg arch (None: as large as allowed, i.e.
             the whole rise; 0: none); LINES only.
-        payload: carried by the tool (torque limits always apply, with the payload): a
+        payload: carried by the tool (the torque limits apply with it, unless ``torque`` is False): a
             :class:`~scara_pin.motion.payload.Payload` or a mass [kg].
         jerk: joint jerk limit, one or four numbers, or None.
         limits: limits instead of ``robot.limits``.
-        branch: the elbow branch.
+        branch: the elbow branch (the robot's branch names: ``right``/``left`` for a SCARA, ``up``/``down`` for
+            a palletizer); default: the default placement's first, a given start's nearest the mid-range.
         options: TOPP-RA grid and verification options (LINES).
         path: JUMP (the default: :func:`~scara_pin.motion.jump.jump_move` out, its time reversal back) or
             LINES (the straight-leg arch, :func:`arch_move`: slower).
@@ -714,6 +725,7 @@ def standard_cycle(
         cell: obstacles, the carried part and the margin (:mod:`scara_pin.cell`): the jump plans around and over
             them; the straight-leg arch (LINES) is verified against them and refused if it comes closer than
             the margin (naming the pair, when and where).
+        torque: respect the effort limits (default); False leaves them out (placeholder efforts in a URDF).
 
     Raises:
         ParameterError: bad input (exit 2); so is InvalidInputError.
@@ -746,7 +758,7 @@ def standard_cycle(
         wmin = math.nan
     if path is CyclePath.JUMP:
         out = jump_move(robot, a, b, rise=rise, clearance_radius=clearance_radius, max_height=max_height,
-                        payload=payload, jerk=jerk, torque=True, limits=limits, branch=branch,
+                        payload=payload, jerk=jerk, torque=torque, limits=limits, branch=branch,
                         options=jump_options, cell=cell)  # fmt: skip
         move: ArchMove | JumpMove = out.and_back()
         bound = LowerBound(2.0 * out.lower_bound.duration, out.lower_bound.joint,
@@ -756,8 +768,8 @@ def standard_cycle(
         if max_height is not None and max_height < max(a[2], b[2]) + rise:
             raise InfeasibleError(f"max_height {max_height:.6g} m is below the traverse height "
                                   f"{max(a[2], b[2]) + rise:.6g} m")  # fmt: skip
-        move = arch_move(robot, np.array([a, b, a]), rise=rise, blend=blend, payload=payload, jerk=jerk, torque=True,
-                         limits=limits, branch=branch, options=options)  # fmt: skip
+        move = arch_move(robot, np.array([a, b, a]), rise=rise, blend=blend, payload=payload, jerk=jerk,
+                         torque=torque, limits=limits, branch=branch, options=options)  # fmt: skip
         used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
         bound = _lines_bound(robot, move, a, b, rise, limits, jerk)
         if cell is not None:
@@ -768,10 +780,10 @@ def standard_cycle(
         q0 = move.trajectory.q_start
         pts = [np.array([*(a[:2] + f * (b[:2] - a[:2])), a[2], a[3]]) for f in np.linspace(0.0, 1.0, 41)]
         wmin = min(robot.manipulability(robot.ik_nearest(p, q0)) for p in pts)
-    check = verify(robot, move.trajectory, limits=limits, jerk=jerk, torque=True, payload=payload)
+    check = verify(robot, move.trajectory, limits=limits, jerk=jerk, torque=torque, payload=payload)
     return CycleResult(move, a, b, span, rise, used, why, float(wmin), path,
                        clearance_radius if path is CyclePath.JUMP else None, max_height, bound, robot.name,
-                       check)  # fmt: skip
+                       check, torque)  # fmt: skip
 
 
 def _lines_bound(

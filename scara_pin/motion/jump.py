@@ -47,7 +47,7 @@ the robot's tool position and inverse dynamics written from its Pinocchio model,
   nearest point was seen with a 14 kg payload). The rigid-body torque of the motion played ``k`` times
   slower is tau_k(t) = (tau(t/k) - g(q)) / k^2 + g(q) (the velocity enters squared, the acceleration
   once), so the smallest ``k >= 1`` that brings every torque, sampled at 256 points of every interval, to
-  its limit is found in closed form and the motion slowed by it (:func:`_torque_stretch`: a few 1e-6
+  its limit is found in closed form and the motion slowed by it (``_torque_stretch``: a few 1e-6
   relative at most after the refinement; every other ratio only drops, the path is the same).
 
 Among the minimum-time motions (the time is unique, the path is not: the joints that do not bind can
@@ -97,7 +97,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import _positive, _vector
-from ..description import JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..kinematics.validate import _pose_error
 from ..limits import MAX_SAMPLES, check_count
@@ -177,7 +176,7 @@ _NEAR = 0.02
 _NODES = -1
 """The interval index of a :class:`_Point` that stands for every node (both sides) of its family."""
 _STRETCH_POINTS = 256
-"""Points per interval where :func:`_torque_stretch` samples the torque."""
+"""Points per interval where ``_torque_stretch`` samples the torque."""
 _QUANTITIES = ("velocity", "acceleration", "jerk", "torque", "tool speed")
 
 
@@ -967,13 +966,14 @@ def _default_intervals(jerk: bool, tool_speed: bool) -> tuple[int, int, int]:
 def _holds_still(robot: Robot, configurations: tuple[np.ndarray, ...], effort: np.ndarray) -> None:
     """InfeasibleError if the static load (gravity, payload included) at one of them is not below an effort limit."""
     q = np.array(configurations)
-    bad = static_overload(static_load(robot, q), effort)
+    bad = static_overload(static_load(robot, q), effort, robot.joint_names)
     if bad is not None:
         raise InfeasibleError(bad.reason(f"at q = {np.round(q[bad.index], 6).tolist()}"))
 
 
 def _one_dof(
-    j: int, d: float, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray | None, exact: bool = True
+    j: int, d: float, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray | None, exact: bool = True,
+    name: str = "",
 ) -> float:
     """[s] joint j's minimum time from rest to rest over a displacement d >= 0 (ruckig with a jerk limit).
 
@@ -999,9 +999,9 @@ def _one_dof(
     try:
         result = Ruckig(1).calculate(inp, out)
     except RuntimeError as exc:  # ruckig raises on limits it cannot handle (e.g. 1e-100)
-        raise InvalidInputError(f"ruckig could not time a 1-DOF move of {JOINT_NAMES[j]} ({exc})") from None
+        raise InvalidInputError(f"ruckig could not time a 1-DOF move of {name or j + 1} ({exc})") from None
     if result not in (Result.Working, Result.Finished):
-        raise InvalidInputError(f"ruckig could not time a 1-DOF move of {JOINT_NAMES[j]}: {result}")
+        raise InvalidInputError(f"ruckig could not time a 1-DOF move of {name or j + 1}: {result}")
     return float(out.duration)
 
 
@@ -1031,22 +1031,23 @@ def lower_bound(
         tool_speed: [m/s] a limit of the tool origin's speed, or None (module docstring, "Lower bound").
     """
     quill = _quill(robot, q_from)
-    best = LowerBound(0.0, JOINT_NAMES[0], "no joint moves")
+    names = robot.joint_names
+    best = LowerBound(0.0, names[0], "no joint moves")
     kind = "velocity, acceleration and jerk" if jerk is not None else "velocity and acceleration"
     for j in range(robot.dof):
         if j == quill:
             up = abs(q_tops[0][j] - q_from[j])
             down = abs(q_tops[1][j] - q_to[j])
             t = _one_dof(j, up, velocity, acceleration, None) + _one_dof(j, down, velocity, acceleration, None)
-            why = (f"{JOINT_NAMES[j]} alone, up {up:.6g} m and down {down:.6g} m, each from rest to rest, velocity and "
+            why = (f"{names[j]} alone, up {up:.6g} m and down {down:.6g} m, each from rest to rest, velocity and "
                    "acceleration limits")  # fmt: skip
         else:
             d = float(q_to[j] - q_from[j])
-            t = _one_dof(j, abs(d), velocity, acceleration, jerk, exact_jerk)
+            t = _one_dof(j, abs(d), velocity, acceleration, jerk, exact_jerk, names[j])
             unit = "m" if robot.joint_kinds[j] == "length" else "rad"
-            why = f"{JOINT_NAMES[j]} alone, {abs(d):.6g} {unit} from rest to rest, {kind} limits"
+            why = f"{names[j]} alone, {abs(d):.6g} {unit} from rest to rest, {kind} limits"
         if t > best.duration:
-            best = LowerBound(t, JOINT_NAMES[j], why)
+            best = LowerBound(t, names[j], why)
     if tool_speed is not None:
         a, b = robot.tool_pose(q_from)[:3], robot.tool_pose(q_to)[:3]
         z_top = max(float(np.asarray(robot.tool_pose(q))[2]) for q in q_tops)
@@ -1326,7 +1327,7 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
         worst[name] = top if worst.get(name) is None else max(top, worst[name] or 0.0)
         if not top <= 1.0 + TOLERANCE:
             i, j = np.unravel_index(int(np.argmax(r)), r.shape)
-            who = "the tool" if name == "tool speed" else JOINT_NAMES[j]
+            who = "the tool" if name == "tool speed" else prob.robot.joint_names[j]
             raise JumpError("VerificationFailed", f"the {name} of {who} reaches {top:.9g} of its limit at t = "
                             f"{float(t[i]):.6g} s (more than 1 + {TOLERANCE:g})")  # fmt: skip
     poses = np.array([prob.robot.tool_pose(qk) for qk in q])
@@ -1344,8 +1345,8 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     hi = np.where(prob.ranged, prob.upper, np.inf) + ENDPOINT_TOL
     if ((q < lo) | (q > hi)).any():
         i, j = np.argwhere((q < lo) | (q > hi))[0]
-        raise JumpError("VerificationFailed", f"{JOINT_NAMES[j]} leaves its range at t = {float(t[i]):.6g} s "
-                        f"(q = {float(q[i, j]):.9g})")  # fmt: skip
+        raise JumpError("VerificationFailed", f"{prob.robot.joint_names[j]} leaves its range at t = "
+                        f"{float(t[i]):.6g} s (q = {float(q[i, j]):.9g})")  # fmt: skip
     for end, pose, name in ((0, prob.A, "pose_from"), (-1, prob.B, "pose_to")):
         err = _pose_error(prob.robot, traj.sample(0.0 if end == 0 else T)[0], pose)
         if err > ENDPOINT_TOL:
@@ -1370,14 +1371,14 @@ def _legs(prob: _Problem, check: _Check, T: np.ndarray) -> tuple[Leg, ...]:
             r = table[sel]
             for j in range(r.shape[1]):
                 top = float(np.max(r[:, j])) if len(r) else 0.0
-                who = "tool" if name == "tool speed" else JOINT_NAMES[j]
+                who = "tool" if name == "tool speed" else prob.robot.joint_names[j]
                 if top > best[2]:
                     best = (name, j, top)
                 if top >= BINDING:
                     share = float(np.mean(table[grid][:, j] >= BINDING)) if grid.any() else 1.0
                     binding.append(Binding(name, who, top, share))
         binding.sort(key=lambda x: -x.share)
-        who = "tool" if best[0] == "tool speed" else JOINT_NAMES[best[1]]
+        who = "tool" if best[0] == "tool speed" else prob.robot.joint_names[best[1]]
         closest = None
         if check.distance is not None and prob.scene is not None:
             ts, ds, ps = check.distance.samples

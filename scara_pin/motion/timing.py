@@ -415,7 +415,7 @@ def _diagnose(
     rows = len(grid)
     S = grid[:, None] + np.append(np.diff(grid), 0.0)[:, None] * (np.arange(m + 1) / m)[None, :]
     S = S.ravel()
-    bad = None if g_static is None or lim.effort is None else static_overload(g_static, lim.effort)
+    bad = None if g_static is None or lim.effort is None else static_overload(g_static, lim.effort, robot.joint_names)
     if bad is not None:
         return TimingError(code, bad.reason(), segment=segment, s=float(S[bad.index]))
     Bmin = B.reshape(rows, m + 1).min(axis=1)

@@ -141,23 +141,25 @@ class Worst:
         ratio: |value| / limit (1.0 = on the limit).
         time: [s] where it occurs (a closed-form peak of a law: the start of its piece).
         joint: the joint's index, or None for the tool speed.
+        names: the robot's joint names (the file's own).
     """
 
     quantity: Quantity
     ratio: float
     time: float
     joint: int | None
+    names: tuple[str, ...] = JOINT_NAMES
 
     @property
     def where(self) -> str:
         """``"joint2 at t = 0.1234 s"``."""
-        who = "the tool" if self.joint is None else JOINT_NAMES[self.joint]
+        who = "the tool" if self.joint is None else self.names[self.joint]
         return f"{who} at t = {self.time:.6g} s"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {"ratio": self.ratio, "time": self.time,
-                "joint": None if self.joint is None else JOINT_NAMES[self.joint]}  # fmt: skip
+                "joint": None if self.joint is None else self.names[self.joint]}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -326,9 +328,10 @@ class _Limits:
 def _limits(robot: Robot, limits: JointLimits | None, tool_speed: float | None, torque: bool) -> _Limits:
     """The limits in force, each refused when NaN, zero, negative or infinite."""
     lim = robot.limits if limits is None else limits
-    v = _limit_vector("velocity", lim.velocity, "rad/s or m/s")
-    a = _limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2")
-    e = _limit_vector("effort", lim.effort, "N m or N") if torque else None
+    names = robot.joint_names
+    v = _limit_vector("velocity", lim.velocity, "rad/s or m/s", names)
+    a = _limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2", names)
+    e = _limit_vector("effort", lim.effort, "N m or N", names) if torque else None
     vt = None if tool_speed is None else _positive("tool_speed", tool_speed, "m/s")
     return _Limits(v, a, e, vt)
 
@@ -412,30 +415,34 @@ class StaticOverload:
         joint: the joint's index.
         load: the static load g [N m or N] (signed).
         limit: the effort limit [N m or N].
+        names: the robot's joint names (the file's own).
     """
 
     index: int
     joint: int
     load: float
     limit: float
+    names: tuple[str, ...] = JOINT_NAMES
 
     def reason(self, where: str = "there") -> str:
         """The sentence, ``where`` saying where the robot is (``"there"``, ``"at q = [...]"``)."""
-        return (f"the static load on {JOINT_NAMES[self.joint]} ({self.load:.6g}) is not below its effort limit "
+        return (f"the static load on {self.names[self.joint]} ({self.load:.6g}) is not below its effort limit "
                 f"{self.limit:.6g}: the robot cannot even hold still {where}")  # fmt: skip
 
 
-def static_overload(g: np.ndarray, effort: np.ndarray) -> StaticOverload | None:
+def static_overload(
+    g: np.ndarray, effort: np.ndarray, names: tuple[str, ...] = JOINT_NAMES
+) -> StaticOverload | None:
     """The first row of static loads ``g`` (n, dof) with |g| >= ``effort`` on a joint, or None.
 
     Whatever its sign: a load above the limit cannot be held, and one below it leaves room on both sides
-    (E - g > 0 and E + g > 0), which :func:`time_scale` relies on.
+    (E - g > 0 and E + g > 0), which :func:`time_scale` relies on. ``names``: the robot's joint names.
     """
     over = np.abs(g) >= effort
     if not over.any():
         return None
     i, j = np.argwhere(over)[0]
-    return StaticOverload(int(i), int(j), float(g[i, j]), float(effort[j]))
+    return StaticOverload(int(i), int(j), float(g[i, j]), float(effort[j]), names)
 
 
 def static_load(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -506,7 +513,7 @@ def time_scale(
     if tau is not None and lim.effort is not None and len(q):
         E = lim.effort
         g = static_load(robot, q)
-        bad = static_overload(g, E)
+        bad = static_overload(g, E, robot.joint_names)
         if bad is not None:
             raise InfeasibleError(bad.reason())
         dyn = tau - g
@@ -616,8 +623,9 @@ def _extra_times(traj: Trajectory) -> np.ndarray:
 class _Worst:
     """Running maxima of |value| / limit per quantity: (ratio, time, joint)."""
 
-    def __init__(self) -> None:
+    def __init__(self, names: tuple[str, ...] = JOINT_NAMES) -> None:
         self.best: dict[Quantity, tuple[float, float, int | None]] = {}
+        self.names = names
 
     def add(self, quantity: Quantity, ratios: np.ndarray, t: np.ndarray, tool: bool = False) -> None:
         if not ratios.size:
@@ -632,7 +640,7 @@ class _Worst:
 
     def get(self, quantity: Quantity) -> Worst | None:
         got = self.best.get(quantity)
-        return None if got is None else Worst(quantity, *got)
+        return None if got is None else Worst(quantity, *got, self.names)
 
 
 def verify(
@@ -683,7 +691,7 @@ def verify(
                 "lower the rate or shorten the motion")  # fmt: skip
     grid = np.arange(-3, n_grid + 4) * h  # three samples of rest on each side (the third differences see the ends)
     times = np.concatenate([grid, np.clip(extra, 0.0, T)])
-    worst = _Worst()
+    worst = _Worst(robot.joint_names)
     q_grid = np.empty((len(grid), dof))
     analytic = jv is not None and any(has_jerk(p) for p in trajectory.pieces)
     nearest = np.empty(len(times)) if scene is not None else None

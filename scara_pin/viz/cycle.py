@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..description import JOINT_NAMES
 from ..units import SI, DisplayUnits
 from .plots import finish, new_figure
 
@@ -19,7 +18,6 @@ if TYPE_CHECKING:
 
     from ..cell import Cell
     from ..cell.shapes import Shape
-
     from ..description import JointLimits
     from ..model import Robot
     from ..motion.cycle import ArchMove, CycleResult
@@ -118,7 +116,7 @@ def plot_cycle(
     for k, (name, ratio) in enumerate(quantities):
         ax = fig.add_subplot(grid[1 + k, :])
         for j in range(4):
-            ax.plot(t, ratio[:, j], color=_COLORS[j], label=JOINT_NAMES[j])
+            ax.plot(t, ratio[:, j], color=_COLORS[j], label=robot.joint_names[j])
         ax.axhline(1.0, color="k", ls="--", lw=1)
         for leg in move.legs:
             ax.axvline(leg.t_start, color="0.85", lw=0.8, zorder=0)
@@ -131,8 +129,11 @@ def plot_cycle(
 
 
 def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarray, k: float) -> None:
-    """The obstacles of a cell: their outline in plan view (the convex hull of the shape's points: a circle's for a
-    vertical cylinder or a sphere) and, in the side view, the box they span along the traverse and in z."""
+    """The obstacles of a cell, drawn on the cycle's side and plan views.
+
+    In plan view, their outline (the convex hull of the shape's points: a circle for a vertical cylinder or a
+    sphere); in the side view, the box they span along the traverse and in z.
+    """
     from matplotlib.patches import Polygon, Rectangle
 
     for i, o in enumerate(cell.obstacles):
@@ -151,8 +152,11 @@ def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarra
 
 
 def _shape_points(shape: Shape) -> np.ndarray:
-    """(k, 3) points of ``shape`` in its frame's axes whose hull outlines it: a vertical cylinder's or a sphere's
-    rings (a circle in plan view), else the corners of the box around it (:meth:`~scara_pin.cell.Shape.corners`)."""
+    """(k, 3) points of ``shape`` whose convex hull outlines it, in its frame's axes.
+
+    A vertical cylinder's or a sphere's rings (a circle in plan view), else the corners of the box around it
+    (:meth:`~scara_pin.cell.Shape.corners`).
+    """
     if shape.kind in ("cylinder", "sphere") and abs(shape.rotation[2, 2]) > 1.0 - 1e-9:
         angle = np.linspace(0.0, 2.0 * np.pi, 73)
         r = shape.size[0]

@@ -11,17 +11,18 @@ obstacles and the boxes placed, numbered in the order placed. The side view look
 
 :func:`job_page` writes the viewer page (:func:`~scara_pin.viz.meshcat.export_html`'s) that plays the job, with
 the cell's obstacles, the part on the tool while it is held and each box from the moment it is placed (the page's
-player shows a node only over its time span: ``motion.shown``).
+player shows a node only over its time spans: ``motion.shown``, ``[{path, spans: [[from, to], ...]}]``).
 """
 
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..description import JOINT_NAMES
+from ..units import SI, DisplayUnits
 from .plots import COLORS, LIMIT_GID, finish, new_figure
 
 if TYPE_CHECKING:
@@ -56,14 +57,15 @@ _PAGE_CARRIED = 0xE07B39
 _PAGE_NODE = "job_cell"
 
 
-def plot_job(result: JobResult, robot: Robot, path: str | os.PathLike[str] | None = None, *,
-             title: str | None = None) -> Figure:  # fmt: skip
+def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, robot: Robot,
+             units: DisplayUnits = SI, title: str | None = None) -> Figure:  # fmt: skip
     """The timeline of a planned job (module docstring); written to ``path`` (PNG, SVG, PDF) when given.
 
     Args:
         result: the planned job.
-        robot: the robot it was planned for (its limits).
         path: the file to write, or None.
+        robot: the robot it was planned for (its limits).
+        units: display units (the timeline's axes are times and ratios: kept for the one plotting signature).
         title: the figure's title (default: the job's file, robot, total and parts per hour).
     """
     traj = result.trajectory
@@ -80,12 +82,12 @@ def plot_job(result: JobResult, robot: Robot, path: str | os.PathLike[str] | Non
     a = np.abs(qdd) / (np.asarray(robot.limits.acceleration)[None, :] * accel[:, None])
     views = result.cell is not None or bool(result.boxes)
     fig = new_figure(11.0, 11.5 if views else 6.5)
+    bottom: Any = fig
     if views:
-        top, bottom = fig.subfigures(2, 1, height_ratios=[5.0, 6.5])
-        plan, side = top.subplots(1, 2)
+        parts: Any = fig.subfigures(2, 1, height_ratios=[5.0, 6.5])
+        plan, side = parts[0].subplots(1, 2)
         _draw_views(plan, side, result, robot)
-    else:
-        bottom = fig
+        bottom = parts[1]
     axes = bottom.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [0.6, 2.0, 2.0]})
     band, ax_v, ax_a = axes
     for s in steps:
@@ -165,21 +167,35 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: Robot) -> None
                                  zorder=2 if is_box else 1))  # fmt: skip
         side.annotate(name, (float(shape.xyz[along]), float(shape.xyz[2])), fontsize=7, ha="center", va="center",
                       zorder=4)  # fmt: skip
-        key = (round(float(shape.xyz[0]), 3), round(float(shape.xyz[1]), 3))
-        labels.setdefault(key, []).append(name)
+        if is_box:  # boxes stacked on each other share a label: "1, 4"
+            key = (round(float(shape.xyz[0]), 3), round(float(shape.xyz[1]), 3))
+            labels.setdefault(key, []).append(name)
+        else:  # an obstacle's name inside its top edge, clear of the boxes on it
+            plan.annotate(name, (float(shape.xyz[0]), float(pts[:, 1].max())), fontsize=7, ha="center", va="top",
+                          xytext=(0, -2), textcoords="offset points", zorder=4)  # fmt: skip
     for (x, y), found in labels.items():
         plan.annotate(", ".join(found), (x, y), fontsize=7, ha="center", va="center", zorder=4)
     for ax, (i, j) in ((plan, (0, 1)), (side, (along, 2))):
-        for state, color, label in ((True, CARRYING_COLOR, "tool, holding the part"),
-                                    (False, EMPTY_COLOR, "tool, empty")):  # fmt: skip
+        for state, color, label, style in ((False, EMPTY_COLOR, "tool, empty", "--"),
+                                           (True, CARRYING_COLOR, "tool, holding the part", "-")):  # fmt: skip
             xy = np.where((carrying == state)[:, None], poses[:, [i, j]], np.nan)
-            ax.plot(xy[:, 0], xy[:, 1], color=color, lw=1.0, label=label, zorder=3)
+            ax.plot(xy[:, 0], xy[:, 1], color=color, lw=1.2, ls=style, label=label, zorder=3 + int(state))
         ax.autoscale_view()
-        ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)
+    plan.set_aspect("equal", adjustable="datalim")
+    what = "the job"
+    if result.boxes:  # the side view frames the stack: the boxes and the tool path above them
+        pts = np.concatenate([_shape_points(b.shape) for b in result.boxes])
+        lo, hi = pts[:, along].min() - 0.25, pts[:, along].max() + 0.25
+        near = (poses[:, along] >= lo) & (poses[:, along] <= hi)
+        z_hi = max(float(pts[:, 2].max()), float(poses[near, 2].max(initial=-np.inf))) + 0.1
+        side.set_xlim(lo, hi)
+        side.set_ylim(0.0 if pts[:, 2].min() >= 0.0 else float(pts[:, 2].min()) - 0.1, z_hi)
+        what = "the stack"
+    side.set_aspect("equal", adjustable="box")
     plan.plot([0.0], [0.0], "k+", ms=10)
     plan.set(xlabel="x [m]", ylabel="y [m]", title="plan view (J1 axis at +)")
-    side.set(xlabel=f"{names[along]} [m]", ylabel="z [m]", title=f"side view (seen along {names[across]})")
+    side.set(xlabel=f"{names[along]} [m]", ylabel="z [m]", title=f"side view of {what} (seen along {names[across]})")
     plan.legend(fontsize=7, loc="best")
 
 
@@ -215,15 +231,14 @@ def job_page(result: JobResult, robot: Robot, path: str | os.PathLike[str], *, r
         node = f"{_PAGE_NODE}/boxes/{b.name}"
         _draw_shape(scene, mg, node, b.shape, scene.oMb, _PAGE_BOX)
         scene.vis[node].set_property("visible", False)
-        shown.append({"path": f"meshcat/{node}", "from": b.time, "to": T + 1.0})
+        shown.append({"path": f"meshcat/{node}", "spans": [[b.time, T + 1.0]]})
     if result.carry is not None:
         frame = robot.model.frames[robot.tool_id]
         node = f"{scene.paths[frame.parentJoint]}/job_carried"
         _draw_shape(scene, mg, node, result.carry, pin.SE3(frame.placement), _PAGE_CARRIED)
         scene.vis[node].set_property("visible", False)
         held = [(s.t_start, s.t_end) for s in result.steps if s.carrying or (s.kind == "place")]
-        for t0, t1 in _merged(held):
-            shown.append({"path": f"meshcat/{node}", "from": t0, "to": t1})
+        shown.append({"path": f"meshcat/{node}", "spans": [list(span) for span in _merged(held)]})
     if shown and "motion" in data:
         data["motion"]["shown"] = shown
     rate_text = f", {result.boxes_per_hour:,.0f} boxes per hour" if result.boxes else ""
@@ -243,21 +258,21 @@ def _merged(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:
     return out
 
 
-def _draw_shape(scene: object, mg: object, node: str, shape: Shape, frameMparent: object, color: int) -> None:
+def _draw_shape(scene: Any, mg: Any, node: str, shape: Shape, frameMparent: Any, color: int) -> None:
     """One shape at ``frameMparent * shape.placement()`` under ``node`` (a cylinder turned: meshcat's is along y)."""
     import pinocchio as pin
 
-    M = frameMparent * shape.placement()  # type: ignore[operator]
+    M = frameMparent * shape.placement()
     if shape.kind == "box":
-        geometry = mg.Box(list(shape.size))  # type: ignore[attr-defined]
+        geometry = mg.Box(list(shape.size))
     elif shape.kind == "cylinder":
-        geometry = mg.Cylinder(shape.size[1], shape.size[0])  # type: ignore[attr-defined]
+        geometry = mg.Cylinder(shape.size[1], shape.size[0])
         M = M * pin.SE3(pin.utils.rotate("x", np.pi / 2), np.zeros(3))
     elif shape.kind == "sphere":
-        geometry = mg.Sphere(shape.size[0])  # type: ignore[attr-defined]
+        geometry = mg.Sphere(shape.size[0])
     else:
-        geometry = mg.TriangularMeshGeometry(shape.vertices, shape.faces)  # type: ignore[attr-defined]
-    material = mg.MeshLambertMaterial(color=color, opacity=0.85, transparent=True)  # type: ignore[attr-defined]
-    vis = scene.vis[node]  # type: ignore[attr-defined]
+        geometry = mg.TriangularMeshGeometry(shape.vertices, shape.faces)
+    material = mg.MeshLambertMaterial(color=color, opacity=0.85, transparent=True)
+    vis = scene.vis[node]
     vis.set_object(geometry, material)
     vis.set_transform(M.homogeneous)

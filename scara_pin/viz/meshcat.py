@@ -634,7 +634,7 @@ class _Scene:
         self.tool_r0 = pin.utils.rotate("z", -yaw0) @ zero.rotation
         self._floor()
         self._camera()
-        self.display(np.zeros(robot.dof))
+        self.display(robot.default_q)
 
     def _load_geometry(self, geometry: pin.GeometryObject) -> None:
         """Load one visual geometry (primitive or mesh, by Pinocchio's loader) under its joint's node."""
@@ -816,7 +816,7 @@ def _scene(
     if (times is None) != (qs is None):
         raise InvalidInputError("times and qs go together: give both or neither")
     data = scene.page_data()
-    shown = np.zeros(robot.dof) if q is None else robot.check_q(q)
+    shown = robot.default_q if q is None else robot.check_q(q)
     if polylines is not None:
         scene.draw_polylines(polylines, "workspace", None, _WORKSPACE_COLOR)
     if path_points is not None:

@@ -190,7 +190,7 @@ class TeachSession:
                 bad name, or unreadable, or taught on another robot.
         """
         self.robot = robot
-        start = np.zeros(robot.dof) if q is None else robot.check_q(q)
+        start = robot.default_q if q is None else robot.check_q(q)
         outside = robot.outside_limits(start)
         if outside:
             raise InvalidInputError(f"the start configuration is outside the limits: {'; '.join(outside)}")

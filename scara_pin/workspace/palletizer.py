@@ -19,6 +19,11 @@ angle from the x axis), each labelled with what bounds the region there:
 - ``stretched`` (theta3 = q2): centre the shoulder, radius a2 + a3, phi = q2;
 - ``folded`` (theta3 = q2 + pi): centre the shoulder, radius |a2 - a3|.
 
+The angles are S2's canonical ones (:mod:`scara_pin.kinematics.palletizer`): a file whose joints are
+turned, shifted or measured from the big arm (``relative``: the box is then the big arm's angle and the
+elbow's) is mapped first; the limit labels use the file's joint names and say which of its limits (a
+joint turning the other way has its lower limit at the canonical upper end).
+
 The start of an arc is given as the joint angle of its candidate (e.g. theta3 on a q2-limit arc).
 Membership (:func:`reachable`) is the planar law-of-cosines solution with the joint limits and the IK's
 tolerances.
@@ -42,10 +47,20 @@ if TYPE_CHECKING:
 
 __all__ = ["ArmPlaneEnvelope", "EnvelopeArc", "arm_plane_envelope", "plot_envelope", "reachable"]
 
-_LABELS = {Role.STRETCHED: ("stretched", 0), Role.FOLDED: ("folded", 1), Role.SECOND_LO: ("joint3_lower", 2),
-           Role.SECOND_HI: ("joint3_upper", 3), Role.FIRST_LO: ("joint2_lower", 4), Role.FIRST_HI: ("joint2_upper", 5)}
-"""The engine's candidate roles as limit names (first joint q2, second theta3), and their rank between
-coincident candidates (lowest wins)."""
+_RANKS = {Role.STRETCHED: 0, Role.FOLDED: 1, Role.SECOND_LO: 2, Role.SECOND_HI: 3, Role.FIRST_LO: 4, Role.FIRST_HI: 5}
+"""The rank of the engine's candidate roles between coincident candidates (lowest wins)."""
+_COLOURS = {Role.STRETCHED: "tab:blue", Role.FOLDED: "tab:purple", Role.SECOND_LO: "tab:red",
+            Role.SECOND_HI: "tab:orange", Role.FIRST_LO: "tab:green", Role.FIRST_HI: "tab:olive"}  # fmt: skip
+
+
+def _labels(geo: PalletizerGeometry) -> dict[Role, tuple[str, int]]:
+    """The roles as the file's limits (``joint2_lower``, ...: first joint q2, second theta3 or the elbow)."""
+    out = {Role.STRETCHED: ("stretched", 0), Role.FOLDED: ("folded", 1)}
+    for j, (lo, hi) in ((1, (Role.FIRST_LO, Role.FIRST_HI)), (2, (Role.SECOND_LO, Role.SECOND_HI))):
+        up = geo.signs[j] > 0  # the canonical lower end is the file's lower limit
+        out[lo] = (f"{geo.names[j]}_{'lower' if up else 'upper'}", _RANKS[lo])
+        out[hi] = (f"{geo.names[j]}_{'upper' if up else 'lower'}", _RANKS[hi])
+    return out
 
 
 @dataclass(frozen=True)
@@ -55,7 +70,8 @@ class EnvelopeArc:
     Attributes:
         center: (r, z) of the centre [m]. radius: [m]. start, sweep: [rad], sweep > 0.
         limit: what bounds the region there: ``joint2_lower``, ``joint2_upper``, ``joint3_lower``,
-            ``joint3_upper``, ``stretched`` or ``folded``.
+            ``joint3_upper`` (with the file's joint names), ``stretched`` or ``folded``.
+        role: the engine's role of the arc (:class:`scara_pin.workspace.arcs.Role`).
         inside_toward_center: the region lies on the centre's side of the arc.
     """
 
@@ -65,6 +81,7 @@ class EnvelopeArc:
     sweep: float
     limit: str
     inside_toward_center: bool
+    role: Role = Role.STRETCHED
 
     def points(self, n: int = 64) -> np.ndarray:
         """(n, 2) points (r, z) along the arc, ends included [m]."""
@@ -145,10 +162,10 @@ class ArmPlaneEnvelope:
 
 
 def _box(geo: PalletizerGeometry) -> ArmBox:
-    """The arm (a2, a3) in (x, y) = (z - h0, r - r0) and its box of absolute angles (q2, theta3)."""
+    """The arm (a2, a3) in (x, y) = (z - h0, r - r0) and its box of canonical angles (q2, theta3 or the elbow)."""
     q2, t3 = ((JointRange(-math.pi, math.pi, True) if geo.continuous[j] else JointRange.of(geo.lower[j], geo.upper[j]))
               for j in (1, 2))  # fmt: skip
-    return ArmBox((0.0, 0.0), geo.arm, q2, t3, relative=False)
+    return ArmBox((0.0, 0.0), geo.arm, q2, t3, relative=geo.relative)
 
 
 def reachable(geo: PalletizerGeometry, r: float, z: float) -> bool:
@@ -162,25 +179,29 @@ def reachable(geo: PalletizerGeometry, r: float, z: float) -> bool:
 
 def arm_plane_envelope(geo: PalletizerGeometry) -> ArmPlaneEnvelope:
     """The exact reach envelope of the tool point in the arm plane under the q2 and theta3 limits."""
-    region = box_region(_box(geo), _LABELS)
+    labels = _labels(geo)
+    roles = {label: role for role, (label, _) in labels.items()}
+    region = box_region(_box(geo), labels)
     arcs = [EnvelopeArc((a.center[1] + geo.r0, a.center[0] + geo.h0), a.radius, a.param_start, a.sweep, a.label,
-                        a.region_inside) for a in region.arcs]  # fmt: skip
+                        a.region_inside, roles[a.label]) for a in region.arcs]  # fmt: skip
     pts = np.array([p for a in arcs for p in a.extreme_points()]) if arcs else np.zeros((1, 2))
     return ArmPlaneEnvelope(tuple(arcs), float(region.area), (float(pts[:, 0].min()), float(pts[:, 0].max())),
                             (float(pts[:, 1].min()), float(pts[:, 1].max())), geo)  # fmt: skip
 
 
 def plot_envelope(env: ArmPlaneEnvelope, path: str | os.PathLike[str] | None = None, *, q: np.ndarray | None = None,
-                  units: DisplayUnits = SI, robot_name: str | None = None, dpi: int = 120) -> Figure:  # fmt: skip
+                  units: DisplayUnits = SI, robot_name: str | None = None, dpi: int = 120,
+                  tool_frame: str = "tool0") -> Figure:  # fmt: skip
     """The envelope in the arm plane: arcs coloured by their limit, and the arm at ``q`` (default mid-range).
 
     Args:
         env: the envelope.
         path: write the figure here (PNG, SVG or PDF by the ending; atomically); None: only return it.
-        q: the configuration the arm is drawn at [rad].
+        q: the configuration the arm is drawn at (the file's joints) [rad]; default mid-range.
         units: the length unit of the axes (``DisplayUnits("mm")`` for millimetres).
         robot_name: named in the title.
         dpi: resolution of a written PNG.
+        tool_frame: the tool frame's name, in the title.
 
     Returns:
         the matplotlib Figure.
@@ -189,8 +210,6 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str | os.PathLike[str] | None = N
     from matplotlib.figure import Figure
     from matplotlib.ticker import FuncFormatter
 
-    colours = {"joint2_lower": "tab:green", "joint2_upper": "tab:olive", "joint3_lower": "tab:red",
-               "joint3_upper": "tab:orange", "stretched": "tab:blue", "folded": "tab:purple"}  # fmt: skip
     geo = env.geometry
     fig = Figure(figsize=(7, 7))  # object-oriented: no pyplot, no global backend or figure state
     FigureCanvasAgg(fig)
@@ -198,13 +217,15 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str | os.PathLike[str] | None = N
     seen: set[str] = set()
     for a in env.arcs:
         pts = a.points(max(8, int(a.sweep * 90)))
-        ax.plot(pts[:, 0], pts[:, 1], color=colours[a.limit], lw=2.0,
+        ax.plot(pts[:, 0], pts[:, 1], color=_COLOURS[a.role], lw=2.0,
                 label=None if a.limit in seen else a.limit)  # fmt: skip
         seen.add(a.limit)
-    q = (np.asarray(geo.lower) + np.asarray(geo.upper)) / 2 if q is None else np.asarray(q, dtype=float)
+    # the arm at q, in canonical angles (the big arm's and the small arm's from the vertical)
+    t = (np.asarray(geo.lower) + np.asarray(geo.upper)) / 2 if q is None else np.array(geo.canonical(list(q)))
+    a2, a3 = float(t[1]), float(t[2] + t[1] if geo.relative else t[2])
     sh = geo.shoulder
-    el = (sh[0] + geo.a2 * math.sin(q[1]), sh[1] + geo.a2 * math.cos(q[1]))
-    wr = (el[0] + geo.a3 * math.sin(q[2]), el[1] + geo.a3 * math.cos(q[2]))
+    el = (sh[0] + geo.a2 * math.sin(a2), sh[1] + geo.a2 * math.cos(a2))
+    wr = (el[0] + geo.a3 * math.sin(a3), el[1] + geo.a3 * math.cos(a3))
     tool = (wr[0] + geo.r0 - sh[0], wr[1] + geo.h0 - sh[1])
     chain = np.array([(0.0, 0.0), (0.0, sh[1]), sh, el, wr, (tool[0], wr[1]), tool])
     ax.plot(chain[:, 0], chain[:, 1], "k-o", ms=3, lw=1.5, label="arm (mid-range)")
@@ -218,7 +239,7 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str | os.PathLike[str] | None = N
     ax.set_xlabel(f"r: from the waist axis [{n}]")
     ax.set_ylabel(f"z: above the floor [{n}]")
     area = format_number(env.area * L * L, decimals_for(L * L, 1e-6))  # to 1 mm^2
-    ax.set_title(f"{robot_name or 'palletizer'}: tool0 in the arm plane, area {area} {n}$^2$")
+    ax.set_title(f"{robot_name or 'palletizer'}: {tool_frame} in the arm plane, area {area} {n}$^2$")
     ax.legend(loc="best", fontsize=8)
     ax.grid(True, alpha=0.3)
     if path is not None:

@@ -446,7 +446,8 @@ class Workspace(Summarized):
             z = S[:, 2]
             if ((z < z_lo - EDGE_TOL) | (z > z_hi + EDGE_TOL)).any():
                 i = int(np.argmax((z < z_lo - EDGE_TOL) | (z > z_hi + EDGE_TOL)))
-                raise OutsideWorkspaceError(S[i], f"z = {z[i]:.9g} m is outside the J3 stroke "
+                quill = self.geometry.names[self.geometry.prismatic]
+                raise OutsideWorkspaceError(S[i], f"z = {z[i]:.9g} m is outside {quill}'s stroke "
                                                   f"[{z_lo:.9g}, {z_hi:.9g}] m")  # fmt: skip
             dz = D[:, 2]
             with np.errstate(divide="ignore", invalid="ignore"):

@@ -1,0 +1,77 @@
+"""Rules of the links' geometry: inertial numbers and the meshes the viewer draws.
+
+Each rule is a function of the :class:`~scara_pin.lint.context.Context`; its code and place in the run are in
+:data:`scara_pin.lint.registry.RULES`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .._checks import number_text
+from .context import Context
+from .report import Severity
+
+__all__ = ["bad_inertial", "colour_ignored", "mesh_missing"]
+
+_INERTIAL = (("mass", ("value",)), ("inertia", ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")))
+
+
+def bad_inertial(ctx: Context) -> None:
+    """A link's mass or inertia that is not finite (NaN would poison every torque), or a negative mass."""
+    doc = ctx.document
+    for name, el in doc.links:
+        inertial = el.find("inertial")
+        if inertial is None:
+            continue
+        for what, attrs in _INERTIAL:
+            part = inertial.find(what)
+            for attr in attrs if part is not None else ():
+                raw = part.get(attr)  # type: ignore[union-attr]
+                if raw is None:
+                    continue
+                value = number_text(raw)
+                if not math.isfinite(value) or (what == "mass" and value < 0):
+                    rule = "must be a finite number >= 0" if what == "mass" else "must be a finite number"
+                    ctx.error("bad-inertial", f"link {name or '?'}'s {what} {attr}={raw!r} {rule}", doc.line(el))
+
+
+def mesh_missing(ctx: Context) -> None:
+    """A visual's mesh the viewer cannot find or may not read (it draws a box instead).
+
+    Found by the viewer's own resolver (:func:`scara_pin.description.mesh_paths.mesh_file`), for a file
+    (``check_urdf_file``: the package folders known); one finding per file name, naming its links.
+    """
+    from ..description.mesh_paths import MeshProblem, mesh_file
+
+    packages = ctx.load_kwargs.get("package_path")
+    if packages is None:  # URDF text without a file: nowhere to look relative names up
+        return
+    doc = ctx.document
+    links: dict[str, list[str]] = {}
+    first: dict[str, int | None] = {}
+    for name, el in doc.links:
+        for mesh in el.findall("visual/geometry/mesh"):
+            filename = mesh.get("filename", "")
+            links.setdefault(filename, []).append(name or "?")
+            first.setdefault(filename, doc.line(mesh))
+    for filename, names in links.items():
+        try:
+            mesh_file(filename, packages)
+        except MeshProblem as exc:
+            shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+            ctx.add(Severity.WARNING, "mesh-missing", f"{exc}: the viewer draws link {shown} as a placeholder box",
+                    first[filename])  # fmt: skip
+
+
+def colour_ignored(ctx: Context) -> None:
+    """Colours urdfdom cannot read and ignores (``rgb=``, a malformed ``rgba``): the loader's rule, said once."""
+    import copy
+
+    from .._urdf_checks import urdfdom_ignores
+
+    ignored = urdfdom_ignores(copy.deepcopy(ctx.parsed[0]))
+    if ignored:
+        shown = ", ".join(ignored[:6]) + (f" and {len(ignored) - 6} more" if len(ignored) > 6 else "")
+        ctx.add(Severity.WARNING, "colour-ignored", f"colours URDF cannot read, ignored by urdfdom and the toolkit "
+                f"(a colour is <color rgba=\"r g b a\"/>, each in [0, 1]): {shown}")  # fmt: skip
