@@ -327,6 +327,16 @@ def plan_job(job: Job, robot: Robot, *, progress: Callable[[int, int], None] | N
         raise JobFileError(job.path, None, f"a job needs a wrist (4 joints); robot {robot.name!r} has {robot.dof}")
     program = job.program(robot)
     cell = _job_cell(job)
+    places = sum(isinstance(a, Grip) and a.kind is GripKind.PLACE for a in program.actions)
+    if places:  # every box placed joins the cell: sized before any move is planned
+        from ..limits import MAX_CELL_OBSTACLES, check_count
+
+        try:
+            check_count(f"obstacles of the cell (its {0 if cell is None else len(cell.obstacles)} and the {places:,} "
+                        "boxes the job places)", places + (0 if cell is None else len(cell.obstacles)),
+                        MAX_CELL_OBSTACLES, "split the job")  # fmt: skip
+        except ScaraError as exc:
+            raise located(job.path, job.lines.get("carry"), exc) from None
     carry = job.carry.part() if job.carry is not None else None
     planner = Planner(robot, torque=job.torque, payload=job.payload, cell=cell, carry=carry)
     q, at, t = program.start_q, program.start, 0.0
@@ -432,7 +442,7 @@ def _clear(robot: Robot, cell: Cell | None, q: np.ndarray, job: Job, action: Gri
     except InCollisionError as exc:
         hint = ""
         if box is not None and exc.pair.b == box:
-            hint = (" (the part must hang at least the margin below the tool's links: lower it in the tool frame, "
-                    f"carry: xyz, by {(exc.margin - exc.distance) * 1e3:.3g} mm or more)")  # fmt: skip
+            hint = (f" (the part must hang more than the margin, {exc.margin * 1e3:g} mm, below the tool's links: "
+                    "lower it in the tool frame, carry: xyz)")  # fmt: skip
         raise JobFileError(job.path, action.line, f"{exc}{hint}") from None
 
