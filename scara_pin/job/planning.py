@@ -26,10 +26,10 @@ than its moves planned one by one, because it IS them.
 
 **Same moves, planned once** (:class:`Planner`). A move whose kind, end configurations (bit for bit),
 limit fractions, clearance, boxes placed and gripper state are those of a move planned before is that move
-again. A jump
-whose reverse was planned is that jump played backwards: under the same symmetric limits and clearance
-the reversed motion is feasible and as fast as any (:mod:`~scara_pin.motion.jump`, "Return move"), so a
-tray job solves one jump per place, not two. The reversed move is verified like a new one.
+again. A jump whose reverse was planned (with the same boxes and gripper state) is that jump played
+backwards: under the same symmetric limits and clearance the reversed motion is feasible and as fast as any
+(:mod:`~scara_pin.motion.jump`, "Return move"), so a tray job solves one jump per place, not two. The
+reversed move is verified like a new one, in its cell too.
 """
 
 from __future__ import annotations
