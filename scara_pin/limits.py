@@ -53,6 +53,7 @@ __all__ = [
     "MAX_VISUALS",
     "MAX_WALK_DEPTH",
     "MAX_WALK_ENTRIES",
+    "MAX_WORKSPACE_GRID",
     "MAX_XACRO_FILES",
     "MAX_YAML_DEPTH",
     "MAX_YAML_NODES",
@@ -116,6 +117,9 @@ the 10 kHz samples of a motion: 500 obstacles and 6 links take about 3 ms a samp
 MAX_CELL_TRIANGLES = 200_000
 """Mesh triangles of one cell, all its meshes together (coal's bounding-volume tree keeps a distance query
 near a few microseconds up to there)."""
+MAX_WORKSPACE_GRID = 250_000
+"""Grid points of one collision-free region (``workspace --cell --height``: 500 x 500; each reachable point
+costs up to two IK solutions and their distance checks, about 10 s at the cap)."""
 
 # ----------------------------------------------------------------------- files named by packages and meshes
 MAX_MESH_BYTES = 200 * 1024 * 1024

@@ -81,7 +81,7 @@ def test_cycle_plot_and_messages_use_the_files_names_and_units(capsys: pytest.Ca
     limits = JointLimits(lim.lower, lim.upper, lim.velocity, (20.0, 20.0, 40.0, 5.0), lim.effort, validate=False)
     result = standard_cycle(robot, torque=False, limits=limits)
     assert result.torque is False
-    fig = plot_cycle(robot, result.move, limits=limits)
+    fig = plot_cycle(result, robot=robot, limits=limits)
     labels = {t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()}
     assert {"J1", "J2", "J3", "J4"} <= labels and not labels & {"joint1", "joint4"}
     assert all(leg.joint in robot.joint_names for leg in result.move.legs)

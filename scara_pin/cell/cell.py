@@ -11,7 +11,7 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, brief
 from ..limits import MAX_CELL_OBSTACLES, MAX_CELL_TRIANGLES, check_count
 from .shapes import Shape
 
@@ -29,8 +29,7 @@ CARRIED = "carried"
 def check_name(name: object, what: str) -> str:
     """``name`` if it is a plain name (letters, digits, ``_ . : / + -``; at most 100 characters), else an error."""
     if not isinstance(name, str) or not _NAME.fullmatch(name):
-        shown = repr(name)[:40] if isinstance(name, str) else type(name).__name__
-        raise InvalidInputError(f"{what} {shown} must be a name of letters, digits and _ . : / + - "
+        raise InvalidInputError(f"{what} {brief(name, 44)} must be a name of letters, digits and _ . : / + - "
                                 "(at most 100 characters)")  # fmt: skip
     return name
 

@@ -108,11 +108,11 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.file is None:
         raise InvalidInputError("check needs a FILE.urdf (or --list-rules)")
     from ..lint import check_urdf_file
+    from ._check_cell import report_with_cell
 
     report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or (),
                              lock=_parse_locks(args.lock))
-    print(report.to_json() if args.json else report.format_text())
-    return int(report.exit_code)
+    return report_with_cell(args, report)
 
 
 def register(sub: Any) -> None:
@@ -132,4 +132,7 @@ def register(sub: Any) -> None:
     p.add_argument("--list-rules", action="store_true", help="print the rules of check, one line each, and exit")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_frame_options(p.add_argument_group("robot"))
+    from ._check_cell import add_check_cell_options
+
+    add_check_cell_options(p)
     p.set_defaults(func=cmd_check)

@@ -289,7 +289,7 @@ def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) ->
 
 
 def cmd_jog(args: argparse.Namespace) -> int:
-    """Jog to the edge: a straight tool move along a direction, ending at rest on the workspace edge."""
+    """Jog to the edge: a straight tool move ending at rest on the workspace edge (or before contact: ``--cell``)."""
     from ..motion.jog import jog_to_edge
 
     units = Units.from_args(args)
@@ -304,7 +304,11 @@ def cmd_jog(args: argparse.Namespace) -> int:
     if len(direction) not in (2, 3):
         raise ParameterError("--direction", " ".join(args.direction), "must be DX DY or DX DY DZ")
     margin = 0.0 if args.margin is None else units.value("--margin", args.margin, "length")
-    jog = jog_to_edge(robot, q0, direction, margin=margin)
+    # --margin is the jog's own (to the edge): the cell keeps its file's margin unless --margin is given
+    cell = cell_from_args(argparse.Namespace(cell=args.cell, package_path=args.package_path))
+    if cell is not None and args.margin is not None:
+        cell = cell.with_margin(margin)
+    jog = jog_to_edge(robot, q0, direction, margin=margin, cell=cell)
     traj = jog.trajectory
     if args.out:
         traj.save(args.out, rate=args.rate)
@@ -313,14 +317,18 @@ def cmd_jog(args: argparse.Namespace) -> int:
 
         plot_trajectory(traj, args.plot, robot=robot, units=units.display, law="jog to the edge, straight line")
     if args.json:
-        print(json.dumps({"robot": robot.name, "hit": jog.hit.to_dict(), "start_pose": jog.start_pose.tolist(),
-                          "end_pose": jog.end_pose.tolist(), "distance": jog.distance, "duration": traj.duration,
-                          "q_end": traj.q_end.tolist(), "limit_ratio": jog.ratio,
+        print(json.dumps({"robot": robot.name, **jog.to_dict(), "cell": None if cell is None else cell.origin,
                           "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
         return 0
     text = sys.stderr if "-" in (args.out, args.plot) else sys.stdout  # stdout carries a file
     print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}", file=text)
-    print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
+    if jog.contact is not None:
+        print(f"stop      {jog.stopped_by}, the margin of {args.cell}", file=text)
+        print(f"edge      beyond: {jog.hit.description} [{jog.hit.limit.value}]", file=text)
+    else:
+        print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
+        if cell is not None:
+            print(f"cell      {cell.origin}: no contact before the edge (margin {cell.margin * 1e3:g} mm)", file=text)
     print(f"travel    {units.num(jog.distance, 'length')} {units.length_name} in {_num(traj.duration, 6)} s (at rest "
           "at both ends)", file=text)  # fmt: skip
     print(f"end pose  {units.fmt(jog.end_pose, _POSE_KINDS)}  [{', '.join(units.names(_POSE_KINDS))}]", file=text)
@@ -387,7 +395,8 @@ def register(sub: Any) -> None:
     p = sub.add_parser("jog", help="jog to the edge: straight tool move ending at rest on the workspace edge")
     p.add_argument("--from", dest="from_q", nargs=4, metavar="Q", required=True, help="current configuration")
     p.add_argument("--direction", nargs="+", metavar="D", required=True, help="DX DY (plan) or DX DY DZ")
-    p.add_argument("--margin", metavar="M", help="stop this far before the edge [m, or mm with --mm] (default 0)")
+    p.add_argument("--margin", metavar="M", help="stop this far before the edge [m, or mm with --mm] (default 0); "
+                   "with --cell, also the cell's margin (instead of its file's)")
     p.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip
     _add_acceleration(p)
@@ -395,4 +404,5 @@ def register(sub: Any) -> None:
     p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
     _add_units(p, inputs=True)
     _add_robot_options(p)
+    add_cell_options(p, margin=False)  # --margin above: the jog's own, and the cell's when given
     p.set_defaults(func=cmd_jog)

@@ -8,7 +8,17 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
 from ..signals import Terminated, handled
-from ._common import Units, _add_robot_options, _add_units, _load, _q_values, check_command_outputs, log
+from ._common import (
+    Units,
+    _add_robot_options,
+    _add_units,
+    _load,
+    _q_values,
+    add_cell_options,
+    cell_from_args,
+    check_command_outputs,
+    log,
+)
 
 if TYPE_CHECKING:
 
@@ -22,6 +32,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     units = Units.from_args(args)
     check_command_outputs(args, {"--html": args.html})  # before any work: not --traj, --urdf, ...
     robot = _load(args, units)
+    cell = cell_from_args(args, units)
     q = None
     if args.q:
         q = robot.check_q(_q_values(args.q, units))
@@ -45,12 +56,14 @@ def cmd_view(args: argparse.Namespace) -> int:
         polylines = workspace_polylines(robot)
     if args.html:
         viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines,
-                        title=f"scara-pin: {robot.name}")  # fmt: skip
+                        title=f"scara-pin: {robot.name}", cell=cell)  # fmt: skip
         print(f"wrote {args.html} (self-contained; open it from disk, no network needed)")
         return 0
     with viz.Viewer(robot, open=args.open) as viewer:
         if polylines is not None:
             viewer.draw_polylines(polylines)
+        if cell is not None:
+            viewer.draw_cell(cell)
         if times is not None and qs is not None:
             viewer.draw_tool_path(qs)
             viewer.animate(times, qs, loop=True)
@@ -79,4 +92,5 @@ def register(sub: Any) -> None:
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
     _add_units(p, json_help=None)
     _add_robot_options(p)
+    add_cell_options(p, margin=False)
     p.set_defaults(func=cmd_view)

@@ -9,7 +9,17 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
 from ..units import decimals_for, format_number
-from ._common import Units, _add_robot_options, _add_units, _fmt, _load, _number, check_command_outputs
+from ._common import (
+    Units,
+    _add_robot_options,
+    _add_units,
+    _fmt,
+    _load,
+    _number,
+    add_cell_options,
+    cell_from_args,
+    check_command_outputs,
+)
 
 _TABLE_RESOLUTION = 1e-6
 """The arc table of ``workspace`` prints centres and radii to 1 um (a summary; --json gives every bit)."""
@@ -32,6 +42,9 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     L = units.length
     check_command_outputs(args, {"--plot": args.plot}, figures=("--plot",))  # before any work
     robot = _load(args, units)
+    cell = cell_from_args(args, units)
+    if cell is not None or args.height is not None:
+        return _free_workspace(args, robot, units, cell)
     if robot.kind == "palletizer":
         return _palletizer_workspace(args, robot, units)
     ws = workspace(robot)
@@ -94,6 +107,42 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     return 0
 
 
+def _free_workspace(args: argparse.Namespace, robot: Robot, units: Units, cell: Any) -> int:
+    """``workspace --cell FILE --height Z``: the plan-view region reachable without collision at that height."""
+    from ..workspace.free import free_region, plot_free_region
+
+    if cell is None or args.height is None:
+        raise InvalidInputError("--cell and --height go together: the region reachable without collision at height "
+                                "Z in the cell")  # fmt: skip
+    if args.ray or args.z is not None or args.dz is not None:
+        raise InvalidInputError("--ray/--z/--dz do not go with --cell (the ray meets the joint limits' edge only)")
+    z = units.value("--height", args.height, "length")
+    h = None if args.resolution is None else units.value("--resolution", args.resolution, "length")
+    yaw = None if args.yaw is None else _number("--yaw", args.yaw)
+    region = free_region(robot, cell, z, resolution=h, yaw=yaw)
+    if args.plot:
+        plot_free_region(region, args.plot, units=units.display, robot_name=robot.name)
+    if args.json:
+        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}, **region.to_dict()}
+        if args.plot:
+            out["plot"] = args.plot
+        print(json.dumps(out))
+        return 0
+    n = units.length_name
+    h = region.resolution
+    print(f"robot     {robot.name}: reachable without collision at z = {units.num(z, 'length')} {n} in {cell.origin}")
+    print(f"free      {units.num(region.area, 'area')} {n}^2 of {units.num(region.workspace.area, 'area')} {n}^2 (the "
+          f"joint limits' exact area; {units.num(region.reachable_area, 'area')} {n}^2 on this grid)")  # fmt: skip
+    print(f"grid      {len(region.x)} x {len(region.y)} points {units.num(h, 'length')} {n} apart (area error at most "
+          f"sqrt(2) h per unit of boundary length)")  # fmt: skip
+    print(f"yaw       {region.yaw_text}")
+    print(f"margin    {cell.margin * 1e3:g} mm; {len(cell.obstacles)} obstacle(s)"
+          + ("" if cell.carried is None else f", carrying a {cell.carried.kind}"))  # fmt: skip
+    if args.plot:
+        print(f"wrote     {args.plot}")
+    return 0
+
+
 def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     """The palletizer's reach envelope of tool0 in its arm plane (r from the waist axis, z)."""
     from ..workspace.palletizer import arm_plane_envelope, plot_envelope
@@ -131,6 +180,14 @@ def register(sub: Any) -> None:
     p.add_argument("--z", metavar="Z", help="with --ray: start height (a 3-D ray also meets the vertical stroke)")
     p.add_argument("--dz", metavar="DZ", help="with --ray: vertical direction component")
     p.add_argument("--plot", metavar="PNG", help="picture of the region (arcs coloured by limit; the ray)")
+    g = p.add_argument_group("collision-free region (with --cell)")
+    g.add_argument("--height", metavar="Z", help="with --cell: the tool's height [m, or mm with --mm]: the plan-view "
+                   "region reachable there with every link clear of the cell by its margin (a raster)")  # fmt: skip
+    g.add_argument("--resolution", metavar="H", help="the raster's spacing [m, or mm with --mm] (default: the "
+                   "workspace's width / 200)")  # fmt: skip
+    g.add_argument("--yaw", metavar="A", help="one tool yaw for every point [rad] (default: free with a carried "
+                   "part, the first of 12 that clears; else 0)")  # fmt: skip
     _add_units(p, deg=False)
     _add_robot_options(p)
+    add_cell_options(p)
     p.set_defaults(func=cmd_workspace)

@@ -5,7 +5,8 @@ Two ways out, sharing one scene builder:
 - :class:`Viewer` starts a meshcat server (a child process bound to 127.0.0.1 only) or connects to a
   running one, and updates the browser live: :meth:`Viewer.display`, :meth:`Viewer.animate` (the
   browser plays the motion in real time), :meth:`Viewer.play` (Python steps it in real time),
-  :meth:`Viewer.draw_path`, :meth:`Viewer.draw_targets`, :meth:`Viewer.draw_polylines`.
+  :meth:`Viewer.draw_path`, :meth:`Viewer.draw_targets`, :meth:`Viewer.draw_polylines`,
+  :meth:`Viewer.draw_cell` (a cell's obstacles, and the part the tool carries: :func:`draw_cell`).
 - :func:`export_html` writes ONE self-contained HTML file (meshcat's JavaScript, ~850 KB, and the scene,
   animation included) that renders offline from ``file://``. It needs no server: the scene's commands are
   recorded and replayed synchronously by the page (no ``fetch``, no network request at all).
@@ -57,12 +58,18 @@ from ..limits import MAX_FRAMES, check_count
 from .page import SHARE_GEOMETRY
 
 if TYPE_CHECKING:
+    from ..cell import Cell
+    from ..cell.shapes import Shape
     from ..model import Robot
 
 __all__ = [
+    "CARRIED_COLOR",
+    "CELL_NODE",
+    "OBSTACLE_COLOR",
     "ROBOT_NODE",
     "Viewer",
     "ViewerError",
+    "draw_cell",
     "export_html",
     "read_trajectory_csv",
     "static_html",
@@ -80,6 +87,14 @@ _DEFAULT_FPS = 30
 _PATH_COLOR = 0x1E90FF  # dodger blue: the tool path
 _WORKSPACE_COLOR = 0x2E8B57  # sea green: the workspace boundary
 _GRID_COLOR = 0x8C96A0  # grey blue: the floor grid
+OBSTACLE_COLOR = 0x6A5ACD
+"""Slate blue: a cell's obstacles (drawn three-quarters opaque)."""
+CARRIED_COLOR = 0x20B2AA
+"""Light sea green: the part the tool carries."""
+_CELL_OPACITY = 0.75
+CELL_NODE = "cell"
+"""The cell's obstacles are under ``/meshcat/cell/<obstacle>``; the carried part is under the tool's joint node,
+``<joint node>/cell_carried``, so it moves with the robot."""
 _SERVER_MARK = "scara-pin-meshcat-server"
 """Argument that marks our meshcat server processes (tests find leftovers by it)."""
 
@@ -806,6 +821,7 @@ def _scene(
     draw_tool_path: bool,
     fps: int,
     loop: bool,
+    cell: Cell | None = None,
 ) -> dict[str, Any]:
     """Fill a scene with what :func:`static_html` and :func:`export_html` take; return the page's data.
 
@@ -823,6 +839,8 @@ def _scene(
         scene.draw_path(path_points, "path", _PATH_COLOR)
     if targets is not None:
         scene.draw_targets(targets, "targets")
+    if cell is not None:
+        draw_cell(scene, cell)
     if times is not None:
         t, qq = _motion(robot, times, qs)
         if q is None:
@@ -855,12 +873,14 @@ def static_html(
     fps: int = _DEFAULT_FPS,
     loop: bool = True,
     title: str | None = None,
+    cell: Cell | None = None,
 ) -> str:
     """Make a self-contained HTML page of the robot (no server needed; arguments as :func:`export_html`)."""
     window = _Window()
     scene = _Scene(robot, window)
     data = _scene(
-        scene, q, times, qs, polylines, path_points, targets, draw_tool_path=draw_tool_path, fps=fps, loop=loop
+        scene, q, times, qs, polylines, path_points, targets, draw_tool_path=draw_tool_path, fps=fps, loop=loop,
+        cell=cell,
     )
     return _page(title or f"scara-pin: {robot.name}", window.recorder.commands(), data)
 
@@ -879,6 +899,7 @@ def export_html(
     fps: int = _DEFAULT_FPS,
     loop: bool = True,
     title: str | None = None,
+    cell: Cell | None = None,
 ) -> Path:
     """Write one self-contained HTML page of the robot, that renders offline from ``file://``; atomically.
 
@@ -901,6 +922,7 @@ def export_html(
         fps: the player's samples per second (joint values are interpolated linearly between samples).
         loop: repeat the animation forever (else play it once and hold the last frame).
         title: the page title.
+        cell: a cell whose obstacles (and carried part, on the tool) are drawn (:func:`draw_cell`).
 
     Returns:
         The path written.
@@ -913,11 +935,51 @@ def export_html(
 
     text = static_html(
         robot, q, times, qs, polylines, path_points, targets,
-        draw_tool_path=draw_tool_path, fps=fps, loop=loop, title=title,
+        draw_tool_path=draw_tool_path, fps=fps, loop=loop, title=title, cell=cell,
     )  # fmt: skip
     out = Path(path)
     write_atomic_with(out, lambda handle: handle.write(text))
     return out
+
+
+# ------------------------------------------------------------------------------------------ the cell
+def draw_cell(target: Viewer | _Scene, cell: Cell) -> None:
+    """Draw a cell: its obstacles where they stand, and the part the tool carries on the tool (it moves with it).
+
+    Boxes, spheres and cylinders are meshcat's primitives (a cylinder along its own z axis, as in URDF: Pinocchio's
+    loader turns three.js's y-axis cylinder), meshes their triangles; obstacles in :data:`OBSTACLE_COLOR`, the
+    carried part in :data:`CARRIED_COLOR`. Drawing again replaces the cell drawn before (``/meshcat/cell``).
+
+    Args:
+        target: a live :class:`Viewer`, or the scene of a page being recorded (the teach pendant's).
+        cell: the cell (its shapes in the robot's base frame; the carried part in the tool frame).
+    """
+    scene = target._live() if isinstance(target, Viewer) else target
+    mg = _meshcat().geometry
+    node = scene.vis[CELL_NODE]
+    node.delete()
+    robot = scene.robot
+    tool = robot.model.frames[robot.tool_id]
+    carried_path = f"{scene.paths[tool.parentJoint]}/cell_carried"
+    scene.vis[carried_path].delete()
+    for o in cell.obstacles:
+        material = mg.MeshLambertMaterial(color=OBSTACLE_COLOR, opacity=_CELL_OPACITY, transparent=True)
+        scene.vis[f"{CELL_NODE}/{o.name}"].set_object(_cell_object(o.shape), material)
+        scene.vis[f"{CELL_NODE}/{o.name}"].set_transform((scene.oMb * o.shape.placement()).homogeneous)
+    if cell.carried is not None:
+        material = mg.MeshLambertMaterial(color=CARRIED_COLOR, opacity=1.0)
+        scene.vis[carried_path].set_object(_cell_object(cell.carried), material)
+        scene.vis[carried_path].set_transform((tool.placement * cell.carried.placement()).homogeneous)
+
+
+def _cell_object(shape: Shape) -> Any:
+    """A meshcat geometry of a cell shape, in the shape's own frame."""
+    from pinocchio.visualize.meshcat_visualizer import loadPrimitive
+
+    if shape.kind == "mesh":
+        assert shape.vertices is not None and shape.faces is not None  # noqa: S101 - a mesh shape has them
+        return _meshcat().geometry.TriangularMeshGeometry(shape.vertices, shape.faces)
+    return loadPrimitive(pin.GeometryObject("cell", 0, 0, pin.SE3.Identity(), shape.geometry()))
 
 
 # ------------------------------------------------------------------------------------------ live viewer
@@ -1084,6 +1146,10 @@ class Viewer:
         Drawing again under the same ``name`` replaces them.
         """
         self._live().draw_polylines(polylines, name, z, color)
+
+    def draw_cell(self, cell: Cell) -> None:
+        """Draw a cell's obstacles and the part the tool carries (:func:`draw_cell`)."""
+        draw_cell(self, cell)
 
     def clear(self, name: str) -> None:
         """Remove an overlay drawn under ``name`` ("path", "targets", "workspace", ...)."""

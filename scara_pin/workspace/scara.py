@@ -638,6 +638,7 @@ def plot_workspace(
     units: DisplayUnits = SI,
     robot_name: str | None = None,
     dpi: int = 120,
+    arm: bool = True,
 ) -> Figure:
     """The region in plan view: filled, arcs coloured by their limit, the arm at ``q``, a ray and its hit.
 
@@ -649,6 +650,7 @@ def plot_workspace(
         units: the length unit of the axes (``DisplayUnits("mm")`` for millimetres).
         robot_name: named in the title.
         dpi: resolution of a written PNG.
+        arm: draw the arm (at ``q``).
 
     Returns:
         the matplotlib Figure.
@@ -693,9 +695,10 @@ def plot_workspace(
     a1 = np.array(geo.a1)
     elbow = a1 + geo.l1 * np.array([math.cos(theta), math.sin(theta)])
     wrist = elbow + geo.l2 * np.array([math.cos(theta + gamma), math.sin(theta + gamma)])
-    arm = np.vstack((a1, elbow, wrist))
-    ax.plot(arm[:, 0], arm[:, 1], "-o", color="black", lw=3, ms=6, label="arm")
-    if ws.offset != (0.0, 0.0):  # the tool point at the region's yaw
+    if arm:
+        links = np.vstack((a1, elbow, wrist))
+        ax.plot(links[:, 0], links[:, 1], "-o", color="black", lw=3, ms=6, label="arm")
+    if arm and ws.offset != (0.0, 0.0):  # the tool point at the region's yaw
         tool = wrist + np.array(ws.offset)
         ax.plot([wrist[0], tool[0]], [wrist[1], tool[1]], "-", color="dimgray", lw=2, label="tool offset")
     if ray is not None:
