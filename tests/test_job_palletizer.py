@@ -245,7 +245,7 @@ def test_the_picture_and_the_page_show_the_cell_and_the_growing_stack(run: dict[
         assert shown[b["name"]] == [[b["time"], T + 1.0]]
     held = [[s["t_start"], s["t_end"]] for s in run["json"]["steps"] if s["kind"] in ("pick", "jump", "place")
             and (s["carrying"] or s["kind"] == "place")]  # fmt: skip
-    assert shown["job_carried"] == [[held[i][0], held[i + 2][1]] for i in range(0, len(held), 3)]
+    assert shown["cell_carried"] == [[held[i][0], held[i + 2][1]] for i in range(0, len(held), 3)]
     # in Chromium: each box appears once placed, the part rides on the tool while held
     page.goto(run["html"].as_uri())
     page.evaluate("window.scaraPlayer.pause()")
@@ -258,7 +258,7 @@ def test_the_picture_and_the_page_show_the_cell_and_the_growing_stack(run: dict[
 
     middle_of_second_jump = (run["json"]["steps"][5]["t_start"] + run["json"]["steps"][5]["t_end"]) / 2.0
     seen = visible(middle_of_second_jump)  # carrying box2 to stack[2]: box1 stands
-    assert seen == {"box1": True, **{f"box{i}": False for i in range(2, 7)}, "job_carried": True}
+    assert seen == {"box1": True, **{f"box{i}": False for i in range(2, 7)}, "cell_carried": True}
     seen = visible(T - 0.01)  # back at the conveyor, empty: the six boxes stand
-    assert seen == {**{f"box{i}": True for i in range(1, 7)}, "job_carried": False}
+    assert seen == {**{f"box{i}": True for i in range(1, 7)}, "cell_carried": False}
     assert page.errors == []

@@ -10,8 +10,9 @@ obstacles and the boxes placed, numbered in the order placed. The side view look
 (or the tool path) spread least along: the stack's rows and layers side by side.
 
 :func:`job_page` writes the viewer page (:func:`~scara_pin.viz.meshcat.export_html`'s) that plays the job, with
-the cell's obstacles, the part on the tool while it is held and each box from the moment it is placed (the page's
-player shows a node only over its time spans: ``motion.shown``, ``[{path, spans: [[from, to], ...]}]``).
+the cell drawn by :func:`~scara_pin.viz.meshcat.draw_cell`: the obstacles, the part on the tool while it is held
+and each box from the moment it is placed (the page's player shows a node only over its time spans:
+``motion.shown``, ``[{path, spans: [[from, to], ...]}]``).
 """
 
 from __future__ import annotations
@@ -51,10 +52,8 @@ OBSTACLE_COLOR = "0.78"
 """The cell's obstacles (grey)."""
 BOX_COLOR = "#d9a066"
 """The boxes placed (cardboard)."""
-_PAGE_OBSTACLE = 0x8C96A0
-_PAGE_BOX = 0xD9A066
-_PAGE_CARRIED = 0xE07B39
-_PAGE_NODE = "job_cell"
+_PAGE_BOX = (0.85, 0.63, 0.40)
+"""The boxes on the page (cardboard, as :data:`BOX_COLOR`), RGB in [0, 1]."""
 
 
 def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, robot: Robot,
@@ -203,39 +202,44 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: Robot) -> None
 def job_page(result: JobResult, robot: Robot, path: str | os.PathLike[str], *, rate: float = 200.0) -> None:
     """The viewer page that plays the job: the cell, the part on the tool while held, each box once placed.
 
+    The cell is drawn by :func:`~scara_pin.viz.meshcat.draw_cell` (the job's obstacles, the boxes placed, the
+    part on the tool); the page's player shows each box from the end of its place step and the part while it is
+    held (``motion.shown``).
+
     Args:
         result: the planned job.
         robot: the robot it was planned for.
         path: the HTML file to write (atomically).
         rate: [Hz] the samples handed to the page (it interpolates between them).
     """
-    import pinocchio as pin
-
+    from ..cell import Cell
     from ..files import write_atomic_with
-    from .meshcat import _meshcat, _page, _Scene, _scene, _Window
+    from .meshcat import CELL_NODE, _page, _Scene, _scene, _Window
 
     traj = result.trajectory
     samples = traj.resample(min(rate, 1e5 / max(traj.duration, 1e-9)))
     ends = {s.target: traj.sample(s.t_end)[0] for s in result.steps if s.kind in ("jump", "move", "go")}
     targets = np.array([robot.tool_pose(q) for q in ends.values()]) if ends else None
+    boxes = tuple(b.obstacle for b in result.boxes)
+    cell = None
+    if result.cell is not None or result.boxes or result.carry is not None:
+        base = result.cell if result.cell is not None else Cell(origin="the job's boxes")
+        cell = base.with_obstacles(boxes).with_carried(result.carry if result.carry is not None else base.carried)
     window = _Window()
     scene = _Scene(robot, window)
-    data = _scene(scene, None, samples.t, samples.q, None, None, targets, draw_tool_path=True, fps=30, loop=True)
-    mg = _meshcat().geometry
+    data = _scene(scene, None, samples.t, samples.q, None, None, targets, draw_tool_path=True, fps=30, loop=True,
+                  cell=cell)  # fmt: skip
     T = traj.duration
     shown: list[dict[str, object]] = []
-    if result.cell is not None:
-        for o in result.cell.obstacles:
-            _draw_shape(scene, mg, f"{_PAGE_NODE}/{o.name}", o.shape, scene.oMb, _PAGE_OBSTACLE)
     for b in result.boxes:
-        node = f"{_PAGE_NODE}/boxes/{b.name}"
-        _draw_shape(scene, mg, node, b.shape, scene.oMb, _PAGE_BOX)
+        node = f"{CELL_NODE}/{b.name}"
+        scene.vis[node].set_property("color", [*_PAGE_BOX, 0.9])
         scene.vis[node].set_property("visible", False)
         shown.append({"path": f"meshcat/{node}", "spans": [[b.time, T + 1.0]]})
     if result.carry is not None:
         frame = robot.model.frames[robot.tool_id]
-        node = f"{scene.paths[frame.parentJoint]}/job_carried"
-        _draw_shape(scene, mg, node, result.carry, pin.SE3(frame.placement), _PAGE_CARRIED)
+        node = f"{scene.paths[frame.parentJoint]}/cell_carried"
+        scene.vis[node].set_property("color", [*_PAGE_BOX, 1.0])
         scene.vis[node].set_property("visible", False)
         held = [(s.t_start, s.t_end) for s in result.steps if s.carrying or (s.kind == "place")]
         shown.append({"path": f"meshcat/{node}", "spans": [list(span) for span in _merged(held)]})
@@ -256,23 +260,3 @@ def _merged(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:
         else:
             out.append((t0, t1))
     return out
-
-
-def _draw_shape(scene: Any, mg: Any, node: str, shape: Shape, frameMparent: Any, color: int) -> None:
-    """One shape at ``frameMparent * shape.placement()`` under ``node`` (a cylinder turned: meshcat's is along y)."""
-    import pinocchio as pin
-
-    M = frameMparent * shape.placement()
-    if shape.kind == "box":
-        geometry = mg.Box(list(shape.size))
-    elif shape.kind == "cylinder":
-        geometry = mg.Cylinder(shape.size[1], shape.size[0])
-        M = M * pin.SE3(pin.utils.rotate("x", np.pi / 2), np.zeros(3))
-    elif shape.kind == "sphere":
-        geometry = mg.Sphere(shape.size[0])
-    else:
-        geometry = mg.TriangularMeshGeometry(shape.vertices, shape.faces)
-    material = mg.MeshLambertMaterial(color=color, opacity=0.85, transparent=True)
-    vis = scene.vis[node]
-    vis.set_object(geometry, material)
-    vis.set_transform(M.homogeneous)
