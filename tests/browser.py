@@ -134,3 +134,41 @@ def page(browser: Any) -> Iterator[Any]:
         yield p
     finally:
         p.close()
+
+
+@contextmanager
+def busy_cores(n: int | None = None) -> Iterator[list[Any]]:
+    """``n`` (default: every core) processes spinning at normal priority while the block runs, then killed by pid.
+
+    Yields their ``psutil.Process`` objects, so a test can check they really took the CPU (``cpu_times``).
+    """
+    import subprocess
+    import sys
+
+    import psutil
+
+    procs = []
+    try:
+        for _ in range(n or os.cpu_count() or 2):
+            procs.append(subprocess.Popen([sys.executable, "-c", "while True: pass"]))
+        yield [psutil.Process(p.pid) for p in procs]
+    finally:
+        for p in procs:
+            p.kill()
+        for p in procs:
+            p.wait()
+
+
+SLOW_FRAMES = """(ms) => {
+    // every WebGL frame of meshcat's renderer takes at least ms more on the page's thread (a slow GPU)
+    const renderer = viewer.renderer, render = renderer.render.bind(renderer);
+    window.slowFrames = 0;
+    renderer.render = (scene, camera) => {
+        const t = performance.now();
+        while (performance.now() - t < ms) {}
+        render(scene, camera);
+        window.slowFrames += 1;
+    };
+}"""
+"""Made every frame slow by ``ms`` milliseconds of busy work on the page's main thread; frames counted in
+``window.slowFrames``."""

@@ -1,5 +1,5 @@
-"""Helpers of the pendant tests: the tool pose from Pinocchio (computed here), and the page's rounded readouts read
-back in SI, checking their format."""
+"""Helpers of the pendant tests: the tool pose and a held joint's rate from Pinocchio (computed here), and the
+page's rounded readouts read back in SI, checking their format."""
 
 from __future__ import annotations
 
@@ -51,3 +51,18 @@ def pin_pose(robot: Any, q: np.ndarray) -> np.ndarray:
     """(x, y, z, yaw) of :func:`pin_placement` [m, rad], the yaw as atan2(R[1, 0], R[0, 0])."""
     M = pin_placement(robot, q)
     return np.array([*M.translation, math.atan2(M.rotation[1, 0], M.rotation[0, 0])])
+
+
+def joint_rate(robot: Any, q: np.ndarray, j: int, override: float) -> float:
+    """The hold-to-jog rate of joint j [rad/s]: its velocity limit, or the manual speed of the tool's origin (from
+    Pinocchio's frame Jacobian here: the origin's speed per unit of joint j's rate), times the override (a robot
+    without continuous joints: joint j is column j)."""
+    import pinocchio as pin
+
+    from scara_pin.motion.manual import MANUAL_SPEED
+
+    data = robot.model.createData()
+    pin.computeJointJacobians(robot.model, data, robot.to_pinocchio_q(q))
+    pin.framesForwardKinematics(robot.model, data, robot.to_pinocchio_q(q))
+    J = pin.getFrameJacobian(robot.model, data, robot.model.getFrameId(robot.tool_frame), pin.LOCAL_WORLD_ALIGNED)
+    return override * min(float(robot.limits.velocity[j]), MANUAL_SPEED / float(np.linalg.norm(J[:3, j])))

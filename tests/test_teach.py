@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -18,12 +19,22 @@ import pinocchio as pin
 import pytest
 from pendant_page import pin_placement, readout, resolution
 
-from scara_pin import InvalidInputError, Robot, load_robot
+from scara_pin import InvalidInputError, Robot, load_robot, load_urdf
 from scara_pin.cli import main
 from scara_pin.kinematics.scara import NotScaraError
 from scara_pin.motion.manual import MANUAL_SPEED, JogMotion
 from scara_pin.viz.meshcat import export_html
-from scara_pin.viz.teach import CONTROL_PERIOD, WATCHDOG, JogAxis, JogFrame, Solver, TeachSession
+from scara_pin.viz.teach import (
+    CONTROL_PERIOD,
+    MAX_STEP_ANGLE,
+    MAX_STEP_LENGTH,
+    WATCHDOG,
+    JogAxis,
+    JogFrame,
+    Solver,
+    StopKind,
+    TeachSession,
+)
 from scara_pin.viz.tree import FIELD_OF_VIEW, framing, joint_nodes
 from scara_pin.workspace import workspace
 
@@ -299,6 +310,9 @@ def test_hold_runs_at_the_override_and_stops_at_once_on_release(robot_s1: Robot)
         q = session.q
     released = session.release(4 * CONTROL_PERIOD + 0.03)  # between two ticks: nothing moves after it
     assert not released.moved and not released.holding and not session.holding and released.message == "released"
+    assert released.reason is not None and released.reason.kind is StopKind.RELEASED and released.status == "OK"
+    travelled = np.linalg.norm(pin_placement(robot_s1, q).translation - pin_placement(robot_s1, Q_S1).translation)
+    assert released.travelled == pytest.approx(travelled, abs=1e-12)
     np.testing.assert_array_equal(released.q, q)
     assert session.tick(5 * CONTROL_PERIOD) is None and session.tick(1.0) is None
     np.testing.assert_array_equal(session.q, q)
@@ -329,13 +343,46 @@ def test_the_watchdog_stops_a_hold_the_page_stopped_confirming(robot_s1: Robot) 
         reply = session.tick(t)
         if not np.array_equal(before, session.q):
             moved_until = t
-    assert reply is not None and reply.status == "WATCHDOG" and "did not confirm" in reply.message
+    # it moved, then stopped: "STOPPED" (not a refusal), the watchdog named, how far it went in all
+    assert reply is not None and reply.status == "STOPPED" and reply.reason is not None
+    assert reply.reason.kind is StopKind.WATCHDOG and "did not confirm the held button for 0.300 s" in reply.message
     assert moved_until <= 0.1 + WATCHDOG and t <= 0.1 + WATCHDOG + CONTROL_PERIOD + 1e-12
     q = session.q
+    chord = np.linalg.norm(pin_placement(robot_s1, q).translation - pin_placement(robot_s1, Q_S1).translation)
+    assert reply.travelled == pytest.approx(chord, abs=1e-12) and not reply.angle  # a straight line along -y
     assert session.tick(t + 1.0) is None
     np.testing.assert_array_equal(session.q, q)
-    told = session.alive(t + 1.1)  # the page, back, hears once why the jog stopped
-    assert told.status == "WATCHDOG" and session.alive(t + 1.2).status == "OK"
+    for told in (session.alive(t + 1.1), session.release(t + 1.2), session.state(), session.alive(t + 1.3)):
+        assert told.status == "STOPPED" and told.reason == reply.reason and told.travelled == reply.travelled
+    session.jog(JogAxis.X, 0.001)  # the next move: the hold's end is forgotten
+    assert session.alive(t + 1.4).reason is None and session.state().status == "OK"
+
+
+def test_a_late_tick_waits_for_the_keep_alives(robot_s1: Robot) -> None:
+    """The server did not run for 0.35 s (a busy PC): its late tick neither stops the hold (the keep-alives may be
+    unread in its socket) nor moves; the next one moves by the time since the last move, at most WATCHDOG. A page
+    that is really gone is still stopped, at the first tick on time."""
+    session = TeachSession(robot_s1, Q_S1)
+    session.hold(JogMotion(1, joint=0), 0.1, now=0.0)
+    session.alive(0.04)
+    session.tick(0.05)
+    one_period = session.q[0] - Q_S1[0]  # J1 turns at a constant rate (the tool's speed caps it at a fixed radius)
+    late = session.tick(0.4)
+    assert late is not None and late.holding and not late.moved and session.q[0] == Q_S1[0] + one_period
+    session.alive(0.41)  # the keep-alive that waited
+    session.tick(0.45)
+    assert session.holding
+    # (each period aims at 99.9 % of the speed cap and lands within 0.1 % of that: manual.py's _AIM)
+    assert session.q[0] - Q_S1[0] == pytest.approx(one_period * (1 + WATCHDOG / CONTROL_PERIOD), rel=2e-3)
+
+    gone = TeachSession(robot_s1, Q_S1)
+    gone.hold(JogMotion(1, joint=0), 0.1, now=0.0)
+    gone.tick(0.05)
+    q = gone.q
+    assert gone.tick(0.4) is not None and gone.holding  # late: not judged
+    reply = gone.tick(0.45)
+    assert reply is not None and reply.reason is not None and reply.reason.kind is StopKind.WATCHDOG
+    np.testing.assert_array_equal(gone.q, q)  # no move after the last word from the page + WATCHDOG
 
 
 def test_a_held_jog_ends_on_the_edge(robot_s1: Robot) -> None:
@@ -349,8 +396,80 @@ def test_a_held_jog_ends_on_the_edge(robot_s1: Robot) -> None:
         session.alive(t)
         reply = session.tick(t)
     assert reply is not None and reply.status == "STOPPED" and reply.limit == hit.limit.value
+    assert reply.reason is not None and reply.reason.kind is StopKind.WORKSPACE and hit.description in reply.message
     np.testing.assert_allclose(pin_placement(robot_s1, session.q).translation, hit.point, rtol=0, atol=1e-9)
-    assert session.release(t).status == "STOPPED"  # the release of the page then hears why it stopped
+    assert reply.travelled == pytest.approx(hit.distance, abs=1e-9)  # the whole hold, from start to the edge
+    assert session.release(t).reason == reply.reason  # the release of the page then hears why it stopped
+
+
+THIRD_PARTY = Path(__file__).resolve().parent / "data" / "third_party"
+
+
+def test_stop_reasons_name_the_joints_as_the_file_does() -> None:
+    """A robot whose joints are lift, shoulder, elbow, wrist: the reasons say so (kind, sentence, limit)."""
+    robot = load_urdf(THIRD_PARTY / "irb920_like.urdf")
+    assert robot.joint_names == ("lift", "shoulder", "elbow", "wrist")
+    q0 = np.array([0.05, 0.3, 1.0, 0.2])
+    session = TeachSession(robot, q0)
+    reply = session.jog_joint("elbow", 3.0)
+    upper = robot.limits.upper[2]
+    assert reply.reason is not None and reply.reason.kind is StopKind.JOINT_LIMIT and reply.limit == "elbow_upper"
+    assert reply.message == f"stopped at elbow's upper limit {upper:.9g} rad" and session.q[2] == upper
+    reply = session.jog_joint(2, 0.1)
+    assert reply.status == "AT_EDGE" and reply.message == f"elbow is at its upper limit {upper:.9g} rad"
+    reply = TeachSession(robot, q0).jog(JogAxis.X, 1.0)
+    assert reply.reason is not None and reply.reason.kind is StopKind.WORKSPACE, reply.message
+    assert re.search(r"\b(shoulder|elbow)\b", reply.message) and not re.search(r"\bjoint\d", reply.message)
+
+
+# a length or an angle as a page restates it: "<number> m|rad|deg" or "[a, b] unit"; 0 and "2 pi" need no unit
+NUMBER = r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?"
+WITH_UNIT = re.compile(rf"(?<![\w.])(?:\[{NUMBER}, {NUMBER}\]|{NUMBER}) (?:m|rad|deg|s)(?![\w/])")
+BARE = re.compile(rf"(?<![\w.]){NUMBER}(?![\w.])")
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_quantity_of_a_reason_has_its_unit(shipped: dict[str, Robot], name: str) -> None:
+    """The page shows a reason in its own units by its units (manual.py's contract): every number of every stop's
+    sentence is "<number> <unit>" (m, rad, deg; s for times). The stops: each joint to both limits, each
+    Cartesian axis both ways in both frames to the edge (ray or IK), a second jog at the edge, the watchdog."""
+    robot = shipped[name]
+    q0 = {"s1": Q_S1, "default": np.array([0.4, 1.0, 0.02, 0.3]), "palletizer": np.array([0.3, 0.5, 1.0, 0.2])}[name]
+    reasons = []
+    for sign in (1, -1):
+        for j in range(robot.dof):
+            session = TeachSession(robot, q0)
+            step = MAX_STEP_ANGLE if robot.joint_kinds[j] == "angle" else MAX_STEP_LENGTH
+            reasons += [session.jog_joint(j, sign * step).reason for _ in range(2)]
+        for axis in JogAxis:
+            for frame in JogFrame:
+                session = TeachSession(robot, q0)
+                step = MAX_STEP_ANGLE if axis is JogAxis.YAW else 1.0
+                reasons += [session.jog(axis, sign * step, frame).reason for _ in range(2)]
+    session = TeachSession(robot, q0)
+    session.hold(JogMotion(1, joint=0), 0.1, now=0.0)
+    for k in range(1, 8):  # no word from the page
+        session.tick(k * CONTROL_PERIOD)
+    reasons.append(session.state().reason)
+    texts = [r.text for r in reasons if r is not None]
+    kinds = {r.kind for r in reasons if r is not None}
+    assert {StopKind.JOINT_LIMIT, StopKind.WATCHDOG} <= kinds and kinds & {StopKind.WORKSPACE, StopKind.IK}, kinds
+    for text in texts:
+        rest = WITH_UNIT.sub("", text).replace("2 pi", "")
+        assert [n for n in BARE.findall(rest) if float(n) != 0] == [], text
+        assert not re.search(r"\b[A-Z]{2,}_[A-Z_]+\b", text), text  # no status codes: those are the limit's
+
+
+def test_a_step_shown_to_12_digits_is_the_half_turn(robot_s1: Robot) -> None:
+    """180 deg shown in rad is 3.14159265359, a hair over pi: still a valid largest step (pi itself)."""
+    session = TeachSession(robot_s1, Q_S1)
+    assert float("3.14159265359") > MAX_STEP_ANGLE == math.pi
+    reply = session.jog_joint(3, 3.14159265359)
+    assert reply.moved and session.q[3] == Q_S1[3] + math.pi and reply.requested == math.pi
+    with pytest.raises(InvalidInputError, match="jog step"):
+        session.jog_joint(3, 3.1416)
+    with pytest.raises(InvalidInputError, match="jog step"):
+        session.handle("jog", {"joint": 3, "direction": 1, "step": 3.1416})
 
 
 def test_points_record_rename_go_to_delete_and_file(robot_s1: Robot, tmp_path: Path) -> None:

@@ -25,14 +25,15 @@ from typing import Any
 import numpy as np
 import psutil
 import pytest
-from pendant_page import pin_placement, read_values, readout, resolution
+from browser import SLOW_FRAMES, busy_cores
+from pendant_page import DECIMALS, TO_SI, joint_rate, pin_placement, pin_pose, read_values, readout, resolution
 from sigint import default_sigint
 
 from scara_pin import Robot
 from scara_pin.cli import main
 from scara_pin.motion import plan as plan_module
 from scara_pin.motion.points import parse_points, read_points
-from scara_pin.viz.teach import CONTROL_PERIOD, WATCHDOG
+from scara_pin.viz.teach import CONTROL_PERIOD, KEEPALIVE, WATCHDOG
 from scara_pin.workspace import workspace
 
 Q_S1 = np.array([0.3, 0.9, 0.02, -0.5])
@@ -172,6 +173,15 @@ def click_and_wait(page: Any, selector: str) -> None:
     page.wait_for_function("(n) => window.scaraReplies > n", arg=before)
 
 
+MINUS, DASH = "\u2212", "\u2014"
+
+
+def in_words(si: float, unit: str) -> str:
+    """An SI value as the page's messages show it in ``unit``: the readout's decimals, trailing zeros dropped."""
+    text = f"{si / TO_SI[unit]:.{DECIMALS[unit]}f}".rstrip("0").rstrip(".")
+    return "0" if text == "-0" else text
+
+
 def status_in_view(page: Any, size: tuple[int, int]) -> str:
     """The status line's text, after checking it is inside the viewport and not covered."""
     box = page.locator("#ik-status").bounding_box()
@@ -210,11 +220,11 @@ def test_live_pendant(server: Server, page: Any, robot_s1: Robot, size: tuple[in
     page.fill("#jog-step", "1000")
     click_and_wait(page, "[id='jog-0+']")
     text = status_in_view(page, size)
-    assert text.startswith("STOPPED after ") and hit.description in text, text
+    assert text == f"stopped on the edge: {hit.description} {DASH} moved {in_words(hit.distance, 'mm')} of 1000 mm"
     q_edge = server.q()
     np.testing.assert_allclose(pin_placement(robot_s1, q_edge).translation, hit.point, rtol=0, atol=1e-9)
     click_and_wait(page, "[id='jog-0+']")
-    assert status_in_view(page, size).startswith("refused: AT_EDGE")
+    assert status_in_view(page, size) == f"not moved: on the edge: {hit.description}"
     np.testing.assert_array_equal(server.q(), q_edge)
 
     # a joint jog moves one joint by the step exactly (5 deg, converted as math.radians)
@@ -344,3 +354,179 @@ def test_hold_to_jog_stops_within_one_control_period_of_release(server: Server, 
     assert not server.state()["holding"], time.monotonic() - closed
     time.sleep(2 * CONTROL_PERIOD)
     np.testing.assert_array_equal(server.q(), q)
+
+
+HOLD = 2.0  # [s] each hold of the loaded test
+SLOW_FRAME = 300  # [ms] what the test adds to every frame: longer than the watchdog (250 ms)
+
+
+def set_speed(page: Any, percent: int) -> None:
+    page.evaluate("""(v) => { const s = document.getElementById('speed'); s.value = String(v);
+                    s.dispatchEvent(new Event('input', { bubbles: true })); }""", percent)  # fmt: skip
+
+
+SETTLED = """() => document.querySelector('.jog button.held') === null && !viewer.needs_render
+    && !document.getElementById('ik-status').textContent.startsWith('jogging')"""
+"""The page's hold has ended (released, or ended by the server), its words said and its pose drawn."""
+
+
+def release_and_settle(page: Any, server: Server) -> None:
+    """Let go of the mouse; wait for the hold's end to be said and the pose it stopped at drawn."""
+    page.mouse.up()
+    page.wait_for_function(SETTLED, polling=50)
+    assert not server.state()["holding"]
+
+
+def test_hold_to_jog_holds_on_a_busy_pc_with_slow_frames(server: Server, page: Any, robot_s1: Robot) -> None:
+    """Issue 31: at 1920 x 1080 with SwiftShader, every core busy with other processes and every frame 300 ms slower
+    (longer than the watchdog: a keep-alive that waited for a frame could not hold), six holds of joint1 at 10 %
+    move rate x held time within 10 % (the rate from Pinocchio's Jacobian here, the time the test's own clock);
+    after each, the page says it was released and how far it went, as the server has it, until the next hold."""
+    server.reset()
+    open_page(page, server, (1920, 1080))
+    page.check("input[name=frame][value=joint]")
+    page.check("input[name=jogmode][value=hold]")
+    set_speed(page, 10)
+    page.evaluate(SLOW_FRAMES, SLOW_FRAME)
+    ratios = []
+    with busy_cores() as spinners:
+        start = time.monotonic()
+        for k in range(6):
+            sign = 1 if k % 2 == 0 else -1
+            q0 = server.q()
+            page.hover("[id='jog-0+']" if sign > 0 else "[id='jog-0-']")
+            t0 = time.monotonic()
+            page.mouse.down()
+            time.sleep(max(0.0, HOLD - (time.monotonic() - t0)))
+            held = time.monotonic() - t0
+            release_and_settle(page, server)
+            moved = sign * (server.q()[0] - q0[0])
+            ratios.append(moved / (joint_rate(robot_s1, q0, 0, 0.1) * held))
+            said = f"released joint1 {'+' if sign > 0 else MINUS} {DASH} moved {in_words(moved, 'deg')} deg"
+            assert status_in_view(page, (1920, 1080)) == said
+        busy = [p.cpu_times().user / (time.monotonic() - start) for p in spinners]
+    said = page.inner_text("#ik-status")
+    time.sleep(5 * KEEPALIVE)  # the reason stays: answers to late keep-alives, if any, change nothing
+    assert page.inner_text("#ik-status") == said
+    assert all(abs(r - 1) <= 0.1 for r in ratios), ratios
+    assert min(busy) > 0.05, busy  # the other processes did run (each a share of a core)
+    assert page.evaluate("() => window.slowFrames") >= 6  # the (slow) view was drawn: at least once per hold
+    assert page.errors == []
+
+
+def held_for(page: Any, server: Server, button: str, seconds: float) -> None:
+    """Press ``button`` for ``seconds`` and let go (the page answers the release)."""
+    page.hover(button)
+    releases = page.evaluate("() => window.scaraReleases || 0")
+    page.mouse.down()
+    time.sleep(seconds)
+    page.mouse.up()
+    page.wait_for_function("(n) => (window.scaraReleases || 0) > n", arg=releases, polling=50)
+
+
+def test_why_a_held_jog_stopped_stays_until_the_next_action(server: Server, page: Any, robot_s1: Robot) -> None:
+    """Issue 31 items 1 and 6: the reason a held jog stopped, in the page's units, stays on screen (held on the edge,
+    released, units switched) until the user's next action; a jog the watchdog stopped after it moved says
+    "stopped", never "refused"."""
+    upper = float(robot_s1.limits.upper[0])
+    q0 = np.array([upper - math.radians(3), *Q_S1[1:]])
+    server.reset(q0)
+    open_page(page, server, (1920, 1080))
+    page.check("input[name=frame][value=joint]")
+    page.check("input[name=jogmode][value=hold]")
+    set_speed(page, 100)
+    page.hover("[id='jog-0+']")
+    page.mouse.down()  # J1 reaches its limit within one control period; the button is still held
+    page.wait_for_function("() => document.querySelector('.jog button.held') === null", polling=50)
+    said = f"stopped at joint1's upper limit {in_words(upper, 'deg')} deg {DASH} moved {in_words(upper - q0[0], 'deg')}"
+    said += " deg"
+    assert status_in_view(page, (1920, 1080)) == said
+    for _ in range(3):  # held on the edge for 6 keep-alive periods, then released: the same words
+        time.sleep(2 * KEEPALIVE)
+        assert page.inner_text("#ik-status") == said
+    page.mouse.up()
+    time.sleep(2 * KEEPALIVE)
+    assert page.inner_text("#ik-status") == said
+    assert server.q()[0] == upper and not server.state()["holding"]
+    page.check("input[name=units][value=m]")  # restated in m and rad
+    assert page.inner_text("#ik-status") == (f"stopped at joint1's upper limit {in_words(upper, 'rad')} rad {DASH} "
+                                             f"moved {in_words(upper - q0[0], 'rad')} rad")  # fmt: skip
+    page.check("input[name=units][value=mm]")
+    assert page.inner_text("#ik-status") == said
+    page.check("input[name=jogmode][value=step]")  # the next action: its own words
+    page.fill("#jog-step-angle", "5")
+    click_and_wait(page, "[id='jog-0-']")
+    assert page.inner_text("#ik-status") == f"jogged joint1 {MINUS} 5 deg"
+
+    # the page's keep-alives held up on the way: the server's watchdog stops the jog, after it moved
+    server.reset()
+    page.check("input[name=jogmode][value=hold]")
+    set_speed(page, 10)
+    page.route("**/api/alive", lambda route: None)  # never answered, never passed on
+    try:
+        held_for(page, server, "[id='jog-0-']", 3 * WATCHDOG)
+    finally:
+        page.unroute("**/api/alive")
+    moved = Q_S1[0] - server.q()[0]
+    text = status_in_view(page, (1920, 1080))
+    assert re.fullmatch(r"stopped by the watchdog: the page did not confirm the held button for 0\.\d{3} s "
+                        rf"\(> {WATCHDOG} s\) {DASH} moved {re.escape(in_words(moved, 'deg'))} deg", text), text
+    assert moved > 0 and not server.state()["holding"]
+    assert page.errors == []
+
+
+def test_the_pendants_words(server: Server, page: Any, robot_s1: Robot) -> None:
+    """Issue 31 item 6: no jargon; a typed step keeps its meaning across the units switch (180 deg is a valid half
+    turn in rad too); the server's refusals in the page's units; recording a point is confirmed where it is seen."""
+    server.reset()
+    for point in server.state()["points"]:  # a clean list
+        server.call("POST", "/api/points/delete", {"name": point["name"]})
+    open_page(page, server, VIEWPORTS[0])
+    seen = [status_in_view(page, VIEWPORTS[0])]
+    assert seen[0] == "ready: jog, go to a pose or record points"
+
+    # 180 deg, switched to rad, shows 12 digits (3.14159265359 > pi) but still jogs by pi itself
+    page.check("input[name=frame][value=joint]")
+    page.fill("#jog-step-angle", "180")
+    page.check("input[name=units][value=m]")
+    assert page.input_value("#jog-step-angle") == "3.14159265359"
+    click_and_wait(page, "[id='jog-3+']")
+    assert server.q()[3] == Q_S1[3] + math.radians(180)
+    seen.append(status_in_view(page, VIEWPORTS[0]))
+    assert seen[-1] == f"jogged joint4 + {in_words(math.pi, 'rad')} rad"
+    page.check("input[name=units][value=mm]")
+    assert page.input_value("#jog-step-angle") == "180"
+    assert page.inner_text("#ik-status") == "jogged joint4 + 180 deg"  # restated in deg
+    click_and_wait(page, "[id='jog-3-']")
+    assert server.q()[3] == Q_S1[3] + math.radians(180) - math.radians(180)
+    seen.append(page.inner_text("#ik-status"))
+
+    # a refusal of the server, its lengths in mm: s1 reaches l1 + l2 = 0.05 + 0.15 m
+    for name, value in (("x", "1000"), ("y", "0"), ("z", "80"), ("yaw", "0")):
+        page.fill(f"#goto-{name}", value)
+    click_and_wait(page, "#goto-submit")
+    seen.append(status_in_view(page, VIEWPORTS[0]))
+    assert seen[-1].startswith("refused: out of reach: ") and "l1 + l2 = 200 mm" in seen[-1], seen[-1]
+    page.fill("#goto-x", "100")
+    page.fill("#goto-z", "500")  # above the stroke: an interval, in mm too
+    click_and_wait(page, "#goto-submit")
+    seen.append(status_in_view(page, VIEWPORTS[0]))
+    assert seen[-1].endswith("needs joint3 = -400 mm, outside its stroke [0, 100] mm"), seen[-1]
+
+    # a recorded point: its name and pose (Pinocchio's FK here) in the status line, its row marked and in view
+    page.evaluate("() => { document.getElementById('pendant').scrollTop = 0; }")
+    click_and_wait(page, "#record")
+    x, y, z, yaw = pin_pose(robot_s1, server.q())
+    seen.append(status_in_view(page, VIEWPORTS[0]))
+    assert seen[-1] == (f"recorded P1 at x {in_words(x, 'mm')}, y {in_words(y, 'mm')}, z {in_words(z, 'mm')} mm, "
+                        f"yaw {in_words(yaw, 'deg')} deg")  # fmt: skip
+    row = page.locator("#points tr.recorded")
+    assert row.get_attribute("data-point") == "P1" and row.is_visible()
+    box = row.bounding_box()
+    assert box is not None and 0 <= box["y"] and box["y"] + box["height"] <= VIEWPORTS[0][1], box
+
+    for text in seen:  # no "OK (none)", no status codes, no SI lengths or angles on a mm/deg page
+        assert not re.search(r"\bOK\b|\(none\)|\b[A-Z]{2,}_[A-Z_]+\b", text), text
+    for text in seen[:1] + seen[2:]:  # (seen[1] was said on the m, rad page)
+        assert not re.search(r"\d (m|rad)\b", text), text
+    assert page.errors == []

@@ -200,11 +200,11 @@ class PalletizerGeometry:
         return (a, b) if a <= b else (b, a)
 
     def outside(self, i: int, t: float, label: str = "") -> str:
-        """``joint3 = 1.2 rad (up) (+2 pi k) is outside [lo, hi]``: canonical ``t`` as the file's joint ``i``."""
+        """``joint3 = 1.2 rad (up) (+2 pi k) is outside [lo, hi] rad``: canonical ``t`` as the file's joint ``i``."""
         lo, hi = self.user_limits(i)
         value = wrap(self.signs[i] * (t - self.offsets[i]))
         return (f"{self.names[i]} = {value:.9g} rad{f' ({label})' if label else ''} (+2 pi k) is outside "
-                f"[{lo:.9g}, {hi:.9g}]")  # fmt: skip
+                f"[{lo:.9g}, {hi:.9g}] rad")  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------ conventions

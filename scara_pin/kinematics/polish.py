@@ -163,9 +163,9 @@ def _polish_one(robot: Robot, geo: ScaraGeometry, sol: IKSolution, task: np.ndar
                                       else ((min(max(v, lo), hi), 0, 0) if lo - LIMIT_TOL <= v <= hi + LIMIT_TOL
                                             else None))  # fmt: skip
         if fit is None:
-            turn = "" if i == geo.prismatic else " (+2 pi k)"
-            return _limit_status(geo, i), (f"{label}: {geo.names[i]} = {v:.9g}{turn} outside [{lo:.9g}, {hi:.9g}] "
-                                           "once refined on the model")  # fmt: skip
+            unit, turn = ("m", "") if i == geo.prismatic else ("rad", " (+2 pi k)")
+            return _limit_status(geo, i), (f"{label}: {geo.names[i]} = {v:.9g} {unit}{turn} outside [{lo:.9g}, "
+                                           f"{hi:.9g}] {unit} once refined on the model")  # fmt: skip
         q[i] = fit[0]
         turns.append(None if cont else (fit[1], fit[2]))
     return IKSolution(q, label, sol.singular, tuple(turns))

@@ -172,7 +172,7 @@ def _branches(
     worst = max(failures, key=lambda f: _STAGE[f[0]])
     # the sentences are written only now, when no branch solves (the nearest path often drops a failure)
     names = geo.names
-    why = [f"{label}: {names[j]} = {wrap(v):.9g} rad (+2 pi k) outside [{lo[j]:.9g}, {hi[j]:.9g}]"
+    why = [f"{label}: {names[j]} = {wrap(v):.9g} rad (+2 pi k) outside [{lo[j]:.9g}, {hi[j]:.9g}] rad"
            for _, (label, j, v) in failures]  # fmt: skip
     return [], (worst[0], "no solution inside the joint limits: " + "; ".join(why))
 

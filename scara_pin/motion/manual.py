@@ -30,6 +30,12 @@ limit times the override for joint jogs. Whatever is jogged, each period's step 
 moves faster than its velocity limit times the override and the tool frame's origin no faster than
 :data:`MANUAL_SPEED` times the override (measured over the period: near a singularity the tool slows down).
 No acceleration ramp is simulated: a hold starts and stops at once.
+
+Why it stopped (:class:`StopReason`): a kind (:class:`StopKind`: a joint limit, an edge of the workspace, the
+IK's refusal, a singularity; for a hold also the release and the watchdog), a sentence, and the machine name
+of the limit. Every length or angle in the sentence is written ``<number> <unit>`` with the unit m, rad or deg
+(``2.30383461 rad``, ``0.002 m``, the workspace's ``132 deg``; an interval ``[a, b] m``), so that a page shown
+in other units can restate it in its own.
 """
 
 from __future__ import annotations
@@ -64,6 +70,8 @@ __all__ = [
     "JogOutcome",
     "PoseAnswer",
     "Solver",
+    "StopKind",
+    "StopReason",
     "hold_advance",
     "jog_step",
     "pose_ik",
@@ -124,6 +132,46 @@ class JogOutcome(enum.Enum):
     REFUSED = "REFUSED"  # did not move: the request cannot be carried out (the status says why)
 
 
+class StopKind(enum.Enum):
+    """What stopped a jog short (or kept it from moving), or ended a hold-to-jog."""
+
+    JOINT_LIMIT = "joint-limit"  # a joint's position limit (a joint jog)
+    WORKSPACE = "workspace"  # an edge of the exact workspace: an arc of a joint limit or a singular pose, a stroke end
+    IK = "ik"  # the IK refuses just beyond (its status code is the limit)
+    SINGULAR = "singular"  # too close to a singularity to move at the jog's speed
+    RELEASED = "released"  # a hold: the button was released
+    WATCHDOG = "watchdog"  # a hold: the page stopped confirming the held button
+    ERROR = "error"  # a hold: the advance raised (the message says what)
+
+
+@dataclass(frozen=True)
+class StopReason:
+    """Why a jog stopped, in words and as data.
+
+    Attributes:
+        kind: what kind of thing stopped it.
+        text: the sentence (``stopped at joint1's upper limit 2.30383461 rad``); each length or angle written
+            ``<number> <unit>`` (m, rad or deg), which a page restates in its units.
+        limit: the machine name of what stopped it: a joint limit (``joint2_upper``), a workspace
+            :class:`~scara_pin.workspace.Limit` value (``outer``), an IK status code (``JOINT_LIMIT``); "" for none.
+    """
+
+    kind: StopKind
+    text: str
+    limit: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.kind, StopKind):
+            raise InvalidInputError(f"stop kind {self.kind!r} must be a StopKind")
+
+    def __str__(self) -> str:
+        return self.text
+
+    def to_json(self) -> dict[str, str]:
+        """``{"kind", "text", "limit"}`` (the kind's value: ``joint-limit``, ``workspace``, ...)."""
+        return {"kind": self.kind.value, "text": self.text, "limit": self.limit}
+
+
 @dataclass(frozen=True)
 class JogMotion:
     """What a jog moves.
@@ -177,9 +225,7 @@ class JogMove:
         q: the joint values after it [rad, m] (the start when it did not move).
         outcome: how it ended.
         status: ``"OK"``, ``"STOPPED"``, ``"AT_EDGE"``, or the code of the refusal (an IK status name).
-        message: what stopped or refused it ("" for a whole step).
-        limit: what stopped it: a joint limit (``joint2_upper``), a workspace :class:`~scara_pin.workspace.Limit`
-            value (``outer``), or the IK's refusal code beyond the stop; "" when nothing did.
+        reason: what stopped or refused it (None for a whole step).
         travelled: how far it moved along the motion [m or rad] (>= 0).
         requested: the step asked for [m or rad] (> 0).
         solver: what answered the last IK.
@@ -188,8 +234,7 @@ class JogMove:
     q: np.ndarray
     outcome: JogOutcome
     status: str
-    message: str
-    limit: str
+    reason: StopReason | None
     travelled: float
     requested: float
     solver: Solver
@@ -198,6 +243,16 @@ class JogMove:
     def moved(self) -> bool:
         """Whether q changed."""
         return self.outcome in (JogOutcome.OK, JogOutcome.STOPPED)
+
+    @property
+    def message(self) -> str:
+        """The reason's sentence ("" for a whole step)."""
+        return "" if self.reason is None else self.reason.text
+
+    @property
+    def limit(self) -> str:
+        """What stopped it (the reason's limit; "" when nothing did)."""
+        return "" if self.reason is None else self.reason.limit
 
 
 # ------------------------------------------------------------------------------------------ IK
@@ -261,20 +316,19 @@ def _joint_step(robot: Robot, q0: np.ndarray, j: int, sign: int, length: float) 
     q = q0.copy()
     q[j] = q0[j] + sign * length
     if robot.continuous[j]:
-        return JogMove(q, JogOutcome.OK, "OK", "", "", length, length, Solver.NONE)
+        return JogMove(q, JogOutcome.OK, "OK", None, length, length, Solver.NONE)
     name = robot.joint_names[j]
     side, bound = ("upper", robot.limits.upper[j]) if sign > 0 else ("lower", robot.limits.lower[j])
     if (q[j] <= bound) if sign > 0 else (q[j] >= bound):
-        return JogMove(q, JogOutcome.OK, "OK", "", "", length, length, Solver.NONE)
+        return JogMove(q, JogOutcome.OK, "OK", None, length, length, Solver.NONE)
     unit = "rad" if robot.joint_kinds[j] == "angle" else "m"
     room = (bound - q0[j]) * sign
     if not room > 0:
-        return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value,
-                       f"{name} is at its {side} limit {bound:.9g} {unit}", f"{name}_{side}", 0.0, length,
-                       Solver.NONE)  # fmt: skip
+        reason = StopReason(StopKind.JOINT_LIMIT, f"{name} is at its {side} limit {bound:.9g} {unit}", f"{name}_{side}")
+        return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, reason, 0.0, length, Solver.NONE)
     q[j] = bound
-    return JogMove(q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, f"stopped at {name}'s {side} limit {bound:.9g} "
-                   f"{unit}", f"{name}_{side}", float(room), length, Solver.NONE)  # fmt: skip
+    reason = StopReason(StopKind.JOINT_LIMIT, f"stopped at {name}'s {side} limit {bound:.9g} {unit}", f"{name}_{side}")
+    return JogMove(q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, float(room), length, Solver.NONE)
 
 
 def direction(robot: Robot, q: np.ndarray, motion: JogMotion) -> np.ndarray:
@@ -310,8 +364,8 @@ def _cartesian_step(robot: Robot, q0: np.ndarray, motion: JogMotion, length: flo
         hit = _ray(robot, q0, pose0, d[:3], ws)
         if hit is not None and hit.distance < length:
             if hit.distance <= _EDGE:
-                return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, f"on the edge: {hit.description}",
-                               hit.limit.value, 0.0, length, Solver.NONE)  # fmt: skip
+                reason = StopReason(StopKind.WORKSPACE, f"on the edge: {hit.description}", hit.limit.value)
+                return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, reason, 0.0, length, Solver.NONE)
             end = hit.distance
         else:
             hit = None
@@ -332,11 +386,11 @@ def _cartesian_step(robot: Robot, q0: np.ndarray, motion: JogMotion, length: flo
         last_s, last_q, solver = s, answer.q, answer.solver
     else:
         if hit is None:
-            return JogMove(last_q, JogOutcome.OK, "OK", "", "", length, length, solver)
+            return JogMove(last_q, JogOutcome.OK, "OK", None, length, length, solver)
         here = _at_limits(robot, last_q)  # which joints the robot has at a limit there (the edge may have two names)
         message = f"stopped on the edge: {hit.description}" + (f" (here {', '.join(here)})" if here else "")
-        return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, message, hit.limit.value, end, length,
-                       solver)  # fmt: skip
+        reason = StopReason(StopKind.WORKSPACE, message, hit.limit.value)
+        return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, end, length, solver)
     # the first refused sample: bisect between the last reachable one and it
     lo, hi, refusal = last_s, s, answer
     while hi - lo > BISECT_TOL:
@@ -347,11 +401,12 @@ def _cartesian_step(robot: Robot, q0: np.ndarray, motion: JogMotion, length: flo
         else:
             lo, last_q, solver = mid, answer.q, answer.solver
     if lo == 0.0:
-        return JogMove(q0, JogOutcome.AT_EDGE, refusal.status, refusal.message, refusal.status, 0.0, length,
-                       refusal.solver)  # fmt: skip
-    return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value,
-                   f"stopped where the IK stops; just beyond: {refusal.status}: {refusal.message}", refusal.status, lo,
-                   length, solver)  # fmt: skip
+        reason = StopReason(StopKind.IK, refusal.message, refusal.status)
+        return JogMove(q0, JogOutcome.AT_EDGE, refusal.status, reason, 0.0, length, refusal.solver)
+    words = refusal.status.lower().replace("_", " ")  # OUT_OF_REACH: out of reach (the code stays in limit)
+    reason = StopReason(StopKind.IK, f"stopped where the IK stops; just beyond: {words}: {refusal.message}",
+                        refusal.status)  # fmt: skip
+    return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, lo, length, solver)
 
 
 def _at_limits(robot: Robot, q: np.ndarray) -> list[str]:
@@ -454,8 +509,8 @@ def hold_advance(
     if best is not None:
         return best
     lo, hi = 0.0, move.travelled / ratio
-    good = JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, "too close to a singularity to move at the "
-                   "jog's speed", "singular", 0.0, length, Solver.NONE)  # fmt: skip
+    singular = StopReason(StopKind.SINGULAR, "too close to a singularity to move at the jog's speed", "singular")
+    good = JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, singular, 0.0, length, Solver.NONE)
     for _ in range(20):  # to a millionth of the step
         mid = 0.5 * (lo + hi)
         trial = jog_step(robot, q0, motion, mid, ws=ws)

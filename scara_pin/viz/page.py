@@ -62,6 +62,7 @@ input[aria-invalid=true] { outline: 2px solid #b3261e; }
 #points { width: 100%; border-collapse: collapse; font-size: 12px; }
 #points td { padding: 1px 2px; vertical-align: middle; }
 #points td.pose { font: 11px ui-monospace, monospace; color: #3a4450; }
+#points tr.recorded td { background: #d9f2df; }
 #points input { width: 5.5em; }
 .row { display: flex; gap: 4px; flex-wrap: wrap; align-items: center; margin: 4px 0; }
 #player { display: flex; gap: 6px; align-items: center; }

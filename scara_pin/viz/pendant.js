@@ -33,6 +33,9 @@
     return s;
   }
   function unitOf(kind) { return kind === "angle" ? angleUnit() : lengthUnit(); }
+  // in words: the readout's rounding, trailing zeros dropped ("132", "24.783"), and with its unit
+  function number(v, kind) { return String(Number(fmt(v, kind))); }
+  function amount(v, kind) { return number(v, kind) + " " + unitOf(kind); }
   var POSE_KINDS = ["length", "length", "length", "angle"];
   function jointKind(index) {
     for (var i = 0; i < data.sliders.length; i++) {
@@ -188,28 +191,33 @@
     if (lastPose) showPose(lastPose);
     if (lastQ) showJoints(lastQ);
     syncSliders();
-    if (teach) { relabelJog(); showPoints(lastPoints); }
+    if (teach) { relabelJog(); showPoints(lastPoints); showStatus(); }
   }
+  // A step field keeps the SI value it stands for: the switch shows it in the new unit (12 digits), and a jog
+  // sent while the field still shows that text sends the SI value itself, not the rounded text read back
+  // (180 deg is pi, not 3.14159265359 > pi). Typing in the field forgets it.
+  var STEP_FIELDS = [["jog-step", "length"], ["jog-step-angle", "angle"]];
   Array.prototype.forEach.call(document.querySelectorAll("input[name=units]"), function (radio) {
     radio.addEventListener("change", function () {
       if (!radio.checked) return;
-      var before = units;
+      var steps = STEP_FIELDS.map(function (pair) { var input = $(pair[0]); return input ? typedStep(input, pair[1]) : null; });
       units = radio.value;
-      // the typed steps keep their meaning: converted to the new unit
-      [["jog-step", "length"], ["jog-step-angle", "angle"]].forEach(function (pair) {
-        var input = $(pair[0]);
-        if (!input) return;
-        var v = Number(input.value);
-        if (input.value.trim() !== "" && isFinite(v)) {
-          units = before;
-          var si = fromUnit(v, pair[1]);
-          units = radio.value;
-          input.value = String(Number(toUnit(si, pair[1]).toPrecision(12)));
-        }
+      STEP_FIELDS.forEach(function (pair, i) {
+        var input = $(pair[0]), si = steps[i];
+        if (!input || si === null) return;
+        input.value = String(Number(toUnit(si, pair[1]).toPrecision(12)));
+        input.dataset.si = String(si);
+        input.dataset.shown = input.value;
       });
       relabel();
     });
   });
+  // the SI value a step field stands for (null when it is not a finite number)
+  function typedStep(input, kind) {
+    if (input.dataset.shown !== undefined && input.value === input.dataset.shown) return Number(input.dataset.si);
+    var text = input.value.trim(), v = Number(text);
+    return text !== "" && isFinite(v) ? fromUnit(v, kind) : null;
+  }
 
   // --------------------------------------------------------------- meshcat's controls
   var showControls = $("show-controls");
@@ -222,11 +230,36 @@
 
   // --------------------------------------------------------------- live teach page
   var chain = Promise.resolve(), pendingQ = false;
-  function say(text, kind) {
-    var status = $("ik-status");
-    status.textContent = text;
-    status.className = kind;
+
+  // Words. A sentence of the server writes each length or angle "<number> m", "rad" or "deg" (SI, or the
+  // workspace's degrees): shown in the page's units, rounded to the readouts' resolution, zeros dropped.
+  var NUMBER = "-?\\d+(?:\\.\\d+)?(?:e[-+]?\\d+)?";
+  var QUANTITY = new RegExp("(?<![\\w.])(?:\\[(" + NUMBER + "), (" + NUMBER + ")\\]|(" + NUMBER + ")) (m|rad|deg)(?![\\w/^\u00b2])", "g");
+  function localise(text) {
+    return String(text).replace(QUANTITY, function (all, lo, hi, one, unit) {
+      var kind = unit === "m" ? "length" : "angle", scale = unit === "deg" ? DEG : 1;
+      var show = function (v) { return number(Number(v) * scale, kind); };
+      return (one !== undefined ? show(one) : "[" + show(lo) + ", " + show(hi) + "]") + " " + unitOf(kind);
+    });
   }
+  function code(status) { return String(status).toLowerCase().replace(/_/g, " "); }  // OUT_OF_REACH: out of reach
+
+  // The status line: the answer to the last thing the user did. It is a function of the page's units (the
+  // switch restates it) and stays until the user's next action: answers to the page's own requests (the
+  // keep-alive of a held button) never replace a reason a jog stopped.
+  var status = function () { return ["-", ""]; };
+  function showStatus() {
+    var said = status(), line = $("ik-status");
+    line.textContent = said[0];
+    line.className = said[1];
+  }
+  function say(text, kind) { status = function () { return [typeof text === "function" ? text() : text, kind]; }; showStatus(); }
+  function travel(r) { return amount(r.travelled, r.angle ? "angle" : "length"); }
+  function refusal(r) {
+    if (r.error) return ["refused: " + localise(r.error), "refused"];
+    return ["refused: " + code(r.status) + ": " + localise(r.message), "refused"];
+  }
+
   function request(route, body) {
     return fetch(teach.api + route, {
       method: body === null ? "GET" : "POST",
@@ -234,24 +267,24 @@
       body: body === null ? undefined : JSON.stringify(body),
     }).then(function (r) { return r.json(); });
   }
-  function post(route, body) {
+  // post one request after the earlier ones; words(r) -> [text, class] (null: the status line is kept)
+  function post(route, body, words) {
+    if (words) recorded = null;
     chain = chain.then(function () {
-      return request(route, body).then(applyReply).catch(function (err) {
+      return request(route, body).then(function (r) {
+        applyReply(r);
+        if (words) status = function () { return r.error ? refusal(r) : words(r); };
+        if (words) showStatus();
+        return r;
+      }).catch(function (err) {
         say("no answer from the server: " + err, "refused");
       });
     });
     return chain;
   }
-  function travelled(r) {
-    var kind = r.angle ? "angle" : "length";
-    return fmt(r.travelled, kind) + " of " + fmt(r.requested, kind) + " " + unitOf(kind);
-  }
   function applyReply(r) {
     window.scaraReplies = (window.scaraReplies || 0) + 1;
-    if (r.error) {
-      say("error: " + r.error, "refused");
-      return r;
-    }
+    if (r.error) return r;
     q = r.q.slice();
     syncSliders();
     applyQ();
@@ -259,21 +292,16 @@
     showJoints(r.q);
     $("branch-now").textContent = r.branch || "-";
     if (r.points) showPoints(r.points);
-    if (r.status === "STOPPED") {
-      say("STOPPED after " + travelled(r) + ": " + r.message, "stopped");
-    } else if (r.moved || r.status === "OK") {
-      say(r.message ? "OK: " + r.message : "OK (" + r.solver + ")", "ok");
-    } else {
-      say("refused: " + r.status + ": " + r.message, "refused");
-    }
-    if (hold && !r.holding && hold.started) endHold(false);
     return r;
   }
   function sendQ() {
     if (pendingQ) return;
     pendingQ = true;
     chain = chain.then(function () { pendingQ = false; });
-    post("/q", { q: q.slice() });
+    if (hold) endHold(true);
+    post("/q", { q: q.slice() }, function (r) {
+      return r.moved ? ["moved to the sliders' joint values", "ok"] : refusal(r);
+    });
   }
 
   // the jog grid: rows are J1..J4 (joint frame) or x, y, z, rz (base and tool frames)
@@ -283,34 +311,41 @@
     if (jogFrame() === "joint") return jointKind(row);
     return row === 3 ? "angle" : "length";
   }
+  function rowLabel(row) {
+    if (jogFrame() === "joint") return data.sliders[row] ? data.sliders[row].name : "J" + (row + 1);
+    return ["x", "y", "z", "rz"][row];
+  }
   function relabelJog() {
     for (var i = 0; i < 4; i++) {
-      var label = jogFrame() === "joint" ? (data.sliders[i] ? data.sliders[i].name : "J" + (i + 1))
-        : ["x", "y", "z", "rz"][i];
+      var label = rowLabel(i);
       $("jog-label-" + i).textContent = label;
       $("jog-" + i + "-").textContent = label + " \u2212";
       $("jog-" + i + "+").textContent = label + " +";
       $("jog-" + i + "-").disabled = $("jog-" + i + "+").disabled = jogFrame() === "joint" && !data.sliders[i];
     }
   }
+  // what a jog moves, in words: "joint2 +", "x \u2212"; and " in the tool frame" for a jog along the tool's axes
+  function jogName(row, sign) { return rowLabel(row) + " " + (sign > 0 ? "+" : "\u2212"); }
+  function frameWords() { return jogFrame() === "tool" ? " in the tool frame" : ""; }
   // the step of a row's kind, in SI, or null after saying why in the status line (nothing is sent)
   function stepFor(kind) {
     var input = kind === "angle" ? $("jog-step-angle") : $("jog-step");
     var range = kind === "angle" ? teach.step_angle : teach.step_length;
-    var text = input.value.trim(), v = Number(text);
-    var lo = toUnit(range[0], kind), hi = toUnit(range[1], kind);
-    var ok = text !== "" && isFinite(v) && v > 0;
-    var si = ok ? fromUnit(v, kind) : NaN;
-    ok = ok && si >= range[0] * (1 - 1e-12) && si <= range[1];
+    var text = input.value.trim(), si = typedStep(input, kind);
+    // the ends with the server's tolerance (STEP_TOL): the 12 digits a switched step shows are inside
+    var ok = si !== null && si >= range[0] * (1 - teach.step_tol) && si <= range[1] * (1 + teach.step_tol);
     input.setAttribute("aria-invalid", ok ? "false" : "true");
     if (!ok) {
       var shown = text !== "" ? "'" + text + "'" : (input.validity.badInput ? "not a number" : "empty");
-      say("refused: the step for " + (kind === "angle" ? "angles" : "lengths") + " is " + shown + "; it must be a " +
-        "number from " + Number(lo.toPrecision(6)) + " to " + Number(hi.toPrecision(6)) + " " + unitOf(kind) +
-        " (the + and \u2212 buttons give the sense)", "refused");
+      say(function () {
+        var lo = toUnit(range[0], kind), hi = toUnit(range[1], kind);
+        return "refused: the step for " + (kind === "angle" ? "angles" : "lengths") + " is " + shown + "; it must " +
+          "be a number from " + Number(lo.toPrecision(6)) + " to " + Number(hi.toPrecision(6)) + " " + unitOf(kind) +
+          " (the + and \u2212 buttons give the sense)";
+      }, "refused");
       return null;
     }
-    return si;
+    return Math.min(si, range[1]);
   }
   function motionBody(row, sign) {
     var body = { direction: sign };
@@ -318,37 +353,132 @@
     else { body.axis = ["x", "y", "z", "yaw"][row]; body.frame = jogFrame(); }
     return body;
   }
+  // how a jog that did not go the whole way ended: the reason in the page's units, and how far it went
+  function stopped(r, of) {
+    var reason = localise(r.reason ? r.reason.text : r.message);
+    if (!(r.travelled > 0)) return ["not moved: " + reason, "stopped"];
+    var kind = r.angle ? "angle" : "length";
+    var moved = of ? number(r.travelled, kind) + " of " + amount(r.requested, kind) : travel(r);
+    return [reason + " \u2014 moved " + moved, "stopped"];
+  }
   function jogStep(row, sign) {
     var kind = rowKind(row), step = stepFor(kind);
     if (step === null) return;
-    var body = motionBody(row, sign);
+    if (hold) endHold(true);
+    var body = motionBody(row, sign), name = jogName(row, sign), frame = frameWords();
     body.step = step;
-    post("/jog", body).then(function () { window.scaraJogs = (window.scaraJogs || 0) + 1; });
+    post("/jog", body, function (r) {
+      if (r.status === "OK" && r.moved) return ["jogged " + name + " " + travel(r) + frame, "ok"];
+      return stopped(r, true);
+    }).then(function () { window.scaraJogs = (window.scaraJogs || 0) + 1; });
   }
-  // hold-to-jog: the server moves; this page says "still held" every keep-alive and "released" at once
-  var hold = null;
+
+  // Hold-to-jog: the server moves while it hears "still held" (a keep-alive) within its watchdog; the page says
+  // "released" at once. The keep-alive is posted by a Worker, on a thread of its own: a slow frame on the page's
+  // thread (software WebGL at full HD on a busy PC) cannot delay it. And while a button is held, a frame slower
+  // than a control period (the server's step, 50 ms) is not drawn: the page's thread stays free for the button
+  // going up (a frame under way would delay the release by what is left of it). The readouts keep up; the view
+  // is drawn on release.
+  var hold = null, holds = 0;
+  function slowFrames() { return renderCost > teach.control_period * 1000; }
+  var WORKER = [
+    "var timer = null;",
+    "onmessage = function (e) {",
+    "  var m = e.data;",
+    "  if (timer !== null) { clearInterval(timer); timer = null; }",
+    "  if (!m.url) return;",
+    "  var alive = function () {",
+    "    fetch(m.url, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: '{}' })",
+    "      .then(function (r) { return r.json(); })",
+    "      .then(function (r) { postMessage({ hold: m.hold, reply: r }); },",
+    "            function (err) { postMessage({ hold: m.hold, error: String(err) }); });",
+    "  };",
+    "  alive();",
+    "  timer = setInterval(alive, m.every);",
+    "};",
+  ].join("\n");
+  var renderCost = 0;  // [ms] the last frame drawn: from its drawing to the next animation frame
+  var keepAlive = null;  // made with the page, not at the first hold: a worker can take long to start on a busy PC
+  function makeKeepAlive() {
+    try {
+      keepAlive = new Worker(URL.createObjectURL(new Blob([WORKER], { type: "text/javascript" })));
+      keepAlive.onmessage = function (e) { kept(e.data); };
+    } catch (err) {  // no Worker here: the page's own timer (exposed to slow frames)
+      var timer = null;
+      keepAlive = { postMessage: function (m) {
+        clearInterval(timer);
+        if (!m.url) return;
+        var alive = function () {
+          request("/alive", {}).then(function (r) { kept({ hold: m.hold, reply: r }); },
+                                     function (err) { kept({ hold: m.hold, error: String(err) }); });
+        };
+        alive();
+        timer = setInterval(alive, m.every);
+      } };
+    }
+  }
+  function startKeepAlive(h) {
+    keepAlive.postMessage({ url: new URL(teach.api + "/alive", location.href).href, every: teach.keepalive * 1000,
+                            hold: h.id });
+  }
+  // an answer to the keep-alive: the robot's new q, and the hold's end when the server ended it
+  function kept(m) {
+    if (!hold || m.hold !== hold.id) return;  // a late answer for a hold already ended
+    var h = hold;
+    if (m.error || m.reply.error) {
+      endHold(true);
+      say("no answer from the server: " + (m.error || m.reply.error), "refused");
+      return;
+    }
+    applyReply(m.reply);
+    if (m.reply.holding) {
+      h.last = m.reply;
+      showStatus();
+    } else {
+      endHold(false);
+      status = function () { return ended(h, m.reply); };
+      showStatus();
+    }
+  }
+  function ended(h, r) {
+    if (!r.reason || r.reason.kind === "released") return ["released " + h.name + " \u2014 moved " + travel(r), "ok"];
+    return stopped(r, false);
+  }
+  function holding(h) {
+    var r = h.last, paused = slowFrames() ? "; frames take " + Math.round(renderCost) + " ms here: the view is drawn " +
+      "on release" : "";
+    return ["jogging " + h.name + " at " + h.speed + " %" + (r ? ": " + travel(r) : "") + " (release to stop" + paused +
+      ")", "ok"];
+  }
   function startHold(row, sign, button) {
     if (hold) endHold(true);
     var body = motionBody(row, sign);
     body.speed = Number($("speed").value);
-    hold = { button: button, timer: null, started: false };
+    var mine = hold = { id: ++holds, button: button, started: false, name: jogName(row, sign) + frameWords(), speed: body.speed,
+                        last: null };
     button.classList.add("held");
-    var mine = hold;
-    post("/hold", body).then(function (r) {
-      if (hold !== mine) return;
-      if (!r || r.error) { endHold(false); return; }
+    status = function () { return holding(mine); };
+    showStatus();
+    post("/hold", body, null).then(function (r) {
+      if (hold !== mine) return;  // released before the server answered: the release follows the hold
+      if (!r || r.error) {
+        endHold(false);
+        if (r) { status = function () { return refusal(r); }; showStatus(); }
+        return;
+      }
       mine.started = true;
-      mine.timer = setInterval(function () { post("/alive", {}); }, teach.keepalive * 1000);
+      startKeepAlive(mine);
     });
   }
   function endHold(send) {
     if (!hold) return;
     var h = hold;
     hold = null;
-    if (h.timer !== null) clearInterval(h.timer);
+    if (keepAlive !== null) keepAlive.postMessage({ url: null });
     h.button.classList.remove("held");
+    viewer.set_dirty();  // the pose it stopped at, drawn at the next frame
     if (send) {
-      post("/release", {}).then(function (r) {
+      post("/release", {}, function (r) { return ended(h, r); }).then(function (r) {
         window.scaraReleases = (window.scaraReleases || 0) + 1;
         window.scaraReleaseAnswered = performance.now();
         window.scaraReleaseMessage = r && r.message;
@@ -356,6 +486,16 @@
     }
   }
   if (teach) {
+    makeKeepAlive();
+    // a frame's cost as the page's thread sees it: from the drawing to the next animation frame (the WebGL
+    // calls return at once; with software WebGL the wait for the drawn frame falls on the next one)
+    var renderFrame = viewer.render.bind(viewer);
+    viewer.render = function () {
+      if (hold && slowFrames()) return;  // needs_render stays set: drawn on release
+      var start = performance.now();
+      renderFrame();
+      requestAnimationFrame(function () { renderCost = performance.now() - start; });
+    };
     for (var row = 0; row < 4; row++) {
       [["-", -1], ["+", 1]].forEach(function (pair) {
         var r = row, button = $("jog-" + r + pair[0]);
@@ -382,8 +522,13 @@
       radio.addEventListener("change", relabelJog);
     });
     $("speed").addEventListener("input", function () { $("speed-value").textContent = $("speed").value + " %"; });
-    ["jog-step", "jog-step-angle"].forEach(function (id) {
-      $(id).addEventListener("input", function () { $(id).removeAttribute("aria-invalid"); });
+    STEP_FIELDS.forEach(function (pair) {
+      $(pair[0]).addEventListener("input", function () {
+        var input = $(pair[0]);
+        input.removeAttribute("aria-invalid");
+        delete input.dataset.si;
+        delete input.dataset.shown;
+      });
     });
     relabelJog();
 
@@ -395,23 +540,41 @@
         if (!isFinite(v)) { say("refused: " + names[i] + " must be a number", "refused"); return; }
         pose.push(fromUnit(v, POSE_KINDS[i]));
       }
-      post("/goto", { pose: pose, branch: $("branch").value });
+      if (hold) endHold(true);
+      post("/goto", { pose: pose, branch: $("branch").value }, function (r) {
+        return r.moved ? ["moved to the pose (" + r.solver + " IK, " + (r.branch || "one") + " branch)", "ok"]
+          : refusal(r);
+      });
     });
 
     // points: record, rename (edit the name), go to, delete; save / reload the server's file
+    // a recorded point: said in the status line (its name and pose), and its row marked and scrolled into view
     $("record").addEventListener("click", function () {
-      var name = $("point-name").value.trim();
-      post("/points/record", name ? { name: name } : {}).then(function () { $("point-name").value = ""; });
+      var name = $("point-name").value.trim(), before = lastPoints.map(function (p) { return p.name; });
+      var added = function (r) { return (r.points || []).filter(function (p) { return before.indexOf(p.name) < 0; })[0]; };
+      post("/points/record", name ? { name: name } : {}, function (r) {
+        var p = added(r);
+        return ["recorded " + p.name + " at x " + number(p.pose[0], "length") + ", y " + number(p.pose[1], "length") +
+          ", z " + amount(p.pose[2], "length") + ", yaw " + amount(p.pose[3], "angle"), "ok"];
+      }).then(function (r) {
+        if (!r || r.error || !added(r)) return;
+        $("point-name").value = "";
+        recorded = added(r).name;
+        showPoints(r.points);
+        document.querySelector("#points tr.recorded").scrollIntoView({ block: "nearest" });
+      });
     });
-    var fileButtons = [["points-save", "/points/save"], ["points-load", "/points/load"]];
-    fileButtons.forEach(function (pair) { $(pair[0]).addEventListener("click", function () { post(pair[1], {}); }); });
-    post("/state", null);
+    var said = function (r) { return [localise(r.message), "ok"]; };
+    $("points-save").addEventListener("click", function () { post("/points/save", {}, said); });
+    $("points-load").addEventListener("click", function () { post("/points/load", {}, said); });
+    post("/state", null, function () { return ["ready: jog, go to a pose or record points", "ok"]; });
   } else {
     syncSliders();
     applyQ();
     showScenePose();
   }
 
+  var recorded = null;  // the point just recorded: its row is marked until the user's next action
   function showPoints(points) {
     lastPoints = points;
     var body = document.querySelector("#points tbody");
@@ -425,7 +588,8 @@
       name.title = "rename: type a new name, then Enter";
       name.setAttribute("aria-label", "name of " + p.name);
       name.addEventListener("change", function () {
-        post("/points/rename", { old: p.name, new: name.value.trim() });
+        var to = name.value.trim();
+        post("/points/rename", { old: p.name, new: to }, function () { return ["renamed " + p.name + " to " + to, "ok"]; });
       });
       var pose = document.createElement("td");
       pose.className = "pose";
@@ -434,17 +598,21 @@
       var go = document.createElement("button");
       go.type = "button";
       go.textContent = "go";
-      go.addEventListener("click", function () { post("/points/goto", { name: p.name }); });
+      go.addEventListener("click", function () {
+        if (hold) endHold(true);
+        post("/points/goto", { name: p.name }, function (r) { return r.moved ? ["moved to " + p.name, "ok"] : refusal(r); });
+      });
       var del = document.createElement("button");
       del.type = "button";
       del.textContent = "\u00d7";
       del.title = "delete " + p.name;
-      del.addEventListener("click", function () { post("/points/delete", { name: p.name }); });
+      del.addEventListener("click", function () { post("/points/delete", { name: p.name }, function () { return ["deleted " + p.name, "ok"]; }); });
       var cell = document.createElement("td");
       cell.appendChild(name);
       tr.appendChild(cell);
       tr.appendChild(pose);
       [go, del].forEach(function (b) { var td = document.createElement("td"); td.appendChild(b); tr.appendChild(td); });
+      if (p.name === recorded) tr.className = "recorded";
       body.appendChild(tr);
     });
   }

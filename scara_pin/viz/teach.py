@@ -8,7 +8,8 @@
 - hold-to-jog (:meth:`~TeachSession.hold`, :meth:`~TeachSession.alive`, :meth:`~TeachSession.release`,
   :meth:`~TeachSession.tick`): the motion advances every :data:`CONTROL_PERIOD` at a rate limited by the
   speed override, and stops on release, on the edge, or when nothing was heard from the page for
-  :data:`WATCHDOG` (a closed or frozen page);
+  :data:`WATCHDOG` (a closed or frozen page); how it ended (a :class:`~scara_pin.motion.manual.StopReason` and
+  how far it went) is in every ``alive``, ``release`` and ``state`` reply until the next move;
 - go to a pose (:meth:`~TeachSession.go_to`, the IK solution nearest to q on the chosen branch) or to joint
   values (:meth:`~TeachSession.set_q`);
 - taught points (:meth:`~TeachSession.record`, :meth:`~TeachSession.rename`, :meth:`~TeachSession.delete`,
@@ -29,7 +30,7 @@ import json
 import logging
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -43,6 +44,8 @@ from ..motion.manual import (
     JogMove,
     JogOutcome,
     Solver,
+    StopKind,
+    StopReason,
     branch_of,
     hold_advance,
     jog_step,
@@ -60,10 +63,13 @@ __all__ = [
     "MAX_STEP_LENGTH",
     "MIN_STEP_ANGLE",
     "MIN_STEP_LENGTH",
+    "STEP_TOL",
     "WATCHDOG",
     "JogAxis",
     "JogFrame",
     "Solver",
+    "StopKind",
+    "StopReason",
     "TeachReply",
     "TeachServer",
     "TeachSession",
@@ -80,7 +86,9 @@ KEEPALIVE = 0.1
 """[s] the page says "still held" this often while a jog button is held."""
 WATCHDOG = 0.25
 """[s] a hold not heard from for this long stops (a closed, frozen or disconnected page): two and a half
-keep-alives, so that a browser timer's usual jitter (tens of ms) does not stop a held jog."""
+keep-alives, so that a browser timer's usual jitter (tens of ms) does not stop a held jog. Counted while the
+server runs: a tick that comes late (this process was not running) waits for the keep-alives to be read."""
+_LATE_TICK = 2 * CONTROL_PERIOD  # [s] a tick this long after the previous one: the server itself did not run
 MIN_STEP_LENGTH = 1e-6
 """[m] the smallest step jog of a length (1 um: the readout's resolution)."""
 MAX_STEP_LENGTH = 1.0
@@ -89,6 +97,9 @@ MIN_STEP_ANGLE = math.radians(1e-3)
 """[rad] the smallest step jog of an angle (0.001 deg: the readout's resolution)."""
 MAX_STEP_ANGLE = math.pi
 """[rad] the largest step jog of an angle (half a turn)."""
+STEP_TOL = 1e-12
+"""[-] relative: a step this close outside its range counts as its end (the largest is then the end itself): the
+12 digits a page shows after converting 180 deg to rad, 3.14159265359, are a valid half turn."""
 
 _AXES = {"x": JogAxis.X, "y": JogAxis.Y, "z": JogAxis.Z, "yaw": JogAxis.YAW}
 _FRAMES = {f.value: f for f in JogFrame}
@@ -103,14 +114,15 @@ class TeachReply:
         pose: the tool frame in the base frame at ``q``: (x, y, z, yaw) [m, rad], Pinocchio's FK.
         branch: the IK branch of ``q`` ("right"/"left", "up"/"down"; "" when the model has none).
         moved: whether q changed.
-        status: ``"OK"``, ``"STOPPED"`` (moved, and stopped ON an edge or limit), ``"AT_EDGE"``, or the code of
-            a refusal (an IK status name such as ``OUT_OF_REACH``, ``JOINT_LIMIT``; ``WATCHDOG`` for a hold the
-            page stopped confirming).
-        message: what stopped or refused it ("" otherwise).
+        status: ``"OK"``, ``"STOPPED"`` (moved, and stopped short: ON an edge or limit, or a hold ended by the
+            watchdog or an error after it moved), ``"AT_EDGE"`` (did not move: already there), or the code of a
+            refusal (an IK status name such as ``OUT_OF_REACH``, ``JOINT_LIMIT``; ``WATCHDOG`` or ``ERROR`` for a
+            hold that ended before it moved).
+        message: what stopped or refused it, or what was done ("" otherwise).
         solver: what answered.
-        limit: what stopped a jog: a joint limit (``joint2_upper``), a workspace limit (``outer``), or the IK's
-            code beyond the stop; "" when nothing did.
-        travelled: how far the jog went [m or rad]; requested: how far it was asked to go.
+        reason: why a jog stopped or did not move, or how a hold ended (None otherwise).
+        travelled: how far the jog went [m or rad] (a hold: so far, or in all once ended); requested: how far
+            a step was asked to go (0 for a hold).
         angle: whether ``travelled`` and ``requested`` are angles [rad] (else lengths [m]).
         holding: whether a hold-to-jog is running after this request.
         points: the taught points, in replies that change or list them (None otherwise).
@@ -123,12 +135,17 @@ class TeachReply:
     status: str
     message: str
     solver: Solver
-    limit: str = ""
+    reason: StopReason | None = None
     travelled: float = 0.0
     requested: float = 0.0
     angle: bool = False
     holding: bool = False
     points: PointSet | None = None
+
+    @property
+    def limit(self) -> str:
+        """What stopped a jog (the reason's limit: ``joint2_upper``, ``outer``, an IK code; "" when nothing did)."""
+        return "" if self.reason is None else self.reason.limit
 
     def to_json(self) -> dict[str, Any]:
         """The reply as the page reads it (SI; full precision: the page rounds for display)."""
@@ -141,6 +158,7 @@ class TeachReply:
             "message": self.message,
             "solver": self.solver.value,
             "limit": self.limit,
+            "reason": None if self.reason is None else self.reason.to_json(),
             "travelled": self.travelled,
             "requested": self.requested,
             "angle": self.angle,
@@ -153,12 +171,29 @@ class TeachReply:
 
 @dataclass
 class _Hold:
-    """A running hold-to-jog: what it moves, how fast, and when the page was last heard [s, monotonic]."""
+    """A running hold-to-jog: what it moves, how fast, how far it went, and its times [s, monotonic].
+
+    ``heard``: the page's last word; ``moved_to``: the time the robot has moved up to; ``ticked``: the last tick.
+    """
 
     motion: JogMotion
     override: float
     heard: float
+    moved_to: float
     ticked: float
+    angle: bool
+    travelled: float = 0.0
+
+
+@dataclass(frozen=True)
+class _HoldEnd:
+    """How the last hold-to-jog ended: told in every alive, release and state reply until the next move."""
+
+    status: str
+    reason: StopReason
+    solver: Solver
+    travelled: float
+    angle: bool
 
 
 class TeachSession:
@@ -196,7 +231,7 @@ class TeachSession:
             raise InvalidInputError(f"the start configuration is outside the limits: {'; '.join(outside)}")
         self._q = start.copy()
         self._hold: _Hold | None = None
-        self._last_end: TeachReply | None = None  # how the last hold ended, told once to the page
+        self._last_end: _HoldEnd | None = None  # how the last hold ended, until the next move
         self.points_file = None if points_file is None else Path(points_file)
         self._points = PointSet(robot=robot.name, base=robot.base_frame, tool=robot.tool_frame)
         if self.points_file is not None:
@@ -231,13 +266,17 @@ class TeachSession:
         q = self.q
         extra: dict[str, Any] = {}
         if move is not None:
-            extra = {"limit": move.limit, "travelled": move.travelled, "requested": move.requested,
+            extra = {"reason": move.reason, "travelled": move.travelled, "requested": move.requested,
                      "angle": motion is not None and motion.is_angle(self.robot)}
+        elif self._hold is not None:  # a running hold: how far so far
+            extra = {"travelled": self._hold.travelled, "angle": self._hold.angle}
         return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), moved, status, message, solver,
                           holding=self.holding, points=self._points if points else None, **extra)  # fmt: skip
 
     def state(self) -> TeachReply:
-        """The current state and the points (moved is False, status OK)."""
+        """The current state and the points (moved is False); after a hold ended, how it ended."""
+        if self._hold is None and self._last_end is not None:
+            return self._ended_reply(points=True)
         return self._reply(False, points=True)
 
     # ----------------------------------------------------------------- moves
@@ -247,6 +286,7 @@ class TeachSession:
         outside = self.robot.outside_limits(values)
         if outside:
             return self._reply(False, "JOINT_LIMIT", "; ".join(outside))
+        self._stop_hold()
         self._q = values.copy()
         return self._reply(True)
 
@@ -323,13 +363,15 @@ class TeachSession:
         if not (isinstance(override, (int, float)) and not isinstance(override, bool) and 0.0 < override <= 1.0):
             raise ParameterError("speed override", override, "must be a fraction in (0, 1] (1 = 100 %)")
         now = time.monotonic() if now is None else float(now)
-        self._hold = _Hold(motion, float(override), now, now)
+        self._stop_hold()
+        self._hold = _Hold(motion, float(override), now, now, now, motion.is_angle(self.robot))
         return self._reply(False)
 
     def alive(self, now: float | None = None) -> TeachReply:
         """The page still holds the button: the watchdog restarts.
 
-        The reply says whether the hold runs, and after it ended (edge, watchdog) why, once.
+        The reply says whether the hold runs and how far it went; after it ended (released, on an edge, by the
+        watchdog), how and why, until the next move.
         """
         now = time.monotonic() if now is None else float(now)
         if self._hold is None:
@@ -338,60 +380,77 @@ class TeachSession:
         return self._reply(False)
 
     def release(self, now: float | None = None) -> TeachReply:
-        """The button is released: the hold stops now (no further advance).
+        """The button is released: the hold stops now (no further advance); message ``released``.
 
-        When the hold had ended before (on an edge, by the watchdog), the reply says why.
+        When the hold had ended before (on an edge, by the watchdog), the reply says how, as :meth:`alive` does.
         """
-        if self._hold is None:
-            return self._ended_reply()
-        self._stop_hold()
-        return self._reply(False, "OK", "released")
+        hold = self._hold
+        if hold is not None:
+            self._hold = None
+            self._last_end = _HoldEnd("OK", StopReason(StopKind.RELEASED, "released"), Solver.NONE, hold.travelled,
+                                      hold.angle)  # fmt: skip
+        return self._ended_reply()
 
     def tick(self, now: float | None = None) -> TeachReply | None:
-        """Advance a running hold by the time since the last tick (at most two periods); None without a hold.
+        """Advance a running hold by the time since it last moved (at most :data:`WATCHDOG`); None without a hold.
 
-        The hold ends when the page was not heard from for :data:`WATCHDOG` (status ``WATCHDOG``), or when the
-        advance stops on an edge or is refused.
+        The hold ends when the page was not heard from for :data:`WATCHDOG` (reason kind ``WATCHDOG``), or when
+        the advance stops on an edge or raises (kind ``ERROR``). An end after the hold moved has status
+        ``STOPPED``: the robot moved, then stopped (a refusal code only when it never moved).
+
+        A tick more than two periods after the previous one (this process did not run: a busy PC) neither
+        judges nor moves: the page's keep-alives may be waiting unread in the server's socket. The next tick,
+        once they are read, does both (by the time since the last move, at most :data:`WATCHDOG`).
         """
         hold = self._hold
         if hold is None:
             return None
         now = time.monotonic() if now is None else float(now)
+        late, hold.ticked = now - hold.ticked > _LATE_TICK, now
+        if late:
+            return self._reply(False)
         if now - hold.heard > WATCHDOG:
-            self._hold = None
-            self._last_end = self._reply(False, "WATCHDOG", f"the page did not confirm the held button for "
-                                         f"{now - hold.heard:.3f} s (> {WATCHDOG} s): jog stopped")  # fmt: skip
-            return self._last_end
-        dt = min(now - hold.ticked, 2 * CONTROL_PERIOD)
+            silent = now - hold.heard
+            return self._end(StopReason(StopKind.WATCHDOG, f"stopped by the watchdog: the page did not confirm the "
+                                        f"held button for {silent:.3f} s (> {WATCHDOG} s)"), "WATCHDOG")  # fmt: skip
+        dt = min(now - hold.moved_to, WATCHDOG)
         if not dt > 0:
             return self._reply(False)
-        hold.ticked = now
+        hold.moved_to = now
         try:
             move = hold_advance(self.robot, self._q, hold.motion, dt, hold.override)
         except ScaraError as exc:
-            self._hold = None
-            self._last_end = self._reply(False, "REFUSED", " ".join(str(exc).split()))
-            return self._last_end
-        if move.outcome is not JogOutcome.OK:
-            self._hold = None
-        reply = self._apply(move, hold.motion)
-        if self._hold is None:
-            self._last_end = reply
-        return reply
+            return self._end(StopReason(StopKind.ERROR, " ".join(str(exc).split())), "ERROR")
+        if move.moved:
+            self._q = np.array(move.q, dtype=float)
+            hold.travelled += move.travelled
+        if move.outcome is JogOutcome.OK:
+            return self._reply(True, solver=move.solver)
+        reason = move.reason or StopReason(StopKind.IK, move.status, move.status)  # (a stop always has a reason)
+        return self._end(reason, move.status, move.solver, moved=move.moved)
+
+    def _end(self, reason: StopReason, status: str, solver: Solver = Solver.NONE, *, moved: bool = False
+             ) -> TeachReply:  # fmt: skip
+        """End the running hold for ``reason``: status ``STOPPED`` once it has moved, else ``status``."""
+        travelled, angle = (0.0, False) if self._hold is None else (self._hold.travelled, self._hold.angle)
+        self._hold = None
+        self._last_end = _HoldEnd("STOPPED" if travelled > 0 else status, reason, solver, travelled, angle)
+        reply = self._ended_reply()
+        return replace(reply, moved=True) if moved else reply
 
     def _stop_hold(self) -> None:
-        if self._hold is not None:
-            self._hold = None
-            self._last_end = None
+        """A new move: a running hold stops, and the last hold's end is forgotten."""
+        self._hold = None
+        self._last_end = None
 
-    def _ended_reply(self) -> TeachReply:
-        ended, self._last_end = self._last_end, None
+    def _ended_reply(self, points: bool = False) -> TeachReply:
+        ended = self._last_end
         if ended is None:
-            return self._reply(False)
-        q = self.q  # the hold's end, reported once, with the current state
-        return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), False, ended.status, ended.message,
-                          ended.solver, ended.limit, ended.travelled, ended.requested, ended.angle,
-                          self.holding)  # fmt: skip
+            return self._reply(False, points=points)
+        q = self.q  # how the last hold ended, with the current state (kept until the next move)
+        return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), False, ended.status, ended.reason.text,
+                          ended.solver, ended.reason, ended.travelled, 0.0, ended.angle, self.holding,
+                          self._points if points else None)  # fmt: skip
 
     # ----------------------------------------------------------------- points
     def _adopt(self, points: PointSet) -> PointSet:
@@ -401,7 +460,7 @@ class TeachSession:
         """Record the current q as a point named ``name`` (default: the first free ``P1``, ``P2``, ...)."""
         name = self._points.next_name() if name in (None, "") else name
         self._points = self._points.added(TaughtPoint.at(self.robot, str(name), self._q))
-        return self._reply(False, points=True)
+        return self._reply(False, "OK", f"recorded {name}", points=True)
 
     def rename(self, old: str, new: str) -> TeachReply:
         """Rename point ``old`` to ``new``."""
@@ -511,9 +570,9 @@ def _step_size(step: object, angle: bool) -> float:
     if isinstance(step, bool) or not isinstance(step, (int, float)):
         raise ParameterError("jog step", step if isinstance(step, str) else ParameterError.NOTHING,
                              f"must be a number in [{lo:.6g}, {hi:.6g}] {unit}")  # fmt: skip
-    if not (math.isfinite(step) and lo * (1 - 1e-12) <= step <= hi):
+    if not (math.isfinite(step) and lo * (1 - STEP_TOL) <= step <= hi * (1 + STEP_TOL)):
         raise ParameterError("jog step", step, f"must be in [{lo:.6g}, {hi:.6g}]", unit)
-    return float(step)
+    return min(float(step), hi)
 
 
 def _text(body: dict[str, Any], key: str) -> str:
@@ -713,5 +772,6 @@ def _teach_page(robot: Robot, session: TeachSession, controls: bool = False) -> 
         "keepalive": KEEPALIVE,
         "step_length": [MIN_STEP_LENGTH, MAX_STEP_LENGTH],
         "step_angle": [MIN_STEP_ANGLE, MAX_STEP_ANGLE],
+        "step_tol": STEP_TOL,
     }
     return _page(f"scara-pin teach: {robot.name}", window.recorder.commands(), data)
