@@ -87,6 +87,9 @@ ROW_POINTS = (0.0,)
 """Where rows go in an interval (fractions of it; 0 is its start node)."""
 CONVERGED = 1e-7
 """[m] the largest shortfall below the margin at the checked points when the iterations stop."""
+FINE_WITHIN = 0.005
+"""[m] a pair this close to the margin in an interval at the checked points is checked at the verifier's rate there
+once the iterations have converged (:meth:`Rows.fine`)."""
 CONVERGED_TIME = 1e-6
 """Relative change of the duration between two solves below which the re-setting of the planes has converged."""
 DEEP = 0.001
@@ -101,6 +104,9 @@ _STEP = 0.005
 """[m] the step of the heights and offsets tried by the candidates."""
 _MAX_OFFSET = 0.4
 """[m] the largest plan-view offset of an AROUND candidate's via point."""
+_MAX_RAISE = 1.0
+"""[m] how far an OVER candidate raises the traverse when no prismatic joint bounds it (a palletizer's arm lifts
+the tool by turning: the raise stops where the IK fails, or here)."""
 _SMOOTH = 1e-3
 """The eps of the smoothed |x| = sqrt(x^2 + eps^2) in the shapes' supports (at most eps times a size: safe)."""
 SECOND_WITHIN = 1.3
@@ -152,6 +158,7 @@ class Rows:
         self._index: set[tuple[int, float, int]] = set()
         self._functions: dict[int, Any] = {}
         self._params = np.zeros((0, self.PARAMETERS))
+        self._near: set[tuple[int, int]] = set()
 
     def add(self, new: list[DistanceRow]) -> bool:
         """Add rows not yet present; True if any was."""
@@ -307,7 +314,31 @@ class Rows:
         q_end = piece._local(np.array([n - 1]), np.array([h[-1]]), 0)
         worst = float(min(D.min(initial=math.inf), float(self.scene.distance_array(q_end).min(initial=math.inf))
                           - self.margin))  # fmt: skip
+        self._near = {(int(kk), int(p)) for kk, p in zip(*np.nonzero(
+            (D < FINE_WITHIN).reshape(n, CHECK_POINTS, -1).any(axis=1)))}  # fmt: skip
         return new, worst
+
+    def fine(self, piece: PolynomialPiece) -> list[DistanceRow]:
+        """Rows where the verifier's grid finds a pair below the margin that :meth:`check`'s points missed.
+
+        Only the pairs that came within :data:`FINE_WITHIN` of the margin in an interval at the last
+        :meth:`check` are sampled there, at the verifier's rate (:data:`~scara_pin.motion.verify.VERIFY_RATE`);
+        each (interval, pair) below the margin by more than :data:`CONVERGED` gets a row at its worst sample.
+        Between :meth:`check`'s points, an edge passing an edge (two boxes) can dip below the margin unseen.
+        """
+        from .verify import VERIFY_RATE
+
+        h = np.diff(piece.breaks)
+        new: list[DistanceRow] = []
+        for kk, p in sorted(self._near):
+            m = max(CHECK_POINTS, math.ceil(h[kk] * VERIFY_RATE) + 1)
+            s = np.arange(1, m) / m
+            q = piece._local(np.full(len(s), kk), s * h[kk], 0)
+            d = self.scene.distance_array(q, [p])[:, 0] - self.margin
+            i = int(np.argmin(d))
+            if d[i] < -CONVERGED and (kk, float(s[i]), p) not in self._index:
+                new.append(DistanceRow(kk, float(s[i]), p))
+        return new
 
 
 # ---------------------------------------------------------------------------------------------- warm starts
@@ -360,7 +391,8 @@ def candidates(
         return [first]
     found = [first]
     # OVER: the traverse raised until the joint lines clear
-    z_max = robot.tool_pose(_stroke_top(robot, tops[0]))[2]
+    top = _stroke_top(robot, tops[0])
+    z_max = z_top + _MAX_RAISE if top is None else robot.tool_pose(top)[2]
     if ceiling is not None:
         z_max = min(z_max, ceiling)
     z = z_top + _STEP
@@ -404,13 +436,16 @@ def candidates(
     return clear_ones
 
 
-def _stroke_top(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """``q`` with the joint that moves the tool up (a SCARA's quill) at the end of its range that raises the tool."""
+def _stroke_top(robot: Robot, q: np.ndarray) -> np.ndarray | None:
+    """``q`` with the joint that moves the tool up (a SCARA's quill) at the end of its range that raises the tool.
+
+    None when that joint is not prismatic (a palletizer raises the tool by turning its arms).
+    """
     J = robot.task_jacobian(q)[2]
     out = q.copy()
     j = int(np.argmax(np.abs(J)))
     if robot.joint_kinds[j] != "length":
-        return out
+        return None
     out[j] = robot.limits.upper[j] if J[j] > 0 else robot.limits.lower[j]
     return out
 
@@ -493,6 +528,8 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
         sol = tr.solve(x0, None, None, params)
         iterations += sol["iterations"]
         solves += 1
+        log.debug("jump in a cell: solve %d: %s after %d iterations, %d rows", solves, sol["status"],
+                  sol["iterations"], len(rows.rows))  # fmt: skip
         T, _, U = tr.unpack(sol["x"])
         if not sol["success"]:
             if clear is not None and not retried:  # every plane from the last clear motion, which meets them all
@@ -511,6 +548,8 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
         new = [p for p in _violations(prob, piece, T) if p not in points]
         fresh, worst = rows.check(piece)
         added = rows.add(fresh)
+        log.debug("jump in a cell: %.6f s, worst %.3g mm beyond the margin, %d rows added, %d limit points",
+                  piece.duration, worst * 1e3, len(fresh), len(new))  # fmt: skip
         params = rows.parameters(piece, None if clear is None else clear[0])
         if worst >= -CONVERGED:
             clear = (piece, sol["x"])
@@ -520,7 +559,12 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
         settled = worst >= -CONVERGED and abs(piece.duration - duration) <= CONVERGED_TIME * piece.duration
         duration = piece.duration
         if not new and not added and settled:
-            break
+            finer = rows.fine(piece)  # converged: what the verifier's grid would see between the checked points
+            if not finer:
+                break
+            rows.add(finer)
+            added = True
+            params = rows.parameters(piece, None if clear is None else clear[0])
         if solves > options.refinements + options.avoid_iterations:
             if last_clear is not None:
                 piece, T = last_clear[0], last_clear[2]
