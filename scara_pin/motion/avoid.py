@@ -37,7 +37,8 @@ with every pair's exact distance (:func:`~scara_pin.motion.verify.verify`).
 starts. The jump's usual warm start (joint lines A -> above A -> above B -> B) is checked against the cell;
 when it collides, candidates are made (:func:`candidates`): OVER (the traverse raised until it clears, up to
 the stroke or the ceiling) and AROUND on either side (a via point beside the first collision, moved out
-until the path clears). The clear candidates are ranked by the duration of their joint lines; the best is
+until the path clears, at the traverse height and up to two steps above it: around one obstacle and over a
+lower one). The clear candidates are ranked by the duration of their joint lines; the best is
 solved, and the second when it is another way (over / left / right) and not much slower; the faster
 verified motion wins. A concave mesh obstacle is handled by the same rows (its witness points), but the
 plane property above holds only locally there.
@@ -96,10 +97,12 @@ DEEP = 0.001
 """[m] a solution this far inside the margin is not re-solved from: the next solve starts from the last clear one."""
 RESOLVE_ITERATIONS = 500
 """IPOPT iterations allowed to a re-solve (warm-started from the last solution; the first solve has the jump's)."""
-_PATH_SAMPLES = 24
+_PATH_SAMPLES = 40
 """Samples of each joint line of a warm-start candidate checked against the cell."""
-SLACK = 0.003
+SLACK = 0.001
 """[m] a warm start counts as clear when its sampled joint lines keep the margin plus this."""
+_RAISED_AROUND = 2
+"""Heights above the traverse height (in steps of _STEP) at which AROUND candidates are also tried."""
 _STEP = 0.005
 """[m] the step of the heights and offsets tried by the candidates."""
 _MAX_OFFSET = 0.4
@@ -127,7 +130,7 @@ class Candidate:
     """A warm start: joint waypoints A, above A, [via], above B, B, and how it goes.
 
     Attributes:
-        way: ``"straight"``, ``"over"``, ``"left"`` or ``"right"``.
+        way: ``"straight"``, ``"over"``, ``"left"`` or ``"right"`` (``"left, raised"``: above the traverse height).
         waypoints: (n, dof) joint waypoints; the lift is the first segment, the descent the last.
         duration: [s] the time of its joint lines, each from rest to rest.
         clearance: [m] its smallest distance to the cell (checked along the lines).
@@ -395,19 +398,23 @@ def candidates(
     z_max = z_top + _MAX_RAISE if top is None else robot.tool_pose(top)[2]
     if ceiling is not None:
         z_max = min(z_max, ceiling)
+    raised = {z_top: tops}  # traverse height -> the configurations above A and B there
     z = z_top + _STEP
     while z <= z_max + 1e-12:
         ta = _ik(robot, np.array([A[0], A[1], z, A[3]]), tops[0])
         tb = _ik(robot, np.array([B[0], B[1], z, B[3]]), tops[1])
         if ta is None or tb is None:
             break
+        if len(raised) < 1 + _RAISED_AROUND:
+            raised[z] = (ta, tb)
         way = np.array([qA, ta, tb, qB])
         t, clear = _score(scene, way, velocity, acceleration)
         if clear >= 0.0:
             found.append(Candidate("over", way, t, clear))
             break
         z += _STEP
-    # AROUND: a via point beside the first collision of the straight lines, moved out on either side
+    # AROUND: a via point beside the first collision of the straight lines, moved out on either side, at the
+    # traverse height and a little above it (around one obstacle and over a lower one)
     samples = _line_samples(straight)
     D = scene.distance_array(samples).min(axis=1) - scene.margin
     hit = int(np.argmax(D < 0.0))
@@ -417,19 +424,20 @@ def candidates(
     normal = np.array([-u[1], u[0]])
     base = A[:2] + u * float(np.clip((p[:2] - A[:2]) @ u, 0.0, np.linalg.norm(B[:2] - A[:2])))
     yaw = float(A[3] + (B[3] - A[3]) * 0.5)
-    for side, sign in (("left", 1.0), ("right", -1.0)):
-        offset = _STEP
-        while offset <= _MAX_OFFSET:
-            xy = base + sign * offset * normal
-            mid = (tops[0] + tops[1]) / 2.0
-            via = _ik(robot, np.array([xy[0], xy[1], z_top, yaw]), mid)
-            if via is not None:
-                way = np.array([qA, tops[0], via, tops[1], qB])
-                t, clear = _score(scene, way, velocity, acceleration)
-                if clear >= 0.0:
-                    found.append(Candidate(side, way, t, clear))
-                    break
-            offset += _STEP
+    for k, (zv, (ta, tb)) in enumerate(raised.items()):
+        step = _STEP if k == 0 else 2.0 * _STEP  # the raised scans are coarser: they only add ways
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            offset = step
+            while offset <= _MAX_OFFSET:
+                xy = base + sign * offset * normal
+                via = _ik(robot, np.array([xy[0], xy[1], zv, yaw]), (ta + tb) / 2.0)
+                if via is not None:
+                    way = np.array([qA, ta, via, tb, qB])
+                    t, clear = _score(scene, way, velocity, acceleration)
+                    if clear >= 0.0:
+                        found.append(Candidate(side if k == 0 else f"{side}, raised", way, t, clear))
+                        break
+                offset += step
     clear_ones = sorted((c for c in found if c.clearance >= 0.0), key=lambda c: c.duration)
     if not clear_ones:  # none clears: every one tried, the least colliding first (the planner may still find a way)
         return sorted(found, key=lambda c: -c.clearance)
