@@ -375,6 +375,25 @@ class Scene:
                 out[i, c] = _sane(pin.computeDistance(gm, gd, k).min_distance)
         return out
 
+    def minimum_array(self, Q: ArrayLike) -> np.ndarray:
+        """(n,) the smallest distance over every checked pair at each row of ``Q`` [m] (one value read per row).
+
+        The same distances as :meth:`distance_array`'s, without reading every pair's back into Python.
+        """
+        import pinocchio as pin
+
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        if self._far_pairs or not self.pairs:  # the bounded pairs need their own pass
+            return self.distance_array(Q).min(axis=1, initial=math.inf)
+        model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
+        convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
+        results = gd.distanceResults
+        out = np.empty(len(Q))
+        for i, q in enumerate(Q):
+            k = pin.computeDistances(model, data, gm, gd, convert(q) if convert else q)
+            out[i] = _sane(results[k].min_distance)
+        return out
+
     def _bounded(self, k: int) -> float:
         """Pair k's distance (placements current): its bounding spheres' beyond :data:`FAR`, else coal's."""
         import pinocchio as pin

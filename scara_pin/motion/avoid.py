@@ -37,8 +37,8 @@ with every pair's exact distance (:func:`~scara_pin.motion.verify.verify`).
 starts. The jump's usual warm start (joint lines A -> above A -> above B -> B) is checked against the cell;
 when it collides, candidates are made (:func:`candidates`): OVER (the traverse raised until it clears, up to
 the stroke or the ceiling) and AROUND on either side (a via point beside the first collision, moved out
-until the path clears, at the traverse height and up to two steps above it: around one obstacle and over a
-lower one). The clear candidates are ranked by the duration of their joint lines; the best is
+until the path clears, at the traverse height, and, when no way clears there, up to two steps above it:
+around one obstacle and over a lower one). The clear candidates are ranked by the duration of their joint lines; the best is
 solved, and the second when it is another way (over / left / right) and not much slower; the faster
 verified motion wins. A concave mesh obstacle is handled by the same rows (its witness points), but the
 plane property above holds only locally there.
@@ -359,7 +359,7 @@ def _score(scene: Scene, waypoints: np.ndarray, velocity: np.ndarray, accelerati
     """
     t = sum(line_optimal_duration(a, b, velocity, acceleration) for a, b in zip(waypoints[:-1], waypoints[1:])
             if not np.array_equal(a, b))  # fmt: skip
-    d = scene.distance_array(_line_samples(waypoints))
+    d = scene.minimum_array(_line_samples(waypoints))
     return float(t), float(d.min(initial=math.inf)) - scene.margin - SLACK
 
 
@@ -416,7 +416,7 @@ def candidates(
     # AROUND: a via point beside the first collision of the straight lines, moved out on either side, at the
     # traverse height and a little above it (around one obstacle and over a lower one)
     samples = _line_samples(straight)
-    D = scene.distance_array(samples).min(axis=1) - scene.margin
+    D = scene.minimum_array(samples) - scene.margin
     hit = int(np.argmax(D < 0.0))
     p = robot.tool_pose(samples[hit])
     u = B[:2] - A[:2]
@@ -425,6 +425,8 @@ def candidates(
     base = A[:2] + u * float(np.clip((p[:2] - A[:2]) @ u, 0.0, np.linalg.norm(B[:2] - A[:2])))
     yaw = float(A[3] + (B[3] - A[3]) * 0.5)
     for k, (zv, (ta, tb)) in enumerate(raised.items()):
+        if k and any(c.clearance >= 0.0 for c in found):
+            break  # a way clears already: raised AROUND scans only when nothing else does
         step = _STEP if k == 0 else 2.0 * _STEP  # the raised scans are coarser: they only add ways
         for side, sign in (("left", 1.0), ("right", -1.0)):
             offset = step
