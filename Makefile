@@ -7,7 +7,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= build
 
-.PHONY: demo test browser bench bench-ik bench-calibration lint docs clean
+.PHONY: demo test browser bench bench-ik bench-calibration bench-cell lint docs clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -57,6 +57,18 @@ bench-calibration: $(VENV)/.installed-test
 	$(FIGAROH_VENV)/bin/python -m pip install -q figaroh==1.0.2
 	$(BIN)/python benchmarks/bench_calibration.py
 
+# pyroboplan (a sampling planner: RRT-Connect, shortcutting) is a benchmark-only dependency: its own environment.
+# pyroboplan 1.3.1 pins toppra==0.6.3 (scara-pin needs >= 0.6.9; pyroboplan never imports toppra: the benchmark
+# calls toppra itself) and drake (only for its trajectory optimisation, not used here): installed without its
+# dependencies, on top of scara-pin's, with the Pinocchio it pins (4.0.0). pytest: the benchmark reads the
+# held-out cells from tests/test_cell_motion.py.
+CELL_VENV ?= .venv-bench-cell
+bench-cell: $(VENV)/.installed-test
+	test -x $(CELL_VENV)/bin/python || $(PYTHON) -m venv $(CELL_VENV)
+	$(CELL_VENV)/bin/python -m pip install -q -e . pin==4.0.0 pytest
+	$(CELL_VENV)/bin/python -m pip install -q --no-deps pyroboplan==1.3.1
+	$(CELL_VENV)/bin/python benchmarks/bench_cell.py
+
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[test,lint]'
 	$(BIN)/ruff check scara_pin tests benchmarks tools
@@ -68,4 +80,4 @@ docs: $(VENV)/.installed
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 clean:
-	rm -rf $(VENV) $(RTB_VENV) $(FIGAROH_VENV) $(OUT) .pytest_cache site
+	rm -rf $(VENV) $(RTB_VENV) $(FIGAROH_VENV) $(CELL_VENV) $(OUT) .pytest_cache site

@@ -1,8 +1,12 @@
 #!/usr/bin/env python
-"""Benchmark: the issue's 4 x 6 tray job (docs/examples/tray) against its moves planned alone, and the clock.
+"""Benchmark: the issue's 4 x 6 tray job (docs/examples/tray) and the palletizer's job (docs/examples/palletizer)
+against their moves planned alone, and the clock.
 
-Run with the project's interpreter (``.venv/bin/python benchmarks/bench_job.py``); reported, not enforced
-(the suite's tests/test_job_plan.py checks the same on a 2 x 2 tray).
+Run with the project's interpreter (``.venv/bin/python benchmarks/bench_job.py [tray] [palletizer]
+[--variants]``, both jobs by default); reported, not enforced (the suite's tests/test_job_plan.py checks the
+tray's promises on a 2 x 2 tray, tests/test_job_palletizer.py the palletizer's on the whole job).
+
+The tray:
 
 1. ``scara-pin job docs/examples/tray/job.yaml --json --out tray.csv --rate 10000`` in a subprocess, timed.
 2. Every jump of it planned ALONE by ``scara-pin traj --arch --from-pose A --to-pose B --json`` (in this
@@ -15,6 +19,17 @@ Run with the project's interpreter (``.venv/bin/python benchmarks/bench_job.py``
 4. The CSV at 10 kHz: the worst |qd| / vmax and |qdd| / amax of its rows, the same by finite differences
    of its positions (a mean over a step, never above the maximum), and the farthest place from the nearest
    row (the SCARA's closed-form FK: every place is passed through).
+
+The palletizer (2 layers of 3 boxes from a conveyor, issue 28 item 3):
+
+5. ``scara-pin job docs/examples/palletizer/job.yaml --json --out pal.csv --rate 10000`` in a subprocess: its
+   wall and CPU time (the child's), total, boxes per hour, the closest pair the package's verifier found.
+6. Each jump planned alone (``jump_move`` between the same configurations, no cell): the largest
+   |job - alone| and the total against the jumps alone and the grips.
+7. The clearance checked independently at every 10 kHz row (tests/test_job_palletizer.py's
+   ``independent_clearance``: coal on Pinocchio's collision model, the boxes from the JSON).
+8. ``--variants``: the same job filled near-first (the boxes carried over the boxes already placed) and with
+   10 mm between the boxes instead of 20: whether they plan, and how long that takes.
 """
 
 from __future__ import annotations
@@ -22,6 +37,8 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -36,6 +53,7 @@ from scara_pin.job import Job
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "docs" / "examples" / "tray" / "job.yaml"
+PALLETIZER = ROOT / "docs" / "examples" / "palletizer"
 RATE = 10_000.0
 
 
@@ -118,5 +136,91 @@ def main_() -> None:
           f"{alone_wall:.1f} s")  # fmt: skip
 
 
+def _job(path: Path, *extra: str) -> tuple[subprocess.CompletedProcess[str], float, float]:
+    """``scara-pin job PATH ...`` in a subprocess: (the process, its wall time [s], its CPU time [s])."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", "import sys; from scara_pin.cli import main; sys.exit(main())", "job",
+                           str(path), *extra], capture_output=True, text=True, check=False)  # fmt: skip
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return done, wall, (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+
+
+def palletizer(variants: bool) -> None:
+    from scara_pin.motion.jump import jump_move
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from test_job_palletizer import independent_clearance
+
+    robot = load_robot("palletizer")
+    with tempfile.TemporaryDirectory() as tmp:
+        csv = Path(tmp) / "pal.csv"
+        done, wall, cpu = _job(PALLETIZER / "job.yaml", "--json", "--out", str(csv), "--rate", str(RATE))
+        if done.returncode != 0:
+            raise SystemExit(done.stderr)
+        out = json.loads(done.stdout)
+        worst, alone_total, t1 = 0.0, 0.0, time.perf_counter()
+        for step in out["steps"]:
+            if step["kind"] != "jump":
+                alone_total += step["duration"]
+                continue
+            qA, qB = np.array(out["steps"][step["index"] - 2]["q"]), np.array(step["q"])
+            alone = jump_move(robot, robot.tool_pose(qA), robot.tool_pose(qB), start=qA, end=qB, torque=False)
+            worst = max(worst, abs(step["duration"] - alone.duration))
+            alone_total += alone.duration
+        alone_wall = time.perf_counter() - t1
+        t2 = time.perf_counter()
+        distance, pair, when, exact, margin = independent_clearance(out, csv, robot)
+        check_wall = time.perf_counter() - t2
+    closest = out["closest"]
+    jumps = sum(s["kind"] == "jump" for s in out["steps"])
+    print(f"job        docs/examples/palletizer/job.yaml: {len(out['steps'])} steps, {jumps} jumps, "
+          f"{len(out['boxes'])} boxes")  # fmt: skip
+    print(f"total      {out['total']:.6f} s, {out['boxes_per_hour']:,.1f} boxes per hour")
+    print(f"alone      the jumps planned alone (no cell) and the grips {alone_total:.6f} s: |difference| "
+          f"{abs(out['total'] - alone_total):.2e} s; largest |job - alone| of a jump {worst:.2e} s")  # fmt: skip
+    print(f"closest    verifier: {closest['pair']} {closest['distance'] * 1e3:.3f} mm (step {closest['step']}); "
+          f"independent coal at {RATE:g} Hz: {pair} {distance * 1e3:.3f} mm at t = {when:.4f} s ({exact:,} exact "
+          f"distances, {check_wall:.1f} s); margin {margin * 1e3:g} mm")  # fmt: skip
+    st = out["planning"]
+    print(f"planning   `scara-pin job` {wall:.1f} s wall, {cpu:.1f} s CPU ({st['planned']} moves planned); the "
+          f"{jumps} jumps alone without the cell, in one process: {alone_wall:.1f} s")  # fmt: skip
+    if not variants:
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, edit in (("near-first", lambda text: text.replace("corners: [S1, S3]", "corners: [S3, S1]")),
+                           ("10 mm gaps", None)):  # fmt: skip
+            folder = Path(tmp) / name.replace(" ", "_")
+            shutil.copytree(PALLETIZER, folder)
+            job = folder / "job.yaml"
+            if edit is not None:
+                job.write_text(edit(job.read_text()))
+            else:  # S1 and S3 taught 10 mm closer to the middle: a pitch of 0.31 m for 0.3 m boxes
+                from scara_pin.motion.points import PointSet, TaughtPoint, read_points, write_points
+
+                points = read_points(folder / "points.yaml")
+                moved = []
+                for p in points:
+                    if p.name in ("S1", "S3"):
+                        pose = p.pose.copy()
+                        pose[1] -= 0.01 * np.sign(pose[1])
+                        p = TaughtPoint.at(robot, p.name, robot.ik_nearest(pose, p.q))
+                    moved.append(p)
+                write_points(folder / "points.yaml", PointSet(tuple(moved), points.robot, points.base, points.tool))
+            done, wall, cpu = _job(job, "--json")
+            if done.returncode == 0:
+                found = json.loads(done.stdout)
+                print(f"variant    {name}: {found['total']:.6f} s, {found['boxes_per_hour']:,.1f} boxes per hour; "
+                      f"{wall:.1f} s wall, {cpu:.1f} s CPU")  # fmt: skip
+            else:
+                print(f"variant    {name}: exit {done.returncode} after {wall:.1f} s wall, {cpu:.1f} s CPU: "
+                      f"{done.stderr.strip().split(': ', 2)[-1]}")  # fmt: skip
+
+
 if __name__ == "__main__":
-    main_()
+    chosen = [a for a in sys.argv[1:] if not a.startswith("--")] or ["tray", "palletizer"]
+    if "tray" in chosen:
+        main_()
+    if "palletizer" in chosen:
+        palletizer("--variants" in sys.argv)

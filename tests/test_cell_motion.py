@@ -191,3 +191,17 @@ def test_a_fixed_path_through_an_obstacle_is_refused(tmp_path, capsys):
                  "--to-pose", *map(str, TO)])  # fmt: skip
     err = capsys.readouterr().err
     assert code == 3 and "closer than the margin" in err and "post" in err and "at t = " in err and " mm in base" in err
+
+
+def test_around_one_obstacle_and_over_a_lower_one(robot):
+    """A post beside the path and a wall 3.5 mm under the traverse height: the warm starts go round the post and
+    over the wall together (a raised AROUND); the motion keeps the margin from both, checked independently."""
+    post = Obstacle("post0", Shape("cylinder", (0.02, 0.6), np.array([0.306, -0.052, 0.0]), np.zeros(3)))
+    wall = Obstacle("box0", Shape("box", (0.3, 0.01, 0.1), np.array([0.30, 0.06, -0.116]), np.zeros(3)))
+    cell = Cell((post, wall), MARGIN)
+    move = jump_move(robot, FROM, TO, cell=cell)
+    q = move.trajectory.sample(_samples(move.trajectory))[0]
+    D = _independent_distances(robot, cell, q)
+    assert D.min(axis=0)[0] == pytest.approx(MARGIN, abs=1e-4) and D.min() >= MARGIN - 1e-6
+    alone = jump_move(robot, FROM, TO, cell=Cell((post,), MARGIN))
+    assert move.duration == pytest.approx(alone.duration, rel=1e-4)  # the wall is cleared at no cost

@@ -238,6 +238,8 @@ def _nested(depth: int) -> str:
     return _steps(body + f"{pad}- jump: feeder\n")
 
 
+CARRY = "carry: {shape: box, size: [0.02, 0.03, 0.015], xyz: [0, 0, 0.0125]}\n"
+
 REFUSED = [
     ("unknown point", _steps("  - jump: feeder\n  - jump: nowhere\n"), "jump: nowhere", "unknown point 'nowhere'"),
     ("past the end", _steps("  - jump: tray[5]\n"), "tray[5]", "index 5 is past the end of pallet tray (4 places"),
@@ -264,6 +266,22 @@ REFUSED = [
     ("negative dwell", _steps("  - dwell: -1\n"), "dwell: -1", "dwell is -1 s; it must be >= 0"),
     ("unknown key", "step:\n  - jump: feeder\n", None, "unknown key(s) step"),
     ("not yaml", "steps: [jump: feeder\n", "steps:", "not valid YAML"),
+    # palletizing: the gripper's steps and the part (docs/job.md, "Palletizing")
+    ("pick without carry", _steps("  - jump: feeder\n  - pick: 0.1\n"), "pick: 0.1", "pick: needs the job's carry:"),
+    ("carry without grips", CARRY + _steps("  - jump: feeder\n"), "carry:",
+     "carry: is the part the tool holds from a pick: to a place:, and the steps have none"),
+    ("place while empty", CARRY + _steps("  - jump: feeder\n  - place: 0.1\n"), "place: 0.1",
+     "place: the tool holds no part here"),
+    ("picked twice by a loop", CARRY + _steps("  - for: tray\n    do:\n      - pick: 0.1\n      - jump: tray[i]\n"),
+     "pick: 0.1", "pick: the tool already holds the part picked at line "),
+    ("pick and place in a step", CARRY + _steps("  - {pick: 0.1, place: 0.1}\n"), "pick: 0.1", "one grip per step"),
+    ("negative pick", CARRY + _steps("  - pick: -1\n  - place: 0\n"), "pick: -1", "pick is -1 s; it must be >= 0"),
+    ("carry not a box", "carry: {shape: cylinder, size: [0.02, 0.03, 0.015]}\n" + _steps("  - pick: 0\n"),
+     "cylinder", "carry shape 'cylinder' is not one scara-pin knows (box)"),
+    ("carry xyz of 2", "carry: {shape: box, size: [0.02, 0.03, 0.015], xyz: [0, 0]}\n" + _steps("  - pick: 0\n"),
+     "xyz: [0, 0]", "xyz is 3 lengths [m]"),
+    ("carry size 0", "carry: {shape: box, size: [0.02, 0, 0.015]}\n" + _steps("  - pick: 0\n"), "size:",
+     "it must be > 0"),
 ]
 
 
@@ -283,6 +301,8 @@ def test_bad_jobs_are_exit_2_with_file_line_and_reason_before_any_planning(
     assert reason is None or reason in err[0], err
     if case == "collinear":
         assert "collinear" in err[0] and "pallet tray" in err[0]
+    if case == "picked twice by a loop":  # the second pass of the loop finds the part of the first still held
+        assert err[0].endswith(f"picked at line {line_of(job, 'pick: 0.1')} (a place: comes first)"), err
     assert not (tmp_path / "out.csv").exists()
 
 
@@ -299,25 +319,59 @@ def test_a_place_out_of_reach_is_exit_3_with_its_line_before_any_planning(
                           "(0.22, -0.06, 0.05, 0.5)") and "out of reach" in err, err
 
 
-def test_cells_are_kept_and_refused_until_wired(
-    robot_default: Robot, tmp_path: Path, capsys: pytest.CaptureFixture[str], no_planning: None
-) -> None:  # fmt: skip
+def test_the_cell_file_is_the_job_s_neighbour_and_is_sized(robot_default: Robot, tmp_path: Path) -> None:
     (tmp_path / "cells").mkdir()
     (tmp_path / "cells" / "cell.yaml").write_text("obstacles: []\n")
     job_file = write_job(tmp_path, "cell: cells/cell.yaml\ncarry: {shape: box, size: [0.2, 0.3, 0.15]}\n"
-                         "steps:\n  - jump: feeder\n  - jump: home\n", robot_default)  # fmt: skip
+                         "steps:\n  - jump: feeder\n  - pick: 0.1\n  - jump: home\n  - place: 0\n",
+                         robot_default)  # fmt: skip
     job = Job.load(job_file)
     assert job.cell == tmp_path / "cells" / "cell.yaml"  # relative to the job file
     assert job.carry is not None and job.carry.size == (0.2, 0.3, 0.15)
-    assert main(["job", str(job_file)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err == f"error: {job_file} line {line_of(job_file, 'cell:')}: cells in jobs are not supported yet (the " \
-                  "job's cell: is kept, not planned with)"
+    assert job.carry.xyz == (0.0, 0.0, 0.075)  # by default the box's top face is on the flange face (z down)
+    assert [type(s).__name__ for s in job.steps] == ["MotionStep", "Grip", "MotionStep", "Grip"]
+    assert job.dwell == 0.1 and job.actions == 4  # a grip is a rest, counted with the dwells
     # the cell file is sized and must be a regular file
     job_file.write_text(job_file.read_text().replace("cells/cell.yaml", "cells"))
     with pytest.raises(JobFileError, match="not a regular file") as info:
         Job.load(job_file)
     assert info.value.line == line_of(job_file, "cell:")
+
+
+@pytest.mark.parametrize(("cell", "reason"), [
+    ("obstacles: []\ncarried: {shape: box, size: [0.01, 0.01, 0.01], xyz: [0, 0, 0.02]}\n",
+     "gives a carried part too: in a job the part is the job's carry:"),
+    ("obstacles:\n  - {name: box2, shape: sphere, radius: 0.01, xyz: [1, 1, 1]}\n",
+     "has an obstacle named box2: box1, box2, ... name the boxes the job places"),
+    ("obstacles:\n  - {name: post, shape: sphere, radius: -0.01, xyz: [1, 1, 1]}\n", "cell.yaml line 2: obstacle post"),
+])  # fmt: skip
+def test_a_cell_the_job_cannot_use_is_refused_before_any_planning(
+    cell: str, reason: str, robot_default: Robot, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+    no_planning: None,
+) -> None:  # fmt: skip
+    (tmp_path / "cell.yaml").write_text(cell)
+    job = write_job(tmp_path, "cell: cell.yaml\n" + CARRY + "steps:\n  - jump: feeder\n  - pick: 0.1\n  - jump: home\n"
+                    "  - place: 0\n", robot_default)  # fmt: skip
+    assert main(["job", str(job)]) == 2
+    err = capsys.readouterr().err.strip()
+    needle = "carry:" if "carried" in cell else "cell:"
+    assert err.startswith(f"error: {job} line {line_of(job, needle)}: ") and reason in err, err
+
+
+def test_more_boxes_than_a_cell_may_hold_are_refused_before_any_planning(
+    robot_default: Robot, tmp_path: Path, capsys: pytest.CaptureFixture[str], no_planning: None
+) -> None:  # fmt: skip
+    from scara_pin.limits import MAX_CELL_OBSTACLES
+
+    (tmp_path / "cell.yaml").write_text("obstacles:\n  - {name: post, shape: sphere, radius: 0.01, xyz: [1, 1, 1]}\n")
+    body = (f"cell: cell.yaml\n{CARRY}steps:\n  - jump: feeder\n  - for: {MAX_CELL_OBSTACLES}\n    do: [{{pick: 0}}, "
+            "{place: 0}]\n")  # fmt: skip
+    job = write_job(tmp_path, body, robot_default)
+    assert main(["job", str(job)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (f"error: {job} line {line_of(job, 'carry:')}: obstacles of the cell (its 1 and the "
+                   f"{MAX_CELL_OBSTACLES} boxes the job places) would be {MAX_CELL_OBSTACLES + 1}, above the cap of "
+                   f"{MAX_CELL_OBSTACLES}; split the job"), err  # fmt: skip
 
 
 def test_another_robot_and_an_output_over_an_input_are_refused(robot_default: Robot, tmp_path: Path,

@@ -19,8 +19,13 @@ relative velocity of the two witness points: ``dd/dq = n . (J_b(p_b) - J_a(p_a))
 Jacobian of the point p fixed to shape x's joint (zero for an obstacle). It holds where the witness points
 are unique (two strictly convex shapes, or a face against a vertex), and is a subgradient elsewhere.
 
-A mesh is a coal bounding-volume tree of its triangles, a SURFACE: a robot geometry entirely inside a closed
-mesh is not in contact with it. Motions are checked densely, so crossing the surface is always seen.
+A closed convex mesh is its hull (``coal.Convex``): a solid, with signed distances. Any other mesh is a coal
+bounding-volume tree of its triangles, a SURFACE: a robot geometry entirely inside a closed mesh is not in
+contact with it; motions are checked densely, so crossing the surface is always seen. coal's distance to a
+bounding-volume tree costs about 2 ms per pair when the tree is far away (10 us near it), so such a pair is
+first bounded below by the two shapes' bounding spheres: beyond :data:`FAR` the bound stands for the
+distance in :meth:`Scene.distance_array` (the planner and the verifier only compare distances with the
+margin and the activation distance, both far below it); nearer, coal's exact distance.
 """
 
 from __future__ import annotations
@@ -41,9 +46,12 @@ if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..model import Robot
 
-__all__ = ["GJK_TOLERANCE", "Distances", "InCollisionError", "Pair", "PairDistance", "Scene", "scene"]
+__all__ = ["FAR", "GJK_TOLERANCE", "Distances", "InCollisionError", "Pair", "PairDistance", "Scene", "scene"]
 
 GJK_TOLERANCE = 1e-10
+FAR = 0.05
+"""[m] a pair with a non-convex mesh whose bounding spheres are farther apart than this takes that bound as its
+distance in :meth:`Scene.distance_array` (not coal's exact one, which costs about 2 ms there)."""
 EPA_ITERATIONS = 1000
 """coal's EPA iterations (its default, 64, leaves penetration depths of parallel cylinders wrong)."""
 """coal's GJK and EPA tolerances used here [m] (distances then agree with closed forms to about 4e-11 m)."""
@@ -271,6 +279,17 @@ class Scene:
             req.epa_max_iterations = EPA_ITERATIONS
         self._data = model.createData()
         self.pairs = tuple(pairs)
+        # pairs with a mesh that is a surface (a bounding-volume tree): bounded by bounding spheres when far
+        import coal
+
+        bvh = [p.index for p in pairs if isinstance(gm.geometryObjects[p.second].geometry, coal.BVHModelBase)
+               or isinstance(gm.geometryObjects[p.first].geometry, coal.BVHModelBase)]  # fmt: skip
+        self._far_pairs = tuple(bvh)
+        self._spheres = {}
+        for i in {k for p in bvh for k in (self.pairs[p].first, self.pairs[p].second)}:
+            geo = gm.geometryObjects[i].geometry
+            geo.computeLocalAABB()
+            self._spheres[i] = (np.asarray(geo.aabb_center, dtype=float).copy(), float(geo.aabb_radius))
         checked = [(names[a], names[b]) for a, b in checked_self]
         disabled += [(na, nb, "allowed by the cell") for na, nb in checked if frozenset((na, nb)) in allowed]
         self.self_pairs = SelfPairs(tuple(p for p in checked if frozenset(p) not in allowed), tuple(disabled))
@@ -316,7 +335,10 @@ class Scene:
             pa = inv.act(np.asarray(res.getNearestPoint1()))
             pb = inv.act(np.asarray(res.getNearestPoint2()))
             normal = inv.rotation @ np.asarray(res.normal)
-            out.append(PairDistance(p, float(res.min_distance), pa, pb, normal))
+            d = _sane(res.min_distance)
+            if d == -math.inf:
+                pa = pb = np.full(3, np.nan)
+            out.append(PairDistance(p, d, pa, pb, normal))
         out.sort(key=lambda d: d.distance)
         return Distances(q, self.margin, tuple(out))
 
@@ -329,17 +351,60 @@ class Scene:
         convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
         if pairs is None:
             out = np.empty((len(Q), len(self.pairs)))
-            for i, q in enumerate(Q):
-                pin.computeDistances(model, data, gm, gd, convert(q) if convert else q)
-                out[i] = [r.min_distance for r in gd.distanceResults]
+            far = self._far_pairs
+            flags = gd.activeCollisionPairs
+            for k in far:  # computeDistances leaves the inactive pairs alone: they are bounded first, below
+                flags[k] = False
+            try:
+                for i, q in enumerate(Q):
+                    pin.computeDistances(model, data, gm, gd, convert(q) if convert else q)
+                    out[i] = [r.min_distance for r in gd.distanceResults]
+                    if out[i].min() < _INSANE:
+                        out[i] = [_sane(v) for v in out[i]]
+                    for k in far:
+                        out[i, k] = self._bounded(k)
+            finally:
+                for k in far:
+                    flags[k] = True
             return out
         idx = [int(k) for k in np.asarray(pairs, dtype=int).ravel()]
         out = np.empty((len(Q), len(idx)))
         for i, q in enumerate(Q):
             pin.updateGeometryPlacements(model, data, gm, gd, convert(q) if convert else q)
             for c, k in enumerate(idx):
-                out[i, c] = pin.computeDistance(gm, gd, k).min_distance
+                out[i, c] = _sane(pin.computeDistance(gm, gd, k).min_distance)
         return out
+
+    def minimum_array(self, Q: ArrayLike) -> np.ndarray:
+        """(n,) the smallest distance over every checked pair at each row of ``Q`` [m] (one value read per row).
+
+        The same distances as :meth:`distance_array`'s, without reading every pair's back into Python.
+        """
+        import pinocchio as pin
+
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        if self._far_pairs or not self.pairs:  # the bounded pairs need their own pass
+            return self.distance_array(Q).min(axis=1, initial=math.inf)
+        model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
+        convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
+        results = gd.distanceResults
+        out = np.empty(len(Q))
+        for i, q in enumerate(Q):
+            k = pin.computeDistances(model, data, gm, gd, convert(q) if convert else q)
+            out[i] = _sane(results[k].min_distance)
+        return out
+
+    def _bounded(self, k: int) -> float:
+        """Pair k's distance (placements current): its bounding spheres' beyond :data:`FAR`, else coal's."""
+        import pinocchio as pin
+
+        pr = self.pairs[k]
+        (ca, ra), (cb, rb) = self._spheres[pr.first], self._spheres[pr.second]
+        Ma, Mb = self._gd.oMg[pr.first], self._gd.oMg[pr.second]
+        bound = float(np.linalg.norm(Ma.act(ca) - Mb.act(cb))) - ra - rb
+        if bound > FAR:
+            return bound
+        return _sane(pin.computeDistance(self._gm, self._gd, k).min_distance)
 
     def gradients(self, q: ArrayLike, pairs: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(d (k,), G (k, dof)): the distances of ``pairs`` (default all) at ``q`` and their derivatives dd/dq.
@@ -371,7 +436,7 @@ class Scene:
         for c, k in enumerate(idx):
             res = pin.computeDistance(gm, gd, k)
             pair = self.pairs[k]
-            d[c] = res.min_distance
+            d[c] = _sane(res.min_distance)
             n = np.asarray(res.normal)
             ja, jb = objs[pair.first].parentJoint, objs[pair.second].parentJoint
             g = n @ (point_jacobian(jb, np.asarray(res.getNearestPoint2()))
@@ -391,6 +456,17 @@ class Scene:
     def __repr__(self) -> str:
         return (f"Scene({self.robot.name}: {len(self.pairs)} pairs checked, {len(self.cell.obstacles)} obstacle(s), "
                 f"margin {self.margin * 1e3:g} mm)")  # fmt: skip
+
+
+_INSANE = -1e3
+"""[m] a distance below this is coal's EPA failing (it returns -DBL_MAX for some deep contacts of a thin cylinder
+with a hull): read as -inf, in contact, depth unknown."""
+
+
+def _sane(d: float) -> float:
+    """Coal's signed distance, or -inf where its penetration depth failed (:data:`_INSANE`): in contact all the same."""
+    d = float(d)
+    return -math.inf if not d >= _INSANE else d
 
 
 def _fresh_guesses(gd: Any) -> None:
@@ -418,8 +494,11 @@ def describe(found: PairDistance, margin: float, unit: str = "mm") -> str:
     """
     if unit not in ("mm", "m"):
         raise InvalidInputError(f"unit {unit!r} must be 'mm' or 'm'")
-    mid = (found.point_a + found.point_b) / 2.0
     a, b = found.pair.a, found.pair.b
+    margin_text = f"{margin:g} m" if unit == "m" else f"{margin * 1e3:g} mm"
+    if found.distance == -math.inf:
+        return f"{a} is in contact with {b}, its depth not computed (margin {margin_text})"
+    mid = (found.point_a + found.point_b) / 2.0
     if unit == "m":
         size, at = (lambda v: f"{v:.3g} m"), ", ".join(f"{k} {v:.6g} m" for k, v in zip("xyz", mid))
         at = f"near {at} in base"
@@ -429,7 +508,6 @@ def describe(found: PairDistance, margin: float, unit: str = "mm") -> str:
         how = f"{a} is {size(-found.distance)} deep in {b}"
     else:
         how = f"{a} and {b} are {size(found.distance)} apart"
-    margin_text = f"{margin:g} m" if unit == "m" else f"{margin * 1e3:g} mm"
     return f"{how} (margin {margin_text}) {at}"
 
 

@@ -7,8 +7,9 @@ axis, centred, a sphere ``(radius,)``. A mesh holds its triangles (vertices alre
 
 Every number is checked here, where the shape is made: finite, sizes > 0 and at most :data:`MAX_SIZE`,
 positions within :data:`MAX_POSITION`, at most :data:`~scara_pin.limits.MAX_CELL_TRIANGLES` triangles.
-Distances are coal's (``coal.Box``, ``coal.Cylinder``, ``coal.Sphere``; a mesh is a ``BVHModelOBBRSS``,
-a surface: see :mod:`scara_pin.cell`).
+Distances are coal's (``coal.Box``, ``coal.Cylinder``, ``coal.Sphere``; a closed convex mesh is its hull, a
+``coal.Convex``, a solid; any other mesh a ``BVHModelOBBRSS`` of its triangles, a surface: see
+:mod:`scara_pin.cell.scene`).
 """
 
 from __future__ import annotations
@@ -146,7 +147,24 @@ class Shape:
         bvh.addVertices(self.vertices)
         bvh.addTriangles(self.faces)
         bvh.endModel()
+        if self.convex:  # a closed convex mesh is its own hull: GJK on it (a solid, signed distances, fast)
+            bvh.buildConvexHull(True, "Qt")
+            return bvh.convex
         return bvh
+
+    @property
+    def convex(self) -> bool:
+        """A mesh that is closed and convex (trimesh's test): its distances are taken on its hull, a solid."""
+        if self.kind != "mesh":
+            return True
+        found = self.__dict__.get("_convex")
+        if found is None:
+            import trimesh
+
+            mesh = trimesh.Trimesh(self.vertices, self.faces, process=True)
+            found = bool(mesh.is_watertight and mesh.is_convex)
+            object.__setattr__(self, "_convex", found)
+        return bool(found)
 
     def corners(self) -> np.ndarray:
         """(k, 3) points whose convex hull holds the shape, in its frame (the box around it; a mesh's vertices)."""

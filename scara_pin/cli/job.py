@@ -76,17 +76,10 @@ def _plan(job: Any, robot: Any) -> Any:
 
 
 def _page(result: Any, robot: Any, path: str) -> None:
-    """``--html``: the viewer page playing the job, the poses it reaches drawn as small frames."""
-    import numpy as np
+    """``--html``: the viewer page playing the job: the poses it reaches as small frames, the cell, the boxes."""
+    from ..viz.job import job_page
 
-    from ..viz.meshcat import export_html
-
-    traj = result.trajectory
-    samples = traj.resample(min(_VIEW_RATE, 1e5 / max(traj.duration, 1e-9)))
-    ends = {s.target: traj.sample(s.t_end)[0] for s in result.steps if s.kind != "dwell"}
-    targets = np.array([robot.tool_pose(q) for q in ends.values()]) if ends else None
-    export_html(robot, path, times=samples.t, qs=samples.q, targets=targets,
-                title=f"scara-pin job {result.path.name}: {result.total:.4f} s")  # fmt: skip
+    job_page(result, robot, path, rate=_VIEW_RATE)
 
 
 def register(sub: Any) -> None:
@@ -96,14 +89,16 @@ def register(sub: Any) -> None:
     p.add_argument("file", metavar="JOB", help="the job file (.yaml; the format: docs/job.md)")
     g = p.add_argument_group("outputs (files in SI units, written only when the whole job is planned)")
     g.add_argument("--json", action="store_true",
-                   help="print one JSON object {total, parts_per_hour, steps: [{kind, target, t_start, t_end, "
-                   "binding}], ...}")  # fmt: skip
+                   help="print one JSON object {total, parts_per_hour, boxes_per_hour, boxes, steps: [{kind, target, "
+                   "t_start, t_end, binding, clearance}], ...}")  # fmt: skip
     g.add_argument("--out", metavar="FILE", help="the whole trajectory: t, q, qd, qdd as CSV (or JSON for *.json)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip
     g.add_argument("--plot", metavar="PNG", help="the timeline: steps, each joint's velocity and acceleration "
-                   "against the limits in force (.png, .svg, .pdf)")  # fmt: skip
-    g.add_argument("--html", metavar="HTML", help="a self-contained viewer page that plays the job")
+                   "against the limits in force; in a cell, plan and side views of the tool path, the obstacles and "
+                   "the boxes placed (.png, .svg, .pdf)")  # fmt: skip
+    g.add_argument("--html", metavar="HTML", help="a self-contained viewer page that plays the job (with its cell, "
+                   "the part while held and the boxes placed)")  # fmt: skip
     _add_acceleration(p)
     _add_robot_options(p)
     p.set_defaults(func=cmd_job)

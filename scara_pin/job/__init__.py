@@ -2,20 +2,23 @@
 
 A job sits above the motion layer: it names taught points (the pendant's points file) and pallets (grids of
 places from taught corners), and runs steps (jumps, straight moves, joint moves, dwells, speed and
-acceleration percentages, loops) that :func:`plan_job` plans move by move with the package's planners,
-each verified at 10 kHz. ``Job.load(path).plan(robot)`` gives the table, the total and the trajectory.
+acceleration percentages, loops, and a gripper's picks and places) that :func:`plan_job` plans move by move
+with the package's planners, each verified at 10 kHz, in the job's cell with the boxes placed so far.
+``Job.load(path).plan(robot)`` gives the table, the total and the trajectory.
 """
 
 from .loading import FORMAT, Carry, Job, load_job
 from .pallets import Order, Pallet
 from .planning import PlannedMove, Planner, Source, plan_job, plan_move, scaled_limits
-from .results import JobResult, PlanningStats, StepResult
-from .steps import Dwell, JumpShape, Move, MoveKind, Program, Target, parse_target
+from .results import JobResult, PlacedBox, PlanningStats, StepResult
+from .steps import Dwell, Grip, GripKind, JumpShape, Move, MoveKind, Program, Target, parse_target
 
 __all__ = [
     "FORMAT",
     "Carry",
     "Dwell",
+    "Grip",
+    "GripKind",
     "Job",
     "JobResult",
     "JumpShape",
@@ -23,6 +26,7 @@ __all__ = [
     "MoveKind",
     "Order",
     "Pallet",
+    "PlacedBox",
     "PlannedMove",
     "Planner",
     "PlanningStats",

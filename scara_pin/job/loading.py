@@ -9,8 +9,8 @@ The format (docs/job.md has it beside its SPEL+ and RAPID equivalents)::
     jump: {rise: 0.025, clearance_radius: 0.005, max_height: 0.0}   # optional: every jump's clearance
     torque: false                    # optional: also respect the effort limits (with payload: the load)
     payload: {mass: 0.5, com: [0, 0, 0.02]}    # optional, with torque: true [kg, m in the tool frame]
-    cell: cell.yaml                  # optional: obstacles (not planned with yet: refused by plan)
-    carry: {shape: box, size: [0.2, 0.3, 0.15]}  # optional: the carried box (idem)
+    cell: cell.yaml                  # optional: obstacles, every move kept the cell's margin away from them
+    carry: {shape: box, size: [0.2, 0.3, 0.15], xyz: [0, 0, 0.095]}  # optional: the part held from pick: to place:
     pallets:
       tray: {corners: [T11, T16, T41], rows: 4, columns: 6}
     steps:
@@ -19,6 +19,11 @@ The format (docs/job.md has it beside its SPEL+ and RAPID equivalents)::
         do:
           - jump: tray[i]
           - dwell: 0.05
+
+With ``carry``, ``pick: S`` and ``place: S`` steps say when the tool holds the part (the gripper closing and
+opening during S seconds at rest); each place leaves a box that every later move avoids (docs/job.md,
+"Palletizing"). A pick while holding, a place while empty, grips without ``carry`` and ``carry`` without grips
+are refused here (:func:`~scara_pin.job.steps.check_grips`).
 
 Values may carry xacro's unit tags (``!millimeters 150``, ``!degrees 90``); lengths are metres, times
 seconds. The file is read through the package's one yaml loader
@@ -44,6 +49,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
+import numpy as np
+
 from ..errors import InvalidInputError, JobFileError, ScaraError
 from ..limits import MAX_DOCUMENT_BYTES, MAX_JOB_BYTES, MAX_JOB_DEPTH, MAX_JOB_STEPS, check_input_file, read_text
 from ..motion.payload import Payload
@@ -52,6 +59,8 @@ from .pallets import Order, Pallet
 from .steps import (
     VARIABLE,
     Dwell,
+    Grip,
+    GripKind,
     JumpShape,
     Loop,
     MotionStep,
@@ -60,6 +69,7 @@ from .steps import (
     Setting,
     Step,
     Target,
+    check_grips,
     expand,
     located,
     parse_target,
@@ -67,6 +77,7 @@ from .steps import (
 )
 
 if TYPE_CHECKING:
+    from ..cell import Shape
     from ..model import Robot
     from .results import JobResult
 
@@ -78,20 +89,44 @@ FORMAT = "scara-pin job 1"
 _KEYS = ("format", "robot", "points", "start", "jump", "torque", "payload", "cell", "carry", "pallets", "steps")
 _PALLET_KEYS = ("corners", "rows", "columns", "layers", "layer_height")
 _JUMP_KEYS = ("rise", "clearance_radius", "max_height")
-_STEP_KINDS = "speed, accel, jump, move, go, dwell, for"
+_STEP_KINDS = "speed, accel, jump, move, go, dwell, pick, place, for"
 
 
 @dataclass(frozen=True)
 class Carry:
-    """What the tool carries, for the cell's distances (issue "The cell"; not planned with yet).
+    """The part the tool holds between a ``pick`` and a ``place``, in the tool frame (docs/job.md).
+
+    ``tool0``'s z axis points out of the flange (down): a box hanging under the flange has a positive z. By
+    default the box's top face is on the flange face (``xyz = (0, 0, size_z / 2)``); a gripper between them
+    is not modelled, and its height is the part's z beyond that (the flange must stay the margin away from
+    the box it has just left).
 
     Attributes:
         shape: ``"box"``.
         size: [m] its edges along the tool frame's x, y, z.
+        xyz: [m] its centre in the tool frame.
+        rpy: [rad] its orientation in the tool frame (URDF's roll, pitch, yaw).
     """
 
     shape: str
     size: tuple[float, float, float]
+    xyz: tuple[float, float, float] | None = None
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if self.xyz is None:
+            object.__setattr__(self, "xyz", (0.0, 0.0, self.size[2] / 2.0))
+
+    def part(self) -> Shape:
+        """The part as a cell's shape, placed in the tool frame (:class:`~scara_pin.cell.Shape`)."""
+        from ..cell import Shape
+
+        return Shape(self.shape, self.size, np.array(self.xyz, dtype=float), np.array(self.rpy, dtype=float),
+                     what="the carried part")  # fmt: skip
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (SI)."""
+        return {"shape": self.shape, "size": list(self.size), "xyz": list(self.xyz or ()), "rpy": list(self.rpy)}
 
 
 class _At:
@@ -274,6 +309,7 @@ def load_job(path: str | Path) -> Job:
         steps_at.fail("steps must be a non-empty list")
     steps = _steps(steps_at, points, pallets, {}, 0)
     count, dwell = tally(steps, pallets)
+    _grips(steps, pallets, path, entries)
     if count > MAX_JOB_STEPS:
         steps_at.fail(f"the steps expand to {count:,} moves and dwells, above the cap of {MAX_JOB_STEPS:,} "
                       "(MAX_JOB_STEPS): split the job")  # fmt: skip
@@ -298,14 +334,48 @@ def _cell(at: _At, job: Path) -> Path:
 
 
 def _carry(at: _At) -> Carry:
-    keys = at.mapping(("shape", "size"), required=("shape", "size"))
+    keys = at.mapping(("shape", "size", "xyz", "rpy"), required=("shape", "size"))
     if keys["shape"].value != "box":
         keys["shape"].fail(f"carry shape {_shown(keys['shape'].value)} is not one scara-pin knows (box)")
-    sizes = keys["size"].elements()
-    if len(sizes) != 3:
-        keys["size"].fail("a box's size is 3 lengths [m] (x, y, z in the tool frame)")
-    size = tuple(s.number(lambda v: v > 0, "> 0", "m") for s in sizes)
-    return Carry("box", (size[0], size[1], size[2]))
+    size = _three(keys["size"], "a box's size is 3 lengths [m] (x, y, z in the tool frame)", lambda v: v > 0, "> 0")
+    xyz = _three(keys["xyz"], "xyz is 3 lengths [m] (the part's centre in the tool frame)") if "xyz" in keys else None
+    rpy = (_three(keys["rpy"], "rpy is 3 angles [rad] (roll, pitch, yaw in the tool frame)", unit="rad")
+           if "rpy" in keys else None)  # fmt: skip
+    carry = Carry("box", size, xyz, rpy or (0.0, 0.0, 0.0))
+    try:
+        carry.part()  # the cell's own checks: sizes and positions within their bounds
+    except InvalidInputError as exc:
+        at.fail(f"carry: {exc}")
+    return carry
+
+
+def _three(at: _At, what: str, rule: Callable[[float], bool] = math.isfinite, rule_text: str = "a number",
+           unit: str = "m") -> tuple[float, float, float]:  # fmt: skip
+    values = at.elements()
+    if len(values) != 3:
+        at.fail(what)
+    a, b, c = (v.number(rule, rule_text, unit) for v in values)
+    return a, b, c
+
+
+def _grips(steps: tuple[Step, ...], pallets: Mapping[str, Pallet], path: Path, entries: Mapping[str, _At]) -> None:
+    """The picks and places in order, and ``carry`` given exactly when there are some (module docstring)."""
+    first = _first_grip(steps)
+    if first is not None and "carry" not in entries:
+        raise JobFileError(path, first.line, f"{first.kind.value}: needs the job's carry: (the part the tool holds, "
+                           "e.g. carry: {shape: box, size: [0.2, 0.3, 0.15]})")  # fmt: skip
+    if first is None and "carry" in entries:
+        entries["carry"].fail("carry: is the part the tool holds from a pick: to a place:, and the steps have none "
+                              "(a part held throughout is the cell file's carried:)")  # fmt: skip
+    check_grips(steps, pallets, path)
+
+
+def _first_grip(steps: tuple[Step, ...]) -> Grip | None:
+    for step in steps:
+        found = _first_grip(step.body) if isinstance(step, Loop) else step if isinstance(step, Grip) else None
+        if found is not None:
+            return found
+    return None
 
 
 def _payload(at: _At) -> Payload:
@@ -429,6 +499,14 @@ def _step(at: _At, points: PointSet, pallets: Mapping[str, Pallet], scope: Mappi
     if "dwell" in keys:
         entries = at.mapping(("dwell",))
         return Dwell(entries["dwell"].number(lambda v: v >= 0, ">= 0 (seconds at rest)", "s"), line)
+    grips = [g for g in GripKind if g.value in keys]
+    if grips:
+        if len(grips) > 1:
+            at.fail("one grip per step: pick and place in one step")
+        entries = at.mapping((grips[0].value,))
+        seconds = entries[grips[0].value].number(lambda v: v >= 0, ">= 0 (seconds at rest while the gripper acts)",
+                                                 "s")  # fmt: skip
+        return Grip(grips[0], seconds, line)
     if keys & {"speed", "accel"}:
         entries = at.mapping(("speed", "accel"))
         return Setting(_percent(entries["speed"]) if "speed" in entries else None,

@@ -11,18 +11,25 @@ under the robot's limits with the velocity limits times the ``speed`` fraction a
 limits times the ``accel`` fraction (SPEL+'s ``Speed`` and ``Accel``), and the effort limits with the
 job's payload when the job asks for the torques. Each move is then verified by the package's verifier
 (:func:`~scara_pin.motion.verify.verify`: every limit at 10 kHz and at every breakpoint, the endpoints,
-rest at both ends); a move it refuses is an error (exit 3), never an output. ``placed`` is the obstacles
-placed so far (the boxes a palletizing job has put down, issue "The cell"): it is part of what makes two
-moves the same, and the cell's planners will take it; until the cell is wired no job has any.
+rest at both ends); a move it refuses is an error (exit 3), never an output.
+
+**In a cell** (:class:`~scara_pin.cell.Cell`: the job's ``cell`` file, the boxes placed so far, the part in the
+tool between a ``pick`` and a ``place``) every move keeps every checked pair at least the cell's margin apart:
+a jump is planned around and over the obstacles (``jump_move(..., cell=)``), a straight or joint move's path is
+fixed, verified against the cell (:func:`~scara_pin.motion.plan.clear_of`) and refused naming the pair. The
+clearance comes from the same verifier at 10 kHz (the planners run it with the cell's scene); a reversed jump is
+verified against the cell again. Each ``place`` leaves the part where the tool holds it (the carried shape
+moved by ``baseMtool``): an obstacle named ``box1``, ``box2``, ... for every move after it.
 
 Every move is from rest to rest, so a job lasts exactly the sum of its moves and dwells: it is never slower
 than its moves planned one by one, because it IS them.
 
 **Same moves, planned once** (:class:`Planner`). A move whose kind, end configurations (bit for bit),
-limit fractions, clearance and obstacles are those of a move planned before is that move again. A jump
-whose reverse was planned is that jump played backwards: under the same symmetric limits and clearance
-the reversed motion is feasible and as fast as any (:mod:`~scara_pin.motion.jump`, "Return move"), so a
-tray job solves one jump per place, not two. The reversed move is verified like a new one.
+limit fractions, clearance, boxes placed and gripper state are those of a move planned before is that move
+again. A jump whose reverse was planned (with the same boxes and gripper state) is that jump played
+backwards: under the same symmetric limits and clearance the reversed motion is feasible and as fast as any
+(:mod:`~scara_pin.motion.jump`, "Return move"), so a tray job solves one jump per place, not two. The
+reversed move is verified like a new one, in its cell too.
 """
 
 from __future__ import annotations
@@ -30,6 +37,7 @@ from __future__ import annotations
 import enum
 import logging
 import math
+import re
 import time
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, replace
@@ -45,20 +53,24 @@ from ..motion.polynomial import PolynomialPiece
 from ..motion.trajectory import Trajectory
 from ..motion.verify import VERIFY_RATE, _limits, state_ratios, verify
 from ..signals import raise_pending
-from .results import JobResult, PlanningStats, StepResult
-from .steps import Dwell, Move, MoveKind, located
+from .results import JobResult, PlacedBox, PlanningStats, StepResult
+from .steps import Dwell, Grip, GripKind, Move, MoveKind, located
 
 if TYPE_CHECKING:
+    from ..cell import Cell, Obstacle, Shape
     from ..description import JointLimits
     from ..model import Robot
+    from ..motion.verify import Clearance
     from .loading import Job
 
-__all__ = ["STILL", "PlannedMove", "Planner", "Source", "plan_job", "plan_move", "scaled_limits"]
+__all__ = ["BOX", "STILL", "PlannedMove", "Planner", "Source", "plan_job", "plan_move", "scaled_limits"]
 
 log = logging.getLogger(__name__)
 
 STILL = 1e-12
 """[rad or m] a move whose end configurations differ by no more than this is no motion (the robot is there)."""
+BOX = "box{}"
+"""The name of the n-th box a job places (``box1``, ``box2``, ...): an obstacle of the cell after its place."""
 
 
 class Source(enum.Enum):
@@ -82,6 +94,7 @@ class PlannedMove:
         lower_bound: [s] what no motion between the same configurations can beat (jumps), or None.
         source: planned, the same as an earlier move, an earlier jump reversed, or still.
         seconds: [s] the wall time its planning took (0 for a move planned before).
+        clearance: in a cell, the smallest verified distance of its checked pairs, which and when (move time).
     """
 
     trajectory: Trajectory | None
@@ -91,6 +104,7 @@ class PlannedMove:
     lower_bound: float | None
     source: Source
     seconds: float = 0.0
+    clearance: Clearance | None = None
 
     @property
     def duration(self) -> float:
@@ -115,7 +129,7 @@ def plan_move(
     *,
     torque: bool = False,
     payload: PayloadLike = None,
-    placed: tuple[Hashable, ...] = (),
+    cell: Cell | None = None,
 ) -> PlannedMove:
     """Plan and verify one move of a job from ``q_from`` (module docstring): the one function every move goes through.
 
@@ -125,17 +139,16 @@ def plan_move(
         q_from: where the robot is, at rest [rad, m].
         torque: respect the effort limits too (with ``payload``).
         payload: carried by the tool (torques): a Payload, or a mass [kg] at the tool frame's origin; None: none.
-        placed: the obstacles placed so far (issue "The cell"); none until the cell is wired.
+        cell: the obstacles in force (the cell file's, the boxes placed so far) and the part in the tool, or
+            None: every checked pair kept the cell's margin apart.
 
     Raises:
         InvalidInputError: the move cannot be made as asked (e.g. a jump between poses closer than twice its
-            clearance radius; exit 2).
-        InfeasibleError: the planner or the verifier refuses it (exit 3).
+            clearance radius; a start or end in collision, naming the pair; exit 2).
+        InfeasibleError: the planner or the verifier refuses it (e.g. a fixed path through an obstacle; exit 3).
     """
     from ..motion.plan import Method, MotionRequest, plan_motion
 
-    if placed:
-        raise InvalidInputError("cells in jobs are not supported yet")
     q0, q1 = np.asarray(q_from, dtype=float), np.asarray(move.q, dtype=float)
     if float(np.max(np.abs(q1 - q0))) <= STILL:
         return PlannedMove(None, "", (), None, None, Source.STILL)
@@ -149,23 +162,35 @@ def plan_move(
             raise InvalidInputError("a jump needs its clearance (rise, clearance_radius)")
         jump = jump_move(robot, robot.tool_pose(q0), move.pose, rise=shape.rise,
                          clearance_radius=shape.clearance_radius, max_height=shape.max_height, payload=payload,
-                         torque=torque, limits=limits, start=q0, end=q1)  # fmt: skip
-        traj, method, bound = jump.trajectory, Method.JUMP.value, jump.lower_bound.duration
+                         torque=torque, limits=limits, start=q0, end=q1, cell=cell)  # fmt: skip
+        traj, method, bound, clearance = jump.trajectory, Method.JUMP.value, jump.lower_bound.duration, jump.distance
     else:
         request = MotionRequest(start_q=q0, end_q=q1, linear=move.kind is MoveKind.MOVE, torque=torque,
-                                payload=payload if torque else None, limits=limits)  # fmt: skip
+                                payload=payload if torque else None, limits=limits, cell=cell)  # fmt: skip
         plan = plan_motion(robot, request)
-        traj, method = plan.trajectory, plan.method.value
-    return _checked(robot, traj, method, limits, torque, payload, bound, Source.PLANNED, time.perf_counter() - t0)
+        traj, method, clearance = plan.trajectory, plan.method.value, plan.clearance
+    return _checked(robot, traj, method, limits, torque, payload, bound, Source.PLANNED, time.perf_counter() - t0,
+                    cell, clearance)  # fmt: skip
 
 
 def _checked(robot: Robot, traj: Trajectory, method: str, limits: JointLimits, torque: bool, payload: Payload,
-             bound: float | None, source: Source, seconds: float) -> PlannedMove:  # fmt: skip
-    """The move verified at 10 kHz (exit 3 if it fails) with what binds on it."""
-    verify(robot, traj, limits=limits, torque=torque, payload=payload, q_start=traj.q_start,
-           q_end=traj.q_end).check()  # fmt: skip
+             bound: float | None, source: Source, seconds: float, cell: Cell | None = None,
+             clearance: Clearance | None = None) -> PlannedMove:  # fmt: skip
+    """The move verified at 10 kHz (exit 3 if it fails) with what binds on it.
+
+    In a cell, the clearance the planner's verification found (the same verifier, at 10 kHz, with the cell's
+    scene) is kept; without one (a reversed jump) the move is verified against the cell here.
+    """
+    sc = None
+    if cell is not None and clearance is None:
+        from ..cell import scene
+
+        sc = scene(robot, cell)
+    found = verify(robot, traj, limits=limits, torque=torque, payload=payload, q_start=traj.q_start,
+                   q_end=traj.q_end, scene=sc).check()  # fmt: skip
     binding, worst = _binding(robot, traj, limits, torque, payload)
-    return PlannedMove(traj, method, binding, worst, bound, source, seconds)
+    return PlannedMove(traj, method, binding, worst, bound, source, seconds,
+                       clearance if clearance is not None else found.clearance)  # fmt: skip
 
 
 def _binding(robot: Robot, traj: Trajectory, limits: JointLimits, torque: bool, payload: Payload
@@ -191,29 +216,65 @@ def _binding(robot: Robot, traj: Trajectory, limits: JointLimits, torque: bool, 
 class Planner:
     """:func:`plan_move` with the job's options, each distinct move planned once (module docstring).
 
+    Args:
+        robot: the robot; torque, payload: the job's (with ``carry``, the payload is held from a pick to a
+            place only, as RAPID's ``GripLoad``).
+        cell: the job's cell (obstacles, margin), or None.
+        carry: the part the tool holds between a pick and a place (tool frame), or None.
+
     Attributes:
-        robot: the robot; torque, payload: the job's.
         stats: how many moves were planned, reused and reversed, and the planning's wall time.
     """
 
-    def __init__(self, robot: Robot, *, torque: bool = False, payload: PayloadLike = None) -> None:
+    def __init__(self, robot: Robot, *, torque: bool = False, payload: PayloadLike = None, cell: Cell | None = None,
+                 carry: Shape | None = None) -> None:  # fmt: skip
         self.robot, self.torque = robot, torque
         self.payload = as_payload(payload)
+        self.cell, self.carry = cell, carry
+        if carry is not None and self.cell is None:
+            from ..cell import Cell
+
+            self.cell = Cell(origin="the job's boxes")
         self._done: dict[Hashable, PlannedMove] = {}
+        self._cells: dict[Hashable, Cell] = {}
         self.stats = PlanningStats()
 
-    def _key(self, move: Move, q_from: np.ndarray, q_to: np.ndarray, placed: tuple[Hashable, ...]) -> Hashable:
-        return (move.kind, q_from.tobytes(), q_to.tobytes(), move.speed, move.accel, move.shape, placed)
+    def cell_for(self, placed: tuple[Obstacle, ...], holding: bool) -> Cell | None:
+        """The cell in force: the job's obstacles, the boxes ``placed`` so far and, ``holding``, the part held."""
+        if self.cell is None:
+            return None
+        key = (_boxes_key(placed), holding)
+        found = self._cells.get(key)
+        if found is None:
+            found = self.cell.with_obstacles(placed)
+            if self.carry is not None:
+                found = found.with_carried(self.carry if holding else None)
+            self._cells[key] = found
+        return found
 
-    def plan(self, move: Move, q_from: np.ndarray, placed: tuple[Hashable, ...] = ()) -> PlannedMove:
-        """The move from ``q_from``: planned, or the same (or reversed) move planned before."""
+    def _key(self, move: Move, q_from: np.ndarray, q_to: np.ndarray, state: Hashable) -> Hashable:
+        return (move.kind, q_from.tobytes(), q_to.tobytes(), move.speed, move.accel, move.shape, state)
+
+    def plan(self, move: Move, q_from: np.ndarray, placed: tuple[Obstacle, ...] = (),
+             holding: bool = False) -> PlannedMove:  # fmt: skip
+        """The move from ``q_from``: planned, or the same (or reversed) move planned before.
+
+        Args:
+            move: the move.
+            q_from: where the robot is, at rest.
+            placed: the boxes placed so far (obstacles).
+            holding: the tool holds the job's part.
+        """
         q0, q1 = np.asarray(q_from, dtype=float), np.asarray(move.q, dtype=float)
-        key = self._key(move, q0, q1, placed)
+        state = (_boxes_key(placed), holding)
+        key = self._key(move, q0, q1, state)
         found = self._done.get(key)
         if found is not None:
             self.stats = replace(self.stats, same=self.stats.same + 1)
             return replace(found, source=Source.SAME if found.trajectory is not None else Source.STILL, seconds=0.0)
-        back = self._done.get(self._key(move, q1, q0, placed)) if move.kind is MoveKind.JUMP else None
+        back = self._done.get(self._key(move, q1, q0, state)) if move.kind is MoveKind.JUMP else None
+        cell = self.cell_for(placed, holding)
+        payload = self.payload if self.carry is None or holding else Payload()
         t0 = time.perf_counter()
         if back is not None and back.trajectory is not None and back.source is not Source.STILL:
             piece = back.trajectory.pieces[0]
@@ -221,15 +282,20 @@ class Planner:
                 raise InvalidInputError("a reversed jump needs a polynomial piece")
             limits = scaled_limits(self.robot, move.speed, move.accel)
             out = _checked(self.robot, Trajectory((piece.reversed(),)), back.method, limits, self.torque,
-                           self.payload, back.lower_bound, Source.REVERSED, time.perf_counter() - t0)  # fmt: skip
+                           payload, back.lower_bound, Source.REVERSED, time.perf_counter() - t0, cell)  # fmt: skip
             self.stats = replace(self.stats, reversed=self.stats.reversed + 1)
         else:
-            out = plan_move(self.robot, move, q0, torque=self.torque, payload=self.payload, placed=placed)
+            out = plan_move(self.robot, move, q0, torque=self.torque, payload=payload, cell=cell)
             if out.trajectory is not None:
                 self.stats = replace(self.stats, planned=self.stats.planned + 1)
         self.stats = replace(self.stats, seconds=self.stats.seconds + time.perf_counter() - t0)
         self._done[key] = out
         return out
+
+
+def _boxes_key(placed: tuple[Obstacle, ...]) -> Hashable:
+    """What makes two sets of placed boxes the same: their shapes and placements, bit for bit."""
+    return tuple((o.name, o.shape.size, o.shape.xyz.tobytes(), o.shape.rpy.tobytes()) for o in placed)
 
 
 def _floats(values: np.ndarray) -> tuple[float, ...]:
@@ -257,30 +323,50 @@ def plan_job(job: Job, robot: Robot, *, progress: Callable[[int, int], None] | N
         JobFileError: the job cannot be run as written (exit 2), with the file and line.
         JobStepError: a place out of reach, a move the planner or the verifier refuses (exit 3), with the line.
     """
-    for key in ("cell", "carry"):
-        if getattr(job, key) is not None:
-            raise JobFileError(job.path, job.lines.get(key), "cells in jobs are not supported yet (the job's "
-                               f"{key}: is kept, not planned with)")  # fmt: skip
     if robot.dof != 4:
         raise JobFileError(job.path, None, f"a job needs a wrist (4 joints); robot {robot.name!r} has {robot.dof}")
     program = job.program(robot)
-    planner = Planner(robot, torque=job.torque, payload=job.payload)
+    cell = _job_cell(job)
+    places = sum(isinstance(a, Grip) and a.kind is GripKind.PLACE for a in program.actions)
+    if places:  # every box placed joins the cell: sized before any move is planned
+        from ..limits import MAX_CELL_OBSTACLES, check_count
+
+        try:
+            check_count(f"obstacles of the cell (its {0 if cell is None else len(cell.obstacles)} and the {places:,} "
+                        "boxes the job places)", places + (0 if cell is None else len(cell.obstacles)),
+                        MAX_CELL_OBSTACLES, "split the job")  # fmt: skip
+        except ScaraError as exc:
+            raise located(job.path, job.lines.get("carry"), exc) from None
+    carry = job.carry.part() if job.carry is not None else None
+    planner = Planner(robot, torque=job.torque, payload=job.payload, cell=cell, carry=carry)
     q, at, t = program.start_q, program.start, 0.0
     pose = robot.tool_pose(q)
-    placed: tuple[Hashable, ...] = ()  # the boxes placed so far: the cell's obstacles for the moves after them
+    placed: tuple[Obstacle, ...] = ()  # the boxes placed so far: the cell's obstacles for the moves after them
+    boxes: list[PlacedBox] = []
+    holding = False
     pieces: list[Any] = []
     rows: list[StepResult] = []
     n = len(program.actions)
     for k, action in enumerate(program.actions):
-        if isinstance(action, Dwell):
+        if isinstance(action, (Dwell, Grip)):
             if action.seconds > 0.0:
                 pieces.append(_hold(q, action.seconds))
-            rows.append(StepResult(k + 1, action.line, "dwell", at, at, t, t + action.seconds, q=_floats(q),
-                                   pose=_floats(pose)))  # fmt: skip
+            box = None
+            if isinstance(action, Grip):
+                holding = action.kind is GripKind.PICK
+                if not holding:
+                    box = _place(robot, planner, job, action, k + 1, q, placed, t + action.seconds)
+                    placed, boxes = placed + (box.obstacle,), [*boxes, box]
+                elif planner.cell is not None:  # the part picked must be clear of the cell where it is picked
+                    _clear(robot, planner.cell_for(placed, True), q, job, action, f"the part picked at {at}")
+            kind = "dwell" if isinstance(action, Dwell) else action.kind.value
+            rows.append(StepResult(k + 1, action.line, kind, at, at, t, t + action.seconds, q=_floats(q),
+                                   pose=_floats(pose), carrying=holding and box is None, boxes=len(placed),
+                                   box=box))  # fmt: skip
             t += action.seconds
         else:
             try:
-                planned = planner.plan(action, q, placed)
+                planned = planner.plan(action, q, placed, holding)
             except ScaraError as exc:
                 raise located(job.path, action.line, exc, f"{action.kind.value} {at} -> {action.target}") from None
             if planned.trajectory is not None:
@@ -290,7 +376,8 @@ def plan_job(job: Job, robot: Robot, *, progress: Callable[[int, int], None] | N
             rows.append(StepResult(k + 1, action.line, action.kind.value, at, action.target, t,
                                    t + planned.duration, action.place, planned.binding, planned.worst,
                                    action.speed, action.accel, planned.source.value, planned.method,
-                                   planned.lower_bound, _floats(action.q), _floats(action.pose)))  # fmt: skip
+                                   planned.lower_bound, _floats(action.q), _floats(action.pose), holding, len(placed),
+                                   planned.clearance))  # fmt: skip
             t += planned.duration
             q, at, pose = np.asarray(action.q, dtype=float), action.target, action.pose
         raise_pending()  # a signal the solver swallowed stops the job here
@@ -298,4 +385,64 @@ def plan_job(job: Job, robot: Robot, *, progress: Callable[[int, int], None] | N
             progress(k + 1, n)
     if not pieces:
         raise JobFileError(job.path, job.lines.get("steps"), "the job never moves nor dwells: nothing to time")
-    return JobResult(job.path, robot.name, tuple(rows), Trajectory(tuple(pieces)), len(program.places), planner.stats)
+    return JobResult(job.path, robot.name, tuple(rows), Trajectory(tuple(pieces)), len(program.places), planner.stats,
+                     tuple(boxes), cell, carry)  # fmt: skip
+
+
+def _job_cell(job: Job) -> Cell | None:
+    """The job's cell file, read (a refusal names the job's ``cell:`` line too), checked against the job's carry."""
+    if job.cell is None:
+        return None
+    from ..cell import load_cell
+
+    try:
+        cell = load_cell(job.cell)
+    except ScaraError as exc:
+        raise located(job.path, job.lines.get("cell"), exc) from None
+    if job.carry is not None and cell.carried is not None:
+        raise JobFileError(job.path, job.lines.get("carry"), f"the cell file {job.cell} gives a carried part too: in "
+                           "a job the part is the job's carry:, held from a pick: to a place: (remove carried: from "
+                           "the cell file)")  # fmt: skip
+    taken = sorted(o.name for o in cell.obstacles if re.fullmatch(BOX.format(r"\d+"), o.name))
+    if job.carry is not None and taken:
+        raise JobFileError(job.path, job.lines.get("cell"), f"the cell file {job.cell} has an obstacle named "
+                           f"{taken[0]}: {BOX.format(1)}, {BOX.format(2)}, ... name the boxes the job places "
+                           "(rename it)")  # fmt: skip
+    return cell
+
+
+def _place(robot: Robot, planner: Planner, job: Job, action: Grip, index: int, q: np.ndarray,
+           placed: tuple[Obstacle, ...], t: float) -> PlacedBox:  # fmt: skip
+    """The box a place leaves: the carried part moved by ``baseMtool`` at ``q``, an obstacle from time ``t``."""
+    from ..cell import Obstacle
+
+    carry = planner.carry
+    if carry is None:  # pragma: no cover - the loader refuses grips without carry
+        raise JobFileError(job.path, action.line, "place: needs the job's carry:")
+    name = BOX.format(len(placed) + 1)
+    box = Obstacle(name, carry.moved(robot.tool_placement(q), what=name))
+    out = PlacedBox(name, index, action.at, t, box)
+    _clear(robot, planner.cell_for((*placed, box), False), q, job, action, f"the robot after leaving {name} at "
+           f"{action.at}", name)  # fmt: skip
+    return out
+
+
+def _clear(robot: Robot, cell: Cell | None, q: np.ndarray, job: Job, action: Grip, what: str,
+           box: str | None = None) -> None:  # fmt: skip
+    """``q`` clear of ``cell`` (exit 2 at the grip's line, naming the pair, otherwise).
+
+    When a link is too close to the ``box`` just left, the message says how to hang the part lower.
+    """
+    from ..cell import InCollisionError, scene
+
+    if cell is None:  # pragma: no cover - a grip always has the job's cell or the boxes' own
+        return
+    try:
+        scene(robot, cell).check(q, what)
+    except InCollisionError as exc:
+        hint = ""
+        if box is not None and exc.pair.b == box:
+            hint = (f" (the part must hang more than the margin, {exc.margin * 1e3:g} mm, below the tool's links: "
+                    "lower it in the tool frame, carry: xyz)")  # fmt: skip
+        raise JobFileError(job.path, action.line, f"{exc}{hint}") from None
+

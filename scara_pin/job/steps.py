@@ -9,6 +9,9 @@ A job's ``steps`` (docs/job.md) are settings, moves, dwells and loops:
   ``clearance_radius`` and ``max_height`` beside it override the job's), ``move: T`` (a straight tool
   line, time-optimal), ``go: T`` (a joint move, time-optimal): from where the robot is to target T;
 - ``dwell: S``: S seconds at rest (a gripper opening, SPEL+'s ``Wait``);
+- ``pick: S`` / ``place: S``: the gripper closes (opens) during S seconds at rest: from a ``pick`` the tool
+  holds the job's ``carry`` part, at a ``place`` it leaves it where it is (SPEL+'s ``On``/``Off`` and
+  ``Wait``, RAPID's ``SetDO`` and ``WaitTime``); :func:`check_grips` checks the order without a robot;
 - ``for: PALLET`` (its places, in ``order``: rows, columns or serpentine) or ``for: N`` (N times), with
   ``do: [steps]`` and the loop variable ``var`` (default ``i``; a nested loop names its own).
 
@@ -43,6 +46,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Dwell",
+    "Grip",
+    "GripKind",
     "JumpShape",
     "Loop",
     "Move",
@@ -52,6 +57,7 @@ __all__ = [
     "Setting",
     "Step",
     "Target",
+    "check_grips",
     "expand",
     "located",
     "parse_target",
@@ -168,6 +174,33 @@ class Dwell:
     at: str = ""
 
 
+class GripKind(enum.Enum):
+    """What the gripper does; the value is the step's key in a job file."""
+
+    PICK = "pick"
+    PLACE = "place"
+
+
+@dataclass(frozen=True)
+class Grip:
+    """The gripper closing (``pick``) or opening (``place``) during ``seconds`` at rest (a step, and an action).
+
+    From a pick the tool holds the job's carried part (it collides with the cell, and the payload is carried);
+    at a place the part stays where the tool leaves it, an obstacle for every move after it.
+
+    Attributes:
+        kind: pick or place.
+        seconds: [s] >= 0, at rest.
+        line: the line of the step in the job file.
+        at: the name of the place the robot rests at (set by the expansion).
+    """
+
+    kind: GripKind
+    seconds: float
+    line: int | None = None
+    at: str = ""
+
+
 @dataclass(frozen=True)
 class Loop:
     """``for``: the body once per place of a pallet (``over`` its name) or ``over`` times (a count).
@@ -187,7 +220,7 @@ class Loop:
     line: int | None = None
 
 
-Step = Setting | MotionStep | Dwell | Loop
+Step = Setting | MotionStep | Dwell | Grip | Loop
 
 
 def tally(steps: tuple[Step, ...], pallets: Mapping[str, Pallet]) -> tuple[int, float]:
@@ -198,11 +231,39 @@ def tally(steps: tuple[Step, ...], pallets: Mapping[str, Pallet]) -> tuple[int, 
             times = step.over if isinstance(step.over, int) else pallets[step.over].places
             inner = tally(step.body, pallets)
             n, dwell = n + times * inner[0], dwell + times * inner[1]
-        elif isinstance(step, Dwell):
+        elif isinstance(step, (Dwell, Grip)):
             n, dwell = n + 1, dwell + step.seconds
         elif not isinstance(step, Setting):
             n += 1
     return n, dwell
+
+
+def check_grips(steps: tuple[Step, ...], pallets: Mapping[str, Pallet], path: Path, holding: int | None = None
+                ) -> int | None:  # fmt: skip
+    """The gripper's state after ``steps`` (the line of the pick holding a part, 0 if unknown; None: empty).
+
+    A pick while the tool holds a part, or a place while it holds none, is refused with the step's line. A loop's
+    body is followed twice when it runs more than once: the state is one of two, so the second pass sees every
+    state a later pass can start from (counted, never unrolled).
+
+    Raises:
+        JobFileError: the grip out of order, with its line.
+    """
+    for step in steps:
+        if isinstance(step, Loop):
+            times = step.over if isinstance(step.over, int) else pallets[step.over].places
+            for _ in range(min(times, 2)):
+                holding = check_grips(step.body, pallets, path, holding)
+        elif isinstance(step, Grip):
+            if step.kind is GripKind.PICK and holding is not None:
+                where = f"at line {holding}" if holding else "before"
+                raise JobFileError(path, step.line, f"pick: the tool already holds the part picked {where} (a place: "
+                                   "comes first)")  # fmt: skip
+            if step.kind is GripKind.PLACE and holding is None:
+                raise JobFileError(path, step.line, "place: the tool holds no part here (no pick: since the job "
+                                   "began or since the last place:)")  # fmt: skip
+            holding = (step.line or 0) if step.kind is GripKind.PICK else None
+    return holding
 
 
 @dataclass(frozen=True, eq=False)
@@ -231,7 +292,7 @@ class Move:
     line: int | None
 
 
-Action = Move | Dwell
+Action = Move | Dwell | Grip
 
 
 @dataclass(frozen=True, eq=False)
@@ -360,6 +421,8 @@ def _unroll(steps: tuple[Step, ...], env: dict[str, int], state: _State, resolve
             state.accel = state.accel if step.accel is None else step.accel / 100.0
         elif isinstance(step, Dwell):
             yield Dwell(step.seconds, step.line, state.at)
+        elif isinstance(step, Grip):
+            yield Grip(step.kind, step.seconds, step.line, state.at)
         elif isinstance(step, MotionStep):
             try:
                 text, place, q, pose = resolver.resolve(step.target, env, state.q)

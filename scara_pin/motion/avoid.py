@@ -37,7 +37,8 @@ with every pair's exact distance (:func:`~scara_pin.motion.verify.verify`).
 starts. The jump's usual warm start (joint lines A -> above A -> above B -> B) is checked against the cell;
 when it collides, candidates are made (:func:`candidates`): OVER (the traverse raised until it clears, up to
 the stroke or the ceiling) and AROUND on either side (a via point beside the first collision, moved out
-until the path clears). The clear candidates are ranked by the duration of their joint lines; the best is
+until the path clears, at the traverse height, and, when no way clears there, up to two steps above it:
+around one obstacle and over a lower one). The clear candidates are ranked by the duration of their joint lines; the best is
 solved, and the second when it is another way (over / left / right) and not much slower; the faster
 verified motion wins. A concave mesh obstacle is handled by the same rows (its witness points), but the
 plane property above holds only locally there.
@@ -87,20 +88,28 @@ ROW_POINTS = (0.0,)
 """Where rows go in an interval (fractions of it; 0 is its start node)."""
 CONVERGED = 1e-7
 """[m] the largest shortfall below the margin at the checked points when the iterations stop."""
+FINE_WITHIN = 0.005
+"""[m] a pair this close to the margin in an interval at the checked points is checked at the verifier's rate there
+once the iterations have converged (:meth:`Rows.fine`)."""
 CONVERGED_TIME = 1e-6
 """Relative change of the duration between two solves below which the re-setting of the planes has converged."""
 DEEP = 0.001
 """[m] a solution this far inside the margin is not re-solved from: the next solve starts from the last clear one."""
 RESOLVE_ITERATIONS = 500
 """IPOPT iterations allowed to a re-solve (warm-started from the last solution; the first solve has the jump's)."""
-_PATH_SAMPLES = 24
+_PATH_SAMPLES = 40
 """Samples of each joint line of a warm-start candidate checked against the cell."""
-SLACK = 0.003
+SLACK = 0.001
 """[m] a warm start counts as clear when its sampled joint lines keep the margin plus this."""
+_RAISED_AROUND = 2
+"""Heights above the traverse height (in steps of _STEP) at which AROUND candidates are also tried."""
 _STEP = 0.005
 """[m] the step of the heights and offsets tried by the candidates."""
 _MAX_OFFSET = 0.4
 """[m] the largest plan-view offset of an AROUND candidate's via point."""
+_MAX_RAISE = 1.0
+"""[m] how far an OVER candidate raises the traverse when no prismatic joint bounds it (a palletizer's arm lifts
+the tool by turning: the raise stops where the IK fails, or here)."""
 _SMOOTH = 1e-3
 """The eps of the smoothed |x| = sqrt(x^2 + eps^2) in the shapes' supports (at most eps times a size: safe)."""
 SECOND_WITHIN = 1.3
@@ -121,7 +130,7 @@ class Candidate:
     """A warm start: joint waypoints A, above A, [via], above B, B, and how it goes.
 
     Attributes:
-        way: ``"straight"``, ``"over"``, ``"left"`` or ``"right"``.
+        way: ``"straight"``, ``"over"``, ``"left"`` or ``"right"`` (``"left, raised"``: above the traverse height).
         waypoints: (n, dof) joint waypoints; the lift is the first segment, the descent the last.
         duration: [s] the time of its joint lines, each from rest to rest.
         clearance: [m] its smallest distance to the cell (checked along the lines).
@@ -152,6 +161,7 @@ class Rows:
         self._index: set[tuple[int, float, int]] = set()
         self._functions: dict[int, Any] = {}
         self._params = np.zeros((0, self.PARAMETERS))
+        self._near: set[tuple[int, int]] = set()
 
     def add(self, new: list[DistanceRow]) -> bool:
         """Add rows not yet present; True if any was."""
@@ -307,7 +317,31 @@ class Rows:
         q_end = piece._local(np.array([n - 1]), np.array([h[-1]]), 0)
         worst = float(min(D.min(initial=math.inf), float(self.scene.distance_array(q_end).min(initial=math.inf))
                           - self.margin))  # fmt: skip
+        self._near = {(int(kk), int(p)) for kk, p in zip(*np.nonzero(
+            (D < FINE_WITHIN).reshape(n, CHECK_POINTS, -1).any(axis=1)))}  # fmt: skip
         return new, worst
+
+    def fine(self, piece: PolynomialPiece) -> list[DistanceRow]:
+        """Rows where the verifier's grid finds a pair below the margin that :meth:`check`'s points missed.
+
+        Only the pairs that came within :data:`FINE_WITHIN` of the margin in an interval at the last
+        :meth:`check` are sampled there, at the verifier's rate (:data:`~scara_pin.motion.verify.VERIFY_RATE`);
+        each (interval, pair) below the margin by more than :data:`CONVERGED` gets a row at its worst sample.
+        Between :meth:`check`'s points, an edge passing an edge (two boxes) can dip below the margin unseen.
+        """
+        from .verify import VERIFY_RATE
+
+        h = np.diff(piece.breaks)
+        new: list[DistanceRow] = []
+        for kk, p in sorted(self._near):
+            m = max(CHECK_POINTS, math.ceil(h[kk] * VERIFY_RATE) + 1)
+            s = np.arange(1, m) / m
+            q = piece._local(np.full(len(s), kk), s * h[kk], 0)
+            d = self.scene.distance_array(q, [p])[:, 0] - self.margin
+            i = int(np.argmin(d))
+            if d[i] < -CONVERGED and (kk, float(s[i]), p) not in self._index:
+                new.append(DistanceRow(kk, float(s[i]), p))
+        return new
 
 
 # ---------------------------------------------------------------------------------------------- warm starts
@@ -325,7 +359,7 @@ def _score(scene: Scene, waypoints: np.ndarray, velocity: np.ndarray, accelerati
     """
     t = sum(line_optimal_duration(a, b, velocity, acceleration) for a, b in zip(waypoints[:-1], waypoints[1:])
             if not np.array_equal(a, b))  # fmt: skip
-    d = scene.distance_array(_line_samples(waypoints))
+    d = scene.minimum_array(_line_samples(waypoints))
     return float(t), float(d.min(initial=math.inf)) - scene.margin - SLACK
 
 
@@ -360,24 +394,29 @@ def candidates(
         return [first]
     found = [first]
     # OVER: the traverse raised until the joint lines clear
-    z_max = robot.tool_pose(_stroke_top(robot, tops[0]))[2]
+    top = _stroke_top(robot, tops[0])
+    z_max = z_top + _MAX_RAISE if top is None else robot.tool_pose(top)[2]
     if ceiling is not None:
         z_max = min(z_max, ceiling)
+    raised = {z_top: tops}  # traverse height -> the configurations above A and B there
     z = z_top + _STEP
     while z <= z_max + 1e-12:
         ta = _ik(robot, np.array([A[0], A[1], z, A[3]]), tops[0])
         tb = _ik(robot, np.array([B[0], B[1], z, B[3]]), tops[1])
         if ta is None or tb is None:
             break
+        if len(raised) < 1 + _RAISED_AROUND:
+            raised[z] = (ta, tb)
         way = np.array([qA, ta, tb, qB])
         t, clear = _score(scene, way, velocity, acceleration)
         if clear >= 0.0:
             found.append(Candidate("over", way, t, clear))
             break
         z += _STEP
-    # AROUND: a via point beside the first collision of the straight lines, moved out on either side
+    # AROUND: a via point beside the first collision of the straight lines, moved out on either side, at the
+    # traverse height and a little above it (around one obstacle and over a lower one)
     samples = _line_samples(straight)
-    D = scene.distance_array(samples).min(axis=1) - scene.margin
+    D = scene.minimum_array(samples) - scene.margin
     hit = int(np.argmax(D < 0.0))
     p = robot.tool_pose(samples[hit])
     u = B[:2] - A[:2]
@@ -385,32 +424,38 @@ def candidates(
     normal = np.array([-u[1], u[0]])
     base = A[:2] + u * float(np.clip((p[:2] - A[:2]) @ u, 0.0, np.linalg.norm(B[:2] - A[:2])))
     yaw = float(A[3] + (B[3] - A[3]) * 0.5)
-    for side, sign in (("left", 1.0), ("right", -1.0)):
-        offset = _STEP
-        while offset <= _MAX_OFFSET:
-            xy = base + sign * offset * normal
-            mid = (tops[0] + tops[1]) / 2.0
-            via = _ik(robot, np.array([xy[0], xy[1], z_top, yaw]), mid)
-            if via is not None:
-                way = np.array([qA, tops[0], via, tops[1], qB])
-                t, clear = _score(scene, way, velocity, acceleration)
-                if clear >= 0.0:
-                    found.append(Candidate(side, way, t, clear))
-                    break
-            offset += _STEP
+    for k, (zv, (ta, tb)) in enumerate(raised.items()):
+        if k and any(c.clearance >= 0.0 for c in found):
+            break  # a way clears already: raised AROUND scans only when nothing else does
+        step = _STEP if k == 0 else 2.0 * _STEP  # the raised scans are coarser: they only add ways
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            offset = step
+            while offset <= _MAX_OFFSET:
+                xy = base + sign * offset * normal
+                via = _ik(robot, np.array([xy[0], xy[1], zv, yaw]), (ta + tb) / 2.0)
+                if via is not None:
+                    way = np.array([qA, ta, via, tb, qB])
+                    t, clear = _score(scene, way, velocity, acceleration)
+                    if clear >= 0.0:
+                        found.append(Candidate(side if k == 0 else f"{side}, raised", way, t, clear))
+                        break
+                offset += step
     clear_ones = sorted((c for c in found if c.clearance >= 0.0), key=lambda c: c.duration)
     if not clear_ones:  # none clears: every one tried, the least colliding first (the planner may still find a way)
         return sorted(found, key=lambda c: -c.clearance)
     return clear_ones
 
 
-def _stroke_top(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """``q`` with the joint that moves the tool up (a SCARA's quill) at the end of its range that raises the tool."""
+def _stroke_top(robot: Robot, q: np.ndarray) -> np.ndarray | None:
+    """``q`` with the joint that moves the tool up (a SCARA's quill) at the end of its range that raises the tool.
+
+    None when that joint is not prismatic (a palletizer raises the tool by turning its arms).
+    """
     J = robot.task_jacobian(q)[2]
     out = q.copy()
     j = int(np.argmax(np.abs(J)))
     if robot.joint_kinds[j] != "length":
-        return out
+        return None
     out[j] = robot.limits.upper[j] if J[j] > 0 else robot.limits.lower[j]
     return out
 
@@ -493,6 +538,8 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
         sol = tr.solve(x0, None, None, params)
         iterations += sol["iterations"]
         solves += 1
+        log.debug("jump in a cell: solve %d: %s after %d iterations, %d rows", solves, sol["status"],
+                  sol["iterations"], len(rows.rows))  # fmt: skip
         T, _, U = tr.unpack(sol["x"])
         if not sol["success"]:
             if clear is not None and not retried:  # every plane from the last clear motion, which meets them all
@@ -511,6 +558,8 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
         new = [p for p in _violations(prob, piece, T) if p not in points]
         fresh, worst = rows.check(piece)
         added = rows.add(fresh)
+        log.debug("jump in a cell: %.6f s, worst %.3g mm beyond the margin, %d rows added, %d limit points",
+                  piece.duration, worst * 1e3, len(fresh), len(new))  # fmt: skip
         params = rows.parameters(piece, None if clear is None else clear[0])
         if worst >= -CONVERGED:
             clear = (piece, sol["x"])
@@ -520,7 +569,12 @@ def solve_avoiding(prob: Any, options: Any, waypoints: np.ndarray) -> tuple[Poly
         settled = worst >= -CONVERGED and abs(piece.duration - duration) <= CONVERGED_TIME * piece.duration
         duration = piece.duration
         if not new and not added and settled:
-            break
+            finer = rows.fine(piece)  # converged: what the verifier's grid would see between the checked points
+            if not finer:
+                break
+            rows.add(finer)
+            added = True
+            params = rows.parameters(piece, None if clear is None else clear[0])
         if solves > options.refinements + options.avoid_iterations:
             if last_clear is not None:
                 piece, T = last_clear[0], last_clear[2]

@@ -875,8 +875,9 @@ def _solve_in_cell(prob: _Problem, options: JumpOptions, scene: Scene, ceiling: 
             return piece, T, stats, traj, _verify(prob, traj)
         except JumpError as exc:
             raise blocked(scene, found, exc.status) from None
-    tries = found[:1] + [c for c in found[1:2] if c.way != found[0].way and c.duration <= SECOND_WITHIN
-                         * found[0].duration]  # fmt: skip
+    way = found[0].way.split(",")[0]  # over, left or right
+    tries = found[:1] + [c for c in found[1:] if c.way.split(",")[0] != way and c.duration <= SECOND_WITHIN
+                         * found[0].duration][:1]  # fmt: skip
     best = None
     error: Exception | None = None
     iterations = 0

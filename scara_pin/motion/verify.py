@@ -184,7 +184,8 @@ class Clearance:
 
     def describe(self) -> str:
         """``link2 - post 1.2 mm deep at t = 0.1234 s near (290, -52, 0) mm in base (margin 2 mm)``."""
-        how = f"{-self.distance * 1e3:.4g} mm deep" if self.distance < 0 else f"{self.distance * 1e3:.4g} mm apart"
+        how = (f"{-self.distance * 1e3:.4g} mm deep" if -math.inf < self.distance < 0 else "in contact (depth not "
+               "computed)" if self.distance < 0 else f"{self.distance * 1e3:.4g} mm apart")  # fmt: skip
         at = "" if self.where is None else " near (" + ", ".join(f"{v * 1e3:.1f}" for v in self.where) + ") mm in base"
         return f"{self.pair} {how} at t = {self.time:.6g} s{at} (margin {self.margin * 1e3:g} mm)"
 

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from ..cell import Cell
+    from ..cell.shapes import Shape
     from ..description import JointLimits
     from ..model import Robot
     from ..motion.cycle import ArchMove, CycleResult
@@ -135,17 +136,9 @@ def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarra
     """
     from matplotlib.patches import Polygon, Rectangle
 
-    angle = np.linspace(0.0, 2.0 * np.pi, 73)
     for i, o in enumerate(cell.obstacles):
         shape = o.shape
-        if shape.kind in ("cylinder", "sphere") and abs(shape.rotation[2, 2]) > 1.0 - 1e-9:
-            r = shape.size[0]
-            ring = shape.xyz[:2] + r * np.column_stack([np.cos(angle), np.sin(angle)])
-            half = shape.size[1] / 2.0 if shape.kind == "cylinder" else r
-            pts = np.column_stack([np.repeat(ring, 2, axis=0), np.tile([shape.xyz[2] - half, shape.xyz[2] + half],
-                                                                       len(ring))])  # fmt: skip
-        else:
-            pts = shape.corners()
+        pts = _shape_points(shape)
         hull = _hull(pts[:, :2])
         label = "obstacles" if i == 0 else None
         plan.add_patch(Polygon(hull * k, closed=True, facecolor="0.75", edgecolor="0.35", lw=1, label=label))
@@ -156,6 +149,22 @@ def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarra
                                  label=label))  # fmt: skip
     side.autoscale_view()
     plan.autoscale_view()
+
+
+def _shape_points(shape: Shape) -> np.ndarray:
+    """(k, 3) points of ``shape`` whose convex hull outlines it, in its frame's axes.
+
+    A vertical cylinder's or a sphere's rings (a circle in plan view), else the corners of the box around it
+    (:meth:`~scara_pin.cell.Shape.corners`).
+    """
+    if shape.kind in ("cylinder", "sphere") and abs(shape.rotation[2, 2]) > 1.0 - 1e-9:
+        angle = np.linspace(0.0, 2.0 * np.pi, 73)
+        r = shape.size[0]
+        ring = shape.xyz[:2] + r * np.column_stack([np.cos(angle), np.sin(angle)])
+        half = shape.size[1] / 2.0 if shape.kind == "cylinder" else r
+        return np.column_stack([np.repeat(ring, 2, axis=0), np.tile([shape.xyz[2] - half, shape.xyz[2] + half],
+                                                                    len(ring))])  # fmt: skip
+    return shape.corners()
 
 
 def _hull(points: np.ndarray) -> np.ndarray:

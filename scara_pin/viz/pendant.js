@@ -147,6 +147,11 @@
         row = row.map(function (v, i) { return v + a * (next[i] - v); });
       }
       q = row.slice();
+      (m.shown || []).forEach(function (s) {  // nodes shown over spans of the motion (a job's boxes)
+        var on = s.spans.some(function (w) { return t >= w[0] && t < w[1]; });
+        var n = node(s.path);
+        if (n) n.set_property("visible", on);
+      });
       time.value = String(t);
       timeValue.textContent = t.toFixed(3) + " s";
       syncSliders();
