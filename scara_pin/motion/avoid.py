@@ -38,8 +38,8 @@ starts. The jump's usual warm start (joint lines A -> above A -> above B -> B) i
 when it collides, candidates are made (:func:`candidates`): OVER (the traverse raised until it clears, up to
 the stroke or the ceiling) and AROUND on either side (a via point beside the first collision, moved out
 until the path clears, at the traverse height, and, when no way clears there, up to two steps above it:
-around one obstacle and over a lower one). The clear candidates are ranked by the duration of their joint lines; the best is
-solved, and the second when it is another way (over / left / right) and not much slower; the faster
+around one obstacle and over a lower one). The clear candidates are ranked by the duration of their joint
+lines; the best is solved, and the second when it is another way (over / left / right) and not much slower; the faster
 verified motion wins. A concave mesh obstacle is handled by the same rows (its witness points), but the
 plane property above holds only locally there.
 """
