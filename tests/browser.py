@@ -116,6 +116,18 @@ def orange_pixels(png: bytes | Path) -> int:
     return int(mask.sum())
 
 
+def slate_pixels(png: bytes) -> int:
+    """Pixels of the obstacles' slate blue (0x6A5ACD), lit or shaded, over any background: blue well above red and
+    green, red at least green (unlike the tool path's dodger blue and the grey-blue floor), not the triads' blue."""
+    import io
+
+    from PIL import Image
+
+    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(float)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    return int(((b > r + 40) & (b > g + 40) & (r >= g) & (r > 30)).sum())
+
+
 @pytest.fixture(scope="session")
 def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
     """A headless Chromium context with a fresh profile, launched once per session (per pytest-xdist worker;

@@ -1,10 +1,17 @@
-"""Helpers of the pendant tests: the tool pose and a held joint's rate from Pinocchio (computed here), and the
-page's rounded readouts read back in SI, checking their format."""
+"""Helpers of the pendant tests: the tool pose and a held joint's rate from Pinocchio (computed here), the
+page's rounded readouts read back in SI, checking their format, and `scara-pin teach` in a subprocess."""
 
 from __future__ import annotations
 
 import math
 import re
+import signal
+import socket
+import subprocess
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -66,3 +73,42 @@ def joint_rate(robot: Any, q: np.ndarray, j: int, override: float) -> float:
     pin.framesForwardKinematics(robot.model, data, robot.to_pinocchio_q(q))
     J = pin.getFrameJacobian(robot.model, data, robot.model.getFrameId(robot.tool_frame), pin.LOCAL_WORLD_ALIGNED)
     return override * min(float(robot.limits.velocity[j]), MANUAL_SPEED / float(np.linalg.norm(J[:3, j])))
+
+
+@contextmanager
+def teach_process(*args: str) -> Iterator[tuple[str, int, subprocess.Popen[str]]]:
+    """``scara-pin teach --port 0 ARGS`` in a subprocess: (its URL, its port, the process), once it says its URL.
+
+    At the end it is stopped with Ctrl-C, which must end it with exit code 0, no traceback or internal error on
+    stderr, and the port closed.
+    """
+    import psutil
+    import pytest
+    from sigint import default_sigint
+
+    script = Path(sys.executable).parent / "scara-pin"
+    cmd = [str(script)] if script.exists() else [sys.executable, "-m", "scara_pin.cli"]
+    proc = subprocess.Popen([*cmd, "teach", "--port", "0", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, preexec_fn=default_sigint)  # fmt: skip
+    port = None
+    try:
+        line = proc.stdout.readline()  # type: ignore[union-attr]
+        match = re.search(r"(http://127\.0\.0\.1:(\d+)/)", line)
+        assert match, line
+        port = int(match.group(2))
+        yield match.group(1), port, proc
+    finally:
+        proc.send_signal(signal.SIGINT)
+        try:
+            code = proc.wait(timeout=10)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    err = proc.stderr.read()  # type: ignore[union-attr]
+    assert code == 0 and "Traceback" not in err and "internal error" not in err, err
+    assert port is not None
+    assert not [c for c in psutil.net_connections("inet") if c.laddr.port == port and c.status == "LISTEN"]
+    with socket.socket() as s, pytest.raises(OSError):
+        s.settimeout(2)
+        s.connect(("127.0.0.1", port))

@@ -151,3 +151,40 @@ def test_first_contact_from_a_collision_and_without_one(robot) -> None:
         first_contact(scene(robot, inside), JointLine(q0, q0 + 0.1))
     far = Cell((Obstacle("ball", Shape("sphere", (0.02,), np.array([-0.3, -0.3, -0.3]), np.zeros(3))),))
     assert first_contact(scene(robot, far), JointLine(q0, q0 + np.array([0.5, 0.0, 0.0, 0.0]))) is None
+
+
+def test_first_contact_follows_a_pair_that_starts_at_the_margin(robot, monkeypatch) -> None:
+    """A jog that stopped at a post then moves along it: the flange starts 0.5 nm above the margin (the plan
+    distance of the axes, written here) and J3 lowers it beside the vertical post, where its distance does not
+    change, onto a floor box: the stop is where the flange's bottom (the tool point) is the margin above the box's
+    top. Conservative advancement alone steps by gap / speed there (1e-9 m at a time: it gave up after 200,000
+    steps); J4 turning the flange (a disc about its own axis) beside the post is no contact at all."""
+    rp, post = 0.02, np.array([0.35, -0.1])
+    floor_top = -0.13
+    cell = Cell((Obstacle("post", Shape("cylinder", (rp, 0.23), np.array([*post, -0.185]), np.zeros(3))),
+                 Obstacle("floor", Shape("box", (0.1, 0.1, 0.05), np.array([0.28, -0.1, floor_top - 0.025]),
+                                         np.zeros(3)))), MARGIN)  # fmt: skip
+    sc = scene(robot, cell)
+    x = post[0] - (rp + FLANGE_R + MARGIN) - 0.5e-9
+    q0 = robot.ik(np.array([x, post[1], -0.1, 0.0])).nearest(np.zeros(4)).q
+    data = robot.model.createData()
+
+    def tool(q: np.ndarray) -> np.ndarray:  # the tool point in the base frame, from Pinocchio's frames
+        pin.framesForwardKinematics(robot.model, data, q)
+        frame = robot.model.getFrameId
+        return data.oMf[frame(robot.base_frame)].actInv(data.oMf[frame(robot.tool_frame)]).translation.copy()
+
+    assert abs(np.linalg.norm(tool(q0)[:2] - post) - (rp + FLANGE_R + MARGIN + 0.5e-9)) < 1e-12
+    calls = []  # configurations whose distances are asked for
+    real = type(sc).distance_array
+    monkeypatch.setattr(type(sc), "distance_array",
+                        lambda self, Q, *a, **k: calls.append(len(np.atleast_2d(Q))) or real(self, Q, *a, **k))
+    assert first_contact(sc, JointLine(q0, q0 + np.array([0.0, 0.0, 0.0, 3.0]))) is None  # J4: 3 rad
+    assert first_contact(sc, JointLine(q0, q0 + np.array([0.0, 0.0, -0.01, 0.0]))) is None  # J3 up 10 mm
+    found = first_contact(sc, JointLine(q0, q0 + np.array([0.0, 0.0, 0.045, 0.0])))  # J3 down 45 mm
+    # the floor stops it (the flange and the quill, coaxial, reach the tool point both), not the post it slid along
+    assert found is not None and found.closest.pair.b == "floor" and found.closest.pair.a in ("flange", "quill")
+    z = tool(found.q)[2]
+    assert floor_top + MARGIN <= z <= floor_top + MARGIN + CONTACT_TOL + 1e-12
+    assert found.s * 0.045 == pytest.approx(-0.1 - (floor_top + MARGIN), abs=CONTACT_TOL + 1e-12)
+    assert sum(calls) < 3000, sum(calls)

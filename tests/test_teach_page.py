@@ -12,10 +12,7 @@ import http.client
 import json
 import math
 import re
-import signal
-import socket
 import subprocess
-import sys
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -23,11 +20,19 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import psutil
 import pytest
 from browser import SLOW_FRAMES, busy_cores
-from pendant_page import DECIMALS, TO_SI, joint_rate, pin_placement, pin_pose, read_values, readout, resolution
-from sigint import default_sigint
+from pendant_page import (
+    DECIMALS,
+    TO_SI,
+    joint_rate,
+    pin_placement,
+    pin_pose,
+    read_values,
+    readout,
+    resolution,
+    teach_process,
+)
 
 from scara_pin import Robot
 from scara_pin.cli import main
@@ -78,34 +83,9 @@ class Server:
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
-    script = Path(sys.executable).parent / "scara-pin"
-    cmd = [str(script)] if script.exists() else [sys.executable, "-m", "scara_pin.cli"]
     points = tmp_path_factory.mktemp("teach") / "cell.yaml"
-    proc = subprocess.Popen([*cmd, "teach", "--robot", "s1", "--port", "0", "--points", str(points),
-                             "--q", *map(repr, Q_S1.tolist())], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, preexec_fn=default_sigint)  # fmt: skip
-    port = None
-    try:
-        line = proc.stdout.readline()  # type: ignore[union-attr]
-        match = re.search(r"(http://127\.0\.0\.1:(\d+)/)", line)
-        assert match, line
-        port = int(match.group(2))
-        yield Server(match.group(1), port, points, proc)
-    finally:
-        proc.send_signal(signal.SIGINT)
-        try:
-            code = proc.wait(timeout=10)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait()
-    err = proc.stderr.read()  # type: ignore[union-attr]
-    assert code == 0 and "Traceback" not in err and "internal error" not in err, err
-    assert port is not None
-    assert not [c for c in psutil.net_connections("inet") if c.laddr.port == port and c.status == "LISTEN"]
-    with socket.socket() as s, pytest.raises(OSError):
-        s.settimeout(2)
-        s.connect(("127.0.0.1", port))
+    with teach_process("--robot", "s1", "--points", str(points), "--q", *map(repr, Q_S1.tolist())) as (url, port, proc):
+        yield Server(url, port, points, proc)
 
 
 # ------------------------------------------------------------------------------------------ HTTP (issue 24, 13)

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from browser import next_frames
+from browser import next_frames, slate_pixels
 from scipy.spatial.transform import Rotation
 
 import scara_pin as sp
@@ -99,18 +99,6 @@ def test_the_page_places_every_obstacle_and_the_carried_part(robot) -> None:
     got = oMj @ local
     want = robot.frame_placement(Q_AWAY, "tool0", relative_to="universe").homogeneous @ CARRIED.placement().homogeneous
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
-
-
-def slate_pixels(png: bytes) -> int:
-    """Pixels of the obstacles' slate blue (0x6A5ACD), lit or shaded, over any background: blue well above red and
-    green, red at least green (unlike the tool path's dodger blue and the grey-blue floor), not the triads' blue."""
-    import io
-
-    from PIL import Image
-
-    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(float)
-    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
-    return int(((b > r + 40) & (b > g + 40) & (r >= g) & (r > 30)).sum())
 
 
 def shot(page: Any, name: str) -> bytes:

@@ -486,17 +486,29 @@ def _fresh_guesses(gd: Any) -> None:
             req.enable_cached_gjk_guess = False
 
 
-def describe(found: PairDistance, margin: float) -> str:
-    """``link2 and post are 1.2 mm apart (margin 2 mm) at (x, y, z) mm``: one pair's distance, in words."""
+def describe(found: PairDistance, margin: float, unit: str = "mm") -> str:
+    """``link2 and post are 1.2 mm apart (margin 2 mm) near (x, y, z) mm in base``: one pair's distance, in words.
+
+    ``unit="m"``: every length written ``<number> m`` (``0.0012 m``; the point ``near x 0.3 m, y -0.1 m, z -0.1 m``),
+    which the teach pendant's page restates in its own units.
+    """
+    if unit not in ("mm", "m"):
+        raise InvalidInputError(f"unit {unit!r} must be 'mm' or 'm'")
     a, b = found.pair.a, found.pair.b
+    margin_text = f"{margin:g} m" if unit == "m" else f"{margin * 1e3:g} mm"
     if found.distance == -math.inf:
-        return f"{a} is in contact with {b}, its depth not computed (margin {margin * 1e3:g} mm)"
-    at = ", ".join(f"{v * 1e3:.1f}" for v in (found.point_a + found.point_b) / 2.0)
-    if found.distance < 0:
-        how = f"{a} is {-found.distance * 1e3:.3g} mm deep in {b}"
+        return f"{a} is in contact with {b}, its depth not computed (margin {margin_text})"
+    mid = (found.point_a + found.point_b) / 2.0
+    if unit == "m":
+        size, at = (lambda v: f"{v:.3g} m"), ", ".join(f"{k} {v:.6g} m" for k, v in zip("xyz", mid))
+        at = f"near {at} in base"
     else:
-        how = f"{a} and {b} are {found.distance * 1e3:.3g} mm apart"
-    return f"{how} (margin {margin * 1e3:g} mm) near ({at}) mm in base"
+        size, at = (lambda v: f"{v * 1e3:.3g} mm"), f"near ({', '.join(f'{v * 1e3:.1f}' for v in mid)}) mm in base"
+    if found.distance < 0:
+        how = f"{a} is {size(-found.distance)} deep in {b}"
+    else:
+        how = f"{a} and {b} are {size(found.distance)} apart"
+    return f"{how} (margin {margin_text}) {at}"
 
 
 def scene(robot: Robot, cell: Cell) -> Scene:

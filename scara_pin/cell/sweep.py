@@ -26,8 +26,23 @@ the closest pair's rate of approach, :meth:`Scene.gradients <scara_pin.cell.Scen
 bisection on coal's distance until the gap at the stop is in [0, :data:`CONTACT_TOL`] m.
 
 The bound holds for the q' of the start of each step; a step after which the bound grew by more than
-:data:`BOUND_GROWTH` is taken again at half the length, so a path whose q' changes fast (near a singularity)
-is followed in small steps.
+:data:`BOUND_GROWTH` is kept only if every pair's gap also allows it at the larger of its bounds at the step's two
+ends, else taken again at half the length, so a path whose q' changes fast (near a singularity, or at the
+corners of a joint polyline) is followed in small steps where a pair is near.
+
+**Starting at the margin.** Conservative advancement cannot follow a pair that starts AT the margin and does
+not approach (a jog that stopped at a post, then moves along it or turns the flange beside it): its steps are
+its gap over its speed, and the gap stays about zero (a vertical move beside a vertical post keeps it exactly
+constant), so the steps shrink to nothing. A pair that starts less than :data:`SLIDE_BAND` above the margin is
+therefore followed by samples instead: its steps are :data:`SLIDE_STEP` of its shapes' motion (its speed bound
+times the step, the bound taken at the first of up to 64 samples evaluated at once and checked at the last as
+above), its exact distance checked at every one (a sample below the margin is bisected as above), until it is
+:data:`SLIDE_BAND` clear; from then on it is followed conservatively like every other pair. The samples go as far
+as the other pairs' conservative steps allow, so these are still followed without a gap.
+Only such a pair could dip below the margin between two samples and come back unseen: a smooth distance
+(curvature radius r of the shapes' relative motion) dips at most ``SLIDE_STEP**2 / (8 r)`` between samples,
+1.25e-7 m for r = 1 cm; a straight translation of convex shapes (a jog along x, y or z beside a post or a
+wall) cannot dip at all (the distance is then convex along the line).
 """
 
 from __future__ import annotations
@@ -47,6 +62,8 @@ __all__ = [
     "BOUND_GROWTH",
     "CONTACT_TOL",
     "MAX_STEPS",
+    "SLIDE_BAND",
+    "SLIDE_STEP",
     "Contact",
     "JointPath",
     "clear_mask",
@@ -62,6 +79,13 @@ BOUND_GROWTH = 1.1
 """A step is taken again at half its length when the speed bound at its end exceeds the start's by this factor."""
 MAX_STEPS = 200_000
 """Conservative steps along one path before giving up (an internal error: the bound is never that slow)."""
+SLIDE_BAND = 1e-4
+"""[m] a pair that starts less than this above the margin is followed by samples until it is this clear (module
+docstring: "Starting at the margin")."""
+SLIDE_STEP = 1e-4
+"""[m] the samples of such a pair: at most this much motion of its shapes between two (by its speed bound)."""
+_BATCH = 64
+"""Samples of a pair at the margin taken at once (one path evaluation, one distance query per sample)."""
 _SAFETY = 0.9
 """The fraction of the conservative step taken (rounding, and q' changing within the step)."""
 _MIN_STEP = 1e-15
@@ -83,7 +107,9 @@ class Contact:
     Attributes:
         s: the path parameter of the stop (every pair at least the margin apart on [0, s]).
         q: the configuration there.
-        closest: the pair at the margin there (its distance within :data:`CONTACT_TOL` above the margin).
+        closest: the pair that comes to the margin there (its distance within :data:`CONTACT_TOL` above the margin):
+            of the pairs below the margin just beyond, the closest. Another pair may be as close (one that slides
+            along an obstacle at the margin), but it is not what stops the path.
     """
 
     s: float
@@ -337,13 +363,36 @@ def first_contact(scene: Scene, path: JointPath, s_end: float = 1.0) -> Contact 
     if g.min() < 0.0:
         scene.check(q, "the start")  # raises, naming the pair
     V = pair_speeds(q, dq, g)
+    sliding = g < SLIDE_BAND  # pairs that start at the margin: sampled until clear (module docstring)
     for _ in range(MAX_STEPS):
         if s >= s_end:
             return None
+        sliding &= g < SLIDE_BAND
         with np.errstate(divide="ignore", invalid="ignore"):
             allowed = np.where(V > 0, g / np.where(V > 0, V, 1.0), np.inf)
+            if sliding.any():
+                allowed = np.where(sliding, np.maximum(allowed, SLIDE_STEP / V), allowed)
         k = int(np.argmin(allowed))
         step = _SAFETY * float(allowed[k])
+        if sliding[k]:  # samples of a pair at the margin, as many at once as the other pairs' steps allow
+            others = allowed[~sliding]
+            horizon = _SAFETY * float(others.min()) if others.size else np.inf
+            n = int(min(max(horizon // step, 1.0), _BATCH))
+            while True:
+                ss = s + step * np.arange(1, n + 1)
+                ss = np.append(ss[ss < s_end], s_end) if ss[-1] >= s_end else ss
+                Q, dQ = path.evaluate(ss, 1)[:2]
+                G = scene.distance_array(Q) - margin
+                below = np.flatnonzero(G.min(axis=1) < 0.0)
+                if below.size:
+                    i = int(below[0])
+                    return _bracketed(scene, at, margin, s if i == 0 else float(ss[i - 1]), float(ss[i]))
+                V1 = pair_speeds(Q[-1], dQ[-1], G[-1])
+                if V1.max() <= BOUND_GROWTH * V.max() or n == 1:
+                    break
+                n //= 2
+            s, q, dq, g, V = float(ss[-1]), Q[-1], dQ[-1], G[-1], V1
+            continue
         if s + 2.0 * step < s_end:  # small steps ahead: a probe where the closest pair would reach the margin
             rate = _rate(scene, q, dq, k)
             if rate < 0.0:
@@ -360,6 +409,10 @@ def first_contact(scene: Scene, path: JointPath, s_end: float = 1.0) -> Contact 
             V1 = pair_speeds(q1, dq1, g1)
             if V1.max() <= BOUND_GROWTH * V.max() or step <= _MIN_STEP:
                 break
+            # the bound grew: the step holds if it holds with each pair's larger bound of its two ends (the samples
+            # of a pair at the margin are its check: the step is at most one)
+            if np.all((step * np.maximum(V, V1) <= g) | sliding):
+                break
             step *= 0.5
         s, q, dq, g, V = s1, q1, dq1, g1, V1
     raise ScaraError(f"the contact search took more than {MAX_STEPS} steps (s = {s:.9g}): please report it")
@@ -372,20 +425,26 @@ def _rate(scene: Scene, q: np.ndarray, dq: np.ndarray, k: int) -> float:
 
 
 def _bracketed(scene: Scene, at: Any, margin: float, lo: float, hi: float) -> Contact:
-    """Bisection on the smallest gap between ``lo`` (clear) and ``hi`` (closer than the margin)."""
+    """Bisection on the smallest gap between ``lo`` (clear) and ``hi`` (closer than the margin).
+
+    It stops when a pair below the margin at ``hi`` (one that blocks) is within :data:`CONTACT_TOL` of it at ``lo``:
+    the smallest gap of all may be a pair that slides along an obstacle at the margin and blocks nothing.
+    """
+    blocking = np.flatnonzero(scene.distance_array(at(hi)[0][None, :])[0] < margin)
+    if not blocking.size:  # (the caller saw a pair below the margin at hi: the same query, the same answer)
+        blocking = np.arange(len(scene.pairs))
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         if not lo < mid < hi:
             break
-        q = at(mid)[0]
-        gap = float(scene.distance_array(q[None, :])[0].min()) - margin
-        if gap < 0.0:
-            hi = mid
+        gaps = scene.distance_array(at(mid)[0][None, :])[0] - margin
+        if gaps.min() < 0.0:
+            hi, blocking = mid, np.flatnonzero(gaps < 0.0)
         else:
             lo = mid
-            if gap <= CONTACT_TOL:
+            if gaps[blocking].min() <= CONTACT_TOL:
                 break
     q = at(lo)[0]
     found = scene.distances(q)
-    assert found.closest is not None  # noqa: S101 - a bracket exists only with pairs
-    return Contact(lo, q, found.closest)
+    stops = set(blocking.tolist())
+    return Contact(lo, q, next(p for p in found.pairs if p.pair.index in stops))  # closest first

@@ -7,7 +7,16 @@ import sys
 from typing import Any
 
 from ..signals import Terminated, handled
-from ._common import Units, _add_robot_options, _add_units, _load, _q_values, integer_type
+from ._common import (
+    Units,
+    _add_robot_options,
+    _add_units,
+    _load,
+    _q_values,
+    add_cell_options,
+    cell_from_args,
+    integer_type,
+)
 
 
 def cmd_teach(args: argparse.Namespace) -> int:
@@ -17,9 +26,14 @@ def cmd_teach(args: argparse.Namespace) -> int:
     units = Units.from_args(args)
     robot = _load(args, units)
     q = _q_values(args.q, units) if args.q else None
-    server = TeachServer(robot, port=args.port, q=q, points_file=args.points, controls=args.controls)
+    cell = cell_from_args(args, units)
+    server = TeachServer(robot, port=args.port, q=q, points_file=args.points, controls=args.controls, cell=cell)
     try:  # from the line that says so on, Ctrl-C stops the server
         print(f"teach pendant: {server.url}  (serving on 127.0.0.1 until Ctrl-C)", flush=True)
+        if cell is not None:
+            print(f"cell          {cell.origin}: {len(cell.obstacles)} obstacle(s)"
+                  f"{'' if cell.carried is None else ', a carried part'}, margin {units.num(cell.margin, 'length')} "
+                  f"{units.length_name}: jogs stop at the margin", flush=True)  # fmt: skip
         if args.open:
             import webbrowser
 
@@ -44,4 +58,5 @@ def register(sub: Any) -> None:
     p.add_argument("--controls", action="store_true", help="show meshcat's own control panel (hidden by default)")
     _add_units(p, json_help=None)
     _add_robot_options(p)
+    add_cell_options(p)
     p.set_defaults(func=cmd_teach)

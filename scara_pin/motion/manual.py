@@ -31,11 +31,20 @@ moves faster than its velocity limit times the override and the tool frame's ori
 :data:`MANUAL_SPEED` times the override (measured over the period: near a singularity the tool slows down).
 No acceleration ramp is simulated: a hold starts and stops at once.
 
+In a cell (``scene=``, :func:`scara_pin.cell.scene`), every move also stops before a checked pair (a link or the
+carried part against an obstacle, or two links checked against each other) comes closer than the cell's margin:
+the move above is followed as the joint path it is (a straight joint line, or the straight tool line by the
+closed-form IK, :class:`~scara_pin.motion.paths.CartesianSegment`; its last or first micrometre through its IK
+solutions when it ends or starts on the stretched or folded arm) by
+:func:`scara_pin.cell.sweep.first_contact`, and ends where the first pair comes to the margin (clear of it by
+0 to 1e-9 m), never beyond; the reason names the obstacle and the robot's shape: ``stopped 0.002 m from post
+(flange)``. A move that would bring a pair at the margin closer does not move (``AT_EDGE``).
+
 Why it stopped (:class:`StopReason`): a kind (:class:`StopKind`: a joint limit, an edge of the workspace, the
-IK's refusal, a singularity; for a hold also the release and the watchdog), a sentence, and the machine name
-of the limit. Every length or angle in the sentence is written ``<number> <unit>`` with the unit m, rad or deg
-(``2.30383461 rad``, ``0.002 m``, the workspace's ``132 deg``; an interval ``[a, b] m``), so that a page shown
-in other units can restate it in its own.
+IK's refusal, a singularity, the cell's margin; for a hold also the release and the watchdog), a sentence, and
+the machine name of the limit. Every length or angle in the sentence is written ``<number> <unit>`` with the
+unit m, rad or deg (``2.30383461 rad``, ``0.002 m``, the workspace's ``132 deg``; an interval ``[a, b] m``), so
+that a page shown in other units can restate it in its own.
 """
 
 from __future__ import annotations
@@ -52,11 +61,16 @@ from .._checks import _limit_vector, _vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, ScaraError, UrdfError
 
 if TYPE_CHECKING:
+    from ..cell import PairDistance, Scene
+    from ..cell.sweep import JointPath
     from ..model import Robot
     from ..workspace.scara import RayHit, Workspace
 
 __all__ = [
     "BISECT_TOL",
+    "CONTACT_ROOM",
+    "MAX_POLYLINE_POINTS",
+    "POLYLINE_SPACING",
     "JUMP",
     "MANUAL_SPEED",
     "MANUAL_TURN_RATE",
@@ -95,6 +109,14 @@ of J4): not one continuous move. Near the stretched arm a 1 mm sample moves the 
 sqrt(2 mm (l1 + l2) / (l1 l2)): 0.14 rad for l1 = l2 = 0.2 m, 0.6 rad for l1 = l2 = 0.05 m."""
 BISECT_TOL = 1e-10
 """[m or rad] the bisection of the first refused sample stops this close to it."""
+CONTACT_ROOM = 1e-9
+"""[m or rad] in a cell, a move shorter than this before the first contact does not move (``AT_EDGE``)."""
+POLYLINE_SPACING = 1e-4
+"""[m or rad] in a cell, the part of a Cartesian move the closed form cannot follow (next to the stretched or
+folded arm) is followed through its IK solutions this far apart (at least 16, at most
+:data:`MAX_POLYLINE_POINTS`), joined by straight joint lines."""
+MAX_POLYLINE_POINTS = 2000
+"""The IK solutions of such a move at most."""
 _EDGE = 1e-9  # [m] a ray edge this close is where the tool is (the workspace's EDGE_TOL)
 _AIM = 0.999  # a shortened hold step aims at this fraction of the speed limits (1 would converge from above)
 
@@ -139,6 +161,7 @@ class StopKind(enum.Enum):
     WORKSPACE = "workspace"  # an edge of the exact workspace: an arc of a joint limit or a singular pose, a stroke end
     IK = "ik"  # the IK refuses just beyond (its status code is the limit)
     SINGULAR = "singular"  # too close to a singularity to move at the jog's speed
+    OBSTACLE = "obstacle"  # a checked pair of the cell at the margin: an obstacle (or a link) and the robot's shape
     RELEASED = "released"  # a hold: the button was released
     WATCHDOG = "watchdog"  # a hold: the page stopped confirming the held button
     ERROR = "error"  # a hold: the advance raised (the message says what)
@@ -153,7 +176,8 @@ class StopReason:
         text: the sentence (``stopped at joint1's upper limit 2.30383461 rad``); each length or angle written
             ``<number> <unit>`` (m, rad or deg), which a page restates in its units.
         limit: the machine name of what stopped it: a joint limit (``joint2_upper``), a workspace
-            :class:`~scara_pin.workspace.Limit` value (``outer``), an IK status code (``JOINT_LIMIT``); "" for none.
+            :class:`~scara_pin.workspace.Limit` value (``outer``), an IK status code (``JOINT_LIMIT``), the
+            obstacle (or link) of the cell a robot's shape came to (``post``); "" for none.
     """
 
     kind: StopKind
@@ -229,6 +253,7 @@ class JogMove:
         travelled: how far it moved along the motion [m or rad] (>= 0).
         requested: the step asked for [m or rad] (> 0).
         solver: what answered the last IK.
+        contact: in a cell, the pair at the margin that stopped it (its distance at ``q``), else None.
     """
 
     q: np.ndarray
@@ -238,6 +263,7 @@ class JogMove:
     travelled: float
     requested: float
     solver: Solver
+    contact: PairDistance | None = None
 
     @property
     def moved(self) -> bool:
@@ -291,23 +317,143 @@ def branch_of(robot: Robot, q: np.ndarray) -> str:
 
 
 # ------------------------------------------------------------------------------------------ steps
-def jog_step(robot: Robot, q: object, motion: JogMotion, step: float, *, ws: Workspace | None = None) -> JogMove:
+def jog_step(robot: Robot, q: object, motion: JogMotion, step: float, *, ws: Workspace | None = None,
+             scene: Scene | None = None) -> JogMove:  # fmt: skip
     """Move by ``step`` [m or rad] > 0 in the sense and along the axis (or joint) of ``motion``.
 
     See the module docstring for where it stops. ``ws`` is the workspace of the jog's tool point, when
     already built (:func:`scara_pin.motion.jog.edge_workspace`); otherwise built here for SCARA translations.
+    ``scene``: the robot in its cell (a 4-joint SCARA with its closed form, for Cartesian moves): the move also
+    stops where a checked pair first comes to the margin.
 
     Raises:
         InvalidInputError: a step that is not a finite number > 0, a joint index out of range, a turn in a
             tool frame whose z axis is not vertical.
+        InCollisionError: in a cell, q is closer than the margin (exit code 2), naming the pair.
     """
     q0 = robot.check_q(q)
     if isinstance(step, bool) or not isinstance(step, (int, float)) or not (math.isfinite(step) and step > 0):
         raise ParameterError("jog step", step, "must be a finite number > 0", "m or rad")
     length = float(step)
     if motion.joint is not None:
-        return _joint_step(robot, q0, motion.joint, motion.sign, length)
-    return _cartesian_step(robot, q0, motion, length, ws)
+        move = _joint_step(robot, q0, motion.joint, motion.sign, length)
+    else:
+        move = _cartesian_step(robot, q0, motion, length, ws)
+    if scene is None or not move.moved:
+        return move
+    return _before_contact(robot, scene, q0, motion, move)
+
+
+def _before_contact(robot: Robot, scene: Scene, q0: np.ndarray, motion: JogMotion, move: JogMove) -> JogMove:
+    """``move`` (from ``q0``), ended where a checked pair of ``scene`` first comes to the margin, if it does."""
+    from ..cell.sweep import first_contact
+
+    done = 0.0
+    for path, length in _move_paths(robot, q0, motion, move):
+        found = first_contact(scene, path)  # InCollisionError (exit 2) when q0 is closer than the margin
+        if found is not None:
+            break
+        done += length
+    else:
+        return move
+    c = found.closest
+    pair = f"{c.pair.b} ({c.pair.a})"
+    travelled = done + found.s * length
+    if not travelled > CONTACT_ROOM:
+        reason = StopReason(StopKind.OBSTACLE, f"at the margin: {c.distance:.6g} m from {pair}, and this way "
+                            "comes closer", c.pair.b)  # fmt: skip
+        at_q0 = next(p for p in scene.distances(q0).pairs if p.pair.index == c.pair.index)
+        return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, reason, 0.0, move.requested, Solver.NONE,
+                       at_q0)  # fmt: skip
+    reason = StopReason(StopKind.OBSTACLE, f"stopped {c.distance:.6g} m from {pair}", c.pair.b)
+    return JogMove(found.q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, travelled, move.requested,
+                   move.solver, c)  # fmt: skip
+
+
+def _move_paths(robot: Robot, q0: np.ndarray, motion: JogMotion, move: JogMove) -> list[tuple[JointPath, float]]:
+    """The joint paths ``move`` follows from ``q0``, one after the other, each with the length [m or rad] it covers.
+
+    A joint move: the straight joint line. A Cartesian one: the straight tool line followed by the closed-form IK
+    (the branch and the J4 turn of ``q0``). That IK's joint rates have no bound on the stretched or folded arm
+    (:func:`~scara_pin.motion.paths.cartesian_path` refuses a line that starts or ends there): the line's last (or
+    first) :data:`~scara_pin.motion.jog.SINGULAR_EDGE_GAP` is followed through its IK solutions instead
+    (:func:`_ik_polyline`), and a line that does both, or that the closed form refuses otherwise, all of it.
+    """
+    from .jog import SINGULAR_EDGE_GAP
+    from .paths import JointLine, PathError, cartesian_path
+
+    if motion.joint is not None:
+        return [(JointLine(q0, move.q), move.travelled)]
+    d = direction(robot, q0, motion)
+    pose0 = np.asarray(robot.tool_pose(q0), dtype=float)
+    length, gap = move.travelled, SINGULAR_EDGE_GAP
+
+    def line(a: float, b: float, start: np.ndarray) -> JointPath:
+        return cartesian_path(robot, [pose0 + a * d, pose0 + b * d], start=start).segments[0]
+
+    try:
+        return [(line(0.0, length, q0), length)]
+    except PathError as exc:
+        log.debug("the jog's line near a singular arm: %s", exc)
+    if length > 2.0 * gap:
+        try:  # it ends on the singular arm
+            head = line(0.0, length - gap, q0)
+            q_near = head.evaluate(np.ones(1), 0)[0][0]
+            tail = _ik_polyline(robot, q_near, pose0 + (length - gap) * d, d, gap, move.q)
+            return [(head, length - gap), (tail, gap)]
+        except PathError as exc:
+            log.debug("not only its end: %s", exc)
+        try:  # it starts on it
+            start = _ik_polyline(robot, q0, pose0, d, gap)
+            return [(start, gap), (line(gap, length, start.Q[-1]), length - gap)]
+        except PathError as exc:
+            log.debug("not only its start: %s", exc)
+    return [(_ik_polyline(robot, q0, pose0, d, length, move.q), length)]
+
+
+def _ik_polyline(robot: Robot, q0: np.ndarray, pose0: np.ndarray, d: np.ndarray, length: float,
+                 q_end: np.ndarray | None = None) -> _Polyline:  # fmt: skip
+    """The IK solutions of the line ``pose0 + s d``, s in [0, ``length``], joined by straight joint lines.
+
+    At least 16, at most :data:`MAX_POLYLINE_POINTS`, :data:`POLYLINE_SPACING` apart where that allows; each the
+    solution of ``q0``'s branch nearest to the one before (:func:`_continuous`); ``q_end`` is the last if given.
+
+    Raises:
+        PathError: a point of the line without such a solution.
+    """
+    from .paths import PathError
+
+    n = min(MAX_POLYLINE_POINTS - 1, max(16, math.ceil(length / POLYLINE_SPACING)))
+    s = np.linspace(0.0, 1.0, n + 1)
+    Q = np.empty((n + 1, robot.dof))
+    Q[0] = q0
+    branch = branch_of(robot, q0) or "all"
+    for k in range(1, n + 1):
+        if k == n and q_end is not None:
+            Q[k] = q_end
+            break
+        answer = _continuous(robot, pose0 + s[k] * length * d, Q[k - 1], branch)
+        if answer.q is None:
+            raise PathError(f"no IK solution on the jog's line ({answer.status}: {answer.message})", s=float(s[k]),
+                            pose=pose0 + s[k] * length * d)  # fmt: skip
+        Q[k] = answer.q
+    return _Polyline(s, Q)
+
+
+@dataclass(frozen=True, eq=False)
+class _Polyline:
+    """The joint path through ``Q`` (rows) at the parameters ``s`` (increasing, 0 to 1), straight between them."""
+
+    s: np.ndarray
+    Q: np.ndarray
+
+    def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
+        """(q, q', q'' = 0) at ``s`` (1-D), each (n, dof); q' of the piece on the right of a knot."""
+        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
+        i = np.clip(np.searchsorted(self.s, s, side="right") - 1, 0, len(self.s) - 2)
+        rate = (self.Q[i + 1] - self.Q[i]) / (self.s[i + 1] - self.s[i])[:, None]
+        out = (self.Q[i] + (s - self.s[i])[:, None] * rate, rate, np.zeros_like(rate))
+        return out[: order + 1]
 
 
 def _joint_step(robot: Robot, q0: np.ndarray, j: int, sign: int, length: float) -> JogMove:
@@ -474,13 +620,15 @@ def nominal_rate(robot: Robot, motion: JogMotion, override: float) -> float:
 
 
 def hold_advance(
-    robot: Robot, q: object, motion: JogMotion, dt: float, override: float, *, ws: Workspace | None = None
+    robot: Robot, q: object, motion: JogMotion, dt: float, override: float, *, ws: Workspace | None = None,
+    scene: Scene | None = None,
 ) -> JogMove:
     """One control period of a hold-to-jog.
 
     The step of ``dt`` [s] at the rate of ``motion`` and ``override`` (a fraction in (0, 1]), shortened until
-    every joint and the tool's origin keep their speeds (module docstring), stopping ON the edge as
-    :func:`jog_step` does.
+    every joint and the tool's origin keep their speeds (module docstring), stopping ON the edge, and in a cell
+    (``scene``) before contact, as :func:`jog_step` does. The shortened steps are parts of the step checked
+    against the cell: they are not checked again.
     """
     q0 = robot.check_q(q)
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
@@ -490,7 +638,7 @@ def hold_advance(
     length = nominal_rate(robot, motion, override) * dt
     if ws is None and motion.axis not in (None, JogAxis.YAW) and robot.kind == "scara":
         ws = _region(robot, q0)  # built once for the period's trial steps
-    move = jog_step(robot, q0, motion, length, ws=ws)
+    move = jog_step(robot, q0, motion, length, ws=ws, scene=scene)
     ratio = _speed_ratio(robot, q0, move.q, dt, override, velocity)
     if not move.moved or ratio <= 1.0:
         return move

@@ -95,7 +95,7 @@ _TEACH = """
   <output id="speed-value">25 %</output>
 </div>
 <div class="jog" id="jog-grid">{rows}</div>
-<p class="row">branch now: <b id="branch-now">?</b></p>
+{cell}<p class="row">branch now: <b id="branch-now">?</b></p>
 <h2>Points</h2>
 <div class="row"><input id="point-name" placeholder="name (P1...)" size="10">
 <button type="button" id="record">record</button></div>
@@ -152,7 +152,10 @@ def _panel(data: dict[str, Any]) -> str:
         path = teach.get("points_file", "")
         file = (f"file: <code>{html.escape(path)}</code>" if path
                 else "no points file: start with <code>--points FILE</code> to save; download meanwhile")  # fmt: skip
-        section += (_TEACH.replace("{options}", options).replace("{rows}", rows)
+        cell = teach.get("cell")  # its words: each length "<number> m", restated in the page's units by the script
+        cell_row = (f'<p class="row" id="cell-info" data-text="{html.escape(cell, quote=True)}">'
+                    f"{html.escape(cell)}</p>\n" if cell else "")  # fmt: skip
+        section += (_TEACH.replace("{options}", options).replace("{rows}", rows).replace("{cell}", cell_row)
                     .replace("{save}", "" if path else "disabled").replace("{file}", file))  # fmt: skip
     frames = f"{html.escape(str(data.get('tool_frame', 'tool')))} in {html.escape(str(data.get('base_frame', 'base')))}"
     return f"""<div id="pendant">

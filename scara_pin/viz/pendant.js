@@ -191,7 +191,7 @@
     if (lastPose) showPose(lastPose);
     if (lastQ) showJoints(lastQ);
     syncSliders();
-    if (teach) { relabelJog(); showPoints(lastPoints); showStatus(); }
+    if (teach) { relabelJog(); showPoints(lastPoints); showStatus(); showCell(); }
   }
   // A step field keeps the SI value it stands for: the switch shows it in the new unit (12 digits), and a jog
   // sent while the field still shows that text sends the SI value itself, not the rounded text read back
@@ -242,6 +242,8 @@
       return (one !== undefined ? show(one) : "[" + show(lo) + ", " + show(hi) + "]") + " " + unitOf(kind);
     });
   }
+  // the cell's line (teach --cell): the server's words, in the page's units
+  function showCell() { var info = $("cell-info"); if (info) info.textContent = localise(info.dataset.text); }
   function code(status) { return String(status).toLowerCase().replace(/_/g, " "); }  // OUT_OF_REACH: out of reach
 
   // The status line: the answer to the last thing the user did. It is a function of the page's units (the
@@ -531,6 +533,7 @@
       });
     });
     relabelJog();
+    showCell();
 
     $("goto").addEventListener("submit", function (evt) {
       evt.preventDefault();

@@ -18,6 +18,13 @@
 
 A refused request leaves q unchanged and says why (a status code and its reason).
 
+In a cell (``cell=``: obstacles, the carried part, the margin; :mod:`scara_pin.cell`), every jog, step or hold,
+stops where a checked pair first comes to the cell's margin (reason kind
+:attr:`~scara_pin.motion.manual.StopKind.OBSTACLE`, naming the obstacle and the robot's shape, and the pair in
+the reply's ``contact``); a go-to (a pose, joint values, a taught point) whose target is closer than the margin,
+or whose straight joint move there comes to it, is refused (status ``COLLISION``) naming the pair; a start closer
+than the margin is an :class:`~scara_pin.cell.InCollisionError` (exit code 2). The page draws the cell.
+
 :class:`TeachServer` serves the page (:mod:`scara_pin.viz.page`, with meshcat's viewer script) and the JSON
 routes of :meth:`TeachSession.handle` under ``/api/`` on 127.0.0.1 only, in the calling process (it stops with
 it). Every route checks the Host header (only ``127.0.0.1:PORT`` and ``localhost:PORT``: a DNS-rebinding
@@ -54,6 +61,7 @@ from ..motion.manual import (
 from ..motion.points import PointSet, TaughtPoint, points_format, read_points, write_points
 
 if TYPE_CHECKING:
+    from ..cell import Cell, PairDistance, Scene
     from ..model import Robot
 
 __all__ = [
@@ -116,8 +124,8 @@ class TeachReply:
         moved: whether q changed.
         status: ``"OK"``, ``"STOPPED"`` (moved, and stopped short: ON an edge or limit, or a hold ended by the
             watchdog or an error after it moved), ``"AT_EDGE"`` (did not move: already there), or the code of a
-            refusal (an IK status name such as ``OUT_OF_REACH``, ``JOINT_LIMIT``; ``WATCHDOG`` or ``ERROR`` for a
-            hold that ended before it moved).
+            refusal (an IK status name such as ``OUT_OF_REACH``, ``JOINT_LIMIT``; ``COLLISION`` for a go-to into
+            the cell; ``WATCHDOG`` or ``ERROR`` for a hold that ended before it moved).
         message: what stopped or refused it, or what was done ("" otherwise).
         solver: what answered.
         reason: why a jog stopped or did not move, or how a hold ended (None otherwise).
@@ -126,6 +134,7 @@ class TeachReply:
         angle: whether ``travelled`` and ``requested`` are angles [rad] (else lengths [m]).
         holding: whether a hold-to-jog is running after this request.
         points: the taught points, in replies that change or list them (None otherwise).
+        contact: in a cell, the pair at the margin that stopped the jog (its distance at ``q``), else None.
     """
 
     q: np.ndarray
@@ -141,6 +150,7 @@ class TeachReply:
     angle: bool = False
     holding: bool = False
     points: PointSet | None = None
+    contact: PairDistance | None = None
 
     @property
     def limit(self) -> str:
@@ -163,6 +173,7 @@ class TeachReply:
             "requested": self.requested,
             "angle": self.angle,
             "holding": self.holding,
+            "contact": None if self.contact is None else self.contact.to_dict(),
         }
         if self.points is not None:
             out["points"] = [p.to_dict() for p in self.points]
@@ -194,6 +205,7 @@ class _HoldEnd:
     solver: Solver
     travelled: float
     angle: bool
+    contact: PairDistance | None = None
 
 
 class TeachSession:
@@ -211,24 +223,32 @@ class TeachSession:
         session.save_points("cell.yaml")
     """
 
-    def __init__(self, robot: Robot, q: object | None = None, *, points_file: str | Path | None = None) -> None:
-        """Start at ``q`` (default: zero), which must be inside the joint limits.
+    def __init__(self, robot: Robot, q: object | None = None, *, points_file: str | Path | None = None,
+                 cell: Cell | None = None) -> None:  # fmt: skip
+        """Start at ``q`` (default: zero), which must be inside the joint limits (and clear of the cell).
 
         Args:
             robot: the robot.
             q: the start configuration [rad, m].
             points_file: the points file (.yaml, .yml or .csv) :meth:`save_points` writes and
                 :meth:`load_points` reads; read now when it exists.
+            cell: the robot's cell (a 4-joint SCARA's): jogs stop at its margin, go-tos into it are refused.
 
         Raises:
             InvalidInputError: ``q`` is not 4 finite numbers or is outside the limits; a points file with a
-                bad name, or unreadable, or taught on another robot.
+                bad name, or unreadable, or taught on another robot; a cell for a robot other than a 4-joint
+                SCARA with its closed-form IK.
+            InCollisionError: ``q`` is closer than the cell's margin (naming the pair).
         """
         self.robot = robot
         start = robot.default_q if q is None else robot.check_q(q)
         outside = robot.outside_limits(start)
         if outside:
             raise InvalidInputError(f"the start configuration is outside the limits: {'; '.join(outside)}")
+        self.cell = cell
+        self._scene = None if cell is None else _cell_scene(robot, cell)
+        if self._scene is not None:
+            self._scene.check(start, "the pendant's start")  # exit 2 naming the pair
         self._q = start.copy()
         self._hold: _Hold | None = None
         self._last_end: _HoldEnd | None = None  # how the last hold ended, until the next move
@@ -267,7 +287,7 @@ class TeachSession:
         extra: dict[str, Any] = {}
         if move is not None:
             extra = {"reason": move.reason, "travelled": move.travelled, "requested": move.requested,
-                     "angle": motion is not None and motion.is_angle(self.robot)}
+                     "angle": motion is not None and motion.is_angle(self.robot), "contact": move.contact}
         elif self._hold is not None:  # a running hold: how far so far
             extra = {"travelled": self._hold.travelled, "angle": self._hold.angle}
         return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), moved, status, message, solver,
@@ -281,14 +301,40 @@ class TeachSession:
 
     # ----------------------------------------------------------------- moves
     def set_q(self, q: object) -> TeachReply:
-        """Move the joints to ``q`` (refused, status ``JOINT_LIMIT``, outside the limits)."""
+        """Move the joints to ``q`` (refused, status ``JOINT_LIMIT``, outside the limits).
+
+        In a cell, refused (status ``COLLISION``, naming the pair) when ``q`` is closer than the margin or the
+        straight joint move there comes to it.
+        """
         values = self.robot.check_q(q)
         outside = self.robot.outside_limits(values)
         if outside:
             return self._reply(False, "JOINT_LIMIT", "; ".join(outside))
+        blocked = self._collision(values)
+        if blocked:
+            return self._reply(False, "COLLISION", blocked)
         self._stop_hold()
         self._q = values.copy()
         return self._reply(True)
+
+    def _collision(self, target: np.ndarray) -> str:
+        """Why the straight joint move from q to ``target`` is refused in the cell ("" when it is clear of it)."""
+        if self._scene is None:
+            return ""
+        from ..cell.scene import describe
+        from ..cell.sweep import first_contact
+        from ..motion.paths import JointLine
+
+        c = self._scene.distances(target).closest
+        if c is not None and c.distance < self._scene.margin:
+            return f"the target is in collision: {describe(c, self._scene.margin, unit='m')}"
+        found = first_contact(self._scene, JointLine(self._q, target))
+        if found is None:
+            return ""
+        c = found.closest
+        x, y, z = self.robot.tool_pose(found.q)[:3]
+        return (f"the straight joint move there comes to the margin ({self._scene.margin:g} m) of {c.pair.b} "
+                f"({c.pair.a}) {found.s:.0%} of the way, the tool at x {x:.6g} m, y {y:.6g} m, z {z:.6g} m")
 
     def jog(self, axis: JogAxis, step: float, frame: JogFrame = JogFrame.BASE) -> TeachReply:
         """Move the tool by ``step`` [m, or rad for the yaw; the sign is the sense] along ``axis`` of ``frame``.
@@ -326,7 +372,7 @@ class TeachSession:
 
     def _step(self, motion: JogMotion, size: float) -> TeachReply:
         self._stop_hold()  # a step while a hold runs: the hold ends first
-        move = jog_step(self.robot, self._q, motion, size)
+        move = jog_step(self.robot, self._q, motion, size, scene=self._scene)
         return self._apply(move, motion)
 
     def _apply(self, move: JogMove, motion: JogMotion) -> TeachReply:
@@ -345,6 +391,9 @@ class TeachSession:
         answer = pose_ik(self.robot, pose, self._q, branch)
         if answer.q is None:
             return self._reply(False, answer.status, answer.message, answer.solver)
+        blocked = self._collision(answer.q)
+        if blocked:
+            return self._reply(False, "COLLISION", blocked, answer.solver)
         self._q = answer.q.copy()
         return self._reply(True, solver=answer.solver)
 
@@ -418,7 +467,7 @@ class TeachSession:
             return self._reply(False)
         hold.moved_to = now
         try:
-            move = hold_advance(self.robot, self._q, hold.motion, dt, hold.override)
+            move = hold_advance(self.robot, self._q, hold.motion, dt, hold.override, scene=self._scene)
         except ScaraError as exc:
             return self._end(StopReason(StopKind.ERROR, " ".join(str(exc).split())), "ERROR")
         if move.moved:
@@ -427,14 +476,14 @@ class TeachSession:
         if move.outcome is JogOutcome.OK:
             return self._reply(True, solver=move.solver)
         reason = move.reason or StopReason(StopKind.IK, move.status, move.status)  # (a stop always has a reason)
-        return self._end(reason, move.status, move.solver, moved=move.moved)
+        return self._end(reason, move.status, move.solver, moved=move.moved, contact=move.contact)
 
-    def _end(self, reason: StopReason, status: str, solver: Solver = Solver.NONE, *, moved: bool = False
-             ) -> TeachReply:  # fmt: skip
+    def _end(self, reason: StopReason, status: str, solver: Solver = Solver.NONE, *, moved: bool = False,
+             contact: PairDistance | None = None) -> TeachReply:  # fmt: skip
         """End the running hold for ``reason``: status ``STOPPED`` once it has moved, else ``status``."""
         travelled, angle = (0.0, False) if self._hold is None else (self._hold.travelled, self._hold.angle)
         self._hold = None
-        self._last_end = _HoldEnd("STOPPED" if travelled > 0 else status, reason, solver, travelled, angle)
+        self._last_end = _HoldEnd("STOPPED" if travelled > 0 else status, reason, solver, travelled, angle, contact)
         reply = self._ended_reply()
         return replace(reply, moved=True) if moved else reply
 
@@ -450,7 +499,7 @@ class TeachSession:
         q = self.q  # how the last hold ended, with the current state (kept until the next move)
         return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), False, ended.status, ended.reason.text,
                           ended.solver, ended.reason, ended.travelled, 0.0, ended.angle, self.holding,
-                          self._points if points else None)  # fmt: skip
+                          self._points if points else None, ended.contact)  # fmt: skip
 
     # ----------------------------------------------------------------- points
     def _adopt(self, points: PointSet) -> PointSet:
@@ -558,6 +607,25 @@ class TeachSession:
         return JogMotion(int(sense), axis=axis, frame=frame)
 
 
+def _cell_scene(robot: Robot, cell: Cell) -> Scene:
+    """The scene of ``robot`` in ``cell`` for the pendant.
+
+    A 4-joint SCARA whose closed form takes its model: its Cartesian jogs are followed as straight tool lines by
+    that IK.
+    """
+    from ..cell import scene
+    from ..errors import UrdfError
+
+    if robot.kind != "scara" or robot.dof != 4:
+        raise InvalidInputError(f"the teach pendant's cell is for 4-joint SCARA robots for now; {robot.name!r} is a "
+                                f"{robot.kind} with {robot.dof} joints")  # fmt: skip
+    try:
+        robot.kinematics  # noqa: B018 - the closed form refuses some models (NotScaraError)
+    except UrdfError as exc:
+        raise InvalidInputError(f"the teach pendant's cell needs the closed-form IK of {robot.name!r}: {exc}") from None
+    return scene(robot, cell)
+
+
 def _signed_step(step: object, angle: bool) -> tuple[int, float]:
     if isinstance(step, bool) or not isinstance(step, (int, float)) or not math.isfinite(step) or step == 0:
         raise ParameterError("jog step", step, "must be a finite number, not 0", "rad" if angle else "m")
@@ -593,7 +661,8 @@ class TeachServer:
     """
 
     def __init__(self, robot: Robot, port: int = 0, q: object | None = None, *,
-                 points_file: str | Path | None = None, controls: bool = False) -> None:  # fmt: skip
+                 points_file: str | Path | None = None, controls: bool = False, cell: Cell | None = None,
+                 ) -> None:  # fmt: skip
         """Build the page and listen on 127.0.0.1:``port`` (0: a free port).
 
         Args:
@@ -602,15 +671,17 @@ class TeachServer:
             q: the start configuration [rad, m].
             points_file: the session's points file (see :class:`TeachSession`).
             controls: show meshcat's own control panel (hidden by default; the page's ``?controls=1`` shows it).
+            cell: the robot's cell (see :class:`TeachSession`); the page draws it.
 
         Raises:
-            InvalidInputError: a bad port, start configuration or points file, or the port is taken.
+            InvalidInputError: a bad port, start configuration, points file or cell, or the port is taken;
+                :class:`~scara_pin.cell.InCollisionError` for a start closer than the cell's margin.
         """
         import asyncio
 
         if not (isinstance(port, int) and 0 <= port <= 65535):
             raise InvalidInputError(f"port is {port!r}; it must be a whole number in [0, 65535]")
-        self.session = TeachSession(robot, q, points_file=points_file)
+        self.session = TeachSession(robot, q, points_file=points_file, cell=cell)
         self.page = _teach_page(robot, self.session, controls)
         self._loop = asyncio.new_event_loop()
         asyncio.set_event_loop(self._loop)
@@ -753,13 +824,23 @@ class TeachServer:
         self._server.stop()
 
 
+def _cell_words(cell: Cell) -> str:
+    """The page's line about the cell: ``cell post.yaml: 1 obstacle(s); every jog stops 0.002 m from them``."""
+    carried = "" if cell.carried is None else f" and a carried {cell.carried.kind}"
+    name = Path(cell.origin).name
+    return (f"cell{'' if name == 'cell' else ' ' + name}: {len(cell.obstacles)} obstacle(s){carried}; every jog "
+            f"stops {cell.margin:g} m from them (the margin)")
+
+
 def _teach_page(robot: Robot, session: TeachSession, controls: bool = False) -> str:
     """The pendant page of the live teach server (no motion player; a ``teach`` section)."""
-    from .meshcat import _page, _Scene, _Window
+    from .meshcat import _page, _Scene, _Window, draw_cell
 
     window = _Window()
     scene = _Scene(robot, window)
     scene.display(session.q)
+    if session.cell is not None:
+        draw_cell(scene, session.cell)
     data = scene.page_data()
     data["q"] = [float(v) for v in session.q]
     data["controls"] = bool(controls)
@@ -773,5 +854,6 @@ def _teach_page(robot: Robot, session: TeachSession, controls: bool = False) -> 
         "step_length": [MIN_STEP_LENGTH, MAX_STEP_LENGTH],
         "step_angle": [MIN_STEP_ANGLE, MAX_STEP_ANGLE],
         "step_tol": STEP_TOL,
+        "cell": "" if session.cell is None else _cell_words(session.cell),
     }
     return _page(f"scara-pin teach: {robot.name}", window.recorder.commands(), data)
