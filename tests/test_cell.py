@@ -295,6 +295,48 @@ def test_a_mesh_obstacle_is_read_and_checked(tmp_path, robot):
     assert 0.6 - 0.1 - 0.425 <= d <= 0.6 - 0.1 * math.cos(math.radians(8)) - 0.425
 
 
+def test_the_closest_pair_of_each_sample_is_the_minimum_over_every_pair(tmp_path, robot, rng):
+    """Scene.nearest_array (the verifier's per-sample read) against the minimum of every pair's distance, and those
+    against coal called here on the scene's own GeometryModel: an open mesh (a bowl: bounded by spheres when far),
+    a box and a sphere, the carried part; configurations near and far from them."""
+    import coal
+    import pinocchio as pin
+    import trimesh
+
+    from scara_pin.cell import scene as make_scene
+
+    bowl = trimesh.creation.icosphere(subdivisions=2, radius=0.05)
+    bowl.update_faces(bowl.triangles_center[:, 2] < 0.02)  # the cap cut off: an open surface, not a solid
+    bowl.export(tmp_path / "bowl.stl")
+    (tmp_path / "cell.yaml").write_text(
+        "obstacles:\n"
+        "  - {name: bowl, shape: mesh, file: bowl.stl, xyz: [0.3, 0.1, -0.12]}\n"
+        "  - {name: crate, shape: box, size: [0.05, 0.08, 0.06], xyz: [0.1, -0.3, -0.1], rpy: [0, 0, 0.4]}\n"
+        "  - {name: ball, shape: sphere, radius: 0.03, xyz: [-0.25, 0.2, -0.08]}\n"
+        "carried: {shape: box, size: [0.02, 0.02, 0.02], xyz: [0, 0, 0.01]}\n")  # fmt: skip
+    sc = make_scene(robot, load_cell(tmp_path / "cell.yaml"))
+    assert sc._far_pairs, "the bowl is a surface: its pairs are bounded when far"
+    Q = rng.uniform(robot.limits.lower, robot.limits.upper, (300, 4))
+    D = sc.distance_array(Q)
+    d, which = sc.nearest_array(Q)
+    np.testing.assert_array_equal(d, D.min(axis=1))
+    np.testing.assert_array_equal(D[np.arange(len(Q)), which], d)
+    # every pair coal computes exactly (not bounded) against coal's distance called here
+    model, data, gm = robot.model, robot.model.createData(), sc.geometry_model
+    gd = gm.createData()
+    for q, row in zip(Q[:40], D[:40]):
+        pin.updateGeometryPlacements(model, data, gm, gd, robot.to_pinocchio_q(q))
+        for k, pair in enumerate(sc.pairs):
+            a, b = gm.geometryObjects[pair.first], gm.geometryObjects[pair.second]
+            request, result = coal.DistanceRequest(), coal.DistanceResult()
+            request.gjk_tolerance = 1e-10  # coal's default (1e-6) stops about 1e-8 m short for a box and a cylinder
+            exact = coal.distance(a.geometry, gd.oMg[pair.first], b.geometry, gd.oMg[pair.second], request, result)
+            if k in sc._far_pairs and row[k] > 0.05:
+                assert row[k] <= exact + 1e-12  # a lower bound where far
+            elif exact > 0:
+                assert row[k] == pytest.approx(exact, abs=1e-9), pair.label
+
+
 def test_a_mesh_with_too_many_triangles_is_refused(tmp_path, monkeypatch):
     from scara_pin.cell import shapes
 

@@ -376,23 +376,47 @@ class Scene:
         return out
 
     def minimum_array(self, Q: ArrayLike) -> np.ndarray:
-        """(n,) the smallest distance over every checked pair at each row of ``Q`` [m] (one value read per row).
+        """(n,) the smallest distance over every checked pair at each row of ``Q`` [m] (see :meth:`nearest_array`)."""
+        return self.nearest_array(Q)[0]
 
-        The same distances as :meth:`distance_array`'s, without reading every pair's back into Python.
+    def nearest_array(self, Q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """((n,) distances, (n,) pair indices): the closest checked pair at each row of ``Q`` and its distance [m].
+
+        The row minima of :meth:`distance_array` (the same distances, the bounded ones included), without reading
+        every pair's result back into Python: Pinocchio's ``computeDistances`` returns the index of the closest
+        pair it computed. No pairs: distances ``inf``, indices ``-1``.
         """
         import pinocchio as pin
 
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
-        if self._far_pairs or not self.pairs:  # the bounded pairs need their own pass
-            return self.distance_array(Q).min(axis=1, initial=math.inf)
+        dist = np.full(len(Q), math.inf)
+        which = np.full(len(Q), -1, dtype=int)
+        if not self.pairs:
+            return dist, which
         model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
         convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
         results = gd.distanceResults
-        out = np.empty(len(Q))
-        for i, q in enumerate(Q):
-            k = pin.computeDistances(model, data, gm, gd, convert(q) if convert else q)
-            out[i] = _sane(results[k].min_distance)
-        return out
+        far = self._far_pairs
+        exact = len(self.pairs) - len(far)
+        flags = gd.activeCollisionPairs
+        for k in far:  # bounded below, as in distance_array
+            flags[k] = False
+        try:
+            for i, q in enumerate(Q):
+                qp = convert(q) if convert else q
+                if exact:
+                    k = pin.computeDistances(model, data, gm, gd, qp)
+                    dist[i], which[i] = _sane(results[k].min_distance), k
+                else:
+                    pin.updateGeometryPlacements(model, data, gm, gd, qp)
+                for k in far:
+                    d = self._bounded(k)
+                    if d < dist[i]:
+                        dist[i], which[i] = d, k
+        finally:
+            for k in far:
+                flags[k] = True
+        return dist, which
 
     def _bounded(self, k: int) -> float:
         """Pair k's distance (placements current): its bounding spheres' beyond :data:`FAR`, else coal's."""

@@ -701,9 +701,7 @@ def verify(
         t = times[lo : lo + _CHUNK]
         q, qd, qdd = trajectory.sample(t)
         if scene is not None and nearest is not None and scene.pairs:
-            D = scene.distance_array(q)
-            nearest_pair[lo : lo + len(t)] = np.argmin(D, axis=1)
-            nearest[lo : lo + len(t)] = D[np.arange(len(t)), nearest_pair[lo : lo + len(t)]]
+            nearest[lo : lo + len(t)], nearest_pair[lo : lo + len(t)] = scene.nearest_array(q)
         inside = lo < len(grid)
         if inside:
             q_grid[lo : lo + len(t)] = q[: max(0, len(grid) - lo)]
