@@ -75,9 +75,11 @@ lint: $(VENV)/.installed-test
 	$(BIN)/mypy scara_pin --ignore-missing-imports
 
 # the documentation site from docs/ and the docstrings, into site/; a warning fails the build
-docs: $(VENV)/.installed
+# then the site's own tests (tests/test_site.py: the tour's outputs, the reference's links, file:// links)
+docs: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[docs]'
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+	SCARA_PIN_SITE=site $(BIN)/python -m pytest -q -n 0 -m site tests/test_site.py
 
 clean:
 	rm -rf $(VENV) $(RTB_VENV) $(FIGAROH_VENV) $(CELL_VENV) $(OUT) .pytest_cache site

@@ -336,7 +336,7 @@ def test_hold_to_jog_stops_within_one_control_period_of_release(server: Server, 
     np.testing.assert_array_equal(server.q(), q)
 
 
-HOLD = 2.0  # [s] each hold of the loaded test
+HOLD = 1.5  # [s] each hold of the loaded test (five 300 ms frames or more: each longer than the watchdog)
 SLOW_FRAME = 300  # [ms] what the test adds to every frame: longer than the watchdog (250 ms)
 
 
