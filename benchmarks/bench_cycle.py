@@ -14,7 +14,7 @@ enforced. Cycle = out and back (the back move of every planner here is the rever
     tried and dropped: continuous piecewise-linear controls cannot switch a bang-bang control inside an
     interval and stayed 0.4 % above ours at 4 times our grid, 15 minutes per jerk-limited solve; single
     shooting made CasADi's exact Hessian of the torques explode.) Its tool position and torques are
-    the CasADi expressions of :mod:`scara_pin.motion.symbolic` (equal to Pinocchio's to 1e-12:
+    the CasADi expressions of :mod:`scara_pin.symbolic` (equal to Pinocchio's to 1e-12:
     tests/test_jump.py). Every reference solution is then checked DENSELY, by Pinocchio at 20 kHz: its
     worst limit ratio and its worst miss of the clearance are printed (a reference that bends a limit
     between its points is optimistic: fine for a minimum). Gap = ours / reference - 1. At the default
@@ -41,7 +41,7 @@ from scara_pin import load_robot
 from scara_pin.motion.cycle import cycle_placement, standard_cycle
 from scara_pin.motion.jump import STANDARD_CLEARANCE, STANDARD_RISE, jump_move
 from scara_pin.motion.payload import Payload, with_payload
-from scara_pin.motion.symbolic import symbolic_model
+from scara_pin.symbolic import symbolic_model
 
 JERK = {"default": [20000.0, 40000.0, 2000.0, 100000.0], "s1": [100.0, 100.0, 5.0, 200.0],
         "palletizer": [20.0, 20.0, 20.0, 60.0]}  # fmt: skip

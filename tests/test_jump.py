@@ -37,7 +37,7 @@ from scara_pin.motion.cycle import STANDARD_RISE, cycle_placement, standard_cycl
 from scara_pin.motion.jump import JumpError, JumpOptions, jump_move, lower_bound
 from scara_pin.motion.payload import Payload, with_payload
 from scara_pin.motion.polynomial import PolynomialPiece
-from scara_pin.motion.symbolic import symbolic_model
+from scara_pin.symbolic import symbolic_model
 
 RATE = 10_000.0
 PROMISE = 1e-6

@@ -421,7 +421,7 @@ LAYERS = (
     ("_typing", "_version", "errors", "signals", "units", "summary"),
     ("limits", "files", "urdf_rules"),
     ("description",),
-    ("_checks", "tables", "_urdf_checks"),
+    ("_checks", "tables", "_urdf_checks", "symbolic"),  # symbolic: the model in CasADi (cell and motion use it)
     ("cell",),  # the robot's collision model and the obstacles: it takes a Robot (types only); model reaches it
     ("model", "chain", "stick"),
     ("kinematics",),

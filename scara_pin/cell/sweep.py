@@ -5,11 +5,12 @@ obstacles), fixed to its joint and made from coal's local bounding box: a SPHERE
 ``rho``: the box's half-diagonal) and a CAPSULE (a segment along the box's longest side, the radius of its
 cross-section's diagonal).
 
-**Clear configurations** (:func:`clear_mask`): every joint placed at every configuration at once with numpy
-(:func:`joint_placements`), then, pair by pair, a pair whose capsules are more than the margin apart
-(segment distance minus both radii, :func:`segment_distance`) is clear without asking coal; every other pair's
-exact distance is coal's (:meth:`Scene.distance_array <scara_pin.cell.Scene.distance_array>`). A configuration
-is clear when every checked pair is at least the margin apart.
+**Clear configurations** (:func:`clear_mask`): every joint placed at every configuration at once
+(:func:`joint_placements`: the robot's symbolic model evaluated on numbers), then, pair by pair, a pair whose
+capsules are more than the margin apart (segment distance minus both radii, :func:`segment_distance`) is clear
+without asking coal; every other pair's exact distance is coal's
+(:meth:`Scene.distance_array <scara_pin.cell.Scene.distance_array>`). A configuration is clear when every checked
+pair is at least the margin apart.
 
 **First contact along a path** (:func:`first_contact`): a joint path ``q(s)``, ``s`` in [0, 1], with its
 derivative ``q'(s)``. A point p of a geometry moves, per unit of s, at
@@ -261,44 +262,23 @@ def joint_motion(joint: Any) -> tuple[str, np.ndarray] | None:
 def joint_placements(robot: Any, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Every joint's placement in the world at each row of ``Q``: (R (n, njoints, 3, 3), p (n, njoints, 3)).
 
-    ``oMi = oMparent * jointPlacement * motion(q)`` composed with numpy over all rows at once for the joints of
-    one degree of freedom (revolute, continuous or prismatic, on an axis); a model with other joints (a
-    mimic joint: the palletizer's parallelogram) is placed row by row by Pinocchio.
+    Pinocchio's ``oMi`` at every row in one call: the robot's symbolic model (:mod:`scara_pin.symbolic`, built
+    from the loaded Pinocchio model, mimic joints included) evaluated on numbers, ``joint_frames.map(n)``.
     """
-    import pinocchio as pin
+    from ..symbolic import symbolic_model
 
-    model = robot.model
-    n, nj = len(Q), model.njoints
-    R = np.empty((n, nj, 3, 3))
-    p = np.empty((n, nj, 3))
-    motions = [joint_motion(model.joints[j]) for j in range(1, nj)]
-    if model.nv != robot.dof or any(m is None for m in motions):
-        data = model.createData()
-        convert = robot.to_pinocchio_q if robot.has_continuous else None
-        for r, q in enumerate(Q):
-            pin.forwardKinematics(model, data, convert(q) if convert else q)
-            for j in range(nj):
-                R[r, j] = data.oMi[j].rotation
-                p[r, j] = data.oMi[j].translation
-        return R, p
-    R[:, 0] = np.eye(3)
-    p[:, 0] = 0.0
-    for j in range(1, nj):
-        kind, axis = motions[j - 1]  # type: ignore[misc]
-        M = model.jointPlacements[j]
-        parent = model.parents[j]
-        R0 = R[:, parent] @ M.rotation
-        p0 = p[:, parent] + R[:, parent] @ M.translation
-        x = Q[:, model.joints[j].idx_v]
-        if kind == "R":  # Rodrigues: I + sin x K + (1 - cos x) K^2
-            K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-            s, c = np.sin(x)[:, None, None], np.cos(x)[:, None, None]
-            R[:, j] = R0 @ (np.eye(3) + s * K + (1.0 - c) * (K @ K))
-            p[:, j] = p0
-        else:
-            R[:, j] = R0
-            p[:, j] = p0 + np.einsum("nab,b->na", R0, axis) * x[:, None]
-    return R, p
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    n, nj = len(Q), robot.model.njoints
+    frames = robot.__dict__.get("_joint_frames")
+    if frames is None or frames[0] is not robot.model:
+        frames = (robot.model, symbolic_model(robot).joint_frames)
+        robot.__dict__["_joint_frames"] = frames
+    if n == 0:
+        return np.empty((0, nj, 3, 3)), np.empty((0, nj, 3))
+    F = np.asarray(frames[1].map(n)(Q.T)).reshape(12, n, nj)  # column i * nj + j: oMi[j] at row i
+    R = F[:9].reshape(3, 3, n, nj, order="F").transpose(2, 3, 0, 1)  # each rotation stored column by column
+    p = F[9:].transpose(1, 2, 0)
+    return np.ascontiguousarray(R), np.ascontiguousarray(p)
 
 
 # ---------------------------------------------------------------------------------------------- along a path

@@ -14,7 +14,7 @@ second shape's joint (an obstacle's plane is fixed in the cell). The row asks fo
 written with the shape's support function (a box, a cylinder, a sphere: closed form, |x| smoothed as
 sqrt(x^2 + eps^2), which only makes the shape look larger by at most eps times its size, ``_SMOOTH``; a
 mesh: its witness point) and the forward kinematics of the shape's joint written in CasADi from the model
-(:attr:`~scara_pin.motion.symbolic.SymbolicModel.joint_frames`). For a CONVEX second shape the plane
+(:attr:`~scara_pin.symbolic.SymbolicModel.joint_frames`). For a CONVEX second shape the plane
 through its witness point supports it, so a row that holds keeps the pair at least the margin apart: the
 rows are conservative, exactly as the planes are tangent, and re-setting them at each solution lets the
 motion slide along the obstacle until it converges. After each solve:
@@ -59,8 +59,8 @@ from .trajectory import line_optimal_duration
 if TYPE_CHECKING:
     from ..cell import Scene
     from ..model import Robot
+    from ..symbolic import SymbolicModel
     from .polynomial import PolynomialPiece
-    from .symbolic import SymbolicModel
 
 __all__ = [
     "ACTIVATION",
@@ -147,7 +147,7 @@ class Rows:
 
     Args:
         scene: the robot in its cell.
-        sym: the robot's symbolic model (:func:`~scara_pin.motion.symbolic.symbolic_model`; its joint frames).
+        sym: the robot's symbolic model (:func:`~scara_pin.symbolic.symbolic_model`; its joint frames).
     """
 
     PARAMETERS = 9
@@ -181,7 +181,7 @@ class Rows:
         """``s = f(Fa, Fb, n, p, w)``: how far the first shape of ``pair`` is beyond the row's plane [m].
 
         Fa, Fb: the placements (12 values: the rotation column by column, then the translation) of the two
-        shapes' joints in the model's world (:attr:`~scara_pin.motion.symbolic.SymbolicModel.joint_frames`).
+        shapes' joints in the model's world (:attr:`~scara_pin.symbolic.SymbolicModel.joint_frames`).
         The plane (unit normal n, point p) is fixed to the second shape's joint (an obstacle's: the root); w is
         a point fixed to the first shape's joint (its witness point), used where the shape's support is not
         written in closed form (a mesh). The support of a box, a cylinder and a sphere is exact but for the

@@ -24,7 +24,7 @@ are (q, qd) (or (q, qd, qdd)), linked by the EXACT integrals
 so the trajectory between nodes is the polynomial itself (:class:`~scara_pin.motion.polynomial.
 PolynomialPiece`), not an interpolation. Minimise T_1 + T_2 + T_3 with IPOPT (CasADi, exact Hessians of
 the robot's tool position and inverse dynamics written from its Pinocchio model,
-:mod:`~scara_pin.motion.symbolic`). Where each bound holds:
+:mod:`~scara_pin.symbolic`). Where each bound holds:
 
 - a quantity LINEAR in time on an interval is bounded everywhere on it by its two ends: the velocity and
   acceleration under acceleration control, the acceleration under jerk control; variable bounds at the
@@ -124,9 +124,9 @@ if TYPE_CHECKING:
     from ..cell import Cell, Scene
     from ..description import JointLimits
     from ..model import Robot
+    from ..symbolic import SymbolicModel
     from ..units import DisplayUnits
     from .avoid import DistanceRow, Rows
-    from .symbolic import SymbolicModel
 
 __all__ = [
     "STANDARD_CLEARANCE",
@@ -838,7 +838,7 @@ def jump_move(
     loaded = with_payload(robot, payload) if torque else robot
     if lim.effort is not None:
         _holds_still(loaded, (qA, qB, *tops), lim.effort)
-    from .symbolic import symbolic_model
+    from ..symbolic import symbolic_model
 
     N = _default_intervals(jv is not None, tool_speed is not None) if options.intervals is None else options.intervals
     lim_all = robot.limits if limits is None else limits

@@ -346,7 +346,7 @@ class _Kinematics:
 
             J q' = p1,   J q'' = p2 - D2[q', q'],   J q''' = p3 - 3 D2[q', q''] - D3[q', q', q'],
 
-        p(q) the tool position of :func:`~scara_pin.motion.symbolic.symbolic_model` (the Pinocchio model
+        p(q) the tool position of :func:`~scara_pin.symbolic.symbolic_model` (the Pinocchio model
         in CasADi: exact derivatives), all the points in one call. Only when :attr:`exact_derivatives`.
         """
         if self._derivatives is None:
@@ -357,7 +357,7 @@ class _Kinematics:
     def _build_derivatives(self) -> Any:
         import casadi as ca
 
-        from .symbolic import symbolic_model
+        from ..symbolic import symbolic_model
 
         geo = self.robot.kinematics.geometry
         q, a, b = ca.SX.sym("q", 4), ca.SX.sym("a", 4), ca.SX.sym("b", 4)

@@ -23,6 +23,10 @@ projected on its source joint), so that ``rnea(q, qd, qdd)`` equals ``pinocchio.
 included, no friction) to rounding. Both are tested against Pinocchio to 1e-12 on the shipped robots,
 a continuous-joint URDF and a model carrying a payload.
 
+The same functions, evaluated on numbers (``joint_frames.map(n)``), place every joint at many configurations in
+one call: the cell's sweep (:func:`scara_pin.cell.sweep.joint_placements`) and the jump planner's obstacle rows
+use them, so the package has one vectorised forward kinematics besides Pinocchio's.
+
 CasADi is imported inside :func:`symbolic_model` only (``scara-pin fk``/``ik`` never load it).
 """
 
@@ -34,10 +38,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from ..errors import InvalidInputError
+from .errors import InvalidInputError
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from .model import Robot
 
 __all__ = ["SymbolicModel", "symbolic_model"]
 
