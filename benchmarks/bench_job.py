@@ -108,7 +108,7 @@ def main_() -> None:
                            "job", "docs/examples/tray/job.yaml"], capture_output=True, text=True, check=True,
                           cwd=ROOT).stdout.splitlines()  # fmt: skip
     readme = (ROOT / "README.md").read_text().split("$ .venv/bin/scara-pin job docs/examples/tray/job.yaml\n")[1]
-    excerpt = [line for line in readme.split("```")[0].splitlines() if line and line != "  ..."]
+    excerpt = [line for line in readme.split("```")[0].splitlines() if line and line.strip() != "..."]
     stale = [line for line in excerpt if not line.startswith("planning") and line not in text]
     t, q, qd, qdd = data[:, 0], data[:, 1:5], data[:, 5:9], data[:, 9:13]
     v, a = np.array(robot.limits.velocity), np.array(robot.limits.acceleration)
