@@ -511,7 +511,8 @@ def test_envelope_area_against_the_rasterised_image_of_the_joint_box(robot: Robo
     r = g["a1"] + g["a4"] + g["a2"] * np.sin(q2) + g["a3"] * np.sin(t3)
     z = g["d1"] + g["d2"] + g["d5"] + g["a2"] * np.cos(q2) + g["a3"] * np.cos(t3)
     px = 0.005
-    cells = np.unique(np.column_stack([np.floor(r.ravel() / px), np.floor(z.ravel() / px)]).astype(np.int64), axis=0)
+    ix, iz = np.floor(r.ravel() / px).astype(np.int64), np.floor(z.ravel() / px).astype(np.int64)
+    cells = np.unique((ix - ix.min()) * (iz.max() - iz.min() + 1) + (iz - iz.min()))  # one integer per pixel
     raster = len(cells) * px * px  # over-counts by about half a pixel along the boundary
     perimeter = sum(a.radius * a.sweep for a in env.arcs)
     assert raster - perimeter * px <= env.area <= raster, (env.area, raster)

@@ -40,19 +40,19 @@ def mg400_pose(q: np.ndarray) -> np.ndarray:
     """The MG400-like fixture: the big arm 0.175 from vertical, the forearm 0.175 from horizontal (j3 absolute:
     its levelling joint takes j2 back), the flange level: shoulder (0.0435, 0.228), flange (+0.066, +0.031),
     shaft 0.07 down."""
-    q1, q2, q3, q5 = q
-    r = 0.0435 + 0.175 * math.sin(q2) + 0.175 * math.cos(q3) + 0.066
-    z = 0.109 + 0.119 + 0.175 * math.cos(q2) - 0.175 * math.sin(q3) + 0.031 - 0.07
-    return np.array([r * math.cos(q1), r * math.sin(q1), z, q1 + q5])
+    q1, q2, q3, q5 = q  # each a number, or a row of many configurations (q: (4, n))
+    r = 0.0435 + 0.175 * np.sin(q2) + 0.175 * np.cos(q3) + 0.066
+    z = 0.109 + 0.119 + 0.175 * np.cos(q2) - 0.175 * np.sin(q3) + 0.031 - 0.07
+    return np.array([r * np.cos(q1), r * np.sin(q1), z, q1 + q5])
 
 
 def magician_pose(q: np.ndarray) -> np.ndarray:
     """The Magician-like fixture: the rear arm 0.135 from vertical, the forearm 0.147 at q2 + q3 from horizontal
     (q3 measured from the rear arm), the end effector level 0.06 ahead and 0.028 down; the base 0.131305 up."""
-    q1, q2, q3, q4 = q
-    r = 0.135 * math.sin(q2) + 0.147 * math.cos(q2 + q3) + 0.06
-    z = 0.131305 + 0.135 * math.cos(q2) - 0.147 * math.sin(q2 + q3) - 0.028
-    return np.array([r * math.cos(q1), r * math.sin(q1), z, q1 + q4])
+    q1, q2, q3, q4 = q  # each a number, or a row of many configurations (q: (4, n))
+    r = 0.135 * np.sin(q2) + 0.147 * np.cos(q2 + q3) + 0.06
+    z = 0.131305 + 0.135 * np.cos(q2) - 0.147 * np.sin(q2 + q3) - 0.028
+    return np.array([r * np.cos(q1), r * np.sin(q1), z, q1 + q4])
 
 
 def rot_y(a: float) -> np.ndarray:
@@ -232,11 +232,12 @@ def test_palletizers_whose_arm_is_horizontal_at_zero(path: Path, pose, relative:
     env = arm_plane_envelope(robot.kinematics.geometry)
     lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
     g2, g3 = np.meshgrid(np.linspace(lo[1], hi[1], 700), np.linspace(lo[2], hi[2], 700))
-    rz = np.array([pose(np.array([0.0, a, b, 0.0]))[[0, 2]] for a, b in zip(g2.ravel()[::97], g3.ravel()[::97])])
-    assert all(env.contains(r, z) for r, z in rz)
-    pts = np.array([pose(np.array([0.0, a, b, 0.0]))[[0, 2]] for a, b in zip(g2.ravel(), g3.ravel())])
+    zero = np.zeros(g2.size)
+    pts = pose(np.array([zero, g2.ravel(), g3.ravel(), zero]))[[0, 2]].T  # (n, 2): r, z of every configuration
+    assert all(env.contains(r, z) for r, z in pts[::97])
     cell = 1e-3  # [m] the raster's cell: the area of the cells the sweep covers
-    covered = {(int(math.floor(r / cell)), int(math.floor(z / cell))) for r, z in pts}
+    ix, iz = np.floor(pts / cell).astype(np.int64).T
+    covered = np.unique((ix - ix.min()) * (iz.max() - iz.min() + 1) + (iz - iz.min()))  # one integer per cell
     assert env.area == pytest.approx(len(covered) * cell * cell, rel=0.03)
 
 
