@@ -31,6 +31,8 @@ margin and the activation distance, both far below it); nearer, coal's exact dis
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -352,10 +354,7 @@ class Scene:
         if pairs is None:
             out = np.empty((len(Q), len(self.pairs)))
             far = self._far_pairs
-            flags = gd.activeCollisionPairs
-            for k in far:  # computeDistances leaves the inactive pairs alone: they are bounded first, below
-                flags[k] = False
-            try:
+            with self._far_pairs_inactive():
                 for i, q in enumerate(Q):
                     pin.computeDistances(model, data, gm, gd, convert(q) if convert else q)
                     out[i] = [r.min_distance for r in gd.distanceResults]
@@ -363,9 +362,6 @@ class Scene:
                         out[i] = [_sane(v) for v in out[i]]
                     for k in far:
                         out[i, k] = self._bounded(k)
-            finally:
-                for k in far:
-                    flags[k] = True
             return out
         idx = [int(k) for k in np.asarray(pairs, dtype=int).ravel()]
         out = np.empty((len(Q), len(idx)))
@@ -398,10 +394,7 @@ class Scene:
         results = gd.distanceResults
         far = self._far_pairs
         exact = len(self.pairs) - len(far)
-        flags = gd.activeCollisionPairs
-        for k in far:  # bounded below, as in distance_array
-            flags[k] = False
-        try:
+        with self._far_pairs_inactive():
             for i, q in enumerate(Q):
                 qp = convert(q) if convert else q
                 if exact:
@@ -413,10 +406,19 @@ class Scene:
                     d = self._bounded(k)
                     if d < dist[i]:
                         dist[i], which[i] = d, k
-        finally:
-            for k in far:
-                flags[k] = True
         return dist, which
+
+    @contextmanager
+    def _far_pairs_inactive(self) -> Iterator[None]:
+        """The mesh pairs that :meth:`_bounded` answers, off in ``computeDistances`` (it skips inactive pairs)."""
+        flags = self._gd.activeCollisionPairs
+        for k in self._far_pairs:
+            flags[k] = False
+        try:
+            yield
+        finally:
+            for k in self._far_pairs:
+                flags[k] = True
 
     def _bounded(self, k: int) -> float:
         """Pair k's distance (placements current): its bounding spheres' beyond :data:`FAR`, else coal's."""
