@@ -57,7 +57,7 @@ from ..errors import InfeasibleError
 from .trajectory import line_optimal_duration
 
 if TYPE_CHECKING:
-    from ..cell import Scene
+    from ..cell import PairDistance, Scene
     from ..model import Robot
     from ..symbolic import SymbolicModel
     from .polynomial import PolynomialPiece
@@ -315,8 +315,7 @@ class Rows:
                     sg = float(s[i])
                 new.append(DistanceRow(int(kk), sg, int(p)))
         q_end = piece._local(np.array([n - 1]), np.array([h[-1]]), 0)
-        worst = float(min(D.min(initial=math.inf), float(self.scene.distance_array(q_end).min(initial=math.inf))
-                          - self.margin))  # fmt: skip
+        worst = float(min(D.min(initial=math.inf), float(self.scene.minimum_array(q_end)[0]) - self.margin))
         self._near = {(int(kk), int(p)) for kk, p in zip(*np.nonzero(
             (D < FINE_WITHIN).reshape(n, CHECK_POINTS, -1).any(axis=1)))}  # fmt: skip
         return new, worst
@@ -460,6 +459,12 @@ def _stroke_top(robot: Robot, q: np.ndarray) -> np.ndarray | None:
     return out
 
 
+def _closest(scene: Scene, Q: np.ndarray) -> tuple[int, PairDistance | None]:
+    """(the row of ``Q`` where a checked pair comes closest, that pair with its witness points)."""
+    i = int(np.argmin(scene.minimum_array(Q)))
+    return i, scene.distances(Q[i]).closest
+
+
 def blocking(scene: Scene, piece: PolynomialPiece) -> str:
     """Which pair comes closest in ``piece`` and where, in words (for a failure message)."""
     from ..cell import describe
@@ -469,9 +474,7 @@ def blocking(scene: Scene, piece: PolynomialPiece) -> str:
     k = np.repeat(np.arange(n), 4)
     s = np.tile(np.arange(4) / 4.0, n)
     q = piece._local(k, s * h[k], 0)
-    D = scene.distance_array(q)
-    i = int(np.argmin(D.min(axis=1)))
-    found = scene.distances(q[i]).closest
+    i, found = _closest(scene, q)
     if found is None:  # pragma: no cover - a scene without pairs plans no rows
         return "no pair"
     return describe(found, scene.margin) + f" at t = {piece.breaks[k[i]] + s[i] * h[k[i]]:.4g} s"
@@ -484,10 +487,7 @@ def blocked(scene: Scene, tried: list[Candidate], status: str) -> InfeasibleErro
 
     parts = []
     for c in tried:
-        samples = _line_samples(c.waypoints)
-        D = scene.distance_array(samples)
-        i = int(np.argmin(D.min(axis=1)))
-        found = scene.distances(samples[i]).closest
+        _, found = _closest(scene, _line_samples(c.waypoints))
         if found is not None:
             parts.append(f"{c.way}: {describe(found, scene.margin)}")
     return JumpError(status, "no collision-free motion found within the limits: " + "; ".join(parts)
