@@ -154,6 +154,10 @@ class Distances:
         """Every pair at least the margin apart."""
         return self.minimum >= self.margin
 
+    def of(self, pair: Pair) -> PairDistance:
+        """The distance of ``pair`` (a pair the scene checks)."""
+        return next(p for p in self.pairs if p.pair.index == pair.index)
+
     def below(self, distance: float | None = None) -> tuple[PairDistance, ...]:
         """The pairs closer than ``distance`` (default: the margin)."""
         limit = self.margin if distance is None else distance

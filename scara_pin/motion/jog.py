@@ -40,7 +40,8 @@ __all__ = ["JogResult", "edge_workspace", "jog_to_edge"]
 CHECK_RATE = 10_000.0
 """[Hz] sampling rate of the limit check of a jog (ten times the 1 kHz promise)."""
 CONTACT_ROOM = 1e-9
-"""[m] in a cell, a jog shorter than this before contact is refused: no room to move."""
+"""[m or rad] in a cell, a jog shorter than this before contact is refused (no room to move); a pendant's step
+(:mod:`~scara_pin.motion.manual`) does not move (``AT_EDGE``)."""
 SINGULAR_EDGE_GAP = 1e-6
 """[m] in a cell, the contact is looked for up to this short of a singular edge (the line cannot end on it)."""
 
@@ -177,8 +178,7 @@ def jog_to_edge(
         ratio = max(_ratios(robot, traj))
     if contact is not None:  # the pair at the end, as the end configuration has it
         assert sc is not None  # noqa: S101
-        found = sc.distances(traj.q_end)
-        contact = next(p for p in found.pairs if p.pair.index == contact.pair.index)
+        contact = sc.distances(traj.q_end).of(contact.pair)
     return JogResult(traj, hit, pose0, end, travel, ratio, contact, 0.0 if sc is None else sc.margin)
 
 

@@ -68,7 +68,6 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BISECT_TOL",
-    "CONTACT_ROOM",
     "MAX_POLYLINE_POINTS",
     "POLYLINE_SPACING",
     "JUMP",
@@ -109,8 +108,6 @@ of J4): not one continuous move. Near the stretched arm a 1 mm sample moves the 
 sqrt(2 mm (l1 + l2) / (l1 l2)): 0.14 rad for l1 = l2 = 0.2 m, 0.6 rad for l1 = l2 = 0.05 m."""
 BISECT_TOL = 1e-10
 """[m or rad] the bisection of the first refused sample stops this close to it."""
-CONTACT_ROOM = 1e-9
-"""[m or rad] in a cell, a move shorter than this before the first contact does not move (``AT_EDGE``)."""
 POLYLINE_SPACING = 1e-4
 """[m or rad] in a cell, the part of a Cartesian move the closed form cannot follow (next to the stretched or
 folded arm) is followed through its IK solutions this far apart (at least 16, at most
@@ -347,6 +344,7 @@ def jog_step(robot: Robot, q: object, motion: JogMotion, step: float, *, ws: Wor
 def _before_contact(robot: Robot, scene: Scene, q0: np.ndarray, motion: JogMotion, move: JogMove) -> JogMove:
     """``move`` (from ``q0``), ended where a checked pair of ``scene`` first comes to the margin, if it does."""
     from ..cell.sweep import first_contact
+    from .jog import CONTACT_ROOM
 
     done = 0.0
     for path, length in _move_paths(robot, q0, motion, move):
@@ -362,9 +360,8 @@ def _before_contact(robot: Robot, scene: Scene, q0: np.ndarray, motion: JogMotio
     if not travelled > CONTACT_ROOM:
         reason = StopReason(StopKind.OBSTACLE, f"at the margin: {c.distance:.6g} m from {pair}, and this way "
                             "comes closer", c.pair.b)  # fmt: skip
-        at_q0 = next(p for p in scene.distances(q0).pairs if p.pair.index == c.pair.index)
         return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, reason, 0.0, move.requested, Solver.NONE,
-                       at_q0)  # fmt: skip
+                       scene.distances(q0).of(c.pair))  # fmt: skip
     reason = StopReason(StopKind.OBSTACLE, f"stopped {c.distance:.6g} m from {pair}", c.pair.b)
     return JogMove(found.q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, travelled, move.requested,
                    move.solver, c)  # fmt: skip
