@@ -37,23 +37,6 @@ def pytest_unconfigure(config: pytest.Config) -> None:
             os.environ[k] = v
 
 
-HEAVY_MODULES = {  # [s] each module's tests and fixtures (pytest --durations=0, an idle 2-core machine, 2026-11)
-    "test_hostile.py": 44, "test_teach_page.py": 30, "test_job_palletizer.py": 24, "test_cell_motion.py": 21,
-    "test_jump.py": 19, "test_docs.py": 17, "test_viz.py": 14, "test_hostile_packages.py": 11,
-    "test_job_plan.py": 11, "test_workspace.py": 11, "test_properties.py": 10, "test_cell.py": 8,
-    "test_hostile_lies.py": 7, "test_teach_cell.py": 7, "test_hostile_meshes.py": 6, "test_real_robots3.py": 6,
-    "test_notebook_api.py": 6, "test_cycle.py": 6, "test_teach.py": 6, "test_view_cell.py": 6,
-}  # fmt: skip
-
-
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """The longest modules first (pyproject.toml: ``--dist loadscope --no-loadscope-reorder``): each worker takes
-    the next whole module when it is free, so the two workers finish together rather than one of them running a
-    long module alone at the end. The order within a module is kept."""
-    position = {item: k for k, item in enumerate(items)}
-    items.sort(key=lambda item: (-HEAVY_MODULES.get(item.path.name, 0), position[item]))
-
-
 @pytest.fixture(scope="session")
 def robot_default() -> Robot:
     """The ``default`` robot (source S4: l1 = l2 = 0.200 m, tool 50 mm below the reference plane)."""
