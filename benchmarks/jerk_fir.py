@@ -38,17 +38,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from scara_pin._checks import _positive
+from scara_pin._checks import as_positive
 from scara_pin.errors import ParameterError
 from scara_pin.motion.jerk import JerkRatios
 from scara_pin.motion.timing import TimingError, TimingOptions
 from scara_pin.motion.trajectory import GeometricPath, Motion, ProfileLaw, TimeLaw, Trajectory
 from scara_pin.motion.verify import (
+    LimitsInForce,
     Quantity,
-    _Limits,
-    _limits,
     jerk_vector,
     joint_jerk,
+    limits_in_force,
     path_third_derivative,
     time_scale,
 )
@@ -84,8 +84,8 @@ class FilteredLaw(TimeLaw):
     _S: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        _positive("window", self.window, "s")
-        _positive("k", self.k)
+        as_positive("window", self.window, "s")
+        as_positive("k", self.k)
         b = self.base
         dt = np.diff(b.t)
         seg = b.s[:-1] * dt + b.sd[:-1] * dt**2 / 2.0 + b.u * dt**3 / 6.0  # integral of s_0 over each segment
@@ -125,7 +125,7 @@ class FilteredLaw(TimeLaw):
 
     def scaled(self, k: float) -> FilteredLaw:
         """The same law ``k`` times slower."""
-        return FilteredLaw(self.base, self.window, self.k * _positive("k", k))
+        return FilteredLaw(self.base, self.window, self.k * as_positive("k", k))
 
     def breakpoints(self) -> np.ndarray:
         """Times [s] where the path jerk changes (it is constant between them)."""
@@ -181,7 +181,7 @@ def _joint_values(
 
 
 def _scale(
-    robot: Robot, motion: Motion, t: np.ndarray, lim: _Limits, jv: np.ndarray, table: _Table | None = None
+    robot: Robot, motion: Motion, t: np.ndarray, lim: LimitsInForce, jv: np.ndarray, table: _Table | None = None
 ) -> tuple[float, JerkRatios]:
     """(k, ratios): the time scale making the worst ratio at times t exactly 1, and the ratios now."""
     k, worst = time_scale(robot, lim, _joint_values(motion, t, table), jv)
@@ -220,7 +220,7 @@ def fir_jerk_limited(
     """
     opts = TimingOptions() if options is None else options
     jv = jerk_vector(jerk)
-    lim = _limits(robot, limits, None, torque)
+    lim = limits_in_force(robot, limits, None, torque)
     out: list[Motion] = []
     ratios: list[JerkRatios] = []
     t_start = 0.0

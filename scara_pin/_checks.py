@@ -21,7 +21,7 @@ precision left (its ulp exceeds 1e-10 rad) and no SCARA is that large."""
 
 
 
-def _floats(name: str, value: object, rule: str) -> np.ndarray:
+def as_floats(name: str, value: object, rule: str) -> np.ndarray:
     """``value`` as a float array (any shape), or a ParameterError saying ``rule``.
 
     Strings, objects and integers too large for a float give the ParameterError, never a bare TypeError,
@@ -36,11 +36,11 @@ def _floats(name: str, value: object, rule: str) -> np.ndarray:
     return arr
 
 
-def _vector(name: str, value: object, n: int | None = 4) -> np.ndarray:
+def as_vector(name: str, value: object, n: int | None = 4) -> np.ndarray:
     """``value`` as ``n`` finite floats (None: one per joint, 4 or 3: JOINT_COUNTS), or a ParameterError."""
     counts = JOINT_COUNTS if n is None else (n,)
     what = " or ".join(map(str, counts))
-    arr = _floats(name, value, f"must be {what} numbers")
+    arr = as_floats(name, value, f"must be {what} numbers")
     if arr.ndim != 1 or len(arr) not in counts:
         raise ParameterError(name, value, f"must be {what} numbers (got shape {arr.shape})")
     if not np.isfinite(arr).all():
@@ -48,7 +48,7 @@ def _vector(name: str, value: object, n: int | None = 4) -> np.ndarray:
     return arr
 
 
-def _positive(name: str, value: object, unit: str = "") -> float:
+def as_positive(name: str, value: object, unit: str = "") -> float:
     """``value`` as a finite float > 0, or a :class:`ParameterError`."""
     try:
         v = float(value)  # type: ignore[arg-type]
@@ -59,7 +59,7 @@ def _positive(name: str, value: object, unit: str = "") -> float:
     return v
 
 
-def _rows(name: str, value: object) -> np.ndarray:
+def as_rows(name: str, value: object) -> np.ndarray:
     """``value`` as an (m, n) float array of finite numbers, m >= 2, n a joint count (4, or 3), or a ParameterError."""
     try:
         arr = np.array(value, dtype=float)
@@ -73,7 +73,7 @@ def _rows(name: str, value: object) -> np.ndarray:
     return arr
 
 
-def _limit_vector(name: str, values: ArrayLike, unit: str, names: Sequence[str] = JOINT_NAMES) -> np.ndarray:
+def as_limit_vector(name: str, values: ArrayLike, unit: str, names: Sequence[str] = JOINT_NAMES) -> np.ndarray:
     """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0 (``names``: the joints')."""
     arr = np.array(values, dtype=float)
     if arr.ndim != 1 or len(arr) not in JOINT_COUNTS:

@@ -320,7 +320,7 @@ def test_an_angle_of_exactly_pi_is_listed_once(robot: Robot, q: list[float]) -> 
 def test_inverse_dynamics_equals_the_twin(robot: Robot, twin: Robot) -> None:
     """timing's RNEA converts q: torques of the continuous robot = its revolute twin's (1e-9 N m / N),
     both given the same off-axis link masses (the fixture has none)."""
-    from scara_pin.motion.verify import _rnea
+    from scara_pin.motion.verify import joint_torques
 
     inertial = ('<link name="{0}"><inertial><origin xyz="0.1 0.03 0"/><mass value="{1}"/>'
                 '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial></link>')  # fmt: skip
@@ -336,6 +336,6 @@ def test_inverse_dynamics_equals_the_twin(robot: Robot, twin: Robot) -> None:
     qs = sample_qs(20, seed=9)
     rng = np.random.default_rng(9)
     v, a = rng.uniform(-2, 2, (20, 4)), rng.uniform(-5, 5, (20, 4))
-    tau, tau_t = _rnea(m, qs, v, a), _rnea(mt, qs, v, a)
+    tau, tau_t = joint_torques(m, qs, v, a), joint_torques(mt, qs, v, a)
     assert np.abs(tau).max() > 1.0  # not a vacuous comparison
     assert np.abs(tau - tau_t).max() <= 1e-9

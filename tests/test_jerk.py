@@ -101,7 +101,7 @@ def test_verify_torque_with_payload_against_an_appended_body(robot):
 def test_static_overload_whatever_the_sign_of_the_motion(robot):
     """A static load above an effort limit is infeasible: time_scale refuses it whichever way the motion pushes
     (it used to see it only where the dynamic part had the sign of the load), and says which joint."""
-    from scara_pin.motion.verify import _limits, static_load, time_scale
+    from scara_pin.motion.verify import limits_in_force, static_load, time_scale
 
     q = np.array([[0.3, 0.4, 0.05, 0.0]])
     g = static_load(robot, q)[0]
@@ -114,7 +114,7 @@ def test_static_overload_whatever_the_sign_of_the_motion(robot):
         qdd = np.zeros((1, 4))
         qdd[0, j] = sign * np.sign(g[j]) * 1e-3
         with pytest.raises(InfeasibleError, match=f"static load on joint{j + 1}.*cannot even hold still"):
-            time_scale(robot, _limits(robot, lim, None, True), (q, np.zeros((1, 4)), qdd))
+            time_scale(robot, limits_in_force(robot, lim, None, True), (q, np.zeros((1, 4)), qdd))
 
 
 def test_verify_sees_a_polynomial_piece_between_its_samples(robot):

@@ -22,7 +22,7 @@ from scara_pin.motion.trajectory import JointLine, PathError, cartesian_path, jo
 PROMISE = 1e-6  # relative: the most any limit may be exceeded at the samples
 
 
-def _limits(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+def limits_in_force(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     return np.array(robot.limits.velocity), np.array(robot.limits.acceleration)
 
 
@@ -63,7 +63,7 @@ def _raw_toppra(path: object, v: np.ndarray, a: np.ndarray, grid: np.ndarray) ->
 
 def test_100_random_curved_paths_respect_the_limits_at_1khz(robot_default: Robot) -> None:
     robot = robot_default
-    v, a = _limits(robot)
+    v, a = limits_in_force(robot)
     ratios, raw_excess, worst = [], [], 0.0
     for W in _random_paths(robot, 100, seed=2024):
         path = joint_path(robot, W)
@@ -88,7 +88,7 @@ def test_100_random_curved_paths_respect_the_limits_at_1khz(robot_default: Robot
 
 
 def test_limits_also_hold_between_1khz_samples(robot_default: Robot) -> None:
-    v, a = _limits(robot_default)
+    v, a = limits_in_force(robot_default)
     for W in _random_paths(robot_default, 8, seed=99):
         traj = time_optimal(robot_default, W)
         for t in (np.arange(0.00037, traj.duration, 1 / 977.0), np.linspace(0.0, traj.duration, 40_001)):
@@ -99,7 +99,7 @@ def test_limits_also_hold_between_1khz_samples(robot_default: Robot) -> None:
 @pytest.mark.parametrize("name", ["default", "s1"])
 def test_straight_joint_lines_reach_the_exact_optimum(robots: dict[str, Robot], name: str) -> None:
     robot = robots[name]
-    v, a = _limits(robot)
+    v, a = limits_in_force(robot)
     lo, hi = np.array(robot.limits.lower), np.array(robot.limits.upper)
     rng = np.random.default_rng(5)
     for _ in range(15):
@@ -142,7 +142,7 @@ def test_torque_limits_from_rnea() -> None:
     tau = np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
     ratio = np.max(np.abs(tau) / np.array(robot.limits.effort))
     assert ratio <= 1 + PROMISE and ratio >= 1 - 1e-3
-    v, a = _limits(robot)
+    v, a = limits_in_force(robot)
     rv, ra = _sampled_ratios(traj, v, a, traj.times(1000.0))
     assert rv <= 1 + PROMISE and ra <= 1 + PROMISE
     check = limit_ratios(robot, traj, torque=True)
@@ -157,7 +157,7 @@ def test_cartesian_path_time_optimal(robot_default: Robot) -> None:
     path = cartesian_path(robot, poses, start=q0)
     traj = time_optimal(robot, path, options=TimingOptions(grid_points=60))
     assert len(traj.pieces) == 2
-    v, a = _limits(robot)
+    v, a = limits_in_force(robot)
     t = traj.times(1000.0)
     rv, ra = _sampled_ratios(traj, v, a, t)
     assert rv <= 1 + PROMISE and ra <= 1 + PROMISE and max(rv, ra) >= 1 - 1e-3

@@ -31,7 +31,7 @@ from ..limits import MAX_PLAN_POSES, MAX_PLAN_WORK, check_count
 from ..model import Robot
 from ..summary import Summarized
 from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame
-from .fit import _random_poses, structural_count
+from .fit import random_poses, structural_count
 from .identify import identify
 from .measurements import measurement_columns
 
@@ -155,7 +155,7 @@ def plan_experiment(
     k = max(check_count("candidate poses", k, MAX_PLAN_WORK), n)
     check_count(f"the plan's work ({n} poses x {k} candidates)", n * k, MAX_PLAN_WORK, "ask fewer candidates or poses")
     rng = np.random.default_rng(seed)
-    pool = _random_poses(robot, k, rng)
+    pool = random_poses(robot, k, rng)
     _, J = chain.predict(np.zeros(chain.size), chain.pinocchio_q(pool), pin.SE3.Identity())
     rows = chain.rows_per_pose
     if yaw:

@@ -338,7 +338,7 @@ def _second_order(problem: _Problem, theta: np.ndarray, trial: np.ndarray, kept:
     return accepted
 
 
-def _random_poses(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
+def random_poses(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
     """``n`` joint readings drawn uniformly inside the limits (a continuous joint's are one turn, -pi .. pi)."""
     return rng.uniform(np.array(robot.limits.lower), np.array(robot.limits.upper), size=(n, robot.dof))
 
@@ -349,7 +349,7 @@ def structural_count(chain: ChainModel, seed: int = 0, tol: float = IDENTIFY_TOL
     At the nominal model, from ``max(3 x errors, STRUCTURAL_POSES)`` poses drawn with ``seed``.
     """
     rng = np.random.default_rng(seed)
-    q = _random_poses(chain.robot, max(3 * chain.size, STRUCTURAL_POSES), rng)
+    q = random_poses(chain.robot, max(3 * chain.size, STRUCTURAL_POSES), rng)
     _, J = chain.predict(np.zeros(chain.size), chain.pinocchio_q(q), pin.SE3.Identity())
     if chain.yaw:
         J = J.copy()  # type: ignore[union-attr]

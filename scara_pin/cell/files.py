@@ -286,7 +286,7 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     from ..description.packages import PackagePath, read_robot_file
     from ..description.placeholders import placeholder_urdf
     from ..limits import check_input_file
-    from .meshes import _scale, load_mesh
+    from .meshes import load_mesh, mesh_scale
 
     check_input_file(path, "cell file", MAX_CELL_BYTES)
     packages: PackagePath = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
@@ -315,7 +315,7 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
         what = f"obstacle {link if i == 0 else f'{link}_{i}'}"
         filename = mesh.get("filename", "")
         try:
-            scale = _scale(mesh.get("scale"), filename)
+            scale = mesh_scale(mesh.get("scale"), filename)
             geometry = load_mesh(mesh_file(filename, packages), filename)
         except MeshProblem as exc:
             raise InvalidInputError(f"{origin}: {what}: {exc}") from None

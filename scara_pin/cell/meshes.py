@@ -167,7 +167,7 @@ class VisualMesh:
         return self.geometry.faces
 
 
-def _scale(text: str | None, filename: str) -> tuple[float, float, float]:
+def mesh_scale(text: str | None, filename: str) -> tuple[float, float, float]:
     if text is None:
         return (1.0, 1.0, 1.0)
     values = [number_text(v) for v in text.split()]  # the URDF number grammar: no "1_0", no "nan"
@@ -439,7 +439,7 @@ def _robot_meshes(robot: Robot, element: str) -> tuple[tuple[VisualMesh, ...], d
         try:
             if not filename:
                 raise MeshProblem(f"a <mesh> of link {link} has no filename")
-            scale = _scale(mesh.get("scale"), filename)
+            scale = mesh_scale(mesh.get("scale"), filename)
             path = mesh_file(filename, robot.package_path)  # the rule `check` applies too
             if path not in read:
                 try:

@@ -51,7 +51,7 @@ from ..motion.jump import BINDING, Binding, jump_move
 from ..motion.payload import Payload, PayloadLike, as_payload, with_payload
 from ..motion.polynomial import PolynomialPiece
 from ..motion.trajectory import Trajectory
-from ..motion.verify import VERIFY_RATE, _limits, state_ratios, verify
+from ..motion.verify import VERIFY_RATE, limits_in_force, state_ratios, verify
 from ..signals import raise_pending
 from .results import JobResult, PlacedBox, PlanningStats, StepResult
 from .steps import Dwell, Grip, GripKind, Move, MoveKind, located
@@ -196,7 +196,7 @@ def _checked(robot: Robot, traj: Trajectory, method: str, limits: JointLimits, t
 def _binding(robot: Robot, traj: Trajectory, limits: JointLimits, torque: bool, payload: Payload
              ) -> tuple[tuple[Binding, ...], Binding]:  # fmt: skip
     """The limits at >= :data:`~scara_pin.motion.jump.BINDING` on the 10 kHz grid, with their share of the time."""
-    lim = _limits(robot, limits, None, torque)
+    lim = limits_in_force(robot, limits, None, torque)
     loaded = with_payload(robot, payload) if torque else robot
     t = np.append(np.arange(math.floor(traj.duration * VERIFY_RATE) + 1) / VERIFY_RATE, traj.duration)
     q, qd, qdd = traj.sample(t)

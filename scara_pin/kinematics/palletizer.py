@@ -53,7 +53,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from .._checks import _vector
+from .._checks import as_vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
 from .planar2r import (
     FREE_R,
@@ -210,25 +210,25 @@ class PalletizerGeometry:
 # ------------------------------------------------------------------------------------ conventions
 def from_s2(q_s2: Sequence[float]) -> np.ndarray:
     """S2's ``(q1, q2, q3, q5)`` (q3 relative to the big arm) -> ``q = (q1, q2, theta3 = q2 + q3, q5)``."""
-    a = _vector("q_s2", q_s2)
+    a = as_vector("q_s2", q_s2)
     return np.array([a[0], a[1], a[1] + a[2], a[3]])
 
 
 def to_s2(q: Sequence[float]) -> np.ndarray:
     """``q = (q1, q2, theta3, q4)`` -> S2's ``(q1, q2, q3 = theta3 - q2, q5 = q4)``."""
-    a = _vector("q", q)
+    a = as_vector("q", q)
     return np.array([a[0], a[1], a[2] - a[1], a[3]])
 
 
 def wrist_pitch(q: Sequence[float]) -> float:
     """S2's passive wrist pitch ``q4 = -(q2 + q3) = -theta3`` [rad] at ``q`` (the ``wrist_pitch`` joint)."""
-    return -float(_vector("q", q)[2])
+    return -float(as_vector("q", q)[2])
 
 
 # ------------------------------------------------------------------------------------ kinematics
 def forward(geo: PalletizerGeometry, q: ArrayLike) -> np.ndarray:
     """S2's closed-form FK: (x, y, z, yaw) of tool0 in ``base`` at ``q`` (motor side) [m, rad]."""
-    q1, q2, t3, q4 = geo.canonical(_vector("q", q))
+    q1, q2, t3, q4 = geo.canonical(as_vector("q", q))
     if geo.relative:
         t3 += q2
     r = geo.r0 + geo.a2 * math.sin(q2) + geo.a3 * math.sin(t3)
@@ -241,7 +241,7 @@ def branch_of(q: ArrayLike, geo: PalletizerGeometry | None = None) -> str:
 
     ``geo``: the palletizer whose joints ``q`` are (default: S2's own, ``q = (q1, q2, theta3, q4)``).
     """
-    a = _vector("q", q)
+    a = as_vector("q", q)
     if geo is not None:
         t = geo.canonical(a)
         return "up" if math.sin(t[2] if geo.relative else t[2] - t[1]) >= 0.0 else "down"

@@ -50,7 +50,7 @@ class Scara3Kinematics(ScaraKinematics):
     # ------------------------------------------------------------------------- 3 <-> 4 joint values
     def _target4(self, target: Any) -> tuple[float, float, float, float]:
         """(x, y, z, yaw0) of a 3-value target: the virtual wrist absorbs the yaw."""
-        from .._checks import _vector
+        from .._checks import as_vector
         from .targets import check_magnitude
 
         size = np.size(target) if not hasattr(target, "homogeneous") else 16
@@ -59,7 +59,7 @@ class Scara3Kinematics(ScaraKinematics):
                 "this SCARA has 3 joints and no wrist: the tool's yaw follows q1 and q2 and cannot be chosen; "
                 "give the target as x, y, z (3 values)"
             )
-        x, y, z = (float(v) for v in _vector("target", target, 3))
+        x, y, z = (float(v) for v in as_vector("target", target, 3))
         check_magnitude((x, y, z))
         return x, y, z, self.geometry.yaw0
 
@@ -67,14 +67,14 @@ class Scara3Kinematics(ScaraKinematics):
     def _ref4(reference: ArrayLike | None) -> np.ndarray | None:
         if reference is None:
             return None
-        from .._checks import _vector
+        from .._checks import as_vector
 
         ref = np.asarray(reference, dtype=float)
         if ref.ndim == 2:
             if ref.shape[1] != 3:
                 raise ParameterError("reference", f"array of shape {ref.shape}", "must be 3 values or (N, 3)")
             return np.column_stack([ref, np.zeros(len(ref))])
-        return np.append(_vector("reference", reference, 3), 0.0)
+        return np.append(as_vector("reference", reference, 3), 0.0)
 
     def _drop(self, res: IKResult, xyz: tuple[float, float, float]) -> IKResult:
         sols = tuple(replace(s, q=s.q[:3].copy(), turns=s.turns[:3]) for s in res.solutions)
@@ -100,9 +100,9 @@ class Scara3Kinematics(ScaraKinematics):
         """The solution nearest ``reference`` (3 values; weighted joint space); NoSolutionError if none."""
         if self.robot is not None:
             return nearest_q(self.solve(target, branch=branch, reference=reference), reference, weights, branch, 3)
-        from .._checks import _vector
+        from .._checks import as_vector
 
-        w = np.append(np.ones(3) if weights is None else _vector("weights", weights, 3), 0.0)  # the wrist: nothing
+        w = np.append(np.ones(3) if weights is None else as_vector("weights", weights, 3), 0.0)  # the wrist: nothing
         q = scara.solve_nearest(self.geometry, self._target4(target), self._ref4(reference), weights=w, branch=branch)
         return q[:3].copy()
 

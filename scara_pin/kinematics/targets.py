@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .._checks import MAGNITUDE_MAX, _floats, _vector
+from .._checks import MAGNITUDE_MAX, as_floats, as_vector
 from ..errors import ParameterError
 
 if TYPE_CHECKING:
@@ -55,7 +55,7 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
             pass  # not 4 plain numbers (a 4 x 4 pose as nested lists, say): the general route below says why
     M = placement_matrix(target)
     if M.shape == (4,):
-        x, y, z, yaw = (float(v) for v in _vector("target", M))
+        x, y, z, yaw = (float(v) for v in as_vector("target", M))
         check_magnitude((x, y, z, yaw))
         return x, y, z, yaw - yaw0, 0.0
     if M.shape != (4, 4) or not np.isfinite(M).all():
@@ -71,7 +71,7 @@ def parse_target(target: object, yaw0: float, R0: np.ndarray) -> tuple[float, fl
 
 def placement_matrix(target: object) -> np.ndarray:
     """A target as a float array: a pin.SE3's 4 x 4 matrix, else the values as given (shape not checked here)."""
-    return target.homogeneous if isinstance(target, pin.SE3) else _floats("target", target, _TARGET_RULE)
+    return target.homogeneous if isinstance(target, pin.SE3) else as_floats("target", target, _TARGET_RULE)
 
 
 def check_magnitude(values: ArrayLike) -> None:
@@ -94,7 +94,7 @@ def reference_floats(reference: object, n: int = 4) -> list[float]:
             m = MAGNITUDE_MAX
             if -m <= a <= m and -m <= b <= m and -m <= c <= m and -m <= d <= m:  # NaN fails
                 return out  # type: ignore[no-any-return]
-    arr = _vector("reference", reference, n)
+    arr = as_vector("reference", reference, n)
     if (np.abs(arr) > MAGNITUDE_MAX).any():
         raise ParameterError("reference", arr.tolist(), f"must be within +/-{MAGNITUDE_MAX:g} (rad or m)")
     return arr.tolist()  # type: ignore[no-any-return]
@@ -102,7 +102,7 @@ def reference_floats(reference: object, n: int = 4) -> list[float]:
 
 def weight_floats(weights: object, n: int = 4) -> list[float]:
     """Weights of a joint-space distance as n finite floats >= 0."""
-    w = _vector("weights", weights, n)
+    w = as_vector("weights", weights, n)
     if (w < 0).any():
         raise ParameterError("weights", w.tolist(), "must be >= 0")
     return w.tolist()  # type: ignore[no-any-return]
@@ -124,7 +124,7 @@ def batch_inputs(targets: object, reference: object, branch: str, branches: tupl
     """
     from ..errors import InvalidInputError
 
-    T = _floats("targets", targets, "must be an (N, 4) array of x, y, z, yaw")
+    T = as_floats("targets", targets, "must be an (N, 4) array of x, y, z, yaw")
     if T.ndim != 2 or T.shape[1] != 4:
         raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")
     if branch not in ("nearest", *branches):
@@ -132,7 +132,7 @@ def batch_inputs(targets: object, reference: object, branch: str, branches: tupl
         raise InvalidInputError(f"branch {branch!r} must be {names.rsplit(', ', 1)[0]} or {names.rsplit(', ', 1)[1]}")
     if T.size and not (T.max() <= MAGNITUDE_MAX and T.min() >= -MAGNITUDE_MAX):  # NaN fails the comparisons
         check_magnitude(T[int(np.argmax(~(np.abs(T) <= MAGNITUDE_MAX).all(axis=1)))].tolist())
-    ref = np.zeros(4) if reference is None else _floats("reference", reference, "must be 4 values or (N, 4)")
+    ref = np.zeros(4) if reference is None else as_floats("reference", reference, "must be 4 values or (N, 4)")
     if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
         raise ParameterError("reference", f"array of shape {ref.shape}", "must be 4 finite values or (N, 4)")
     return T, ref

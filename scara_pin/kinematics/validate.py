@@ -86,7 +86,7 @@ class ValidationReport:
         return "\n".join(lines + [f"  {f}" for f in self.failures])
 
 
-def _pose_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
+def pose_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
     e = robot.tool_pose(q) - target
     e[3] = (e[3] + math.pi) % (2 * math.pi) - math.pi
     return float(np.abs(e).max())
@@ -118,7 +118,7 @@ def validate_ik(
         t_closed += time.perf_counter() - t0
         report.solutions += len(result.solutions)
         for sol in result.solutions:
-            err = _pose_error(robot, sol.q, target)
+            err = pose_error(robot, sol.q, target)
             report.worst_pose_error = max(report.worst_pose_error, err)
             if err > POSE_TOL:
                 report.fk_fail += 1

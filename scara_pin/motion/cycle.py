@@ -45,7 +45,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import _vector
+from .._checks import as_vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..summary import Summarized
 from ..units import SI, DisplayUnits, format_number
@@ -63,7 +63,7 @@ from .jump import (
 )
 from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
 from .payload import Payload, PayloadLike, as_payload, with_payload
-from .timing import TimingOptions, _limits, parameterize
+from .timing import TimingOptions, limits_in_force, parameterize
 from .trajectory import Motion, Trajectory
 from .verify import Quantity, Verification, state_ratios, trajectory_jerk, verify
 
@@ -283,7 +283,7 @@ def arch_path(
         InvalidInputError: no horizontal move.
         PathError: the path leaves the workspace or the joint limits, or reaches the singularity.
     """
-    A, B = _vector("pose_from", pose_from), _vector("pose_to", pose_to)
+    A, B = as_vector("pose_from", pose_from), as_vector("pose_to", pose_to)
     rise = _nonneg("rise", rise, strict=True)
     blend = math.inf if blend is None else _nonneg("blend", blend)
     g = _arch_geometry(A, B, rise, blend)
@@ -526,7 +526,7 @@ def arch_move(
     P = np.asarray(poses, dtype=float)
     if P.ndim != 2 or P.shape[1] != 4 or P.shape[0] < 2:
         raise ParameterError("poses", f"shape {P.shape}", "must be (m, 4) with m >= 2")
-    lim = _limits(robot, limits, None, torque)  # refuses NaN (a URDF's missing accelerations) up front
+    lim = limits_in_force(robot, limits, None, torque)  # refuses NaN (a URDF's missing accelerations) up front
     loaded = with_payload(robot, payload)
     paths: list[Any] = []
     q = None if start is None else np.asarray(start, dtype=float)
@@ -747,8 +747,8 @@ def standard_cycle(
         why = ("chord perpendicular to the arm at mid J1 range, centred on it, at mid-stroke height, at the distance "
                "from the J1 axis that maximises the smallest manipulability |det J| along it")  # fmt: skip
     else:
-        a = _vector("start", start)
-        dvec = np.array([1.0, 0.0]) if direction is None else _vector("direction", direction, 2)
+        a = as_vector("start", start)
+        dvec = np.array([1.0, 0.0]) if direction is None else as_vector("direction", direction, 2)
         norm = float(np.hypot(*dvec))
         if norm == 0.0:
             raise ParameterError("direction", dvec.tolist(), "must not be zero")

@@ -55,7 +55,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import _positive
+from .._checks import as_positive
 from ..errors import InfeasibleError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
 from ..summary import Summarized
@@ -64,10 +64,10 @@ from .timing import TimingError
 from .trajectory import Motion, TimeLaw, Trajectory
 from .verify import (
     VERIFY_RATE,
+    LimitsInForce,
     Quantity,
-    _Limits,
-    _limits,
     jerk_vector,
+    limits_in_force,
     motion_states,
     state_ratios,
     time_scale,
@@ -128,7 +128,7 @@ class JerkOptions:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not low <= v <= high:
                 raise ParameterError(name, v, f"must be an integer in [{low}, {high}]")
-        _positive("check_rate", self.check_rate, "Hz")
+        as_positive("check_rate", self.check_rate, "Hz")
 
 
 @dataclass(frozen=True)
@@ -228,7 +228,7 @@ class JerkLaw(TimeLaw):
 
     def scaled(self, k: float) -> JerkLaw:
         """The same law ``k`` times slower (times * k, jerks / k^3), exactly."""
-        k = _positive("k", k)
+        k = as_positive("k", k)
         return JerkLaw(self.t * k, self.c / k**3, self.knots)
 
     def breakpoints(self) -> np.ndarray:
@@ -289,7 +289,7 @@ def minimum_duration(path: GeometricPath, jerk: np.ndarray, velocity: np.ndarray
     return float(np.max(np.maximum.reduce([np.cbrt(32.0 * d / jerk), 2.0 * np.sqrt(d / acceleration), d / velocity])))
 
 
-def _size(path: GeometricPath, jv: np.ndarray, lim: _Limits, opts: JerkOptions) -> None:
+def _size(path: GeometricPath, jv: np.ndarray, lim: LimitsInForce, opts: JerkOptions) -> None:
     """Refuse (exit 2) a jerk limit whose implied duration needs more verified samples than the cap."""
     T = minimum_duration(path, jv, lim.velocity, lim.acceleration)
     check_count(f"verified samples of the jerk-limited motion (at least {T:.3g} s at {opts.check_rate:g} Hz)",
@@ -436,7 +436,7 @@ def _law_times(law: TimeLaw, s_target: np.ndarray) -> np.ndarray:
 class _Solver:
     """The NLP on one path (module docstring): guess, solve, re-grid, solve, tighten locally where exceeded."""
 
-    def __init__(self, robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, opts: JerkOptions,
+    def __init__(self, robot: Robot, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, opts: JerkOptions,
                  segment: int) -> None:  # fmt: skip
         self.robot, self.path, self.lim, self.jv, self.opts, self.segment = robot, path, lim, jv, opts, segment
         self.knots = np.unique(np.clip(path.knots(), 0.0, 1.0))[1:-1]
@@ -516,7 +516,7 @@ class _Solver:
         return True
 
 
-def _guess(robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, n: int) -> JerkLaw:
+def _guess(robot: Robot, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, n: int) -> JerkLaw:
     """A feasible law on n equal intervals: a double-S in s, slowed as a whole to fit the limits.
 
     The path jerk is +c, 0, -c, 0, -c, 0, +c over seven equal phases; the law is then slowed until every
@@ -540,7 +540,7 @@ def _check_times(law: JerkLaw, t_start: float, rate: float) -> np.ndarray:
     return np.clip(t, 0.0, T)
 
 
-def _ratios_at(robot: Robot, motion: Motion, t: np.ndarray, lim: _Limits, jv: np.ndarray) -> np.ndarray:
+def _ratios_at(robot: Robot, motion: Motion, t: np.ndarray, lim: LimitsInForce, jv: np.ndarray) -> np.ndarray:
     """(len(t), 4 dof): |velocity|, |acceleration|, |jerk|, |torque| over their limits at local times t."""
     r = state_ratios(robot, lim, motion_states(motion, t), jv)
     d = len(lim.velocity)
@@ -561,7 +561,7 @@ def _interval_worst(law: JerkLaw, t: np.ndarray, ratios: np.ndarray) -> np.ndarr
 
 
 def _time_path(
-    robot: Robot, path: GeometricPath, lim: _Limits, jv: np.ndarray, opts: JerkOptions, segment: int
+    robot: Robot, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, opts: JerkOptions, segment: int
 ) -> tuple[JerkLaw, int]:
     """(law, NLPs) of one path before the final correction (module docstring)."""
     solver = _Solver(robot, path, lim, jv, opts, segment)
@@ -582,7 +582,7 @@ def _time_path(
 
 
 def _finish(
-    robot: Robot, path: GeometricPath, law: JerkLaw, lim: _Limits, jv: np.ndarray, t_start: float, rate: float,
+    robot: Robot, path: GeometricPath, law: JerkLaw, lim: LimitsInForce, jv: np.ndarray, t_start: float, rate: float,
     segment: int, k: float | None = None,
 ) -> tuple[Motion, JerkRatios, float]:
     """(motion, ratios, k): ``law`` slowed k times until its worst ratio on the ``rate`` grid and nodes is 1.
@@ -698,7 +698,7 @@ def time_optimal_jerk(
     """
     paths = path_segments(robot, path)
     opts = JerkOptions() if options is None else options
-    lim = _limits(robot, limits, None, torque)
+    lim = limits_in_force(robot, limits, None, torque)
     jv = jerk_vector(jerk, len(lim.velocity))
     for p in paths:
         _size(p, jv, lim, opts)

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import _limit_vector
+from .._checks import as_limit_vector
 from .._typing import ArrayLike
 from ..errors import InfeasibleError, ParameterError
 from ..model import Robot
@@ -122,8 +122,8 @@ def jog_to_edge(
     q0 = robot.check_q(q0)
     # the stretch below needs every limit: an unknown one (NaN: a URDF file has no acceleration limits)
     # is refused here, never dropped by max()
-    _limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
-    _limit_vector("acceleration", robot.limits.acceleration, "rad/s^2 or m/s^2")
+    as_limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
+    as_limit_vector("acceleration", robot.limits.acceleration, "rad/s^2 or m/s^2")
     if not (math.isfinite(margin) and margin >= 0):
         raise ParameterError("margin", margin, "must be a finite number >= 0", "m")
     d = np.asarray(direction, dtype=float)

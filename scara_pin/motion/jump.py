@@ -96,9 +96,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import _positive, _vector
+from .._checks import as_positive, as_vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..kinematics.validate import _pose_error
+from ..kinematics.validate import pose_error
 from ..limits import MAX_SAMPLES, check_count
 from ..summary import Summarized
 from ..units import SI, DisplayUnits
@@ -111,8 +111,8 @@ from .verify import (
     VERIFY_RATE,
     Clearance,
     LimitViolation,
-    _limits,
     jerk_vector,
+    limits_in_force,
     state_ratios,
     static_load,
     static_overload,
@@ -231,7 +231,7 @@ class JumpOptions:
                                       for v in n):  # fmt: skip
                 raise ParameterError("intervals", self.intervals, "must be 3 integers in [1, 500]")
             object.__setattr__(self, "intervals", tuple(int(v) for v in n))
-        _positive("tolerance", self.tolerance)
+        as_positive("tolerance", self.tolerance)
         for name in ("max_iterations", "refinements", "avoid_iterations"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v <= 100_000:
@@ -801,14 +801,14 @@ def jump_move(
     options = JumpOptions() if options is None else options
     if robot.dof != 4:
         raise InvalidInputError(f"a jump move needs a wrist (4 joints); robot {robot.name!r} has {robot.dof}")
-    A, B = _vector("pose_from", pose_from), _vector("pose_to", pose_to)
-    rise = _positive("rise", rise, "m")
-    R = _positive("clearance_radius", clearance_radius, "m")
+    A, B = as_vector("pose_from", pose_from), as_vector("pose_to", pose_to)
+    rise = as_positive("rise", rise, "m")
+    R = as_positive("clearance_radius", clearance_radius, "m")
     ceiling = None
     if max_height is not None:
-        ceiling = float(_vector("max_height", [max_height], 1)[0])
+        ceiling = float(as_vector("max_height", [max_height], 1)[0])
     payload = as_payload(payload)
-    lim = _limits(robot, limits, tool_speed, torque)
+    lim = limits_in_force(robot, limits, tool_speed, torque)
     jv = None if jerk is None else jerk_vector(jerk)
     D = float(np.hypot(*(B[:2] - A[:2])))
     if D <= 2.0 * R:
@@ -902,7 +902,7 @@ def _solve_in_cell(prob: _Problem, options: JumpOptions, scene: Scene, ceiling: 
 def _given(robot: Robot, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarray:
     """A configuration given for a pose, checked: FK within ENDPOINT_TOL of the pose, inside the limits."""
     qq = np.array(robot.check_q(q), dtype=float)
-    err = _pose_error(robot, qq, pose)
+    err = pose_error(robot, qq, pose)
     if err > ENDPOINT_TOL:
         raise InvalidInputError(f"{name} {np.round(qq, 9).tolist()} puts the tool {err:.3g} m (or rad) from its pose")
     outside = robot.outside_limits(qq)
@@ -1301,7 +1301,7 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
     piece = traj.pieces[0]
     if not isinstance(piece, PolynomialPiece):  # pragma: no cover - _solve makes them
         raise InvalidInputError("the verification takes a polynomial piece")
-    lim = _limits(prob.base, prob.limits, prob.tool_speed, prob.effort is not None)
+    lim = limits_in_force(prob.base, prob.limits, prob.tool_speed, prob.effort is not None)
     try:
         found = verify(prob.base, traj, limits=prob.limits, jerk=prob.jerk, torque=prob.effort is not None,
                        payload=prob.payload, tool_speed=prob.tool_speed, q_start=prob.qA, q_end=prob.qB,
@@ -1349,7 +1349,7 @@ def _verify(prob: _Problem, traj: Trajectory) -> _Check:
         raise JumpError("VerificationFailed", f"{prob.robot.joint_names[j]} leaves its range at t = "
                         f"{float(t[i]):.6g} s (q = {float(q[i, j]):.9g})")  # fmt: skip
     for end, pose, name in ((0, prob.A, "pose_from"), (-1, prob.B, "pose_to")):
-        err = _pose_error(prob.robot, traj.sample(0.0 if end == 0 else T)[0], pose)
+        err = pose_error(prob.robot, traj.sample(0.0 if end == 0 else T)[0], pose)
         if err > ENDPOINT_TOL:
             raise JumpError("VerificationFailed", f"the move misses {name} by {err:.3g} m")
     u = prob.B[:2] - prob.A[:2]

@@ -57,7 +57,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._checks import _limit_vector, _vector
+from .._checks import as_limit_vector, as_vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, ScaraError, UrdfError
 
 if TYPE_CHECKING:
@@ -286,7 +286,7 @@ def pose_ik(robot: Robot, target: object, reference: np.ndarray, branch: str = "
     numeric solver (:func:`scara_pin.kinematics.numeric.solve_numeric`) started at ``reference``. A refusal
     is an answer (``q`` None, its status code and reason), never an exception.
     """
-    pose = _vector("pose", target)
+    pose = as_vector("pose", target)
     try:
         return PoseAnswer(np.asarray(robot.ik_nearest(pose, reference, branch=branch), dtype=float),
                           Solver.CLOSED_FORM)  # fmt: skip
@@ -611,7 +611,7 @@ def nominal_rate(robot: Robot, motion: JogMotion, override: float) -> float:
     """The hold-to-jog rate [m/s or rad/s] before the limits of the period (see the module docstring)."""
     override = _override(override)
     if motion.joint is not None:
-        velocity = _limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
+        velocity = as_limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
         return override * float(velocity[motion.joint])
     return override * (MANUAL_TURN_RATE if motion.axis is JogAxis.YAW else MANUAL_SPEED)
 
@@ -630,7 +630,7 @@ def hold_advance(
     q0 = robot.check_q(q)
     if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
         raise ParameterError("control period", dt, "must be a finite number > 0", "s")
-    velocity = _limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
+    velocity = as_limit_vector("velocity", robot.limits.velocity, "rad/s or m/s")
     override = _override(override)
     length = nominal_rate(robot, motion, override) * dt
     if ws is None and motion.axis not in (None, JogAxis.YAW) and robot.kind == "scara":

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .._checks import _limit_vector, _positive, _rows, _vector
+from .._checks import as_limit_vector, as_positive, as_rows, as_vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..kinematics.scara_batch import solve_batch
 from ..kinematics.scara_geometry import IKStatus, branch_of
@@ -151,8 +151,8 @@ class JointLine(GeometricPath):
     q1: np.ndarray
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "q0", _vector("q0", self.q0, None))
-        object.__setattr__(self, "q1", _vector("q1", self.q1, len(self.q0)))
+        object.__setattr__(self, "q0", as_vector("q0", self.q0, None))
+        object.__setattr__(self, "q1", as_vector("q1", self.q1, len(self.q0)))
 
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
         s = np.asarray(s, dtype=float).reshape(-1, 1)
@@ -182,8 +182,8 @@ class JointSpline(GeometricPath):
     def __post_init__(self) -> None:
         from scipy.interpolate import CubicSpline
 
-        W = _rows("waypoints", self.waypoints)
-        w = _limit_vector("weight", self.weights, "")
+        W = as_rows("waypoints", self.waypoints)
+        w = as_limit_vector("weight", self.weights, "")
         chord = np.max(np.abs(np.diff(W, axis=0)) * w, axis=1)
         if not (chord > 0).all():
             k = int(np.argmin(chord))
@@ -218,7 +218,7 @@ def joint_path(robot: Robot, waypoints: Sequence[ArrayLike] | np.ndarray) -> Joi
         ParameterError: a waypoint is not 4 finite numbers, is outside the joint limits, or all are equal.
         PathError: the spline leaves the joint limits between waypoints (s and q where it does).
     """
-    W = _rows("waypoints", waypoints)
+    W = as_rows("waypoints", waypoints)
     for k, q in enumerate(W):
         robot.check_q(q)
         out = robot.outside_limits(q, tol=1e-10)
@@ -581,15 +581,15 @@ def cartesian_path(
         PathError: the line leaves the workspace or the joint limits, crosses the singularity, would
             make a joint jump (J4 at its limit), or does not end at ``end``; with ``s`` and the pose.
     """
-    P = _rows("poses", poses)
+    P = as_rows("poses", poses)
     if branch is not None and branch not in ("right", "left"):
         raise InvalidInputError(f"branch {branch!r} must be 'right' or 'left'")
     if n is not None and (max_step is not None or max_yaw_step is not None):
         raise InvalidInputError("give either n (points per segment) or max_step/max_yaw_step, not both")
     if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2):
         raise ParameterError("n", n, "must be an integer >= 2 (points per segment, ends included)")
-    step = _positive("max_step", _DEFAULT_STEP if max_step is None else max_step, "m")
-    yaw_step = _positive("max_yaw_step", _DEFAULT_YAW_STEP if max_yaw_step is None else max_yaw_step, "rad")
+    step = as_positive("max_step", _DEFAULT_STEP if max_step is None else max_step, "m")
+    yaw_step = as_positive("max_yaw_step", _DEFAULT_YAW_STEP if max_yaw_step is None else max_yaw_step, "rad")
     geo = robot.kinematics.geometry
     if start is not None:
         q0 = robot.check_q(start).astype(float)

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from .._checks import _vector
+from .._checks import as_vector
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..summary import Summarized
 from . import trajectory as tr
@@ -62,7 +62,7 @@ class Method(enum.Enum):
 
 
 def _optional_vector(name: str, value: object) -> np.ndarray | None:
-    return None if value is None else _vector(name, value, None)  # one per joint (4, or 3 without a wrist)
+    return None if value is None else as_vector(name, value, None)  # one per joint (4, or 3 without a wrist)
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,7 +121,7 @@ class MotionRequest:
             from .payload import as_payload
 
             object.__setattr__(self, "payload", as_payload(self.payload))
-        object.__setattr__(self, "vias", tuple(_vector(f"via {i + 1}", v, None) for i, v in enumerate(self.vias)))
+        object.__setattr__(self, "vias", tuple(as_vector(f"via {i + 1}", v, None) for i, v in enumerate(self.vias)))
         if (self.start_q is None) == (self.start_pose is None):
             raise InvalidInputError("a move needs exactly one start: start_q or start_pose")
         if (self.end_q is None) == (self.end_pose is None):

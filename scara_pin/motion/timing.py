@@ -57,15 +57,15 @@ from .trajectory import (
     Motion,
     ProfileLaw,
     Trajectory,
-    _positive,
+    as_positive,
 )
 from .verify import (
+    LimitsInForce,
     Quantity,
-    _Limits,
-    _limits,
-    _tool_rows,
+    limits_in_force,
     static_overload,
     time_scale,
+    tool_speeds,
     torque_coefficients,
     verify,
 )
@@ -138,7 +138,7 @@ class TimingOptions:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low or v > 1_000_000:
                 raise ParameterError(name, v, f"must be an integer in [{low}, 1000000]")
-        _positive("check_rate", self.check_rate, "Hz")
+        as_positive("check_rate", self.check_rate, "Hz")
 
 
 @dataclass(frozen=True)
@@ -241,7 +241,7 @@ def parameterize(
         TimingError: toppra found no parameterisation (return code and likely cause).
     """
     opts = TimingOptions() if options is None else options
-    lim = _limits(robot, limits, tool_speed, torque)
+    lim = limits_in_force(robot, limits, tool_speed, torque)
     paths = path_segments(robot, path)
     motions: list[Motion] = []
     t_toppra, ratios, npts, t_start = 0.0, [], 0, 0.0
@@ -282,7 +282,7 @@ def _grid(path: GeometricPath, n: int) -> np.ndarray:
 
 
 def _time_segment(
-    robot: Robot, path: GeometricPath, lim: _Limits, opts: TimingOptions, segment: int, t_start: float
+    robot: Robot, path: GeometricPath, lim: LimitsInForce, opts: TimingOptions, segment: int, t_start: float
 ) -> tuple[Motion, float, LimitRatios, int]:
     """Time one path segment that starts at ``t_start`` in the whole trajectory (for its 1 kHz grid)."""
     import toppra
@@ -313,7 +313,7 @@ def _time_segment(
     with np.errstate(divide="ignore"):
         B = np.min(v**2 / dq**2, axis=1)
         if lim.tool_speed is not None:
-            B = np.minimum(B, lim.tool_speed**2 / _tool_rows(robot, q, dq) ** 2)
+            B = np.minimum(B, lim.tool_speed**2 / tool_speeds(robot, q, dq) ** 2)
     B = np.minimum(B, _X_CAP)
     blocks_a = [tw.reshape(rows, m + 1)]
     blocks_b = [np.ones((rows, m + 1))]
@@ -406,7 +406,7 @@ def _diagnose(
     B: np.ndarray,
     q: np.ndarray,
     g_static: np.ndarray | None,
-    lim: _Limits,
+    lim: LimitsInForce,
     m: int,
     segment: int,
     data: Any,
@@ -463,7 +463,7 @@ def _check(
     robot: Robot,
     motion: Motion,
     law: ProfileLaw,
-    lim: _Limits,
+    lim: LimitsInForce,
     opts: TimingOptions,
     t_start: float | None,
     extremes: tuple[np.ndarray, np.ndarray] | None = None,

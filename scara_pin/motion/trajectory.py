@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import _limit_vector, _positive, _vector
+from .._checks import as_limit_vector, as_positive, as_vector
 from ..description import JOINT_COUNTS, JOINT_NAMES
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import write_text_atomic
@@ -115,7 +115,7 @@ class TimeLaw(abc.ABC):
 
     def scaled(self, k: float) -> TimeLaw:
         """The same law ``k`` times slower: s_k(t) = s(t / k), so sd / k and sdd / k^2."""
-        return _ScaledLaw(self, _positive("k", k))
+        return _ScaledLaw(self, as_positive("k", k))
 
     def peaks(self) -> tuple[float, float] | None:
         """The exact maxima (max sd, max |sdd|) over [0, duration] in closed form, or None if unknown.
@@ -163,7 +163,7 @@ class QuinticLaw(TimeLaw):
     def __post_init__(self) -> None:
         from scipy.interpolate import BPoly
 
-        T = _positive("duration", self.duration, "s")
+        T = as_positive("duration", self.duration, "s")
         object.__setattr__(self, "duration", T)
         object.__setattr__(self, "_poly", BPoly.from_derivatives([0.0, T], [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]))
 
@@ -196,8 +196,8 @@ class TrapezoidLaw(TimeLaw):
     t_acc: float = field(init=False)
 
     def __post_init__(self) -> None:
-        V = _positive("velocity", self.velocity, "1/s")
-        A = _positive("acceleration", self.acceleration, "1/s^2")
+        V = as_positive("velocity", self.velocity, "1/s")
+        A = as_positive("acceleration", self.acceleration, "1/s^2")
         peak = min(V, math.sqrt(A))
         t_acc = peak / A
         coast = max(1.0 / peak - peak / A, 0.0)
@@ -212,8 +212,8 @@ class TrapezoidLaw(TimeLaw):
         Raises:
             InfeasibleError: T < 2 / sqrt(A) (even a triangle at A is slower).
         """
-        A = _positive("acceleration", acceleration, "1/s^2")
-        T = _positive("duration", duration, "s")
+        A = as_positive("acceleration", acceleration, "1/s^2")
+        T = as_positive("duration", duration, "s")
         disc = A * A * T * T - 4.0 * A
         if disc < -1e-12 * A * A * T * T:
             raise InfeasibleError(f"duration {T:.9g} s is shorter than the fastest move {2 / math.sqrt(A):.9g} s")
@@ -291,7 +291,7 @@ class ProfileLaw(TimeLaw):
 
     def scaled(self, k: float) -> ProfileLaw:
         """The same profile ``k`` times slower (sd / k; hence times * k and u / k^2), exactly."""
-        return ProfileLaw(self.s, self.sd / _positive("k", k))
+        return ProfileLaw(self.s, self.sd / as_positive("k", k))
 
 
 # ---------------------------------------------------------------------------------------------- motions
@@ -544,7 +544,7 @@ class Trajectory(Summarized):
         end, which lies up to one sample period 1 / rate past T: a period longer than both the motion and
         1 s is refused (``rate = 1e-50`` would put the last sample at t = 1e50 s).
         """
-        rate = _positive("rate", rate, "Hz")
+        rate = as_positive("rate", rate, "Hz")
         if self.duration > 0 and 1.0 / rate > max(self.duration, 1.0):  # then the grid is [0, 1 / rate]
             raise InvalidInputError(f"a rate of {rate:.6g} Hz samples every {1.0 / rate:.6g} s, longer than the "
                                     f"{self.duration:.6g} s motion and 1 s: its last sample would be at "
@@ -563,7 +563,7 @@ class Trajectory(Summarized):
 
     def scaled(self, k: float) -> Trajectory:
         """The same trajectory ``k`` times slower (velocities / k, accelerations / k^2)."""
-        k = _positive("k", k)
+        k = as_positive("k", k)
         pieces = []
         for p in self.pieces:
             if not isinstance(p, Motion):
@@ -612,8 +612,8 @@ class Trajectory(Summarized):
             delays: per-axis command latency [s], >= 0 (default: none).
             motor: conversion to integer motor steps (optional).
         """
-        rate = _positive("rate", rate, "Hz")
-        d = np.zeros(self.dof) if delays is None else _vector("delays", delays, self.dof)
+        rate = as_positive("rate", rate, "Hz")
+        d = np.zeros(self.dof) if delays is None else as_vector("delays", delays, self.dof)
         if (d < 0).any():
             raise ParameterError("delays", d.tolist(), "must be >= 0", "s")
         check_count(f"setpoints ({float(d.max()) + self.duration:.6g} s at {rate:.6g} Hz)",
@@ -698,7 +698,7 @@ class MotorUnits:
     counts_per_unit: tuple[float, ...]
 
     def __post_init__(self) -> None:
-        arr = _limit_vector("counts_per_unit", self.counts_per_unit, "steps per unit")
+        arr = as_limit_vector("counts_per_unit", self.counts_per_unit, "steps per unit")
         object.__setattr__(self, "counts_per_unit", tuple(float(v) for v in arr))
 
     @classmethod
@@ -720,9 +720,9 @@ class MotorUnits:
             screw_lead: [m] travel per screw turn.
             prismatic: index of the prismatic joint in q.
         """
-        g = _limit_vector("gear_ratio", gear_ratio, "")
-        spr = _limit_vector("steps_per_revolution", steps_per_revolution, "")
-        lead = _positive("screw_lead", screw_lead, "m")
+        g = as_limit_vector("gear_ratio", gear_ratio, "")
+        spr = as_limit_vector("steps_per_revolution", steps_per_revolution, "")
+        lead = as_positive("screw_lead", screw_lead, "m")
         if prismatic not in range(4):
             raise ParameterError("prismatic", prismatic, "must be a joint index 0..3")
         cpu = g * spr / (2.0 * math.pi)
@@ -793,15 +793,16 @@ def quintic(q0: ArrayLike, q1: ArrayLike, duration: float) -> Trajectory:
         q1: end [rad, m].
         duration: T [s] > 0.
     """
-    return Trajectory((Motion(JointLine(_vector("q0", q0, None), _vector("q1", q1, len(q0))), QuinticLaw(duration)),))
+    line = JointLine(as_vector("q0", q0, None), as_vector("q1", q1, len(q0)))
+    return Trajectory((Motion(line, QuinticLaw(duration)),))
 
 
 def _line_rates(
     q0: ArrayLike, q1: ArrayLike, velocity: ArrayLike, acceleration: ArrayLike
 ) -> tuple[JointLine, float, float]:
-    line = JointLine(_vector("q0", q0, None), _vector("q1", q1, len(q0)))
-    v = _limit_vector("velocity", velocity, "rad/s or m/s")
-    a = _limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
+    line = JointLine(as_vector("q0", q0, None), as_vector("q1", q1, len(q0)))
+    v = as_limit_vector("velocity", velocity, "rad/s or m/s")
+    a = as_limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
     dq = np.abs(line.q1 - line.q0)
     moving = dq > 0
     if not moving.any():
@@ -819,9 +820,9 @@ def quintic_min_duration(
     The peaks 1.875 |dq| / T and (10 / sqrt(3)) |dq| / T^2 reach a limit:
     T = max_i max(1.875 |dq_i| / v_i, sqrt(10 / sqrt(3) |dq_i| / a_i)).
     """
-    line = JointLine(_vector("q0", q0, None), _vector("q1", q1, len(q0)))
-    v = _limit_vector("velocity", velocity, "rad/s or m/s")
-    a = _limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
+    line = JointLine(as_vector("q0", q0, None), as_vector("q1", q1, len(q0)))
+    v = as_limit_vector("velocity", velocity, "rad/s or m/s")
+    a = as_limit_vector("acceleration", acceleration, "rad/s^2 or m/s^2")
     dq = np.abs(line.q1 - line.q0)
     return float(max(np.max(_QUINTIC_PEAK_SD * dq / v), np.max(np.sqrt(_QUINTIC_PEAK_SDD * dq / a))))
 
@@ -866,7 +867,7 @@ def trapezoidal(
     if duration is None:
         law = TrapezoidLaw(V, A)
     else:
-        T = _positive("duration", duration, "s")
+        T = as_positive("duration", duration, "s")
         T_opt = line_optimal_duration(q0, q1, velocity, acceleration)
         if T < T_opt * (1 - 1e-12):
             raise InfeasibleError(f"duration {T:.9g} s is shorter than the fastest synchronised move {T_opt:.9g} s")
@@ -880,7 +881,7 @@ def timed(path: GeometricPath | CartesianPath, duration: float) -> Trajectory:
     A Cartesian path with via points stops at each: its segments share ``duration`` in proportion to
     their joint-space lengths weighted by 1 / vmax (so all peak at comparable speeds).
     """
-    T = _positive("duration", duration, "s")
+    T = as_positive("duration", duration, "s")
     if isinstance(path, GeometricPath):
         return Trajectory((Motion(path, QuinticLaw(T)),))
     if not isinstance(path, CartesianPath):

@@ -56,7 +56,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple, cast
 import numpy as np
 import pinocchio as pin
 
-from .._checks import _limit_vector, _positive
+from .._checks import as_limit_vector, as_positive
 from ..description import JOINT_NAMES, JointLimits
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..limits import MAX_SAMPLES, check_count
@@ -319,22 +319,22 @@ class Verification(Summarized):
 
 # ---------------------------------------------------------------------------------------------- limits
 @dataclass(frozen=True)
-class _Limits:
+class LimitsInForce:
     velocity: np.ndarray
     acceleration: np.ndarray
     effort: np.ndarray | None
     tool_speed: float | None
 
 
-def _limits(robot: Robot, limits: JointLimits | None, tool_speed: float | None, torque: bool) -> _Limits:
+def limits_in_force(robot: Robot, limits: JointLimits | None, tool_speed: float | None, torque: bool) -> LimitsInForce:
     """The limits in force, each refused when NaN, zero, negative or infinite."""
     lim = robot.limits if limits is None else limits
     names = robot.joint_names
-    v = _limit_vector("velocity", lim.velocity, "rad/s or m/s", names)
-    a = _limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2", names)
-    e = _limit_vector("effort", lim.effort, "N m or N", names) if torque else None
-    vt = None if tool_speed is None else _positive("tool_speed", tool_speed, "m/s")
-    return _Limits(v, a, e, vt)
+    v = as_limit_vector("velocity", lim.velocity, "rad/s or m/s", names)
+    a = as_limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2", names)
+    e = as_limit_vector("effort", lim.effort, "N m or N", names) if torque else None
+    vt = None if tool_speed is None else as_positive("tool_speed", tool_speed, "m/s")
+    return LimitsInForce(v, a, e, vt)
 
 
 def jerk_vector(jerk: float | ArrayLike, dof: int = 4) -> np.ndarray:
@@ -354,12 +354,12 @@ def jerk_vector(jerk: float | ArrayLike, dof: int = 4) -> np.ndarray:
     return jv
 
 
-def _tool_rows(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+def tool_speeds(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
     """|J_xyz(q) dq| per row."""
     return np.array([np.linalg.norm(robot.task_jacobian(q[k])[:3] @ dq[k]) for k in range(len(q))])
 
 
-def _rnea(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+def joint_torques(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
     """Joint efforts (n, dof) by Pinocchio's RNEA, gravity included, row by row."""
     model = robot.model
     data = model.createData()
@@ -378,7 +378,7 @@ class JointStates(NamedTuple):
 
 
 def state_ratios(
-    robot: Robot, lim: _Limits, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
+    robot: Robot, lim: LimitsInForce, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
 ) -> dict[Quantity, np.ndarray]:
     """|value| / limit per sample (rows) and joint (columns; one column for the tool speed), per quantity.
 
@@ -389,17 +389,17 @@ def state_ratios(
 
 
 def _ratios(
-    robot: Robot, lim: _Limits, states: JointStates, jerk: np.ndarray | None
+    robot: Robot, lim: LimitsInForce, states: JointStates, jerk: np.ndarray | None
 ) -> tuple[dict[Quantity, np.ndarray], np.ndarray | None]:
     """(:func:`state_ratios`, the efforts or None)."""
     q, qd, qdd, qddd = states
     out = {Quantity.VELOCITY: np.abs(qd) / lim.velocity, Quantity.ACCELERATION: np.abs(qdd) / lim.acceleration}
     tau = None
     if lim.effort is not None:
-        tau = _rnea(robot, q, qd, qdd)
+        tau = joint_torques(robot, q, qd, qdd)
         out[Quantity.TORQUE] = np.abs(tau) / lim.effort
     if lim.tool_speed is not None:
-        out[Quantity.TOOL_SPEED] = (_tool_rows(robot, q, qd) / lim.tool_speed)[:, None]
+        out[Quantity.TOOL_SPEED] = (tool_speeds(robot, q, qd) / lim.tool_speed)[:, None]
     if qddd is not None and jerk is not None:
         out[Quantity.JERK] = np.abs(qddd) / jerk
     return out, tau
@@ -449,7 +449,7 @@ def static_overload(
 def static_load(robot: Robot, q: np.ndarray) -> np.ndarray:
     """g(q) (n, dof): the joint efforts that hold the robot still (RNEA at rest, gravity and payload)."""
     zero = np.zeros_like(q)
-    return _rnea(robot, q, zero, zero)
+    return joint_torques(robot, q, zero, zero)
 
 
 def static_payload(robot: Robot, q: np.ndarray, limits: JointLimits | None = None) -> float:
@@ -486,11 +486,11 @@ def torque_coefficients(robot: Robot, q: np.ndarray, d1: np.ndarray, d2: np.ndar
     """
     zero = np.zeros_like(d1)
     g = static_load(robot, q)
-    return _rnea(robot, q, zero, d1) - g, _rnea(robot, q, d1, d2) - g, g
+    return joint_torques(robot, q, zero, d1) - g, joint_torques(robot, q, d1, d2) - g, g
 
 
 def time_scale(
-    robot: Robot, lim: _Limits, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
+    robot: Robot, lim: LimitsInForce, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
 ) -> tuple[float, dict[Quantity, float]]:
     """(k, worst ratios): the time scale k that brings the worst ratio of these states to exactly 1.
 
@@ -679,8 +679,8 @@ def verify(
         ParameterError: a limit is NaN, zero, negative or not finite; a bad rate or jerk.
         InvalidInputError: the samples would exceed :data:`~scara_pin.limits.MAX_SAMPLES`.
     """
-    rate = _positive("rate", rate, "Hz")
-    lim = _limits(robot, limits, tool_speed, torque)
+    rate = as_positive("rate", rate, "Hz")
+    lim = limits_in_force(robot, limits, tool_speed, torque)
     dof = trajectory.dof
     jv = None if jerk is None else jerk_vector(jerk, dof)
     loaded = with_payload(robot, payload) if torque else robot

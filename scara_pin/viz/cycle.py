@@ -65,7 +65,7 @@ def plot_cycle(
     """
     from ..motion.cycle import CycleResult
     from ..motion.payload import with_payload
-    from ..motion.verify import _rnea
+    from ..motion.verify import joint_torques
 
     move = result.move if isinstance(result, CycleResult) else result
     lim = robot.limits if limits is None else limits
@@ -111,7 +111,7 @@ def plot_cycle(
     if move.jerk is not None:
         quantities.append(("|qddd| / jmax", np.abs(_jerk(traj, t)) / np.array(move.jerk)))
     # the cycle always respects the effort limits (a robot's are always known): the loaded arm's efforts, RNEA
-    tau = _rnea(with_payload(robot, move.payload), q, qd, qdd)
+    tau = joint_torques(with_payload(robot, move.payload), q, qd, qdd)
     quantities.append((TORQUE_LABEL, np.abs(tau) / np.array(lim.effort)))
     for k, (name, ratio) in enumerate(quantities):
         ax = fig.add_subplot(grid[1 + k, :])

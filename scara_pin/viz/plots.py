@@ -196,9 +196,9 @@ def plot_trajectory(
         ("acceleration", qdd, None if limits is None else [(-a, a) for a in limits.acceleration], 2),
     ]
     if torque and robot is not None:
-        from ..motion.verify import _rnea
+        from ..motion.verify import joint_torques
 
-        tau = _rnea(robot, q, qd, qdd)
+        tau = joint_torques(robot, q, qd, qdd)
         series.append(("torque", tau, None if limits is None else [(-e, e) for e in limits.effort], -1))
     cols = len(series) + (1 if robot is not None else 0)
     fig = new_figure(3.6 * len(series) + (4.6 if robot is not None else 0.0), 1.0 + 2.1 * dof)
@@ -235,7 +235,7 @@ def plot_trajectory(
 def _tool_panels(fig: Figure, grid: Any, robot: Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
                  units: DisplayUnits, tool_speed: float | None) -> None:  # fmt: skip
     """The tool path in plan view (with a SCARA's reach circles) and side view, and the tool speed."""
-    from ..motion.timing import _tool_rows
+    from ..motion.timing import tool_speeds
 
     L, n = units.scale("length"), units.name("length")
     P = np.array([robot.tool_pose(x) for x in q])
@@ -266,7 +266,7 @@ def _tool_panels(fig: Figure, grid: Any, robot: Robot, t: np.ndarray, q: np.ndar
     side.set_title("tool path, side view", fontsize=10)
     side.grid(True, alpha=0.3)
     speed = fig.add_subplot(grid[2])
-    v = _tool_rows(robot, q, qd) * L
+    v = tool_speeds(robot, q, qd) * L
     speed.plot(t, v, color="black", linewidth=1.6)
     if tool_speed is not None:
         draw_limits(speed, (tool_speed,), v, "black", L, rate_unit(n, 1))
