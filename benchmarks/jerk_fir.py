@@ -56,7 +56,7 @@ from scara_pin.motion.verify import (
 if TYPE_CHECKING:
     from scara_pin._typing import ArrayLike
     from scara_pin.description import JointLimits
-    from scara_pin.model import Robot
+    from scara_pin.model import RobotModel as Robot
 
 __all__ = ["FilteredLaw", "JerkRatios", "fir_jerk_limited"]
 

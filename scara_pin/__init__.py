@@ -30,8 +30,8 @@ from .errors import (
     UnknownRobotError,
     UrdfError,
 )
-from .model import Kinematics, Robot, pose_from_placement
-from .robots import kinematics_for, load_robot, load_urdf, robot_from_urdf
+from .model import Kinematics, RobotModel, pose_from_placement
+from .robots import Robot, kinematics_for, load_robot, load_urdf, robot_from_urdf
 
 if TYPE_CHECKING:
     from .cell import Cell
@@ -47,6 +47,7 @@ __all__ = [
     "NoSolutionError",
     "ParameterError",
     "Robot",
+    "RobotModel",
     "RobotParameters",
     "ScaraError",
     "UnknownRobotError",

@@ -1,6 +1,6 @@
 """The robot's chain in a URDF tree: the joints of ``q``, the geared ones that follow them, the locked ones.
 
-A URDF may hold more joints than the arm's degrees of freedom. :class:`scara_pin.model.Robot` keeps in ``q``
+A URDF may hold more joints than the arm's degrees of freedom. :class:`scara_pin.model.RobotModel` keeps in ``q``
 only the joints that move the tool freely:
 
 - **geared joints** (URDF ``<mimic joint="J" multiplier="m" offset="c"/>``): Pinocchio loads them as mimic

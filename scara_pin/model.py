@@ -20,11 +20,10 @@ from __future__ import annotations
 import enum
 import logging
 import math
-import os
 from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, Self
 
 import numpy as np
 import pinocchio as pin
@@ -37,12 +36,11 @@ from .urdf_rules import choose_frames, edges_of, read_tree, resolve_mimics
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
-    from .cell import Cell, Distances
     from .chain import GearedJoint, JointAxis, LockedJoint
     from .description.packages import PackagePath
     from .kinematics.results import BatchIKResult, IKResult
 
-__all__ = ["Kinematics", "Robot", "pose_from_placement"]
+__all__ = ["Kinematics", "KinematicsFactory", "RobotModel", "pose_from_placement"]
 
 _Q_MAX2 = (0.5 * MAGNITUDE_MAX) ** 2
 """The largest sum of squares of q that the cheap input test waves through (NaN and inf never pass)."""
@@ -84,7 +82,7 @@ class Kinematics(Protocol):
         ...
 
 
-KinematicsFactory = Callable[["Robot"], Kinematics]
+KinematicsFactory = Callable[["RobotModel"], Kinematics]
 
 
 def _rerooted(model: pin.Model, baseMo: pin.SE3) -> pin.Model:
@@ -227,7 +225,7 @@ def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
     return tuple(out)
 
 
-class Robot:
+class RobotModel:
     """A 4-joint robot (SCARA or palletizer) in Pinocchio, with its frames and limits.
 
     Continuous joints (URDF ``continuous``; Pinocchio stores them as (cos q, sin q), nq = 2) are accepted:
@@ -347,8 +345,6 @@ class Robot:
             + (" ..." if len(off_chain) > 12 else "") + " (--lock JOINT=VALUE sets them, rad or m)"
         )  # fmt: skip
         self._package_path = package_path
-        self.model = model
-        self.data = model.createData()
         self.urdf = urdf
         self.name = model.name
         self.parameters = parameters
@@ -371,15 +367,27 @@ class Robot:
                 effort=tuple(float(v) for v in model.effortLimit),
                 validate=False,
             )
+        self.continuous = continuous
+        self.dof = len(continuous)
+        self.has_continuous = any(continuous)
+        self._kinematics_factory = kinematics
+        self._attach(model)
+        self.kind = parameters.kind if parameters is not None else _urdf_kind(self)
+
+    def _attach(self, model: pin.Model) -> None:
+        """Build what the robot computes with from ``model``: its data, the re-rooted copy, the per-call paths."""
+        self.model = model
+        self.data = model.createData()
         # base is fixed to the root: its placement never changes; keep its inverse for the fast path.
         pin.framesForwardKinematics(model, self.data, pin.neutral(model))
         # A private copy of the model re-rooted at the base frame: its oMf are placements in `base` and its
         # LOCAL_WORLD_ALIGNED Jacobians are in base axes, so the hot paths need no extra products.
         self._base_model = _rerooted(model, self.data.oMf[self.base_id].inverse())
         self._base_data = self._base_model.createData()
-        self.continuous = continuous
-        self.dof = len(continuous)
-        self.has_continuous = any(continuous)
+        if self.has_continuous:
+            # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
+            iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
+            self._q_map = tuple(zip(range(self.dof), iq, self.continuous))
         # the per-call paths take q as it is when the cheap check passes: 4 plain joints only
         self._slow_q = self.has_continuous or self.dof != 4
         self._per_call = _per_call_paths(self)
@@ -388,12 +396,29 @@ class Robot:
             self.tool_placement = self._per_call[0]  # type: ignore[method-assign,assignment]
         if type(self).task_jacobian is _ROBOT_TASK_JACOBIAN:
             self.task_jacobian = self._per_call[1]  # type: ignore[method-assign,assignment]
-        self._kinematics_factory = kinematics
-        self.kind = parameters.kind if parameters is not None else _urdf_kind(self)
-        if self.has_continuous:
-            # (index in q, index in Pinocchio's q, continuous?) per joint, for the conversion to Pinocchio's q
-            iq = [model.joints[j].idx_q for j in range(1, model.njoints) if model.joints[j].nv == 1]
-            self._q_map = tuple(zip(range(self.dof), iq, continuous))
+
+    def with_model(self, model: pin.Model) -> Self:
+        """The same robot on ``model``, a Pinocchio model of the same joints and frames (a payload's inertias).
+
+        A new robot of the same class, rebuilt around ``model`` (its data, re-rooted copy and per-call paths
+        are its own); what the package caches per robot (collision geometry, scenes, IK objects) is not shared
+        with this one.
+
+        Raises:
+            InvalidInputError: ``model`` has other joints or frames than this robot's.
+        """
+        if (model.nq, model.nv, model.njoints, model.nframes) != (self.model.nq, self.model.nv, self.model.njoints,
+                                                                   self.model.nframes) \
+                or list(model.names) != list(self.model.names):  # fmt: skip
+            raise InvalidInputError("with_model takes a model of the same joints and frames as the robot's")
+        out = object.__new__(type(self))
+        keep = ("_pinocchio_urdf", "locked", "geared", "frame_note", "lock_note", "_package_path", "urdf", "name",
+                "parameters", "base_frame", "tool_frame", "base_id", "tool_id", "limits", "continuous", "dof",
+                "has_continuous", "_kinematics_factory", "kind")  # fmt: skip
+        for name in keep:
+            setattr(out, name, getattr(self, name))
+        out._attach(model)
+        return out
 
     def tool_placement(self, q: np.ndarray) -> pin.SE3:
         """``baseMtool``: the placement of the tool frame in the base frame, at ``q``.
@@ -419,7 +444,7 @@ class Robot:
         robot: str | Path | RobotParameters = "default",
         overrides: Mapping[str, object] | None = None,
         **kwargs: Any,
-    ) -> Robot:
+    ) -> Self:
         """Generate the URDF of a configured robot (see :mod:`scara_pin.description`) and load it.
 
         Keyword arguments (``tool_frame``, ``base_frame``) are passed to the constructor.
@@ -428,7 +453,7 @@ class Robot:
         return cls(urdf, parameters=params, origin=f"robot {params.name!r}", generated=True, **kwargs)
 
     @classmethod
-    def from_file(cls, path: str | Path, *, package_dirs: Sequence[str | Path] = (), **kwargs: Any) -> Robot:
+    def from_file(cls, path: str | Path, *, package_dirs: Sequence[str | Path] = (), **kwargs: Any) -> Self:
         """Load a URDF file, or a xacro file (name ending in ``.xacro``) expanded first.
 
         ``$(find pkg)`` and ``package://pkg/...`` are resolved in ``package_dirs`` (folders holding packages),
@@ -482,16 +507,6 @@ class Robot:
                                            pin.GeometryType.COLLISION)  # fmt: skip
 
     # ----------------------------------------------------------------- a summary for people (repr, notebooks)
-    def plot(self, q: object = None, path: str | os.PathLike[str] | None = None, **kwargs: Any) -> Any:
-        """The arm at ``q`` as a matplotlib stick figure (a Figure; written to ``path`` when one is given).
-
-        ``robot.plot(q)`` is :func:`scara_pin.stick.plot_robot` (its keywords: ``units``, ``view`` ``"3d"`` /
-        ``"top"`` / ``"side"``, ``ax``, ``title``, ``dpi``). matplotlib is imported only when it draws.
-        """
-        from .stick import plot_robot
-
-        return plot_robot(self, q, path, **kwargs)
-
     def summary(self) -> tuple[str, list[list[str]]]:
         """The robot at a glance: a headline and one row per joint, in degrees and millimetres.
 
@@ -535,17 +550,6 @@ class Robot:
         lines = ["  ".join(v.rjust(w) if c >= 3 else v.ljust(w) for c, (v, w) in enumerate(zip(r, widths))).rstrip()
                  for r in table]  # fmt: skip
         return "\n".join([head, *("  " + line for line in lines)])
-
-    def _repr_html_(self) -> str:
-        """The summary as an HTML table (Jupyter shows it for a robot at the end of a cell)."""
-        from html import escape
-
-        head, rows = self.summary()
-        cols = ["#", "joint", "type", "lower", "upper", "velocity", "acceleration", "effort"]
-        th = "".join(f"<th>{c}</th>" for c in cols)
-        body = "".join("<tr>" + "".join(f"<td>{escape(v)}</td>" for v in r) + "</tr>" for r in rows)
-        return (f"<div class='scara-pin-robot'><p><b>{escape(head)}</b></p><table><thead><tr>{th}</tr></thead>"
-                f"<tbody>{body}</tbody></table></div>")  # fmt: skip
 
     # ----------------------------------------------------------------- inverse kinematics (delegated)
     @property
@@ -768,17 +772,6 @@ class Robot:
             reference = _REFERENCES[reference.lower()]
         return pin.computeFrameJacobian(self.model, self.data, q, fid, reference)
 
-    def distances(self, q: ArrayLike, cell: Cell) -> Distances:
-        """Every checked pair's distance at ``q`` in ``cell`` (:class:`scara_pin.cell.Distances`), closest first.
-
-        The robot's links (its URDF ``<collision>`` elements) and the cell's carried part against the cell's
-        obstacles, and the robot's self-collision pairs (:mod:`scara_pin.cell`); coal's signed distances, witness
-        points and normals in the base frame.
-        """
-        from .cell import scene
-
-        return scene(self, cell).distances(q)
-
     def manipulability(self, q: np.ndarray) -> float:
         """Yoshikawa's manipulability sqrt(det(J J^T)) of the task Jacobian (= |det J| for 4 x 4).
 
@@ -793,7 +786,7 @@ class Robot:
         return int(self.model.getFrameId(frame))
 
 
-def _urdf_kind(robot: Robot) -> str:
+def _urdf_kind(robot: RobotModel) -> str:
     """``"palletizer"`` for a palletizer's layout whose flange stays level, else ``"scara"``.
 
     The layout (:func:`scara_pin.chain.palletizer_layout`): a vertical waist, two parallel horizontal arm
@@ -811,11 +804,11 @@ def _urdf_kind(robot: Robot) -> str:
     return "palletizer" if level else "scara"
 
 
-_ROBOT_TOOL_PLACEMENT = Robot.tool_placement
-_ROBOT_TASK_JACOBIAN = Robot.task_jacobian
+_ROBOT_TOOL_PLACEMENT = RobotModel.tool_placement
+_ROBOT_TASK_JACOBIAN = RobotModel.task_jacobian
 
 
-def _per_call_paths(robot: Robot) -> tuple[Callable[[np.ndarray], pin.SE3], Callable[[np.ndarray], np.ndarray]]:
+def _per_call_paths(robot: RobotModel) -> tuple[Callable[[np.ndarray], pin.SE3], Callable[[np.ndarray], np.ndarray]]:
     """The robot's ``tool_placement`` and ``task_jacobian``, as closures over its model.
 
     These are the per-call hot paths (a controller calls them at kHz): closures read their model, data and

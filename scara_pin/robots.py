@@ -1,23 +1,33 @@
-"""Loading a robot with the kinematics of its kind: the package's front door (:func:`load_robot`).
+"""The user's robot and the package's front door (:func:`load_robot`): a facade above the layers.
 
-A :class:`~scara_pin.model.Robot` is the Pinocchio model (FK, frames, Jacobians); its inverse kinematics is
-the object :func:`scara_pin.kinematics.kinds.kinematics_for` builds for its kind, on first use. The kinds
-themselves live in :mod:`scara_pin.kinematics` (``scara_kinematics``, ``scara3_kinematics``,
-``palletizer_kinematics``); their names are still importable from here.
+A :class:`~scara_pin.model.RobotModel` is the Pinocchio model (FK, frames, Jacobians, limits, checks); its
+inverse kinematics is the object :func:`scara_pin.kinematics.kinds.kinematics_for` builds for its kind, on first
+use. :class:`Robot`, what :func:`load_robot` returns, is that model with the conveniences of the layers above it
+(as Pinocchio's ``RobotWrapper`` composes model, geometry and viewer): :meth:`Robot.plot` (a stick figure,
+:mod:`scara_pin.viz.stick`), :meth:`Robot.distances` (in a cell, :mod:`scara_pin.cell`) and the HTML table a
+notebook shows. The package's own code takes the model; a ``Robot`` is one. The kinds live in
+:mod:`scara_pin.kinematics` (``scara_kinematics``, ``scara3_kinematics``, ``palletizer_kinematics``); their
+names are still importable from here.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .description import RobotParameters
 from .errors import InvalidInputError
 from .kinematics.kinds import kinematics_for
-from .model import Robot
+from .model import RobotModel
+
+if TYPE_CHECKING:
+    from ._typing import ArrayLike
+    from .cell import Cell, Distances
 
 __all__ = [
+    "Robot",
     "kinematics_for",
     "load_robot",
     "load_urdf",
@@ -38,6 +48,45 @@ def __getattr__(name: str) -> Any:
 
         return getattr(importlib.import_module(f".kinematics.{_KINDS[name]}", __package__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+class Robot(RobotModel):
+    """A robot as users hold it: the model with a stick figure, its distances in a cell, a notebook's table.
+
+    See the module docstring; everything else is :class:`~scara_pin.model.RobotModel`'s.
+    """
+
+    def plot(self, q: object = None, path: str | os.PathLike[str] | None = None, **kwargs: Any) -> Any:
+        """The arm at ``q`` as a matplotlib stick figure (a Figure; written to ``path`` when one is given).
+
+        ``robot.plot(q)`` is :func:`scara_pin.viz.stick.plot_robot` (its keywords: ``units``, ``view`` ``"3d"`` /
+        ``"top"`` / ``"side"``, ``ax``, ``title``, ``dpi``). matplotlib is imported only when it draws.
+        """
+        from .viz.stick import plot_robot
+
+        return plot_robot(self, q, path, **kwargs)
+
+    def distances(self, q: ArrayLike, cell: Cell) -> Distances:
+        """Every checked pair's distance at ``q`` in ``cell`` (:class:`scara_pin.cell.Distances`), closest first.
+
+        The robot's links (its URDF ``<collision>`` elements) and the cell's carried part against the cell's
+        obstacles, and the robot's self-collision pairs (:mod:`scara_pin.cell`); coal's signed distances, witness
+        points and normals in the base frame.
+        """
+        from .cell import scene
+
+        return scene(self, cell).distances(q)
+
+    def _repr_html_(self) -> str:
+        """The summary as an HTML table (Jupyter shows it for a robot at the end of a cell)."""
+        from html import escape
+
+        head, rows = self.summary()
+        cols = ["#", "joint", "type", "lower", "upper", "velocity", "acceleration", "effort"]
+        th = "".join(f"<th>{c}</th>" for c in cols)
+        body = "".join("<tr>" + "".join(f"<td>{escape(v)}</td>" for v in r) + "</tr>" for r in rows)
+        return (f"<div class='scara-pin-robot'><p><b>{escape(head)}</b></p><table><thead><tr>{th}</tr></thead>"
+                f"<tbody>{body}</tbody></table></div>")  # fmt: skip
 
 
 def load_robot(

@@ -32,6 +32,7 @@ CasADi is imported inside :func:`symbolic_model` only (``scara-pin fk``/``ik`` n
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -41,7 +42,7 @@ import pinocchio as pin
 from .errors import InvalidInputError
 
 if TYPE_CHECKING:
-    from .model import Robot
+    from .model import RobotModel
 
 __all__ = ["SymbolicModel", "symbolic_model"]
 
@@ -88,7 +89,7 @@ class SymbolicModel:
     joint_frames: Any = None
 
 
-def _joints(robot: Robot) -> tuple[list[_Joint], pin.SE3]:
+def _joints(robot: RobotModel) -> tuple[list[_Joint], pin.SE3]:
     """The chain read from the model, and the base frame's placement (inverse) for the tool position."""
     model = robot.model
     data = model.createData()
@@ -120,12 +121,27 @@ def _joints(robot: Robot) -> tuple[list[_Joint], pin.SE3]:
     return out, data.oMf[robot.base_id].inverse()
 
 
-def symbolic_model(robot: Robot) -> SymbolicModel:
+_BUILT: weakref.WeakKeyDictionary[pin.Model, dict[tuple[int, int], SymbolicModel]] = weakref.WeakKeyDictionary()
+"""The symbolic models built, per Pinocchio model (a payload's is another model) and (base, tool) frame."""
+
+
+def symbolic_model(robot: RobotModel) -> SymbolicModel:
     """The tool position and inverse dynamics of ``robot`` (its current model: a payload included) in CasADi.
+
+    Built once per Pinocchio model and frames (a model is not changed in place once loaded: a payload is a copy,
+    :func:`~scara_pin.motion.payload.with_payload`).
 
     Raises:
         InvalidInputError: a joint with more than one degree of freedom, or without a motion axis.
     """
+    built = _BUILT.setdefault(robot.model, {})
+    key = (int(robot.base_id), int(robot.tool_id))
+    if key not in built:
+        built[key] = _build(robot)
+    return built[key]
+
+
+def _build(robot: RobotModel) -> SymbolicModel:
     import casadi as ca
 
     joints, bMo = _joints(robot)

@@ -1,4 +1,4 @@
-"""Rules shared by the loader (:class:`scara_pin.model.Robot`) and the linter (:mod:`scara_pin.lint`).
+"""Rules shared by the loader (:class:`scara_pin.model.RobotModel`) and the linter (:mod:`scara_pin.lint`).
 
 One place for what both must agree on, so that whatever ``scara-pin check`` says the toolkit will do, it
 does:
@@ -372,7 +372,7 @@ def resolve_mimics(joints: Sequence[JointEdge], origin: str) -> dict[str, Mimic]
 
     A joint following a joint that itself follows another (a parallelogram's plate following its rod) is
     the composition: ``a = m1 b + c1``, ``b = m2 f + c2`` give ``a = (m1 m2) f + (m1 c2 + c1)``. Pinocchio
-    takes one level only: the loader hands it the composed ``<mimic>`` (:class:`scara_pin.model.Robot`).
+    takes one level only: the loader hands it the composed ``<mimic>`` (:class:`scara_pin.model.RobotModel`).
 
     Raises:
         UrdfError: what cannot be resolved, naming the joints: a loop of mimics; a source that is no joint of

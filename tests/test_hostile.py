@@ -36,7 +36,7 @@ from scara_pin.description import generate_urdf
 from scara_pin.errors import InvalidInputError, ParameterError, UrdfError
 from scara_pin.files import atomic_output, write_text_atomic
 from scara_pin.limits import MAX_SAMPLES, MAX_URDF_ELEMENTS
-from scara_pin.model import Robot
+from scara_pin.robots import Robot
 
 RUN = "import sys; from scara_pin.cli import main; sys.exit(main(sys.argv[1:]))"
 MEMORY = 3 << 30  # bytes of address space per command

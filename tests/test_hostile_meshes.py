@@ -38,7 +38,7 @@ from scara_pin.cell.meshes import visual_meshes
 from scara_pin.cli import main
 from scara_pin.description import generate_urdf
 from scara_pin.limits import MAX_MESH_BYTES, MAX_VISUALS
-from scara_pin.model import Robot
+from scara_pin.robots import Robot
 
 PKG = "hostile_meshes"
 TIMEOUT = 60.0

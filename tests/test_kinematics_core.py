@@ -415,66 +415,6 @@ def test_q1_on_its_limit_with_a_nearly_stretched_elbow_is_solved() -> None:
         assert min(s.distance(q) for s in res.solutions) <= singular_tol(g, q), (q.tolist(), res.solutions)
 
 
-# the layers, lowest first (STYLE.md: description -> model -> kinematics -> workspace -> motion -> job -> viz -> cli);
-# a module may import its own layer and those below, never one above
-LAYERS = (
-    ("_typing", "_version", "errors", "signals", "units", "summary"),
-    ("limits", "files", "urdf_rules"),
-    ("description",),
-    ("_checks", "tables", "_urdf_checks", "symbolic"),  # symbolic: the model in CasADi (cell and motion use it)
-    ("cell",),  # the robot's collision model and the obstacles: it takes a Robot (types only); model reaches it
-    ("model", "chain", "stick"),
-    ("kinematics",),
-    ("calibration",),  # beside kinematics: imports description, model, kinematics; nothing lower imports it
-    ("robots", "workspace", "lint"),
-    ("motion",),
-    ("job",),  # a program of moves: above motion, below the pictures and the command line
-    ("viz",),
-    ("cli",),
-    ("__init__",),
-)
-
-
-def _runtime_imports(path: Path, root: Path) -> list[tuple[int, str]]:
-    """(line, target module) of every relative import of a module that runs: at the top, in a function, in a
-    method; not the imports under ``if TYPE_CHECKING:`` (they name types and never execute)."""
-    import ast
-
-    pkg = ".".join(path.relative_to(root.parent).with_suffix("").parts)
-    if path.name == "__init__.py":
-        pkg += ".__init__"
-    tree = ast.parse(path.read_text())
-    skipped: set[int] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-            skipped.update(id(n) for stmt in node.body for n in ast.walk(stmt))
-    out = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.level and id(node) not in skipped:
-            base = pkg.split(".")[: -node.level]
-            out.append((node.lineno, ".".join(base + ([node.module] if node.module else []))))
-    return out
-
-
-def test_layers_import_only_downward() -> None:
-    """No module of the package imports a higher layer (issue 21 part 8), at the top or inside a function."""
-    root = Path(sp.__file__).parent
-    layer = {name: k for k, names in enumerate(LAYERS) for name in names}
-    bad = []
-    for f in sorted(root.rglob("*.py")):
-        rel = f.relative_to(root).with_suffix("").parts
-        src = rel[0] if rel != ("__init__",) else "__init__"
-        assert src in layer, f"{f}: add its layer to LAYERS"
-        for line, target in _runtime_imports(f, root):
-            parts = target.split(".")
-            dst = parts[1] if len(parts) > 1 else "__init__"
-            if dst == "__init__" and len(parts) > 2:
-                dst = parts[1]
-            if layer[dst] > layer[src]:
-                bad.append(f"{f.relative_to(root.parent)}:{line} imports {target} ({dst} is above {src})")
-    assert not bad, "\n".join(bad)
-
-
 def test_fk_imports_no_inverse_kinematics() -> None:
     """`scara-pin fk` loads the model and computes FK: no IK kind, closed form, palletizer or workspace module."""
     import subprocess
@@ -518,7 +458,6 @@ def test_fk_loads_neither_other_commands_nor_the_tree_tools() -> None:
 
 
 def test_no_compiled_twin() -> None:
-    from pathlib import Path
 
     root = Path(sp.__file__).parent
     assert not list(root.glob("_speedups*")) and not (root / "_fast.py").exists()

@@ -165,7 +165,7 @@ def test_one_plotting_signature() -> None:
 
 
 def test_robot_plot_is_a_stick_figure_of_the_arm(robot, tmp_path) -> None:
-    from scara_pin.stick import STICK_GID, TOOL_GID
+    from scara_pin.viz.stick import STICK_GID, TOOL_GID
 
     q = np.array([0.4, -1.1, 0.03, 0.7])
     fig = robot.plot(q, tmp_path / "arm.png", units=HUMAN, view="top")

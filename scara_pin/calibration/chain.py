@@ -45,7 +45,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInputError
-from ..model import Robot
+from ..model import RobotModel
 
 __all__ = [
     "ALL_GROUPS",
@@ -229,7 +229,7 @@ class ChainModel:
         notes: what the model leaves out and why (e.g. a tool frame with no fixed joint to carry its offset).
     """
 
-    robot: Robot
+    robot: RobotModel
     frame: MeasurementFrame
     yaw: bool
     groups: frozenset[Group]
@@ -244,7 +244,7 @@ class ChainModel:
     @classmethod
     def from_robot(
         cls,
-        robot: Robot,
+        robot: RobotModel,
         *,
         frame: MeasurementFrame = MeasurementFrame.BASE,
         yaw: bool = False,

@@ -28,7 +28,7 @@ import pinocchio as pin
 
 from ..errors import InvalidInputError
 from ..limits import MAX_PLAN_POSES, MAX_PLAN_WORK, check_count
-from ..model import Robot
+from ..model import RobotModel
 from ..summary import Summarized
 from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame
 from .fit import random_poses, structural_count
@@ -120,7 +120,7 @@ def _min_sv(M: np.ndarray) -> float:
 
 
 def plan_experiment(
-    robot: Robot,
+    robot: RobotModel,
     n: int,
     *,
     criterion: Criterion = Criterion.DET,

@@ -46,7 +46,7 @@ import pinocchio as pin
 
 from ..errors import InvalidInputError, ParameterError
 from ..kinematics.planar2r import wrap
-from ..model import Robot
+from ..model import RobotModel
 from .chain import ALL_GROUPS, ChainModel, Group, MeasurementFrame
 from .identify import IDENTIFY_TOL, Identifiability, identify
 from .measurements import Measurements
@@ -338,7 +338,7 @@ def _second_order(problem: _Problem, theta: np.ndarray, trial: np.ndarray, kept:
     return accepted
 
 
-def random_poses(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
+def random_poses(robot: RobotModel, n: int, rng: np.random.Generator) -> np.ndarray:
     """``n`` joint readings drawn uniformly inside the limits (a continuous joint's are one turn, -pi .. pi)."""
     return rng.uniform(np.array(robot.limits.lower), np.array(robot.limits.upper), size=(n, robot.dof))
 
@@ -400,7 +400,8 @@ def _standardised(problem: _Problem, used: np.ndarray, theta: np.ndarray, kept: 
     return out
 
 
-def calibrate(robot: Robot, measurements: Measurements, options: CalibrationOptions | None = None) -> CalibrationResult:
+def calibrate(robot: RobotModel, measurements: Measurements,
+              options: CalibrationOptions | None = None) -> CalibrationResult:  # fmt: skip
     """Identify the robot's errors from measured poses and write the calibrated URDF (see the module docstring).
 
     Args:
@@ -547,7 +548,7 @@ def _calibrated_urdf(chain: ChainModel, theta: np.ndarray) -> str:
 def _check_urdf(problem: _Problem, theta: np.ndarray, urdf: str) -> None:
     """The calibrated URDF, loaded back, reproduces the fit's predictions (base frame) to URDF_CHECK_TOL."""
     chain = problem.chain
-    robot = Robot(urdf, base_frame=chain.robot.base_frame, tool_frame=chain.robot.tool_frame)
+    robot = RobotModel(urdf, base_frame=chain.robot.base_frame, tool_frame=chain.robot.tool_frame)
     pred, _ = chain.predict(theta, problem.qpin, problem.device0, jacobian=False)
     bMd = chain.device_placement(theta, problem.device0).inverse()
     p_base = pred[:, :3] @ bMd.rotation.T + bMd.translation

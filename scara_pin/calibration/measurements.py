@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InvalidInputError, ParameterError
-from ..model import Robot
+from ..model import RobotModel
 
 __all__ = ["DISTINCT_TOL", "Measurements", "measurement_columns"]
 
@@ -102,7 +102,7 @@ class Measurements:
         rank[np.argsort(first)] = np.arange(len(first))  # number the poses in the rows' order
         return rank[inverse.reshape(-1)], len(first)
 
-    def check(self, robot: Robot) -> None:
+    def check(self, robot: RobotModel) -> None:
         """Refuse readings the robot cannot take (the limits: :func:`~scara_pin.calibration.screen.screen`).
 
         Raises:

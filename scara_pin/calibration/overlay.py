@@ -19,7 +19,6 @@ import numpy as np
 from ..description import SCHEMAS, generate_urdf
 from ..errors import InvalidInputError
 from ..kinematics.planar2r import wrap
-from ..model import Robot
 from .chain import ChainModel, read_triple
 from .results import CalibrationResult, ResidualStats
 
@@ -105,7 +104,8 @@ def yaml_overlay(result: CalibrationResult) -> YamlOverlay:
               for axis in axes]  # fmt: skip
     values = {kinematic[k]: float(params.values[kinematic[k]] + delta[k]) for k in range(len(kinematic))
               if abs(delta[k]) > _EXPRESSED}  # fmt: skip
-    overlaid = Robot.from_config(params, values, base_frame=chain.robot.base_frame, tool_frame=chain.robot.tool_frame)
+    frames = {"base_frame": chain.robot.base_frame, "tool_frame": chain.robot.tool_frame}
+    overlaid = type(chain.robot).from_config(params, values, **frames)
     chain_o = ChainModel.from_robot(overlaid, frame=chain.frame, yaw=chain.yaw, groups=chain.groups)
     keep = {p.name: v for p, v in zip(chain.parameters, result.theta) if p.group.value in ("scale", "device")}
     theta_o = np.array([keep.get(p.name, 0.0) for p in chain_o.parameters])

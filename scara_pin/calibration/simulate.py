@@ -24,7 +24,7 @@ import pinocchio as pin
 
 from ..errors import ParameterError
 from ..kinematics.planar2r import wrap
-from ..model import Robot
+from ..model import RobotModel
 from .chain import read_triple, rotation_basis
 from .measurements import Measurements, measurement_columns
 from .urdf_edit import edit_origins
@@ -81,7 +81,7 @@ class Simulation:
     """
 
     robot: str
-    truth: Robot
+    truth: RobotModel
     errors: dict[str, tuple[np.ndarray, np.ndarray]]
     measurements: Measurements
     noise: float
@@ -107,7 +107,7 @@ class Simulation:
         return "\n".join(lines) + "\n"
 
 
-def simulate(robot: Robot, readings: np.ndarray, *, seed: int = 0, noise: float = NOISE, yaw: bool = False,
+def simulate(robot: RobotModel, readings: np.ndarray, *, seed: int = 0, noise: float = NOISE, yaw: bool = False,
              yaw_weight: float = 0.1) -> Simulation:  # fmt: skip
     """Measure the tool of a perturbed copy of ``robot`` at ``readings`` (see the module docstring).
 
@@ -131,7 +131,8 @@ def simulate(robot: Robot, readings: np.ndarray, *, seed: int = 0, noise: float 
     Measurements(q, np.zeros((len(q), 3))).check(robot)
     rng = np.random.default_rng(seed)
     urdf, errors = perturbed_urdf(robot.urdf, rng)
-    truth = Robot(urdf, base_frame=robot.base_frame, tool_frame=robot.tool_frame, origin=f"{robot.name} (perturbed)")
+    truth = type(robot)(urdf, base_frame=robot.base_frame, tool_frame=robot.tool_frame,
+                        origin=f"{robot.name} (perturbed)")  # fmt: skip
     poses = np.array([truth.tool_pose(x) for x in q])
     position = poses[:, :3] + rng.normal(0.0, noise, (len(q), 3))
     measured_yaw = np.array([wrap(float(v)) for v in poses[:, 3] + rng.normal(0.0, noise / yaw_weight, len(q))]) \

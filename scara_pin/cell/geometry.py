@@ -20,6 +20,7 @@ The choice is a :class:`SelfPairs` (checked and disabled pairs, each disabled on
 from __future__ import annotations
 
 import logging
+import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -28,7 +29,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pinocchio as pin
 
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["SAMPLES", "RobotGeometry", "SelfPairs", "robot_geometry"]
 
@@ -74,15 +75,19 @@ class RobotGeometry:
     adjacent: frozenset[tuple[int, int]]
 
 
-def robot_geometry(robot: Robot) -> RobotGeometry:
-    """The robot's collision geometry (cached on the robot; see the module docstring).
+_GEOMETRY: weakref.WeakKeyDictionary[RobotModel, RobotGeometry] = weakref.WeakKeyDictionary()
+"""Each robot's collision geometry, built once (the entry goes with the robot)."""
+
+
+def robot_geometry(robot: RobotModel) -> RobotGeometry:
+    """The robot's collision geometry (built once per robot; see the module docstring).
 
     Raises:
         InvalidInputError: a collision mesh cannot be read (distances to it could not be computed).
     """
-    cached = robot.__dict__.get("_cell_geometry")
+    cached = _GEOMETRY.get(robot)
     if cached is not None:
-        return cached  # type: ignore[no-any-return]
+        return cached
     import pinocchio as pin
 
     from .meshes import collision_meshes
@@ -122,11 +127,11 @@ def robot_geometry(robot: Robot) -> RobotGeometry:
             if ja == jb or (ja != 0 and geometric_parent(ja) == jb) or (jb != 0 and geometric_parent(jb) == ja):
                 adjacent.add((a, b))
     out = RobotGeometry(gm, links, frozenset(adjacent))
-    robot.__dict__["_cell_geometry"] = out
+    _GEOMETRY[robot] = out
     return out
 
 
-def sample_configurations(robot: Robot, n: int = SAMPLES, seed: int = _SEED) -> np.ndarray:
+def sample_configurations(robot: RobotModel, n: int = SAMPLES, seed: int = _SEED) -> np.ndarray:
     """(n + 1, dof) configurations: q = 0 (clipped into the limits) and n drawn uniformly inside the limits."""
     lo = np.array(robot.limits.lower, dtype=float)
     hi = np.array(robot.limits.upper, dtype=float)

@@ -71,7 +71,7 @@ from ..limits import (
 from ..signals import raise_pending
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "LARGE_RATIO",
@@ -168,6 +168,7 @@ class VisualMesh:
 
 
 def mesh_scale(text: str | None, filename: str) -> tuple[float, float, float]:
+    """A URDF ``<mesh scale="...">``: one number or three (the URDF number grammar), each finite and non-zero."""
     if text is None:
         return (1.0, 1.0, 1.0)
     values = [number_text(v) for v in text.split()]  # the URDF number grammar: no "1_0", no "nan"
@@ -299,7 +300,7 @@ def _load(path: Path, filename: str) -> MeshGeometry:
     return MeshGeometry(path, vertices, faces, unit, len(data))
 
 
-def robot_size(robot: Robot) -> float:
+def robot_size(robot: RobotModel) -> float:
     """[m] the robot's size: the diagonal of the box of its frames' origins at q = 0 (at least 5 cm).
 
     The yardstick of the meshes' plausibility: the links laid out end to end.
@@ -378,7 +379,7 @@ def _mesh_elements(root: ET.Element, element: str = "visual") -> list[tuple[str,
     return out
 
 
-def check_visual_count(robot: Robot) -> int:
+def check_visual_count(robot: RobotModel) -> int:
     """The number of visuals of the robot, refused above :data:`~scara_pin.limits.MAX_VISUALS` (before any is built).
 
     Raises:
@@ -389,7 +390,7 @@ def check_visual_count(robot: Robot) -> int:
                        "a page draws at most that many")  # fmt: skip
 
 
-def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
+def visual_meshes(robot: RobotModel) -> tuple[VisualMesh, ...]:
     """The meshes of the robot's visuals that can be read; one ``warning`` per mesh that cannot.
 
     Names are Pinocchio's geometry names (``robot.visual_model``), where the placeholder boxes are. Each
@@ -405,7 +406,7 @@ def visual_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
     return out
 
 
-def collision_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
+def collision_meshes(robot: RobotModel) -> tuple[VisualMesh, ...]:
     """The meshes of the robot's ``<collision>`` elements (names as in ``robot.collision_model``), all of them.
 
     Read as :func:`visual_meshes` reads visuals, but a collision mesh that cannot be read is an error, not
@@ -423,7 +424,7 @@ def collision_meshes(robot: Robot) -> tuple[VisualMesh, ...]:
     return out
 
 
-def _robot_meshes(robot: Robot, element: str) -> tuple[tuple[VisualMesh, ...], dict[str, tuple[list[str], bool]]]:
+def _robot_meshes(robot: RobotModel, element: str) -> tuple[tuple[VisualMesh, ...], dict[str, tuple[list[str], bool]]]:
     """The readable meshes of the robot's ``element`` (``visual`` or ``collision``) and the problems met.
 
     Returns:

@@ -31,6 +31,7 @@ margin and the activation distance, both far below it); nearer, coal's exact dis
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -46,7 +47,7 @@ if TYPE_CHECKING:
     import pinocchio as pin
 
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["FAR", "GJK_TOLERANCE", "Distances", "InCollisionError", "Pair", "PairDistance", "Scene", "scene"]
 
@@ -188,7 +189,7 @@ class Scene:
         margin: [m] the cell's margin.
     """
 
-    robot: Robot
+    robot: RobotModel
     cell: Cell
     pairs: tuple[Pair, ...] = field(init=False)
     self_pairs: SelfPairs = field(init=False)
@@ -541,13 +542,19 @@ def describe(found: PairDistance, margin: float, unit: str = "mm") -> str:
     return f"{how} (margin {margin_text}) {at}"
 
 
-def scene(robot: Robot, cell: Cell) -> Scene:
-    """The scene of ``robot`` in ``cell``, built once per (robot, cell) and kept on the robot."""
-    cache: dict[int, tuple[Cell, Scene]] = robot.__dict__.setdefault("_cell_scenes", {})
+_SCENES: weakref.WeakKeyDictionary[RobotModel, dict[int, tuple[Cell, Scene]]] = weakref.WeakKeyDictionary()
+"""Each robot's scenes by cell (at most :data:`_SCENES_PER_ROBOT`); a scene holds its robot, so an entry lasts as long
+as the cache keeps it, not the robot."""
+_SCENES_PER_ROBOT = 8
+
+
+def scene(robot: RobotModel, cell: Cell) -> Scene:
+    """The scene of ``robot`` in ``cell``, built once per (robot, cell)."""
+    cache = _SCENES.setdefault(robot, {})
     hit = cache.get(id(cell))
     if hit is not None and hit[0] is cell:
         return hit[1]
-    if len(cache) >= 8:
+    if len(cache) >= _SCENES_PER_ROBOT:
         cache.clear()
     out = Scene(robot, cell)
     cache[id(cell)] = (cell, out)

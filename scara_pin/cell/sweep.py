@@ -269,13 +269,10 @@ def joint_placements(robot: Any, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
     n, nj = len(Q), robot.model.njoints
-    frames = robot.__dict__.get("_joint_frames")
-    if frames is None or frames[0] is not robot.model:
-        frames = (robot.model, symbolic_model(robot).joint_frames)
-        robot.__dict__["_joint_frames"] = frames
     if n == 0:
         return np.empty((0, nj, 3, 3)), np.empty((0, nj, 3))
-    F = np.asarray(frames[1].map(n)(Q.T)).reshape(12, n, nj)  # column i * nj + j: oMi[j] at row i
+    # column i * nj + j: oMi[j] at row i
+    F = np.asarray(symbolic_model(robot).joint_frames.map(n)(Q.T)).reshape(12, n, nj)
     R = F[:9].reshape(3, 3, n, nj, order="F").transpose(2, 3, 0, 1)  # each rotation stored column by column
     p = F[9:].transpose(1, 2, 0)
     return np.ascontiguousarray(R), np.ascontiguousarray(p)

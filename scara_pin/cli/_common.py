@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..robots import Robot
 
 log = logging.getLogger("scara_pin")
 

@@ -21,8 +21,8 @@ from ..errors import InfeasibleError, InvalidInputError
 from ._common import MIN_NUMBER, Units
 
 if TYPE_CHECKING:
-    from ..model import Robot
     from ..motion.points import PointSet
+    from ..robots import Robot
 
 _SAME = 1e-9  # [m, rad] the cycle's two points share their height and yaw to this
 

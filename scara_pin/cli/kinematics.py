@@ -36,7 +36,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..robots import Robot
 
 
 _SI_UNITS = {"length": "m", "angle": "rad"}

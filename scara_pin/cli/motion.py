@@ -103,10 +103,10 @@ def cmd_traj(args: argparse.Namespace) -> int:
     plan = plan_motion(robot, request)
     if plan.arch is not None:
         return _print_arch(args, plan.robot, plan.arch, units, plan.method, tool_speed, request.cell)
-    robot, traj, method = plan.robot, plan.trajectory, plan.method.value
+    planned, traj, method = plan.robot, plan.trajectory, plan.method.value
     from ..motion.timing import limit_ratios
 
-    ratios = limit_ratios(robot, traj, rate=1000.0, tool_speed=tool_speed, torque=args.torque)
+    ratios = limit_ratios(planned, traj, rate=1000.0, tool_speed=tool_speed, torque=args.torque)
     if not ratios.worst <= 1 + 1e-6:  # NaN (an unknown limit) fails too
         message = (f"the trajectory exceeds a limit: worst ratio {ratios.worst:.6g} (velocity "
                    f"{ratios.velocity:.6g}, acceleration {ratios.acceleration:.6g}); a longer --duration, or "
@@ -119,16 +119,16 @@ def cmd_traj(args: argparse.Namespace) -> int:
         traj.save(args.out, rate=args.rate)
         outputs["trajectory"] = str(args.out)
     if args.setpoints:
-        _write_setpoints(args, robot, traj, units)
+        _write_setpoints(args, planned, traj, units)
         outputs["setpoints"] = args.setpoints
     if args.plot:
         from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=method, torque=args.torque,
+        plot_trajectory(traj, args.plot, robot=planned, units=units.display, law=method, torque=args.torque,
                         tool_speed=tool_speed)  # fmt: skip
         outputs["plot"] = args.plot
     summary = {
-        "robot": robot.name,
+        "robot": planned.name,
         "method": method,
         "duration": traj.duration,
         "q_from": traj.q_start.tolist(),
@@ -146,7 +146,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
         print(json.dumps(summary))
         return 0
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
-    print(f"robot     {robot.name}: {method}", file=text)
+    print(f"robot     {planned.name}: {method}", file=text)
     q_units = ", ".join(units.names(units.q))
     print(f"duration  {_num(traj.duration)} s", file=text)
     print(f"from      {units.fmt(traj.q_start, units.q)}  [{q_units}]", file=text)

@@ -26,7 +26,7 @@ _TABLE_RESOLUTION = 1e-6
 
 if TYPE_CHECKING:
 
-    from ..model import Robot
+    from ..robots import Robot
 
 
 LISTED_ARC_MIN = 1e-6

@@ -78,7 +78,7 @@ from .steps import (
 
 if TYPE_CHECKING:
     from ..cell import Shape
-    from ..model import Robot
+    from ..model import RobotModel
     from .results import JobResult
 
 __all__ = ["FORMAT", "Carry", "Job", "load_job"]
@@ -237,7 +237,7 @@ class Job:
         """Read and check a job file (:func:`load_job`)."""
         return load_job(path)
 
-    def program(self, robot: Robot) -> Program:
+    def program(self, robot: RobotModel) -> Program:
         """The job for ``robot``, expanded (:func:`~scara_pin.job.steps.expand`), every target resolved.
 
         Raises:
@@ -255,7 +255,7 @@ class Job:
                       shape=self.jump, path=self.path, start_line=self.lines.get("start"),
                       pallet_lines={k[8:]: v for k, v in self.lines.items() if k.startswith("pallets.")})  # fmt: skip
 
-    def plan(self, robot: Robot, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
+    def plan(self, robot: RobotModel, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
         """Plan every move of the job for ``robot`` (:func:`~scara_pin.job.planning.plan_job`)."""
         from .planning import plan_job
 

@@ -59,7 +59,7 @@ from .steps import Dwell, Grip, GripKind, Move, MoveKind, located
 if TYPE_CHECKING:
     from ..cell import Cell, Obstacle, Shape
     from ..description import JointLimits
-    from ..model import Robot
+    from ..model import RobotModel
     from ..motion.verify import Clearance
     from .loading import Job
 
@@ -112,7 +112,7 @@ class PlannedMove:
         return 0.0 if self.trajectory is None else self.trajectory.duration
 
 
-def scaled_limits(robot: Robot, speed: float, accel: float) -> JointLimits:
+def scaled_limits(robot: RobotModel, speed: float, accel: float) -> JointLimits:
     """The robot's limits with the velocities times ``speed`` and the accelerations times ``accel`` (in (0, 1])."""
     for name, f in (("speed", speed), ("accel", accel)):
         if not (isinstance(f, (int, float)) and 0.0 < f <= 1.0):
@@ -123,7 +123,7 @@ def scaled_limits(robot: Robot, speed: float, accel: float) -> JointLimits:
 
 
 def plan_move(
-    robot: Robot,
+    robot: RobotModel,
     move: Move,
     q_from: np.ndarray,
     *,
@@ -173,7 +173,7 @@ def plan_move(
                     cell, clearance)  # fmt: skip
 
 
-def _checked(robot: Robot, traj: Trajectory, method: str, limits: JointLimits, torque: bool, payload: Payload,
+def _checked(robot: RobotModel, traj: Trajectory, method: str, limits: JointLimits, torque: bool, payload: Payload,
              bound: float | None, source: Source, seconds: float, cell: Cell | None = None,
              clearance: Clearance | None = None) -> PlannedMove:  # fmt: skip
     """The move verified at 10 kHz (exit 3 if it fails) with what binds on it.
@@ -193,7 +193,7 @@ def _checked(robot: Robot, traj: Trajectory, method: str, limits: JointLimits, t
                        clearance if clearance is not None else found.clearance)  # fmt: skip
 
 
-def _binding(robot: Robot, traj: Trajectory, limits: JointLimits, torque: bool, payload: Payload
+def _binding(robot: RobotModel, traj: Trajectory, limits: JointLimits, torque: bool, payload: Payload
              ) -> tuple[tuple[Binding, ...], Binding]:  # fmt: skip
     """The limits at >= :data:`~scara_pin.motion.jump.BINDING` on the 10 kHz grid, with their share of the time."""
     lim = limits_in_force(robot, limits, None, torque)
@@ -226,8 +226,8 @@ class Planner:
         stats: how many moves were planned, reused and reversed, and the planning's wall time.
     """
 
-    def __init__(self, robot: Robot, *, torque: bool = False, payload: PayloadLike = None, cell: Cell | None = None,
-                 carry: Shape | None = None) -> None:  # fmt: skip
+    def __init__(self, robot: RobotModel, *, torque: bool = False, payload: PayloadLike = None,
+                 cell: Cell | None = None, carry: Shape | None = None) -> None:  # fmt: skip
         self.robot, self.torque = robot, torque
         self.payload = as_payload(payload)
         self.cell, self.carry = cell, carry
@@ -307,7 +307,7 @@ def _hold(q: np.ndarray, seconds: float) -> PolynomialPiece:
     return PolynomialPiece(np.array([0.0, seconds]), np.asarray(q, dtype=float)[None, None, :])
 
 
-def plan_job(job: Job, robot: Robot, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
+def plan_job(job: Job, robot: RobotModel, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
     """Plan every move of ``job`` for ``robot`` (module docstring): the table, the total, the trajectory.
 
     Everything the job file and the robot can tell is checked first (:meth:`Job.program`); then the moves are
@@ -411,7 +411,7 @@ def _job_cell(job: Job) -> Cell | None:
     return cell
 
 
-def _place(robot: Robot, planner: Planner, job: Job, action: Grip, index: int, q: np.ndarray,
+def _place(robot: RobotModel, planner: Planner, job: Job, action: Grip, index: int, q: np.ndarray,
            placed: tuple[Obstacle, ...], t: float) -> PlacedBox:  # fmt: skip
     """The box a place leaves: the carried part moved by ``baseMtool`` at ``q``, an obstacle from time ``t``."""
     from ..cell import Obstacle
@@ -427,7 +427,7 @@ def _place(robot: Robot, planner: Planner, job: Job, action: Grip, index: int, q
     return out
 
 
-def _clear(robot: Robot, cell: Cell | None, q: np.ndarray, job: Job, action: Grip, what: str,
+def _clear(robot: RobotModel, cell: Cell | None, q: np.ndarray, job: Job, action: Grip, what: str,
            box: str | None = None) -> None:  # fmt: skip
     """``q`` clear of ``cell`` (exit 2 at the grip's line, naming the pair, otherwise).
 

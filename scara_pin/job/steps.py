@@ -41,7 +41,7 @@ from ..motion.jump import STANDARD_CLEARANCE, STANDARD_RISE
 from .pallets import Order, Pallet
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
     from ..motion.points import PointSet
 
 __all__ = [
@@ -322,7 +322,7 @@ class _State:
 class _Resolver:
     """Targets to joint values: points as taught, places by IK on their first corner's branch."""
 
-    def __init__(self, robot: Robot, points: PointSet, pallets: Mapping[str, Pallet],
+    def __init__(self, robot: RobotModel, points: PointSet, pallets: Mapping[str, Pallet],
                  pallet_lines: Mapping[str, int | None], path: Path) -> None:  # fmt: skip
         self.robot, self.points, self.pallets, self.path = robot, points, pallets, path
         self.pallet_lines = pallet_lines
@@ -363,7 +363,7 @@ class _Resolver:
 def expand(
     steps: tuple[Step, ...],
     *,
-    robot: Robot,
+    robot: RobotModel,
     points: PointSet,
     pallets: Mapping[str, Pallet],
     start: Target | None,

@@ -4,7 +4,7 @@ Input: a header naming ``x, y, z, yaw`` (other columns ignored), one target per 
 (``pose_scale`` converts SI to them). Output, written atomically (:mod:`scara_pin.files`):
 ``x, y, z, yaw, q1, q2, q3, q4, branch, status``, one row per target in input order, the joint cells
 empty and ``branch`` blank where there is no solution. Rows are solved in chunks by the vectorised
-closed form (:meth:`scara_pin.model.Robot.ik_batch`), so memory stays bounded whatever the file's size.
+closed form (:meth:`scara_pin.model.RobotModel.ik_batch`), so memory stays bounded whatever the file's size.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from ..tables import csv_rows, open_csv
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["CHUNK", "INPUT_COLUMNS", "OUTPUT_COLUMNS", "BatchSummary", "solve_csv"]
 
@@ -58,7 +58,7 @@ class BatchSummary:
 
 
 def solve_csv(
-    robot: Robot,
+    robot: RobotModel,
     source: str | os.PathLike[str],
     destination: str | os.PathLike[str],
     *,

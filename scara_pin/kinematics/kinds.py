@@ -1,6 +1,6 @@
 """The kinematics of a robot's kind: which closed form serves ``robot.kinematics``.
 
-A :class:`~scara_pin.model.Robot` is the Pinocchio model (FK, frames, Jacobians); what it knows of inverse
+A :class:`~scara_pin.model.RobotModel` is the Pinocchio model (FK, frames, Jacobians); what it knows of inverse
 kinematics is one object of the :class:`~scara_pin.model.Kinematics` protocol, built from the loaded
 model by its kind (:func:`kinematics_for`, the factory :func:`scara_pin.load_robot` gives the robot):
 
@@ -23,12 +23,12 @@ import numpy as np
 from ..errors import InvalidInputError
 
 if TYPE_CHECKING:
-    from ..model import Kinematics, Robot
+    from ..model import Kinematics, RobotModel
 
 __all__ = ["kinematics_for", "what_arm"]
 
 
-def kinematics_for(robot: Robot) -> Kinematics:
+def kinematics_for(robot: RobotModel) -> Kinematics:
     """The kinematics object of the robot's kind (``robot.kind``) and joint count (``robot.dof``).
 
     Raises:
@@ -58,7 +58,7 @@ def kinematics_for(robot: Robot) -> Kinematics:
         raise NotScaraError(f"{exc}; {what}") from None
 
 
-def what_arm(robot: Robot) -> str | None:
+def what_arm(robot: RobotModel) -> str | None:
     """What an arm the SCARA closed form refuses is, when its layout says (else None), and what applies to it.
 
     - three revolute joints, a vertical waist and two parallel horizontal ones: an R-R-R arm without a wrist;

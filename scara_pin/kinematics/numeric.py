@@ -35,7 +35,7 @@ from ..errors import InvalidInputError, ParameterError
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["NumericIKOptions", "NumericIKReason", "NumericIKResult", "elbow_index", "elbow_sign", "solve_numeric"]
 
@@ -115,7 +115,7 @@ class NumericIKResult:
 _DEFAULTS = NumericIKOptions()
 
 
-def _error(robot: Robot, q: np.ndarray, target: np.ndarray) -> np.ndarray:
+def _error(robot: RobotModel, q: np.ndarray, target: np.ndarray) -> np.ndarray:
     pose = robot.tool_pose(q)
     e = target - pose
     e[3] = (e[3] + math.pi) % _TWO_PI - math.pi
@@ -123,7 +123,7 @@ def _error(robot: Robot, q: np.ndarray, target: np.ndarray) -> np.ndarray:
 
 
 def solve_numeric(
-    robot: Robot,
+    robot: RobotModel,
     target: ArrayLike,
     q0: ArrayLike | None = None,
     options: NumericIKOptions | None = None,
@@ -201,7 +201,7 @@ ELBOW_PARALLEL = 0.02
 """[rad] two revolute axes within this angle make the shoulder and elbow of an arm (near-parallel included)."""
 
 
-def elbow_index(robot: Robot) -> int | None:
+def elbow_index(robot: RobotModel) -> int | None:
     """The index in q of the elbow, or None when the arm has none.
 
     The elbow is the second of the first two revolute joints (in q order) with parallel axes at q = 0: a
@@ -216,7 +216,7 @@ def elbow_index(robot: Robot) -> int | None:
     return turning[1].index if len(turning) >= 2 else None
 
 
-def elbow_sign(robot: Robot, q: ArrayLike) -> str:
+def elbow_sign(robot: RobotModel, q: ArrayLike) -> str:
     """The branch of a numeric solution, for any arm: ``elbow+`` / ``elbow-``, the sign of sin(q_elbow).
 
     The elbow as :func:`elbow_index` finds it; ``elbow 0`` when it is stretched or folded (|sin| < 1e-12) or
@@ -239,7 +239,7 @@ class _Task:
     leaves q unchanged.
     """
 
-    def __init__(self, robot: Robot, target: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: list[bool],
+    def __init__(self, robot: RobotModel, target: np.ndarray, lo: np.ndarray, hi: np.ndarray, revolute: list[bool],
                  opts: NumericIKOptions) -> None:  # fmt: skip
         self.robot = robot
         # a 3-joint arm: q and the task carry a 4th coordinate that nothing moves (error 0, Jacobian row and

@@ -72,7 +72,7 @@ from .targets import batch_inputs, parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "BRANCHES",
@@ -175,7 +175,7 @@ class PalletizerGeometry:
         object.__setattr__(self, "arm", Planar2R(self.a2, self.a3))
 
     @classmethod
-    def from_robot(cls, robot: Robot) -> PalletizerGeometry:
+    def from_robot(cls, robot: RobotModel) -> PalletizerGeometry:
         """Read the geometry from the robot's Pinocchio model (:func:`scara_pin.kinematics.palletizer_model.read`).
 
         Raises:

@@ -17,7 +17,7 @@ from .results import BatchIKResult, IKResult
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["PalletizerKinematics"]
 
@@ -38,7 +38,7 @@ class PalletizerKinematics:
         self.geometry = geometry
 
     @classmethod
-    def from_robot(cls, robot: Robot) -> PalletizerKinematics:
+    def from_robot(cls, robot: RobotModel) -> PalletizerKinematics:
         """Read the geometry from the robot's model; NotPalletizerError says where it departs."""
         return cls(palletizer.PalletizerGeometry.from_robot(robot))
 

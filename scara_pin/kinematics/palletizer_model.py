@@ -34,7 +34,7 @@ from .palletizer import FK_TOL, NotPalletizerError, PalletizerGeometry, forward
 from .planar2r import wrap
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["LENGTH_TOL", "SNAP_TOL", "read"]
 
@@ -56,7 +56,7 @@ def _angle(d: np.ndarray) -> float:
     return math.atan2(float(d[0]), float(d[1]))
 
 
-def _turn_sign(before: np.ndarray, after: np.ndarray, name: str, robot: Robot) -> float:
+def _turn_sign(before: np.ndarray, after: np.ndarray, name: str, robot: RobotModel) -> float:
     """+1 or -1: the way a quarter turn of a joint turns the point from ``before`` to ``after`` (about 0)."""
     turn = wrap(_angle(after) - _angle(before))
     if abs(abs(turn) - _QUARTER) > 1e-6:
@@ -66,7 +66,7 @@ def _turn_sign(before: np.ndarray, after: np.ndarray, name: str, robot: Robot) -
     return 1.0 if turn > 0 else -1.0
 
 
-def read(robot: Robot) -> PalletizerGeometry:
+def read(robot: RobotModel) -> PalletizerGeometry:
     """The palletizer's geometry from the robot's model (module docstring).
 
     Raises:
@@ -146,7 +146,7 @@ def read(robot: Robot) -> PalletizerGeometry:
     raise NotPalletizerError(f"robot {robot.name!r}: {worst[1]}")
 
 
-def _departure(geo: PalletizerGeometry, robot: Robot) -> tuple[float, np.ndarray]:
+def _departure(geo: PalletizerGeometry, robot: RobotModel) -> tuple[float, np.ndarray]:
     """The largest difference of the closed form from the model [m, rad] at 8 seeded configurations, and where."""
     rng = np.random.default_rng(0)
     worst = (0.0, np.zeros(4))

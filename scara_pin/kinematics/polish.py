@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
     from .results import BatchIKResult
 
 __all__ = [
@@ -93,14 +93,14 @@ class Refined:
     converged: bool
 
 
-def _error(robot: Robot, q: np.ndarray, task: np.ndarray) -> np.ndarray:
+def _error(robot: RobotModel, q: np.ndarray, task: np.ndarray) -> np.ndarray:
     e = task - robot.tool_pose(q)[: len(task)]
     if len(task) == 4:
         e[3] = math.remainder(e[3], TWO_PI)
     return e
 
 
-def refine(robot: Robot, seed: np.ndarray, task: np.ndarray) -> Refined:
+def refine(robot: RobotModel, seed: np.ndarray, task: np.ndarray) -> Refined:
     """Newton steps on the model from ``seed`` towards ``task``.
 
     Args:
@@ -143,7 +143,7 @@ def _limit_status(geo: ScaraGeometry, i: int) -> IKStatus:
     return IKStatus.J1_LIMIT if i == ra else (IKStatus.J2_LIMIT if i == rb else IKStatus.J4_LIMIT)
 
 
-def _polish_one(robot: Robot, geo: ScaraGeometry, sol: IKSolution, task: np.ndarray
+def _polish_one(robot: RobotModel, geo: ScaraGeometry, sol: IKSolution, task: np.ndarray
                 ) -> IKSolution | tuple[IKStatus, str]:  # fmt: skip
     """The polished solution, or (status, reason) why this branch has none."""
     out = refine(robot, sol.q, task)
@@ -171,7 +171,7 @@ def _polish_one(robot: Robot, geo: ScaraGeometry, sol: IKSolution, task: np.ndar
     return IKSolution(q, label, sol.singular, tuple(turns))
 
 
-def polish_result(robot: Robot, geo: ScaraGeometry, result: IKResult, task: np.ndarray) -> IKResult:
+def polish_result(robot: RobotModel, geo: ScaraGeometry, result: IKResult, task: np.ndarray) -> IKResult:
     """Every solution of a closed-form result polished on the model (see the module docstring).
 
     Args:
@@ -231,7 +231,7 @@ def _refined(geo: ScaraGeometry) -> str:
     return f"refined on the model (axes up to {geo.tilt:.3g} rad from vertical)"
 
 
-def solve_refined(robot: Robot, geo: ScaraGeometry, seeds: Callable[[np.ndarray], IKResult], task: np.ndarray
+def solve_refined(robot: RobotModel, geo: ScaraGeometry, seeds: Callable[[np.ndarray], IKResult], task: np.ndarray
                   ) -> IKResult:  # fmt: skip
     """The closed form's seeds, polished on the model (see the module docstring).
 
@@ -272,7 +272,7 @@ def solve_refined(robot: Robot, geo: ScaraGeometry, seeds: Callable[[np.ndarray]
 
 
 def polish_batch(
-    robot: Robot,
+    robot: RobotModel,
     geo: ScaraGeometry,
     tasks: np.ndarray,
     batch: BatchIKResult,
@@ -320,7 +320,7 @@ class UnrefinedError:
     seed: int
 
 
-def unrefined_error(robot: Robot, samples: int = 200, seed: int = 0) -> UnrefinedError:
+def unrefined_error(robot: RobotModel, samples: int = 200, seed: int = 0) -> UnrefinedError:
     """The error the closed form would make on this model without refinement (what ``check`` reports).
 
     For each sampled q: the tool task f(q) on the model, every solution of the closed form alone (the

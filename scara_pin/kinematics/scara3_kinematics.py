@@ -20,7 +20,7 @@ from .scara_batch import solve_batch
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 from .scara_kinematics import ScaraKinematics
 
 __all__ = ["Scara3Kinematics"]
@@ -43,7 +43,7 @@ class Scara3Kinematics(ScaraKinematics):
     dof: int = 3
 
     @classmethod
-    def from_robot(cls, robot: Robot) -> Scara3Kinematics:
+    def from_robot(cls, robot: RobotModel) -> Scara3Kinematics:
         """Read the geometry from the robot's model; NotScaraError names what is not SCARA-like."""
         return cls(scara.ScaraGeometry.without_wrist(robot), robot)
 

@@ -42,7 +42,7 @@ from .planar2r import (
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "BRANCHES",
@@ -171,7 +171,7 @@ class ScaraGeometry:
                                                 for j in range(4)))  # fmt: skip
 
     @classmethod
-    def from_robot(cls, robot: Robot) -> ScaraGeometry:
+    def from_robot(cls, robot: RobotModel) -> ScaraGeometry:
         """Read the geometry from a loaded robot; raise :class:`NotScaraError` naming what is wrong.
 
         Axes up to ``NEAR_PARALLEL_TOL`` from the base z axis are accepted: the geometry is then the ideal
@@ -181,7 +181,7 @@ class ScaraGeometry:
         return cls._read(robot, wrist=True)
 
     @classmethod
-    def without_wrist(cls, robot: Robot) -> ScaraGeometry:
+    def without_wrist(cls, robot: RobotModel) -> ScaraGeometry:
         """The geometry of a 3-joint SCARA (two revolute joints and one prismatic, in any order, no wrist).
 
         It is read as a 4-joint SCARA whose wrist, virtual and continuous, is index 3 of q and turns about
@@ -192,7 +192,7 @@ class ScaraGeometry:
         return cls._read(robot, wrist=False)
 
     @classmethod
-    def _read(cls, robot: Robot, wrist: bool) -> ScaraGeometry:
+    def _read(cls, robot: RobotModel, wrist: bool) -> ScaraGeometry:
         model = robot.model
         data = model.createData()
         # the joints of q (nv = 1); geared (<mimic>) joints, nv = 0, follow one of them: those between the root
@@ -323,7 +323,7 @@ GEARED_AXIS_TOL = 1e-9
 tool about its own point: the position stays the SCARA's)."""
 
 
-def _check_geared(robot: Robot, data: pin.Data, geared: list[int], actuated: list[int], oMb: pin.SE3,
+def _check_geared(robot: RobotModel, data: pin.Data, geared: list[int], actuated: list[int], oMb: pin.SE3,
                   tool: np.ndarray, wrist: bool) -> None:  # fmt: skip
     """Refuse (NotScaraError) geared joints the closed form cannot take.
 

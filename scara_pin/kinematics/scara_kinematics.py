@@ -26,7 +26,7 @@ from .scara_batch import solve_batch
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["POSE_TILT_FACTOR", "ScaraKinematics"]
 
@@ -45,9 +45,9 @@ class ScaraKinematics:
     branches: tuple[str, ...] = scara.BRANCHES
     status: type[enum.IntEnum] = scara.IKStatus
     geometry: scara.ScaraGeometry
-    robot: Robot | None
+    robot: RobotModel | None
 
-    def __init__(self, geometry: scara.ScaraGeometry, robot: Robot | None = None) -> None:
+    def __init__(self, geometry: scara.ScaraGeometry, robot: RobotModel | None = None) -> None:
         self.geometry = geometry
         self.robot = robot if geometry.tilt > scara.EXACT_TILT else None
         self._seeds = seed_geometry(geometry) if self.robot is not None else geometry
@@ -57,7 +57,7 @@ class ScaraKinematics:
             self.nearest = types.MethodType(scara.solve_nearest, geometry)  # type: ignore[method-assign]
 
     @classmethod
-    def from_robot(cls, robot: Robot) -> ScaraKinematics:
+    def from_robot(cls, robot: RobotModel) -> ScaraKinematics:
         """Read the geometry from the robot's model; NotScaraError names what is not SCARA-like."""
         return cls(scara.ScaraGeometry.from_robot(robot), robot)
 
@@ -114,7 +114,7 @@ POSE_TILT_FACTOR = 8.0
 roll/pitch then checked); beyond, it is NOT_A_YAW_POSE at once."""
 
 
-def _with_rotation(robot: Robot, res: IKResult, rotation: np.ndarray) -> IKResult:
+def _with_rotation(robot: RobotModel, res: IKResult, rotation: np.ndarray) -> IKResult:
     """The solutions of ``res`` whose tool rotation is the target's (to YAW_POSE_TOL rad), or NOT_A_YAW_POSE.
 
     A near-parallel robot reaches a position and yaw with a roll/pitch set by its configuration: of the

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import Robot
+from ..model import RobotModel
 from .numeric import solve_numeric
 
 __all__ = ["POSE_TOL", "Q_TOL", "ValidationReport", "validate_ik"]
@@ -86,14 +86,15 @@ class ValidationReport:
         return "\n".join(lines + [f"  {f}" for f in self.failures])
 
 
-def pose_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
+def pose_error(robot: RobotModel, q: np.ndarray, target: np.ndarray) -> float:
+    """The largest of |FK(q) - target| over (x, y, z, yaw), the yaw difference wrapped to [-pi, pi) [m or rad]."""
     e = robot.tool_pose(q) - target
     e[3] = (e[3] + math.pi) % (2 * math.pi) - math.pi
     return float(np.abs(e).max())
 
 
 def validate_ik(
-    robot: Robot, samples: int = 1000, seed: int = 0, max_failures: int = 10,
+    robot: RobotModel, samples: int = 1000, seed: int = 0, max_failures: int = 10,
     progress: Callable[[int], object] | None = None,
 ) -> ValidationReport:  # fmt: skip
     """Run the three checks on ``samples`` seeded configurations (see the module docstring).

@@ -12,7 +12,7 @@ every rule its code, family, severity and place in the run:
 
 The rules share a :class:`~scara_pin.lint.context.Context`: the document read with each element's line (expat),
 the tree walked at q = 0 with the linter's own transforms (independent of Pinocchio), and the robot as
-:class:`scara_pin.model.Robot` loads it, so that what ``check`` reports is what the other commands will do.
+:class:`scara_pin.model.RobotModel` loads it, so that what ``check`` reports is what the other commands will do.
 The tool and base frames, and the rules that make a joint unusable (inverted limits, zero axis), are the
 loader's own (:mod:`scara_pin.urdf_rules`).
 

@@ -31,7 +31,7 @@ from .report import Finding, Severity
 
 if TYPE_CHECKING:
     from ..description.xacro_sources import SourceMap
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["KNOWN_TYPES", "SAMPLES", "Context", "LintJoint", "Stop", "rpy_matrix", "shown_path"]
 
@@ -191,7 +191,7 @@ class Context:
         text: the URDF document (a file's: read by the ``unreadable`` or ``xacro-failed`` rule). source: its name
             in the report. path: the file, when one is checked; package_dirs: where its packages are looked for.
         tool_asked, base_asked: the frames asked for (``--tool``, ``--base``). lock: ``--lock`` values [rad, m].
-        load_kwargs: passed to :class:`scara_pin.model.Robot` (a file's package folders: set with its text).
+        load_kwargs: passed to :class:`scara_pin.model.RobotModel` (a file's package folders: set with its text).
         sources: a xacro file's map from expanded lines to where each element was written (likewise).
         findings: in the order found.
     """
@@ -423,16 +423,16 @@ class Context:
 
     # ------------------------------------------------------------------------------------------ the toolkit
     @cached_property
-    def loaded(self) -> tuple[Robot | None, Exception | None]:
+    def loaded(self) -> tuple[RobotModel | None, Exception | None]:
         """(the robot as the toolkit loads it, None) or (None, the UrdfError saying why it cannot)."""
         from ..errors import UrdfError
         from ..kinematics.kinds import kinematics_for
-        from ..model import Robot
+        from ..model import RobotModel
 
         quiet = _Quiet()  # the loader's warnings are findings here already (xacro-ignored): not logged twice
         logging.getLogger("scara_pin").addFilter(quiet)
         try:
-            robot = Robot(self.text, origin=self.source, tool_frame=self.tool_asked, base_frame=self.base_asked,
+            robot = RobotModel(self.text, origin=self.source, tool_frame=self.tool_asked, base_frame=self.base_asked,
                           kinematics=kinematics_for, lock=self.lock, **self.load_kwargs)  # the same choose_frames
         except UrdfError as exc:
             return None, exc
@@ -441,7 +441,7 @@ class Context:
         return robot, None
 
     @property
-    def robot(self) -> Robot | None:
+    def robot(self) -> RobotModel | None:
         """The loaded robot, or None when the toolkit refuses the file."""
         return self.loaded[0]
 

@@ -1,7 +1,7 @@
 """Rules of scope: whether the toolkit loads the file, and what kind of arm it is (its closed form's verdict).
 
 Each rule is a function of the :class:`~scara_pin.lint.context.Context`; its code and place in the run are in
-:data:`scara_pin.lint.registry.RULES`. They read the robot as :class:`scara_pin.model.Robot` loads it and its
+:data:`scara_pin.lint.registry.RULES`. They read the robot as :class:`scara_pin.model.RobotModel` loads it and its
 kinematics as :func:`scara_pin.kinematics.kinds.kinematics_for` builds them: what they say, the commands do.
 """
 

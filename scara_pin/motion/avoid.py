@@ -58,7 +58,7 @@ from .trajectory import line_optimal_duration
 
 if TYPE_CHECKING:
     from ..cell import PairDistance, Scene
-    from ..model import Robot
+    from ..model import RobotModel
     from ..symbolic import SymbolicModel
     from .polynomial import PolynomialPiece
 
@@ -362,7 +362,7 @@ def _score(scene: Scene, waypoints: np.ndarray, velocity: np.ndarray, accelerati
     return float(t), float(d.min(initial=math.inf)) - scene.margin - SLACK
 
 
-def _ik(robot: Robot, pose: np.ndarray, near: np.ndarray) -> np.ndarray | None:
+def _ik(robot: RobotModel, pose: np.ndarray, near: np.ndarray) -> np.ndarray | None:
     res = robot.ik(pose)
     sol = res.nearest(near, branch=robot.branch_of(near)) if res.success else None
     return None if sol is None else np.array(sol.q, dtype=float)
@@ -445,7 +445,7 @@ def candidates(
     return clear_ones
 
 
-def _stroke_top(robot: Robot, q: np.ndarray) -> np.ndarray | None:
+def _stroke_top(robot: RobotModel, q: np.ndarray) -> np.ndarray | None:
     """``q`` with the joint that moves the tool up (a SCARA's quill) at the end of its range that raises the tool.
 
     None when that joint is not prismatic (a palletizer raises the tool by turning its arms).

@@ -71,7 +71,7 @@ if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..cell import Cell
     from ..description import JointLimits
-    from ..model import Robot
+    from ..model import RobotModel
     from .verify import Clearance
 
 __all__ = [
@@ -251,7 +251,7 @@ def _arch_geometry(pose_from: np.ndarray, pose_to: np.ndarray, rise: float, blen
 
 
 def arch_path(
-    robot: Robot,
+    robot: RobotModel,
     pose_from: ArrayLike,
     pose_to: ArrayLike,
     *,
@@ -486,7 +486,7 @@ class CycleResult(Summarized):
 
 # ---------------------------------------------------------------------------------------------- timing
 def arch_move(
-    robot: Robot,
+    robot: RobotModel,
     poses: ArrayLike,
     *,
     rise: float = STANDARD_RISE,
@@ -570,7 +570,7 @@ def _law_time(law: Any, s_target: float) -> float:
 
 
 def _legs(
-    robot: Robot, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
+    robot: RobotModel, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
 ) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
     """Legs (time spans) and, per leg, the most used limit, from a dense sampling (rate and 8 per 1/rate)."""
     spans: list[tuple[str, int, float, float]] = []
@@ -609,7 +609,8 @@ def _legs(
     return tuple(legs), worst
 
 
-def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: np.ndarray | None) -> dict[str, Any]:
+def _ratio_table(robot: RobotModel, traj: Trajectory, t: np.ndarray, lim: Any,
+                 jerk: np.ndarray | None) -> dict[str, Any]:  # fmt: skip
     """|value| / limit per sample and joint, per quantity."""
     q, qd, qdd = traj.sample(t)
     qddd = None if jerk is None else trajectory_jerk(traj, t)
@@ -618,7 +619,7 @@ def _ratio_table(robot: Robot, traj: Trajectory, t: np.ndarray, lim: Any, jerk: 
 
 # ---------------------------------------------------------------------------------------------- the cycle
 def cycle_placement(
-    robot: Robot, span: float = STANDARD_SPAN, rise: float = STANDARD_RISE, branch: str | None = None, n: int = 160
+    robot: RobotModel, span: float = STANDARD_SPAN, rise: float = STANDARD_RISE, branch: str | None = None, n: int = 160
 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The default placement of the standard cycle (module docstring): (start pose, end pose, min |det J|).
 
@@ -680,7 +681,7 @@ def cycle_placement(
 
 
 def standard_cycle(
-    robot: Robot,
+    robot: RobotModel,
     *,
     start: ArrayLike | None = None,
     direction: ArrayLike | None = None,
@@ -787,7 +788,7 @@ def standard_cycle(
 
 
 def _lines_bound(
-    robot: Robot, move: ArchMove, a: np.ndarray, b: np.ndarray, rise: float, limits: JointLimits | None,
+    robot: RobotModel, move: ArchMove, a: np.ndarray, b: np.ndarray, rise: float, limits: JointLimits | None,
     jerk: float | ArrayLike | None,
 ) -> LowerBound:
     """The cycle's lower bound (the jump's: it holds for any motion) for the straight-leg arch's endpoints."""
@@ -801,7 +802,7 @@ def _lines_bound(
     return LowerBound(2.0 * one.duration, one.joint, one.reason + ", out and back")
 
 
-def limits_dict(robot: Robot, limits: JointLimits | None, jerk: tuple[float, ...] | None) -> dict[str, Any]:
+def limits_dict(robot: RobotModel, limits: JointLimits | None, jerk: tuple[float, ...] | None) -> dict[str, Any]:
     """The limits used, JSON-ready (per joint, SI)."""
     lim = robot.limits if limits is None else limits
     return {"velocity": list(lim.velocity), "acceleration": list(lim.acceleration), "effort": list(lim.effort),

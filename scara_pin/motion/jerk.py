@@ -77,7 +77,7 @@ from .verify import (
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..description import JointLimits
-    from ..model import Robot
+    from ..model import RobotModel
     from ..units import DisplayUnits
 
 __all__ = ["JerkLaw", "JerkOptions", "JerkRatios", "JerkResult", "minimum_duration", "time_optimal_jerk"]
@@ -359,7 +359,7 @@ def _nlp(n: int, torque: bool, dof: int, ipopt_iterations: int) -> Any:
     return ca.nlpsol("jerk_time_optimal", "ipopt", nlp, opts), n_eq, n_lim
 
 
-def _path_data(robot: Robot, path: GeometricPath, s: np.ndarray, torque: bool, Tr: float) -> np.ndarray:
+def _path_data(robot: RobotModel, path: GeometricPath, s: np.ndarray, torque: bool, Tr: float) -> np.ndarray:
     """(n, 3 dof) q', q'', q''' at s; with ``torque`` also the RNEA coefficients a, b (in reference units) and g.
 
     tau = a sdd + b sd^2 + g (:func:`~scara_pin.motion.verify.torque_coefficients`); a and b are divided by
@@ -436,7 +436,7 @@ def _law_times(law: TimeLaw, s_target: np.ndarray) -> np.ndarray:
 class _Solver:
     """The NLP on one path (module docstring): guess, solve, re-grid, solve, tighten locally where exceeded."""
 
-    def __init__(self, robot: Robot, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, opts: JerkOptions,
+    def __init__(self, robot: RobotModel, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, opts: JerkOptions,
                  segment: int) -> None:  # fmt: skip
         self.robot, self.path, self.lim, self.jv, self.opts, self.segment = robot, path, lim, jv, opts, segment
         self.knots = np.unique(np.clip(path.knots(), 0.0, 1.0))[1:-1]
@@ -516,7 +516,7 @@ class _Solver:
         return True
 
 
-def _guess(robot: Robot, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, n: int) -> JerkLaw:
+def _guess(robot: RobotModel, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, n: int) -> JerkLaw:
     """A feasible law on n equal intervals: a double-S in s, slowed as a whole to fit the limits.
 
     The path jerk is +c, 0, -c, 0, -c, 0, +c over seven equal phases; the law is then slowed until every
@@ -540,7 +540,7 @@ def _check_times(law: JerkLaw, t_start: float, rate: float) -> np.ndarray:
     return np.clip(t, 0.0, T)
 
 
-def _ratios_at(robot: Robot, motion: Motion, t: np.ndarray, lim: LimitsInForce, jv: np.ndarray) -> np.ndarray:
+def _ratios_at(robot: RobotModel, motion: Motion, t: np.ndarray, lim: LimitsInForce, jv: np.ndarray) -> np.ndarray:
     """(len(t), 4 dof): |velocity|, |acceleration|, |jerk|, |torque| over their limits at local times t."""
     r = state_ratios(robot, lim, motion_states(motion, t), jv)
     d = len(lim.velocity)
@@ -561,7 +561,7 @@ def _interval_worst(law: JerkLaw, t: np.ndarray, ratios: np.ndarray) -> np.ndarr
 
 
 def _time_path(
-    robot: Robot, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, opts: JerkOptions, segment: int
+    robot: RobotModel, path: GeometricPath, lim: LimitsInForce, jv: np.ndarray, opts: JerkOptions, segment: int
 ) -> tuple[JerkLaw, int]:
     """(law, NLPs) of one path before the final correction (module docstring)."""
     solver = _Solver(robot, path, lim, jv, opts, segment)
@@ -582,8 +582,8 @@ def _time_path(
 
 
 def _finish(
-    robot: Robot, path: GeometricPath, law: JerkLaw, lim: LimitsInForce, jv: np.ndarray, t_start: float, rate: float,
-    segment: int, k: float | None = None,
+    robot: RobotModel, path: GeometricPath, law: JerkLaw, lim: LimitsInForce, jv: np.ndarray, t_start: float,
+    rate: float, segment: int, k: float | None = None,
 ) -> tuple[Motion, JerkRatios, float]:
     """(motion, ratios, k): ``law`` slowed k times until its worst ratio on the ``rate`` grid and nodes is 1.
 
@@ -669,7 +669,7 @@ class JerkResult(Summarized):
 
 
 def time_optimal_jerk(
-    robot: Robot,
+    robot: RobotModel,
     path: GeometricPath | CartesianPath | Sequence[GeometricPath | CartesianPath] | Sequence[ArrayLike] | np.ndarray,
     jerk: float | ArrayLike,
     *,

@@ -28,7 +28,7 @@ import numpy as np
 from .._checks import as_limit_vector
 from .._typing import ArrayLike
 from ..errors import InfeasibleError, ParameterError
-from ..model import Robot
+from ..model import RobotModel
 from ..workspace.scara import Limit, RayHit, Workspace, workspace
 from .trajectory import Trajectory, cartesian_path, joint_pose, timed
 
@@ -90,7 +90,7 @@ class JogResult:
 
 
 def jog_to_edge(
-    robot: Robot,
+    robot: RobotModel,
     q0: ArrayLike,
     direction: ArrayLike,
     *,
@@ -182,7 +182,7 @@ def jog_to_edge(
     return JogResult(traj, hit, pose0, end, travel, ratio, contact, 0.0 if sc is None else sc.margin)
 
 
-def _contact(robot: Robot, sc: Any, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, reach: float
+def _contact(robot: RobotModel, sc: Any, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, reach: float
              ) -> tuple[PairDistance | None, float]:  # fmt: skip
     """The first contact along the straight line of length ``reach`` from ``pose0``: (pair, travel) or (None, 0)."""
     from ..cell.sweep import first_contact
@@ -196,7 +196,7 @@ def _contact(robot: Robot, sc: Any, q0: np.ndarray, pose0: np.ndarray, u: np.nda
     return found.closest, found.s * reach
 
 
-def edge_workspace(robot: Robot, yaw: float) -> Workspace:
+def edge_workspace(robot: RobotModel, yaw: float) -> Workspace:
     """The region a jog's tool point moves in at a constant ``yaw`` [rad].
 
     The wrist region, or with a plan-view tool offset the tool point's region at that yaw
@@ -209,7 +209,7 @@ def edge_workspace(robot: Robot, yaw: float) -> Workspace:
     return workspace(robot, yaw=yaw) if offset else workspace(robot)
 
 
-def _ratios(robot: Robot, traj: Trajectory) -> tuple[float, float]:
+def _ratios(robot: RobotModel, traj: Trajectory) -> tuple[float, float]:
     t = traj.times(CHECK_RATE)
     _, qd, qdd = traj.sample(t)
     lim = robot.limits

@@ -123,7 +123,7 @@ if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..cell import Cell, Scene
     from ..description import JointLimits
-    from ..model import Robot
+    from ..model import RobotModel
     from ..symbolic import SymbolicModel
     from ..units import DisplayUnits
     from .avoid import DistanceRow, Rows
@@ -466,9 +466,9 @@ _MIRROR = {Phase.LIFT.value: Phase.DESCEND.value, Phase.DESCEND.value: Phase.LIF
 class _Problem:
     """The data of one move, SI units; ``order`` 2 (acceleration control) or 3 (jerk control)."""
 
-    robot: Robot
+    robot: RobotModel
     sym: SymbolicModel
-    base: Robot
+    base: RobotModel
     payload: Payload
     limits: JointLimits | None
     A: np.ndarray
@@ -749,7 +749,7 @@ class _Transcription:
 
 # ---------------------------------------------------------------------------------------------- the move
 def jump_move(
-    robot: Robot,
+    robot: RobotModel,
     pose_from: ArrayLike,
     pose_to: ArrayLike,
     *,
@@ -899,7 +899,7 @@ def _solve_in_cell(prob: _Problem, options: JumpOptions, scene: Scene, ceiling: 
     return best[0], best[1], replace(best[2], iterations=iterations), best[3], best[4]
 
 
-def _given(robot: Robot, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarray:
+def _given(robot: RobotModel, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarray:
     """A configuration given for a pose, checked: FK within ENDPOINT_TOL of the pose, inside the limits."""
     qq = np.array(robot.check_q(q), dtype=float)
     err = pose_error(robot, qq, pose)
@@ -912,7 +912,7 @@ def _given(robot: Robot, q: ArrayLike, pose: np.ndarray, name: str) -> np.ndarra
 
 
 def _endpoints(
-    robot: Robot, A: np.ndarray, B: np.ndarray, start: ArrayLike | None, end: ArrayLike | None, branch: str | None
+    robot: RobotModel, A: np.ndarray, B: np.ndarray, start: ArrayLike | None, end: ArrayLike | None, branch: str | None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The configurations at A (``start``, or the IK solution nearest mid-range) and at B (``end``, or nearest qA)."""
     mid = (np.array(robot.limits.lower) + np.array(robot.limits.upper)) / 2.0
@@ -934,7 +934,7 @@ def _endpoints(
     return np.array(qA, dtype=float), np.array(sol.q, dtype=float)
 
 
-def _top(robot: Robot, pose: np.ndarray, z_top: float, near: np.ndarray, name: str, rise: float) -> np.ndarray:
+def _top(robot: RobotModel, pose: np.ndarray, z_top: float, near: np.ndarray, name: str, rise: float) -> np.ndarray:
     """The configuration at the traverse height above ``pose`` nearest ``near`` (same branch)."""
     target = np.array([pose[0], pose[1], z_top, pose[3]])
     res = robot.ik(target)
@@ -946,7 +946,7 @@ def _top(robot: Robot, pose: np.ndarray, z_top: float, near: np.ndarray, name: s
 
 
 # ---------------------------------------------------------------------------------------------- lower bound
-def _quill(robot: Robot, q: np.ndarray) -> int | None:
+def _quill(robot: RobotModel, q: np.ndarray) -> int | None:
     """The joint that alone moves the tool vertically (a SCARA's quill), or None."""
     if robot.kind != "scara":
         return None
@@ -964,7 +964,7 @@ def _default_intervals(jerk: bool, tool_speed: bool) -> tuple[int, int, int]:
     return lift, traverse * (2 if tool_speed else 1), lift
 
 
-def _holds_still(robot: Robot, configurations: tuple[np.ndarray, ...], effort: np.ndarray) -> None:
+def _holds_still(robot: RobotModel, configurations: tuple[np.ndarray, ...], effort: np.ndarray) -> None:
     """InfeasibleError if the static load (gravity, payload included) at one of them is not below an effort limit."""
     q = np.array(configurations)
     bad = static_overload(static_load(robot, q), effort, robot.joint_names)
@@ -1007,7 +1007,7 @@ def _one_dof(
 
 
 def lower_bound(
-    robot: Robot,
+    robot: RobotModel,
     q_from: np.ndarray,
     q_to: np.ndarray,
     q_tops: tuple[np.ndarray, np.ndarray],

@@ -63,7 +63,7 @@ from ..errors import InvalidInputError, NoSolutionError, ParameterError, ScaraEr
 if TYPE_CHECKING:
     from ..cell import PairDistance, Scene
     from ..cell.sweep import JointPath
-    from ..model import Robot
+    from ..model import RobotModel
     from ..workspace.scara import RayHit, Workspace
 
 __all__ = [
@@ -221,7 +221,7 @@ class JogMotion:
         if self.joint is not None and (isinstance(self.joint, bool) or not isinstance(self.joint, int)):
             raise InvalidInputError(f"joint {self.joint!r} must be an index into q (0 for J1)")
 
-    def is_angle(self, robot: Robot) -> bool:
+    def is_angle(self, robot: RobotModel) -> bool:
         """Whether the step is an angle [rad] (a revolute joint, a turn) rather than a length [m]."""
         if self.joint is not None:
             return robot.joint_kinds[self.joint] == "angle"
@@ -279,10 +279,10 @@ class JogMove:
 
 
 # ------------------------------------------------------------------------------------------ IK
-def pose_ik(robot: Robot, target: object, reference: np.ndarray, branch: str = "all") -> PoseAnswer:
+def pose_ik(robot: RobotModel, target: object, reference: np.ndarray, branch: str = "all") -> PoseAnswer:
     """The IK solution of ``target`` (x, y, z, yaw) [m, rad] nearest to ``reference`` on ``branch``.
 
-    The closed form (:meth:`scara_pin.model.Robot.ik_nearest`) where it takes the robot's model, else the
+    The closed form (:meth:`scara_pin.model.RobotModel.ik_nearest`) where it takes the robot's model, else the
     numeric solver (:func:`scara_pin.kinematics.numeric.solve_numeric`) started at ``reference``. A refusal
     is an answer (``q`` None, its status code and reason), never an exception.
     """
@@ -305,7 +305,7 @@ def pose_ik(robot: Robot, target: object, reference: np.ndarray, branch: str = "
         return PoseAnswer(np.asarray(result.q, dtype=float), Solver.NUMERIC)
 
 
-def branch_of(robot: Robot, q: np.ndarray) -> str:
+def branch_of(robot: RobotModel, q: np.ndarray) -> str:
     """The IK branch of ``q`` ("" when the robot's model has no named branches)."""
     try:
         return robot.branch_of(q)
@@ -314,7 +314,7 @@ def branch_of(robot: Robot, q: np.ndarray) -> str:
 
 
 # ------------------------------------------------------------------------------------------ steps
-def jog_step(robot: Robot, q: object, motion: JogMotion, step: float, *, ws: Workspace | None = None,
+def jog_step(robot: RobotModel, q: object, motion: JogMotion, step: float, *, ws: Workspace | None = None,
              scene: Scene | None = None) -> JogMove:  # fmt: skip
     """Move by ``step`` [m or rad] > 0 in the sense and along the axis (or joint) of ``motion``.
 
@@ -341,7 +341,7 @@ def jog_step(robot: Robot, q: object, motion: JogMotion, step: float, *, ws: Wor
     return _before_contact(robot, scene, q0, motion, move)
 
 
-def _before_contact(robot: Robot, scene: Scene, q0: np.ndarray, motion: JogMotion, move: JogMove) -> JogMove:
+def _before_contact(robot: RobotModel, scene: Scene, q0: np.ndarray, motion: JogMotion, move: JogMove) -> JogMove:
     """``move`` (from ``q0``), ended where a checked pair of ``scene`` first comes to the margin, if it does."""
     from ..cell.sweep import first_contact
     from .jog import CONTACT_ROOM
@@ -367,7 +367,7 @@ def _before_contact(robot: Robot, scene: Scene, q0: np.ndarray, motion: JogMotio
                    move.solver, c)  # fmt: skip
 
 
-def _move_paths(robot: Robot, q0: np.ndarray, motion: JogMotion, move: JogMove) -> list[tuple[JointPath, float]]:
+def _move_paths(robot: RobotModel, q0: np.ndarray, motion: JogMotion, move: JogMove) -> list[tuple[JointPath, float]]:
     """The joint paths ``move`` follows from ``q0``, one after the other, each with the length [m or rad] it covers.
 
     A joint move: the straight joint line. A Cartesian one: the straight tool line followed by the closed-form IK
@@ -408,7 +408,7 @@ def _move_paths(robot: Robot, q0: np.ndarray, motion: JogMotion, move: JogMove) 
     return [(_ik_polyline(robot, q0, pose0, d, length, move.q), length)]
 
 
-def _ik_polyline(robot: Robot, q0: np.ndarray, pose0: np.ndarray, d: np.ndarray, length: float,
+def _ik_polyline(robot: RobotModel, q0: np.ndarray, pose0: np.ndarray, d: np.ndarray, length: float,
                  q_end: np.ndarray | None = None) -> _Polyline:  # fmt: skip
     """The IK solutions of the line ``pose0 + s d``, s in [0, ``length``], joined by straight joint lines.
 
@@ -453,7 +453,7 @@ class _Polyline:
         return out[: order + 1]
 
 
-def _joint_step(robot: Robot, q0: np.ndarray, j: int, sign: int, length: float) -> JogMove:
+def _joint_step(robot: RobotModel, q0: np.ndarray, j: int, sign: int, length: float) -> JogMove:
     if not 0 <= j < robot.dof:
         raise InvalidInputError(f"joint index {j} must be in [0, {robot.dof - 1}] (J1..J{robot.dof})")
     q = q0.copy()
@@ -474,7 +474,7 @@ def _joint_step(robot: Robot, q0: np.ndarray, j: int, sign: int, length: float) 
     return JogMove(q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, float(room), length, Solver.NONE)
 
 
-def direction(robot: Robot, q: np.ndarray, motion: JogMotion) -> np.ndarray:
+def direction(robot: RobotModel, q: np.ndarray, motion: JogMotion) -> np.ndarray:
     """The (dx, dy, dz, dyaw) of the tool per unit of step for a Cartesian ``motion`` at ``q`` (unit length).
 
     Raises:
@@ -498,7 +498,8 @@ def direction(robot: Robot, q: np.ndarray, motion: JogMotion) -> np.ndarray:
     return d
 
 
-def _cartesian_step(robot: Robot, q0: np.ndarray, motion: JogMotion, length: float, ws: Workspace | None) -> JogMove:
+def _cartesian_step(robot: RobotModel, q0: np.ndarray, motion: JogMotion, length: float,
+                    ws: Workspace | None) -> JogMove:  # fmt: skip
     d = direction(robot, q0, motion)
     pose0 = np.asarray(robot.tool_pose(q0), dtype=float)
     branch = branch_of(robot, q0) or "all"
@@ -552,7 +553,7 @@ def _cartesian_step(robot: Robot, q0: np.ndarray, motion: JogMotion, length: flo
     return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, lo, length, solver)
 
 
-def _at_limits(robot: Robot, q: np.ndarray) -> list[str]:
+def _at_limits(robot: RobotModel, q: np.ndarray) -> list[str]:
     """The joints of ``q`` at a position limit (within 1e-9), as "joint2 at its upper limit 2.61799388 rad"."""
     out = []
     for i, name in enumerate(robot.joint_names):
@@ -563,7 +564,7 @@ def _at_limits(robot: Robot, q: np.ndarray) -> list[str]:
     return out
 
 
-def _region(robot: Robot, q: np.ndarray) -> Workspace | None:
+def _region(robot: RobotModel, q: np.ndarray) -> Workspace | None:
     """The workspace of the tool point at q's yaw (:func:`scara_pin.motion.jog.edge_workspace`), or None.
 
     None where it is not defined (a tool offset with J4 limited to less than a turn): the IK decides.
@@ -577,7 +578,7 @@ def _region(robot: Robot, q: np.ndarray) -> Workspace | None:
         return None
 
 
-def _ray(robot: Robot, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, ws: Workspace | None) -> RayHit | None:
+def _ray(robot: RobotModel, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, ws: Workspace | None) -> RayHit | None:
     """The workspace's edge along ``u`` from the tool point, or None where the region does not apply."""
     region = ws if ws is not None else _region(robot, q0)
     if region is None:
@@ -589,7 +590,7 @@ def _ray(robot: Robot, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, ws: Wor
         return None
 
 
-def _continuous(robot: Robot, pose: np.ndarray, previous: np.ndarray, branch: str) -> PoseAnswer:
+def _continuous(robot: RobotModel, pose: np.ndarray, previous: np.ndarray, branch: str) -> PoseAnswer:
     """The IK of ``pose`` on ``branch`` nearest ``previous``, refused when a revolute joint jumps (> JUMP)."""
     answer = pose_ik(robot, pose, previous, branch)
     if answer.q is None:
@@ -607,7 +608,7 @@ def _continuous(robot: Robot, pose: np.ndarray, previous: np.ndarray, branch: st
 
 
 # ------------------------------------------------------------------------------------------ hold-to-jog
-def nominal_rate(robot: Robot, motion: JogMotion, override: float) -> float:
+def nominal_rate(robot: RobotModel, motion: JogMotion, override: float) -> float:
     """The hold-to-jog rate [m/s or rad/s] before the limits of the period (see the module docstring)."""
     override = _override(override)
     if motion.joint is not None:
@@ -617,7 +618,7 @@ def nominal_rate(robot: Robot, motion: JogMotion, override: float) -> float:
 
 
 def hold_advance(
-    robot: Robot, q: object, motion: JogMotion, dt: float, override: float, *, ws: Workspace | None = None,
+    robot: RobotModel, q: object, motion: JogMotion, dt: float, override: float, *, ws: Workspace | None = None,
     scene: Scene | None = None,
 ) -> JogMove:
     """One control period of a hold-to-jog.
@@ -673,7 +674,7 @@ def _override(value: float) -> float:
 
 
 def _speed_ratio(
-    robot: Robot, q0: np.ndarray, q1: np.ndarray, dt: float, override: float, velocity: np.ndarray
+    robot: RobotModel, q0: np.ndarray, q1: np.ndarray, dt: float, override: float, velocity: np.ndarray
 ) -> float:
     """The largest of |dq_i| / (override vmax_i dt) and |dp| / (override MANUAL_SPEED dt) over one period."""
     joints = float(np.max(np.abs(q1 - q0) / (override * velocity * dt)))

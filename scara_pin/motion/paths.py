@@ -33,7 +33,7 @@ from ..limits import MAX_PATH_POINTS, check_count
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "JUMP_TOL",
@@ -204,7 +204,7 @@ class JointSpline(GeometricPath):
         return tuple(self._spline(s, nu) for nu in range(order + 1))
 
 
-def joint_path(robot: Robot, waypoints: Sequence[ArrayLike] | np.ndarray) -> JointLine | JointSpline:
+def joint_path(robot: RobotModel, waypoints: Sequence[ArrayLike] | np.ndarray) -> JointLine | JointSpline:
     """The path through joint waypoints: a :class:`JointLine` for two, else a :class:`JointSpline`.
 
     Consecutive equal waypoints are merged. The spline's knots weight each joint by 1 / vmax. The path
@@ -238,7 +238,7 @@ def joint_path(robot: Robot, waypoints: Sequence[ArrayLike] | np.ndarray) -> Joi
 
 
 def path_segments(
-    robot: Robot,
+    robot: RobotModel,
     path: GeometricPath | CartesianPath | Sequence[GeometricPath | CartesianPath] | Sequence[ArrayLike] | np.ndarray,
 ) -> tuple[GeometricPath, ...]:
     """The paths a timing takes one by one, each rest to rest.
@@ -255,7 +255,7 @@ def path_segments(
     return (joint_path(robot, path),)  # type: ignore[arg-type]
 
 
-def _check_joint_limits(robot: Robot, path: GeometricPath, n: int = 2001) -> None:
+def _check_joint_limits(robot: RobotModel, path: GeometricPath, n: int = 2001) -> None:
     """Raise :class:`PathError` where a path leaves the position limits (dense grid, then bisection)."""
     lo = np.array(robot.limits.lower) - 1e-10
     hi = np.array(robot.limits.upper) + 1e-10
@@ -321,7 +321,7 @@ class _Kinematics:
     :meth:`derivatives` gives the exact q', q'', q''' along a tool curve (CasADi, built on first use).
     """
 
-    def __init__(self, robot: Robot) -> None:
+    def __init__(self, robot: RobotModel) -> None:
         self.model = robot.model
         self.data = robot.model.createData()
         self.tool_id = robot.tool_id
@@ -414,7 +414,7 @@ class CartesianSegment(GeometricPath):
         s_ref, q_ref: the dense checked solutions (increasing s, from 0 to 1).
     """
 
-    robot: Robot
+    robot: RobotModel
     branch: str
     pose0: np.ndarray
     pose1: np.ndarray
@@ -506,7 +506,7 @@ class CartesianPath:
         checkpoints: per segment, (s, q) at the requested points (n points or the maximum step).
     """
 
-    robot: Robot
+    robot: RobotModel
     poses: np.ndarray
     branch: str
     segments: tuple[CartesianSegment, ...]
@@ -523,7 +523,7 @@ class CartesianPath:
         return self.segments[-1].q_ref[-1].copy()
 
 
-def joint_pose(robot: Robot, q: ArrayLike) -> np.ndarray:
+def joint_pose(robot: RobotModel, q: ArrayLike) -> np.ndarray:
     """The tool pose (x, y, z, yaw) at q with the yaw UNWRAPPED as the joints turn.
 
     The yaw is yaw0 plus the signed revolute angles, equal to FK's yaw modulo 2 pi. A line between two
@@ -539,14 +539,14 @@ def joint_pose(robot: Robot, q: ArrayLike) -> np.ndarray:
     return pose
 
 
-def _elbow_sin(robot: Robot, q: np.ndarray) -> np.ndarray:
+def _elbow_sin(robot: RobotModel, q: np.ndarray) -> np.ndarray:
     """sin(gamma) of configurations (n, 4): > 0 on the right branch, < 0 on the left, 0 when singular."""
     geo = robot.kinematics.geometry
     return np.sin(geo.elbow_angle(q[..., geo.revolute[1]]))
 
 
 def cartesian_path(
-    robot: Robot,
+    robot: RobotModel,
     poses: Sequence[ArrayLike] | np.ndarray,
     *,
     start: ArrayLike | None = None,
@@ -658,7 +658,7 @@ class _Line:
 
 
 def follow_curve(
-    robot: Robot, branch: str, curve: PoseCurve, q_start: np.ndarray, m: int, segment: int = 0,
+    robot: RobotModel, branch: str, curve: PoseCurve, q_start: np.ndarray, m: int, segment: int = 0,
     extent: tuple[float, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Follow a tool-pose curve with the closed-form IK on one branch, continuously; checked densely.
@@ -699,7 +699,7 @@ def _at(curve: PoseCurve, s: float) -> np.ndarray:
 
 
 def _ik_step(
-    robot: Robot, branch: str, pose: np.ndarray, q_prev: np.ndarray
+    robot: RobotModel, branch: str, pose: np.ndarray, q_prev: np.ndarray
 ) -> tuple[np.ndarray | None, str, enum.IntEnum | None]:
     """The branch solution at ``pose`` nearest ``q_prev``, or None with the reason and the IK status."""
     res = robot.ik(pose, branch=branch, reference=q_prev)
@@ -716,7 +716,7 @@ def _ik_step(
     return q, "", None
 
 
-def _jump(robot: Robot, q: np.ndarray, q_prev: np.ndarray) -> str:
+def _jump(robot: RobotModel, q: np.ndarray, q_prev: np.ndarray) -> str:
     """Why q does not follow q_prev continuously, or '' if it does."""
     dq = np.abs(q - q_prev)
     j = int(np.argmax(dq))
@@ -730,7 +730,7 @@ def _jump(robot: Robot, q: np.ndarray, q_prev: np.ndarray) -> str:
     return f"{name} would jump from {q_prev[j]:.9g} to {q[j]:.9g}: the arm passes through the singularity"
 
 
-def _check_start(robot: Robot, pose: np.ndarray, q: np.ndarray, segment: int) -> None:
+def _check_start(robot: RobotModel, pose: np.ndarray, q: np.ndarray, segment: int) -> None:
     """Refuse a singular configuration at a segment's start."""
     if abs(float(_elbow_sin(robot, q))) < SINGULAR_TOL:
         raise PathError("the arm is at the stretched/folded singularity (sin(elbow) = 0): a straight line from "
@@ -738,7 +738,7 @@ def _check_start(robot: Robot, pose: np.ndarray, q: np.ndarray, segment: int) ->
 
 
 def _checkpoint(
-    robot: Robot, branch: str, curve: PoseCurve, segment: int, s0: float, s1: float, q0: np.ndarray
+    robot: RobotModel, branch: str, curve: PoseCurve, segment: int, s0: float, s1: float, q0: np.ndarray
 ) -> np.ndarray:
     """IK at s1 continuing q0 (at s0); on failure, locate it by bisection and raise :class:`PathError`."""
     q, _, _ = _ik_step(robot, branch, _at(curve, s1), q0)
@@ -749,7 +749,7 @@ def _checkpoint(
 
 
 def _fail(
-    robot: Robot,
+    robot: RobotModel,
     branch: str,
     curve: PoseCurve,
     segment: int,
@@ -774,7 +774,7 @@ def _fail(
 
 
 def _dense_check(
-    robot: Robot,
+    robot: RobotModel,
     branch: str,
     curve: PoseCurve,
     extent: tuple[float, float],

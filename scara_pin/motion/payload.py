@@ -11,7 +11,6 @@ returns a shallow copy whose ``model`` (and ``data``) are new; kinematics, limit
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -22,7 +21,7 @@ import pinocchio as pin
 from ..errors import ParameterError
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["Payload", "PayloadLike", "as_payload", "with_payload"]
 
@@ -79,8 +78,8 @@ def as_payload(payload: PayloadLike) -> Payload:
     return Payload(float(payload))
 
 
-def with_payload(robot: Robot, payload: PayloadLike) -> Robot:
-    """The robot carrying ``payload``: a shallow copy with a copied Pinocchio model (``robot`` is untouched).
+def with_payload(robot: RobotModel, payload: PayloadLike) -> RobotModel:
+    """The robot carrying ``payload``: rebuilt on a copy of its Pinocchio model (``robot`` is untouched).
 
     ``payload``: a :class:`Payload` or a mass [kg] (:func:`as_payload`). Without a payload (None or zero mass)
     the robot itself is returned.
@@ -93,7 +92,4 @@ def with_payload(robot: Robot, payload: PayloadLike) -> Robot:
     joint = frame.parentJoint
     added = frame.placement.act(pin.Inertia(payload.mass, np.array(payload.com), np.zeros((3, 3))))
     model.inertias[joint] = model.inertias[joint] + added
-    out = copy.copy(robot)
-    out.model = model
-    out.data = model.createData()
-    return out
+    return robot.with_model(model)

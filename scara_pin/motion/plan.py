@@ -37,7 +37,7 @@ from . import trajectory as tr
 if TYPE_CHECKING:
     from ..cell import Cell
     from ..description import JointLimits
-    from ..model import Robot
+    from ..model import RobotModel
     from ..units import DisplayUnits
     from .cycle import ArchMove
     from .jump import JumpMove
@@ -171,7 +171,7 @@ class MotionPlan(Summarized):
 
     trajectory: tr.Trajectory
     method: Method
-    robot: Robot
+    robot: RobotModel
     arch: ArchMove | JumpMove | None = None
     clearance: Clearance | None = None
 
@@ -181,7 +181,7 @@ class MotionPlan(Summarized):
         return head if self.arch is None else head + "\n" + self.arch.summary(units)
 
 
-def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
+def plan_motion(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     """Choose the method for ``request`` (see the module docstring) and make the trajectory.
 
     With a cell (``request.cell``) the jump plans around and over the obstacles; any other move is verified
@@ -201,7 +201,7 @@ def plan_motion(robot: Robot, request: MotionRequest) -> MotionPlan:
     return replace(plan, clearance=clear_of(robot, plan.trajectory, request.cell))
 
 
-def clear_of(robot: Robot, trajectory: tr.Trajectory, cell: Cell) -> Clearance | None:
+def clear_of(robot: RobotModel, trajectory: tr.Trajectory, cell: Cell) -> Clearance | None:
     """The smallest distance of ``cell``'s checked pairs along ``trajectory`` (the 10 kHz verifier's), or an error.
 
     Raises:
@@ -217,7 +217,7 @@ def clear_of(robot: Robot, trajectory: tr.Trajectory, cell: Cell) -> Clearance |
     return verify(robot, trajectory, scene=sc).check_clearance().clearance
 
 
-def _plan(robot: Robot, request: MotionRequest) -> MotionPlan:
+def _plan(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     if request.linear and robot.kind != "scara":
         raise InvalidInputError(f"a straight tool line (--linear) is SCARA-only for now; robot {robot.name!r} is a "
                                 f"{robot.kind} (joint-space --duration and TOPP-RA timing work)")  # fmt: skip
@@ -240,7 +240,7 @@ def _plan(robot: Robot, request: MotionRequest) -> MotionPlan:
     return _joint(robot, request)
 
 
-def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Trajectory:
+def _time_optimal(robot: RobotModel, path: object, request: MotionRequest) -> tr.Trajectory:
     if request.jerk is not None:
         from .jerk import time_optimal_jerk
 
@@ -253,7 +253,7 @@ def _time_optimal(robot: Robot, path: object, request: MotionRequest) -> tr.Traj
                         limits=request.limits)  # fmt: skip
 
 
-def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
+def _line(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     q_from, q_to = request.start_q, request.end_q
     first = request.start_pose if q_from is None else tr.joint_pose(robot, q_from)
     last = request.end_pose if q_to is None else tr.joint_pose(robot, q_to)
@@ -265,7 +265,7 @@ def _line(robot: Robot, request: MotionRequest) -> MotionPlan:
     return MotionPlan(_time_optimal(robot, path, request), method, robot)
 
 
-def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
+def _joint(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     vias = list(request.vias)
     q_from, q_to = request.start_q, request.end_q
     if q_from is None:
@@ -285,7 +285,7 @@ def _joint(robot: Robot, request: MotionRequest) -> MotionPlan:
     return MotionPlan(_time_optimal(robot, [q_from, *vias, q_to], request), method, robot)
 
 
-def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
+def _arch(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     from .cycle import STANDARD_RISE, arch_move
 
     first = request.start_pose if request.start_q is None else tr.joint_pose(robot, request.start_q)
@@ -300,7 +300,7 @@ def _arch(robot: Robot, request: MotionRequest) -> MotionPlan:
     return MotionPlan(move.trajectory, Method.ARCH, robot, move)
 
 
-def _jump(robot: Robot, request: MotionRequest) -> MotionPlan:
+def _jump(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     from .jump import STANDARD_CLEARANCE, STANDARD_RISE, jump_move
 
     first = request.start_pose if request.start_q is None else tr.joint_pose(robot, request.start_q)
@@ -314,7 +314,7 @@ def _jump(robot: Robot, request: MotionRequest) -> MotionPlan:
     return MotionPlan(move.trajectory, Method.JUMP, robot, move, move.distance)
 
 
-def _pose_to_q(robot: Robot, pose: np.ndarray | None, near: np.ndarray, what: str) -> np.ndarray:
+def _pose_to_q(robot: RobotModel, pose: np.ndarray | None, near: np.ndarray, what: str) -> np.ndarray:
     """The closed-form IK solution of ``pose`` nearest ``near``; an :class:`InfeasibleError` if none."""
     result = robot.ik(pose)
     best = result.nearest(near) if result.success else None

@@ -53,7 +53,7 @@ from ..limits import MAX_POINTS, MAX_POINTS_BYTES, check_input_file, read_text
 from ..units import number_text
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "FORMAT",
@@ -107,7 +107,7 @@ class TaughtPoint:
             object.__setattr__(self, "pose", _finite(f"point {self.name}: pose", self.pose, 4))
 
     @classmethod
-    def at(cls, robot: Robot, name: str, q: object) -> TaughtPoint:
+    def at(cls, robot: RobotModel, name: str, q: object) -> TaughtPoint:
         """The point ``name`` at joint values ``q`` of ``robot``, its pose from the robot's FK."""
         values = robot.check_q(q)
         return cls(name, values, np.asarray(robot.tool_pose(values), dtype=float))
@@ -192,11 +192,11 @@ class PointSet:
         self[name]  # noqa: B018 - raises naming the known points when there is none
         return replace(self, points=tuple(p for p in self.points if p.name != name))
 
-    def check(self, robot: Robot, origin: str = "points") -> None:
+    def check(self, robot: RobotModel, origin: str = "points") -> None:
         """Refuse points that do not fit ``robot``.
 
         Another joint count, a joint value the robot cannot take (beyond +/-1e6 rad or m:
-        :meth:`~scara_pin.model.Robot.check_q`), or a written pose that is not the FK of its q on this robot
+        :meth:`~scara_pin.model.RobotModel.check_q`), or a written pose that is not the FK of its q on this robot
         (beyond :data:`POSE_TOL`; the yaw compared modulo 2 pi). The joint limits are not checked here: a
         pendant shows such a point; a command that moves to it refuses it.
 
@@ -298,7 +298,7 @@ def points_format(path: str | Path) -> str:
     raise InvalidInputError(f"points file {path}: the name must end in .yaml, .yml or .csv (the format)")
 
 
-def read_points(path: str | Path, robot: Robot | None = None) -> PointSet:
+def read_points(path: str | Path, robot: RobotModel | None = None) -> PointSet:
     """Read a points file (YAML or CSV by its extension; see the module docstring).
 
     Args:

@@ -72,7 +72,7 @@ from .verify import (
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "LimitRatios",
@@ -201,7 +201,7 @@ class TimingResult:
 
 
 def time_optimal(
-    robot: Robot,
+    robot: RobotModel,
     path: GeometricPath | CartesianPath | Sequence[ArrayLike] | np.ndarray,
     *,
     tool_speed: float | None = None,
@@ -214,7 +214,7 @@ def time_optimal(
 
 
 def parameterize(
-    robot: Robot,
+    robot: RobotModel,
     path: GeometricPath | CartesianPath | Sequence[ArrayLike] | np.ndarray,
     *,
     tool_speed: float | None = None,
@@ -282,7 +282,7 @@ def _grid(path: GeometricPath, n: int) -> np.ndarray:
 
 
 def _time_segment(
-    robot: Robot, path: GeometricPath, lim: LimitsInForce, opts: TimingOptions, segment: int, t_start: float
+    robot: RobotModel, path: GeometricPath, lim: LimitsInForce, opts: TimingOptions, segment: int, t_start: float
 ) -> tuple[Motion, float, LimitRatios, int]:
     """Time one path segment that starts at ``t_start`` in the whole trajectory (for its 1 kHz grid)."""
     import toppra
@@ -401,7 +401,7 @@ def _precomputed_constraint(a: np.ndarray, b: np.ndarray, c: np.ndarray, F: np.n
 
 def _diagnose(
     code: str,
-    robot: Robot,
+    robot: RobotModel,
     grid: np.ndarray,
     B: np.ndarray,
     q: np.ndarray,
@@ -460,7 +460,7 @@ def _check_times(law: ProfileLaw, opts: TimingOptions, sub: bool, t_start: float
 
 
 def _check(
-    robot: Robot,
+    robot: RobotModel,
     motion: Motion,
     law: ProfileLaw,
     lim: LimitsInForce,
@@ -533,7 +533,7 @@ def _polynomial_extremes(path: GeometricPath, law: ProfileLaw) -> tuple[np.ndarr
 
 
 def limit_ratios(
-    robot: Robot,
+    robot: RobotModel,
     trajectory: Trajectory,
     *,
     rate: float = 1000.0,

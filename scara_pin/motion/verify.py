@@ -68,7 +68,7 @@ from .trajectory import Motion, Trajectory
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..cell import Scene
-    from ..model import Robot
+    from ..model import RobotModel
     from ..units import DisplayUnits
 
 __all__ = [
@@ -326,7 +326,8 @@ class LimitsInForce:
     tool_speed: float | None
 
 
-def limits_in_force(robot: Robot, limits: JointLimits | None, tool_speed: float | None, torque: bool) -> LimitsInForce:
+def limits_in_force(robot: RobotModel, limits: JointLimits | None, tool_speed: float | None,
+                    torque: bool) -> LimitsInForce:  # fmt: skip
     """The limits in force, each refused when NaN, zero, negative or infinite."""
     lim = robot.limits if limits is None else limits
     names = robot.joint_names
@@ -354,12 +355,12 @@ def jerk_vector(jerk: float | ArrayLike, dof: int = 4) -> np.ndarray:
     return jv
 
 
-def tool_speeds(robot: Robot, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
+def tool_speeds(robot: RobotModel, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
     """|J_xyz(q) dq| per row."""
     return np.array([np.linalg.norm(robot.task_jacobian(q[k])[:3] @ dq[k]) for k in range(len(q))])
 
 
-def joint_torques(robot: Robot, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+def joint_torques(robot: RobotModel, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
     """Joint efforts (n, dof) by Pinocchio's RNEA, gravity included, row by row."""
     model = robot.model
     data = model.createData()
@@ -378,7 +379,7 @@ class JointStates(NamedTuple):
 
 
 def state_ratios(
-    robot: Robot, lim: LimitsInForce, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
+    robot: RobotModel, lim: LimitsInForce, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
 ) -> dict[Quantity, np.ndarray]:
     """|value| / limit per sample (rows) and joint (columns; one column for the tool speed), per quantity.
 
@@ -389,7 +390,7 @@ def state_ratios(
 
 
 def _ratios(
-    robot: Robot, lim: LimitsInForce, states: JointStates, jerk: np.ndarray | None
+    robot: RobotModel, lim: LimitsInForce, states: JointStates, jerk: np.ndarray | None
 ) -> tuple[dict[Quantity, np.ndarray], np.ndarray | None]:
     """(:func:`state_ratios`, the efforts or None)."""
     q, qd, qdd, qddd = states
@@ -446,13 +447,13 @@ def static_overload(
     return StaticOverload(int(i), int(j), float(g[i, j]), float(effort[j]), names)
 
 
-def static_load(robot: Robot, q: np.ndarray) -> np.ndarray:
+def static_load(robot: RobotModel, q: np.ndarray) -> np.ndarray:
     """g(q) (n, dof): the joint efforts that hold the robot still (RNEA at rest, gravity and payload)."""
     zero = np.zeros_like(q)
     return joint_torques(robot, q, zero, zero)
 
 
-def static_payload(robot: Robot, q: np.ndarray, limits: JointLimits | None = None) -> float:
+def static_payload(robot: RobotModel, q: np.ndarray, limits: JointLimits | None = None) -> float:
     """The largest point mass [kg] at the tool frame's origin that the effort limits hold at rest at every row of q.
 
     The static load is linear in the mass: ``g(q; m) = g0(q) + m g1(q)`` (``g1`` the load of 1 kg, the
@@ -477,7 +478,7 @@ def static_payload(robot: Robot, q: np.ndarray, limits: JointLimits | None = Non
     return max(0.0, float(room.min()))
 
 
-def torque_coefficients(robot: Robot, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, ...]:
+def torque_coefficients(robot: RobotModel, q: np.ndarray, d1: np.ndarray, d2: np.ndarray) -> tuple[np.ndarray, ...]:
     """(a, b, g), each (n, dof), of the joint efforts along a path: tau = a(s) sdd + b(s) sd^2 + g(s).
 
     With q' = d1 and q'' = d2 at the points q: qd = q' sd and qdd = q' sdd + q'' sd^2 in the rigid-body
@@ -490,7 +491,7 @@ def torque_coefficients(robot: Robot, q: np.ndarray, d1: np.ndarray, d2: np.ndar
 
 
 def time_scale(
-    robot: Robot, lim: LimitsInForce, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
+    robot: RobotModel, lim: LimitsInForce, states: JointStates | tuple[Any, ...], jerk: np.ndarray | None = None
 ) -> tuple[float, dict[Quantity, float]]:
     """(k, worst ratios): the time scale k that brings the worst ratio of these states to exactly 1.
 
@@ -645,7 +646,7 @@ class _Worst:
 
 
 def verify(
-    robot: Robot,
+    robot: RobotModel,
     trajectory: Trajectory,
     *,
     limits: JointLimits | None = None,

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from ..cell import Cell
     from ..cell.shapes import Shape
     from ..description import JointLimits
-    from ..model import Robot
+    from ..model import RobotModel
     from ..motion.cycle import ArchMove, CycleResult
     from ..motion.jump import JumpMove
     from ..motion.trajectory import Trajectory
@@ -38,7 +38,7 @@ def plot_cycle(
     result: CycleResult | ArchMove | JumpMove,
     path: str | os.PathLike[str] | None = None,
     *,
-    robot: Robot,
+    robot: RobotModel,
     units: DisplayUnits = SI,
     limits: JointLimits | None = None,
     title: str | None = None,

@@ -26,7 +26,7 @@ from ..limits import MAX_FRAMES, check_count
 from ..summary import Summarized
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
     from ..motion.trajectory import Trajectory
 
 __all__ = ["SceneView", "show", "workspace_polylines"]
@@ -66,7 +66,7 @@ class SceneView(Summarized):
         return Path(path)
 
 
-def workspace_polylines(robot: Robot) -> list[np.ndarray]:
+def workspace_polylines(robot: RobotModel) -> list[np.ndarray]:
     """The workspace boundary as the viewer draws it.
 
     A SCARA's boundary arcs on the floor ((M, 2) arrays of x, y [m]); a palletizer's envelope in 3-D ((M, 3)
@@ -81,7 +81,7 @@ def workspace_polylines(robot: Robot) -> list[np.ndarray]:
 
 
 def show(
-    robot: Robot,
+    robot: RobotModel,
     q: Any = None,
     *,
     trajectory: Trajectory | None = None,

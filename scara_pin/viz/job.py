@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 
     from ..cell import Shape
     from ..job.results import JobResult
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["BOX_COLOR", "CARRYING_COLOR", "EMPTY_COLOR", "KIND_COLORS", "OBSTACLE_COLOR", "job_page", "plot_job"]
 
@@ -56,7 +56,7 @@ _PAGE_BOX = (0.85, 0.63, 0.40)
 """The boxes on the page (cardboard, as :data:`BOX_COLOR`), RGB in [0, 1]."""
 
 
-def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, robot: Robot,
+def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, robot: RobotModel,
              units: DisplayUnits = SI, title: str | None = None) -> Figure:  # fmt: skip
     """The timeline of a planned job (module docstring); written to ``path`` (PNG, SVG, PDF) when given.
 
@@ -124,7 +124,7 @@ def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, r
     return finish(fig, path)
 
 
-def _tool_path(result: JobResult, robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+def _tool_path(result: JobResult, robot: RobotModel) -> tuple[np.ndarray, np.ndarray]:
     """(poses (n, 4) of the tool, carrying (n,) bool) every 1 / :data:`_PATH_RATE` s and at every step's ends."""
     traj = result.trajectory
     T = traj.duration
@@ -139,7 +139,7 @@ def _tool_path(result: JobResult, robot: Robot) -> tuple[np.ndarray, np.ndarray]
     return poses, carrying
 
 
-def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: Robot) -> None:
+def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) -> None:
     """The plan and side views of the job: obstacles, boxes placed (numbered), the tool path by gripper state."""
     from matplotlib.patches import Polygon, Rectangle
 
@@ -199,7 +199,7 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: Robot) -> None
 
 
 # ---------------------------------------------------------------------------------------------- the page
-def job_page(result: JobResult, robot: Robot, path: str | os.PathLike[str], *, rate: float = 200.0) -> None:
+def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str], *, rate: float = 200.0) -> None:
     """The viewer page that plays the job: the cell, the part on the tool while held, each box once placed.
 
     The cell is drawn by :func:`~scara_pin.viz.meshcat.draw_cell` (the job's obstacles, the boxes placed, the

@@ -60,7 +60,7 @@ from .page import SHARE_GEOMETRY
 if TYPE_CHECKING:
     from ..cell import Cell
     from ..cell.shapes import Shape
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "CARRIED_COLOR",
@@ -119,7 +119,7 @@ def _meshcat() -> Any:
     return meshcat
 
 
-def _tree_visualizer(robot: Robot, paths: list[str]) -> Any:
+def _tree_visualizer(robot: RobotModel, paths: list[str]) -> Any:
     """Pinocchio's ``MeshcatVisualizer`` (its geometry and mesh loaders), with tree node names.
 
     Each geometry's node is under its joint's node of the scene tree (``<joint path>/visuals/<geometry>``),
@@ -181,7 +181,7 @@ def _points(name: str, value: object, dim: int) -> np.ndarray:
     return arr
 
 
-def _motion(robot: Robot, times: object, qs: object, rate: float = _DEFAULT_FPS) -> tuple[np.ndarray, np.ndarray]:
+def _motion(robot: RobotModel, times: object, qs: object, rate: float = _DEFAULT_FPS) -> tuple[np.ndarray, np.ndarray]:
     """Check a sampled motion: (N,) strictly increasing finite times [s] and (N, dof) joint values.
 
     ``times`` may be a :class:`~scara_pin.motion.trajectory.Trajectory` instead (``qs`` None): it is sampled at
@@ -241,7 +241,7 @@ def read_trajectory_csv(path: str | os.PathLike[str], dof: int = 4) -> tuple[np.
     return table[:, 0], table[:, 1:]
 
 
-def tool_path(robot: Robot, qs: object) -> np.ndarray:
+def tool_path(robot: RobotModel, qs: object) -> np.ndarray:
     """(N, 3) positions of the tool frame in the base frame [m] along the joint values ``qs`` (N, 4)."""
     q = np.array(qs, dtype=float)
     if q.ndim != 2 or q.shape[1] != robot.dof:
@@ -559,7 +559,7 @@ _STAND_IN = (np.eye(3, dtype=np.float32) * PLACEHOLDER_SIZE, np.array([[0, 1, 2]
 """The one triangle a sharing visual's object holds until the page gives it the shared geometry."""
 
 
-def _draw_meshes(vis: Any, robot: Robot, viz: Any, share: bool) -> None:
+def _draw_meshes(vis: Any, robot: RobotModel, viz: Any, share: bool) -> None:
     """Set each readable mesh of the robot's visuals (:func:`scara_pin.cell.meshes.visual_meshes`) on its node.
 
     The scene drew a placeholder box for each mesh at the geometry's node (``viz.getViewerNodeName``, under
@@ -614,7 +614,7 @@ class _Scene:
     nodes' transforms only. The floor grid lies at z = 0 of the root link; the camera frames the workspace.
     """
 
-    def __init__(self, robot: Robot, window: _Window) -> None:
+    def __init__(self, robot: RobotModel, window: _Window) -> None:
         from ..cell.meshes import check_visual_count
         from .tree import framing, joint_nodes, node_paths
 
@@ -861,7 +861,7 @@ def _scene(
 
 
 def static_html(
-    robot: Robot,
+    robot: RobotModel,
     q: object | None = None,
     times: object | None = None,
     qs: object | None = None,
@@ -886,7 +886,7 @@ def static_html(
 
 
 def export_html(
-    robot: Robot,
+    robot: RobotModel,
     path: str | os.PathLike[str],
     q: object | None = None,
     times: object | None = None,
@@ -1002,12 +1002,12 @@ class Viewer:
         robot: the robot shown.
     """
 
-    robot: Robot
+    robot: RobotModel
     DEFAULT_TIMEOUT: ClassVar[float] = 20.0
 
     def __init__(
         self,
-        robot: Robot,
+        robot: RobotModel,
         open: bool = False,  # noqa: A002 - the name the command line uses (--open)
         *,
         zmq_url: str | None = None,

@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "COLORS",
@@ -91,7 +91,7 @@ def quantity_label(what: str, kind: str, units: DisplayUnits = SI, order: int = 
     return f"{what} [{rate_unit(units.name(kind), order)}]"
 
 
-def joint_kinds(robot: Robot | None, dof: int) -> tuple[str, ...]:
+def joint_kinds(robot: RobotModel | None, dof: int) -> tuple[str, ...]:
     """What each joint value measures (the robot's own; without one, a SCARA's: the third joint a length)."""
     return robot.joint_kinds if robot is not None else _DEFAULT_KINDS[:dof]
 
@@ -139,7 +139,7 @@ def plot_trajectory(
     trajectory: Trajectory,
     path: str | os.PathLike[str] | None = None,
     *,
-    robot: Robot | None = None,
+    robot: RobotModel | None = None,
     limits: JointLimits | None = None,
     units: DisplayUnits = SI,
     law: str | None = None,
@@ -232,7 +232,7 @@ def plot_trajectory(
     return finish(fig, path, dpi)
 
 
-def _tool_panels(fig: Figure, grid: Any, robot: Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
+def _tool_panels(fig: Figure, grid: Any, robot: RobotModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
                  units: DisplayUnits, tool_speed: float | None) -> None:  # fmt: skip
     """The tool path in plan view (with a SCARA's reach circles) and side view, and the tool speed."""
     from ..motion.timing import tool_speeds

@@ -62,7 +62,7 @@ from ..motion.points import PointSet, TaughtPoint, points_format, read_points, w
 
 if TYPE_CHECKING:
     from ..cell import Cell, PairDistance, Scene
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "CONTROL_PERIOD",
@@ -223,7 +223,7 @@ class TeachSession:
         session.save_points("cell.yaml")
     """
 
-    def __init__(self, robot: Robot, q: object | None = None, *, points_file: str | Path | None = None,
+    def __init__(self, robot: RobotModel, q: object | None = None, *, points_file: str | Path | None = None,
                  cell: Cell | None = None) -> None:  # fmt: skip
         """Start at ``q`` (default: zero), which must be inside the joint limits (and clear of the cell).
 
@@ -607,7 +607,7 @@ class TeachSession:
         return JogMotion(int(sense), axis=axis, frame=frame)
 
 
-def _cell_scene(robot: Robot, cell: Cell) -> Scene:
+def _cell_scene(robot: RobotModel, cell: Cell) -> Scene:
     """The scene of ``robot`` in ``cell`` for the pendant.
 
     A 4-joint SCARA whose closed form takes its model: its Cartesian jogs are followed as straight tool lines by
@@ -660,7 +660,7 @@ class TeachServer:
         url: the page's address.
     """
 
-    def __init__(self, robot: Robot, port: int = 0, q: object | None = None, *,
+    def __init__(self, robot: RobotModel, port: int = 0, q: object | None = None, *,
                  points_file: str | Path | None = None, controls: bool = False, cell: Cell | None = None,
                  ) -> None:  # fmt: skip
         """Build the page and listen on 127.0.0.1:``port`` (0: a free port).
@@ -832,7 +832,7 @@ def _cell_words(cell: Cell) -> str:
             f"stops {cell.margin:g} m from them (the margin)")
 
 
-def _teach_page(robot: Robot, session: TeachSession, controls: bool = False) -> str:
+def _teach_page(robot: RobotModel, session: TeachSession, controls: bool = False) -> str:
     """The pendant page of the live teach server (no motion player; a ``teach`` section)."""
     from .meshcat import _page, _Scene, _Window, draw_cell
 

@@ -25,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["Framing", "JointNode", "framing", "joint_nodes", "node_paths"]
 
@@ -73,7 +73,7 @@ class JointNode:
         return pin.SE3(np.array(self.placement)) * motion
 
 
-def node_paths(robot: Robot, root: str) -> list[str]:
+def node_paths(robot: RobotModel, root: str) -> list[str]:
     """The scene path of every Pinocchio joint (index 0, the universe, is ``root``)."""
     model = robot.model
     paths = [root]
@@ -82,7 +82,7 @@ def node_paths(robot: Robot, root: str) -> list[str]:
     return paths
 
 
-def joint_nodes(robot: Robot, root: str) -> tuple[JointNode, ...]:
+def joint_nodes(robot: RobotModel, root: str) -> tuple[JointNode, ...]:
     """The joints of ``robot`` as scene nodes, in Pinocchio's order (parents before children)."""
     model = robot.model
     data = model.createData()
@@ -170,7 +170,7 @@ def _nice(value: float) -> float:
     return 10.0 ** (exponent + 1)  # pragma: no cover - the loop always returns
 
 
-def framing(robot: Robot, samples: int = 5) -> Framing:
+def framing(robot: RobotModel, samples: int = 5) -> Framing:
     """Frame the robot's whole workspace: the box of every frame's origin over a grid of joint values.
 
     ``samples`` values per joint over its range (a continuous joint: one turn), ``samples**4`` configurations.

@@ -19,7 +19,7 @@ from .scara import (
 )
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import RobotModel
     from .palletizer import ArmPlaneEnvelope
 
 __all__ = [
@@ -37,7 +37,7 @@ __all__ = [
 ]
 
 
-def workspace_of(robot: Robot, **kwargs: Any) -> Workspace | ArmPlaneEnvelope:
+def workspace_of(robot: RobotModel, **kwargs: Any) -> Workspace | ArmPlaneEnvelope:
     """The reachable region of a robot, by its kind.
 
     A SCARA (4 or 3 joints): its exact plan-view region (:func:`~scara_pin.workspace.scara.workspace`,

@@ -8,7 +8,7 @@ links sweep over obstacles of any shape), so it is sampled:
 - a square grid in the base frame's plan, of spacing ``h`` (the resolution), its points at the centres of the
   grid's squares, covering the workspace's outline;
 - at each point (x, y) and the height z, every IK branch (right and left elbow) whose solution is inside the
-  joint limits (the closed form, :meth:`Robot.ik_batch <scara_pin.model.Robot.ik_batch>`), and the yaws below;
+  joint limits (the closed form, :meth:`Robot.ik_batch <scara_pin.model.RobotModel.ik_batch>`), and the yaws below;
 - a point is REACHABLE when some branch and yaw has a solution, FREE when some branch and yaw is also clear of
   the cell: every checked pair at least the margin apart (:func:`scara_pin.cell.sweep.clear_mask`: coal's
   distances, bounding spheres first).
@@ -41,7 +41,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from ..cell import Cell
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = ["DEFAULT_POINTS", "YAW_SAMPLES", "FreeRegion", "free_region", "plot_free_region"]
 
@@ -112,7 +112,7 @@ class FreeRegion:
 
 
 def free_region(
-    robot: Robot,
+    robot: RobotModel,
     cell: Cell,
     z: float,
     *,

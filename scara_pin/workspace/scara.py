@@ -76,7 +76,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from .._typing import ArrayLike
-    from ..model import Robot
+    from ..model import RobotModel
 
 __all__ = [
     "EDGE_TOL",
@@ -500,7 +500,7 @@ class Workspace(Summarized):
 
 # ------------------------------------------------------------------------------------------ building
 def workspace(
-    robot: Robot | ScaraGeometry,
+    robot: RobotModel | ScaraGeometry,
     *,
     lower: Sequence[float] | None = None,
     upper: Sequence[float] | None = None,
@@ -509,7 +509,7 @@ def workspace(
     """Build the exact workspace of a robot.
 
     Args:
-        robot: a :class:`~scara_pin.model.Robot` or its :class:`~scara_pin.kinematics.scara.ScaraGeometry`
+        robot: a :class:`~scara_pin.model.RobotModel` or its :class:`~scara_pin.kinematics.scara.ScaraGeometry`
             (a 3-joint SCARA: the region of its tool point; ``lower``/``upper`` then take 3 values, no yaw).
         lower: lower joint limits in q order replacing the model's (e.g. a software range) [rad, m].
         upper: upper joint limits in q order replacing the model's [rad, m].

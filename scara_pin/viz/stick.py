@@ -18,14 +18,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
-from .errors import ParameterError
-from .units import SI, DisplayUnits
+from ..errors import ParameterError
+from ..units import SI, DisplayUnits
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from .model import Robot
+    from ..model import RobotModel
 
 __all__ = ["STICK_GID", "TOOL_GID", "plot_robot", "stick_points"]
 
@@ -36,7 +36,7 @@ TOOL_GID = "tool-triad"
 _VIEWS = ("3d", "top", "side")
 
 
-def stick_points(robot: Robot, q: object) -> np.ndarray:
+def stick_points(robot: RobotModel, q: object) -> np.ndarray:
     """(K, 3) points of the stick figure at ``q``, in the base frame [m].
 
     The base origin, the origin of each joint of the tool's chain (root to tip), the tool frame's origin.
@@ -53,7 +53,7 @@ def stick_points(robot: Robot, q: object) -> np.ndarray:
 
 
 def plot_robot(
-    robot: Robot,
+    robot: RobotModel,
     q: object = None,
     path: str | os.PathLike[str] | None = None,
     *,
@@ -81,7 +81,7 @@ def plot_robot(
     Raises:
         ParameterError: a ``q`` that is not ``robot.dof`` finite numbers, or an unknown ``view``.
     """
-    from .files import save_figure
+    from ..files import save_figure
 
     if view not in _VIEWS:
         raise ParameterError("view", view, f"must be one of {', '.join(_VIEWS)}")
