@@ -41,6 +41,7 @@ from scara_pin.kinematics.palletizer import (
     to_s2,
     wrist_pitch,
 )
+from scara_pin.kinematics.palletizer_model import read as read_palletizer
 from scara_pin.kinematics.results import IKResult
 from scara_pin.kinematics.validate import validate_ik
 from scara_pin.workspace import workspace_of
@@ -378,13 +379,13 @@ def test_geometry_is_read_from_the_model() -> None:
     """The palletizer's geometry comes from its URDF (FK probes), as the SCARA's: the yaml values come back."""
     v = load_robot("palletizer").parameters.values  # the independent route: the yaml the URDF was made from
     for robot in (load_robot("palletizer"), load_urdf(GOLDEN)):  # a URDF file as well: no yaml needed
-        geo = PalletizerGeometry.from_robot(robot)
+        geo = read_palletizer(robot)
         assert geo.a2 == pytest.approx(v["a2"], abs=1e-12) and geo.a3 == pytest.approx(v["a3"], abs=1e-12)
         assert geo.r0 == pytest.approx(v["a1"] + v["a4"], abs=1e-12)
         assert geo.h0 == pytest.approx(v["d1"] + v["d2"] + v["d5"], abs=1e-12)
         assert geo.shoulder == pytest.approx((v["a1"], v["d1"] + v["d2"]), abs=1e-12)
     with pytest.raises(NotPalletizerError, match="not a palletizer"):
-        PalletizerGeometry.from_robot(load_robot("default"))  # a SCARA's joint 2 turns about z
+        read_palletizer(load_robot("default"))  # a SCARA's joint 2 turns about z
 
 
 def test_geometric_ik_agrees_with_numeric_ik(robot: Robot) -> None:

@@ -25,7 +25,7 @@ in S2's coordinates, the *canonical* ``t = (phi, q2, theta3, q4)`` (``theta3`` r
 ``q`` turned and shifted: ``t_i = s_i q_i + c_i`` (``signs`` +/-1, ``offsets``; q4's offset is in
 ``tool_yaw``). Limits, turns and references map the same way, so every formula below is S2's.
 
-The geometry is read from the loaded Pinocchio model (:mod:`scara_pin.kinematics.palletizer_model`), as
+The geometry is read from the loaded Pinocchio model (:func:`scara_pin.kinematics.palletizer_model.read`), as
 the SCARA's is: the tool's path in the arm plane as each arm joint turns gives r0 = a1 + a4,
 h0 = d1 + d2 + d5, a2, a3, the signs and zero offsets, and whether the third joint is relative; the closed
 form is then checked against the model at random configurations.
@@ -72,7 +72,6 @@ from .targets import batch_inputs, parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..model import RobotModel
 
 __all__ = [
     "BRANCHES",
@@ -173,18 +172,6 @@ class PalletizerGeometry:
             if getattr(self, name) <= 0:
                 raise ParameterError(name, getattr(self, name), "must be > 0")
         object.__setattr__(self, "arm", Planar2R(self.a2, self.a3))
-
-    @classmethod
-    def from_robot(cls, robot: RobotModel) -> PalletizerGeometry:
-        """Read the geometry from the robot's Pinocchio model (:func:`scara_pin.kinematics.palletizer_model.read`).
-
-        Raises:
-            NotPalletizerError: the model does not follow the closed form (checked at 8 seeded random
-                configurations to FK_TOL), or one of its arms has no length.
-        """
-        from .palletizer_model import read
-
-        return read(robot)
 
     def canonical(self, q: Sequence[float] | np.ndarray) -> list[float]:
         """The file's ``q`` in canonical coordinates ``t`` (module docstring)."""

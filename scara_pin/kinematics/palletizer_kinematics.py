@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import palletizer
+from .palletizer_model import read
 from .results import BatchIKResult, IKResult
 
 if TYPE_CHECKING:
@@ -40,7 +41,7 @@ class PalletizerKinematics:
     @classmethod
     def from_robot(cls, robot: RobotModel) -> PalletizerKinematics:
         """Read the geometry from the robot's model; NotPalletizerError says where it departs."""
-        return cls(palletizer.PalletizerGeometry.from_robot(robot))
+        return cls(read(robot))
 
     def solve(self, target: Any, *, branch: str = "all", reference: ArrayLike | None = None,
               all_turns: bool = False) -> IKResult:  # fmt: skip
