@@ -774,7 +774,7 @@ def standard_cycle(
         used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
         bound = _lines_bound(robot, move, a, b, rise, limits, jerk)
         if cell is not None:
-            from .plan import clear_of
+            from .verify import clear_of
 
             move = replace(move, distance=clear_of(robot, move.trajectory, cell))
     if wmin != wmin:  # the smallest manipulability along the traverse of the given placement

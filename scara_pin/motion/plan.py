@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     from .payload import Payload, PayloadLike
     from .verify import Clearance
 
-__all__ = ["Method", "MotionPlan", "MotionRequest", "clear_of", "plan_motion"]
+__all__ = ["Method", "MotionPlan", "MotionRequest", "plan_motion"]
 
 class Method(enum.Enum):
     """How a move is made; the value is the sentence ``scara-pin traj`` prints."""
@@ -185,7 +185,7 @@ def plan_motion(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     """Choose the method for ``request`` (see the module docstring) and make the trajectory.
 
     With a cell (``request.cell``) the jump plans around and over the obstacles; any other move is verified
-    against the cell (:func:`clear_of`) and refused if it comes closer than the margin.
+    against the cell (:func:`~scara_pin.motion.verify.clear_of`) and refused if it comes closer than the margin.
 
     Raises:
         InvalidInputError: a straight line or an arch asked of a robot other than a SCARA, an arch with
@@ -198,23 +198,9 @@ def plan_motion(robot: RobotModel, request: MotionRequest) -> MotionPlan:
         return plan
     from dataclasses import replace
 
+    from .verify import clear_of
+
     return replace(plan, clearance=clear_of(robot, plan.trajectory, request.cell))
-
-
-def clear_of(robot: RobotModel, trajectory: tr.Trajectory, cell: Cell) -> Clearance | None:
-    """The smallest distance of ``cell``'s checked pairs along ``trajectory`` (the 10 kHz verifier's), or an error.
-
-    Raises:
-        InCollisionError: the start or the end is closer than the margin (exit 2, naming the pair).
-        LimitViolation: the path comes closer than the margin (exit 3, naming the pair, when and where).
-    """
-    from ..cell import scene
-    from .verify import verify
-
-    sc = scene(robot, cell)
-    sc.check(trajectory.q_start, "the start")
-    sc.check(trajectory.q_end, "the end")
-    return verify(robot, trajectory, scene=sc).check_clearance().clearance
 
 
 def _plan(robot: RobotModel, request: MotionRequest) -> MotionPlan:

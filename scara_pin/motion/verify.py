@@ -67,7 +67,7 @@ from .trajectory import Motion, Trajectory
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
-    from ..cell import Scene
+    from ..cell import Cell, Scene
     from ..model import RobotModel
     from ..units import DisplayUnits
 
@@ -85,6 +85,7 @@ __all__ = [
     "StaticOverload",
     "Verification",
     "Worst",
+    "clear_of",
     "jerk_vector",
     "joint_jerk",
     "motion_states",
@@ -750,6 +751,21 @@ def verify(
     return Verification(T, rate, len(times), v, a, worst.get(Quantity.JERK), worst.get(Quantity.JERK_DIFFERENCES),
                         floor, worst.get(Quantity.TORQUE), worst.get(Quantity.TOOL_SPEED), start_err, end_err,
                         rest, clearance)  # fmt: skip
+
+
+def clear_of(robot: RobotModel, trajectory: Trajectory, cell: Cell) -> Clearance | None:
+    """The smallest distance of ``cell``'s checked pairs along ``trajectory`` (the 10 kHz verifier's), or an error.
+
+    Raises:
+        InCollisionError: the start or the end is closer than the margin (exit 2, naming the pair).
+        LimitViolation: the path comes closer than the margin (exit 3, naming the pair, when and where).
+    """
+    from ..cell import scene
+
+    sc = scene(robot, cell)
+    sc.check(trajectory.q_start, "the start")
+    sc.check(trajectory.q_end, "the end")
+    return verify(robot, trajectory, scene=sc).check_clearance().clearance
 
 
 def _analytic_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
