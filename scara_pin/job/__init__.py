@@ -7,10 +7,12 @@ with the package's planners, each verified at 10 kHz, in the job's cell with the
 ``Job.load(path).plan(robot)`` gives the table, the total and the trajectory.
 """
 
-from .loading import FORMAT, Carry, Job, load_job
+from .job import Job, load_job
+from .loading import FORMAT, read_job
 from .pallets import Order, Pallet
 from .planning import PlannedMove, Planner, Source, plan_job, plan_move, scaled_limits
 from .results import JobResult, PlacedBox, PlanningStats, StepResult
+from .spec import Carry, JobSpec
 from .steps import Dwell, Grip, GripKind, JumpShape, Move, MoveKind, Program, Target, parse_target
 
 __all__ = [
@@ -20,6 +22,7 @@ __all__ = [
     "Grip",
     "GripKind",
     "Job",
+    "JobSpec",
     "JobResult",
     "JumpShape",
     "Move",
@@ -35,6 +38,7 @@ __all__ = [
     "StepResult",
     "Target",
     "load_job",
+    "read_job",
     "parse_target",
     "plan_job",
     "plan_move",

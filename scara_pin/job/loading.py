@@ -45,17 +45,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import Any, NoReturn
 
-import numpy as np
-
-from ..errors import InvalidInputError, JobFileError, ScaraError
+from ..errors import InvalidInputError, JobFileError
 from ..limits import MAX_DOCUMENT_BYTES, MAX_JOB_BYTES, MAX_JOB_DEPTH, MAX_JOB_STEPS, check_input_file, read_text
 from ..motion.payload import Payload
 from ..motion.points import PointSet, check_point_name, read_points
 from .pallets import Order, Pallet
+from .spec import Carry, JobSpec
 from .steps import (
     VARIABLE,
     Dwell,
@@ -65,23 +64,15 @@ from .steps import (
     Loop,
     MotionStep,
     MoveKind,
-    Program,
     Setting,
     Step,
     Target,
     check_grips,
-    expand,
-    located,
     parse_target,
     tally,
 )
 
-if TYPE_CHECKING:
-    from ..cell import Shape
-    from ..model import RobotModel
-    from .results import JobResult
-
-__all__ = ["FORMAT", "Carry", "Job", "load_job"]
+__all__ = ["FORMAT", "read_job"]
 
 FORMAT = "scara-pin job 1"
 """The ``format:`` value of a job file."""
@@ -90,43 +81,6 @@ _KEYS = ("format", "robot", "points", "start", "jump", "torque", "payload", "cel
 _PALLET_KEYS = ("corners", "rows", "columns", "layers", "layer_height")
 _JUMP_KEYS = ("rise", "clearance_radius", "max_height")
 _STEP_KINDS = "speed, accel, jump, move, go, dwell, pick, place, for"
-
-
-@dataclass(frozen=True)
-class Carry:
-    """The part the tool holds between a ``pick`` and a ``place``, in the tool frame (docs/job.md).
-
-    ``tool0``'s z axis points out of the flange (down): a box hanging under the flange has a positive z. By
-    default the box's top face is on the flange face (``xyz = (0, 0, size_z / 2)``); a gripper between them
-    is not modelled, and its height is the part's z beyond that (the flange must stay the margin away from
-    the box it has just left).
-
-    Attributes:
-        shape: ``"box"``.
-        size: [m] its edges along the tool frame's x, y, z.
-        xyz: [m] its centre in the tool frame.
-        rpy: [rad] its orientation in the tool frame (URDF's roll, pitch, yaw).
-    """
-
-    shape: str
-    size: tuple[float, float, float]
-    xyz: tuple[float, float, float] | None = None
-    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-    def __post_init__(self) -> None:
-        if self.xyz is None:
-            object.__setattr__(self, "xyz", (0.0, 0.0, self.size[2] / 2.0))
-
-    def part(self) -> Shape:
-        """The part as a cell's shape, placed in the tool frame (:class:`~scara_pin.cell.Shape`)."""
-        from ..cell import Shape
-
-        return Shape(self.shape, self.size, np.array(self.xyz, dtype=float), np.array(self.rpy, dtype=float),
-                     what="the carried part")  # fmt: skip
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready (SI)."""
-        return {"shape": self.shape, "size": list(self.size), "xyz": list(self.xyz or ()), "rpy": list(self.rpy)}
 
 
 class _At:
@@ -194,76 +148,10 @@ def _shown(value: object) -> str:
     return text if len(text) <= 40 else text[:40] + "..."
 
 
-@dataclass(frozen=True, eq=False)
-class Job:
-    """A job: taught points, pallets and steps, checked (module docstring). :meth:`load` reads one.
-
-    Attributes:
-        path: the job file.
-        points_file: the points file (resolved relative to the job file).
-        points: the taught points.
-        pallets: the pallets by name.
-        steps: the steps.
-        robot: the robot's name the job is for, or None.
-        start: where the robot is when the job begins, or None (the first move's target).
-        jump: every jump's clearance unless a step overrides it.
-        torque: respect the effort limits too.
-        payload: the payload carried (for the torques).
-        cell: the cell file (obstacles), or None.
-        carry: what the tool carries, or None.
-        actions: the number of moves and dwells the steps expand to.
-        dwell: [s] the time of all its dwells: a lower bound of its total, known before any planning.
-        lines: the line of each top-level key, and of each pallet (``"pallets.NAME"``).
-    """
-
-    path: Path
-    points_file: Path
-    points: PointSet
-    pallets: Mapping[str, Pallet]
-    steps: tuple[Step, ...]
-    robot: str | None = None
-    start: Target | None = None
-    jump: JumpShape = field(default_factory=JumpShape)
-    torque: bool = False
-    payload: Payload = field(default_factory=Payload)
-    cell: Path | None = None
-    carry: Carry | None = None
-    actions: int = 0
-    dwell: float = 0.0
-    lines: Mapping[str, int | None] = field(default_factory=dict)
-
-    @classmethod
-    def load(cls, path: str | Path) -> Job:
-        """Read and check a job file (:func:`load_job`)."""
-        return load_job(path)
-
-    def program(self, robot: RobotModel) -> Program:
-        """The job for ``robot``, expanded (:func:`~scara_pin.job.steps.expand`), every target resolved.
-
-        Raises:
-            JobFileError: another robot, points that do not fit it, collinear corners (exit 2).
-            JobStepError: a place out of reach (exit 3).
-        """
-        if self.robot is not None and self.robot != robot.name:
-            raise JobFileError(self.path, self.lines.get("robot"), f"the job is for robot {self.robot!r}; this is "
-                               f"{robot.name!r}")  # fmt: skip
-        try:
-            self.points.check(robot, f"points file {self.points_file}")
-        except ScaraError as exc:
-            raise located(self.path, self.lines.get("points"), exc) from None
-        return expand(self.steps, robot=robot, points=self.points, pallets=self.pallets, start=self.start,
-                      shape=self.jump, path=self.path, start_line=self.lines.get("start"),
-                      pallet_lines={k[8:]: v for k, v in self.lines.items() if k.startswith("pallets.")})  # fmt: skip
-
-    def plan(self, robot: RobotModel, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
-        """Plan every move of the job for ``robot`` (:func:`~scara_pin.job.planning.plan_job`)."""
-        from .planning import plan_job
-
-        return plan_job(self, robot, progress=progress)
-
-
-def load_job(path: str | Path) -> Job:
+def read_job(path: str | Path) -> JobSpec:
     """Read a job file and check it (module docstring); the points file is read too.
+
+    :func:`~scara_pin.job.job.load_job` gives it as the :class:`~scara_pin.job.job.Job` users hold.
 
     Raises:
         JobFileError: the file, the line and the reason of the first problem (exit 2).
@@ -313,8 +201,8 @@ def load_job(path: str | Path) -> Job:
     if count > MAX_JOB_STEPS:
         steps_at.fail(f"the steps expand to {count:,} moves and dwells, above the cap of {MAX_JOB_STEPS:,} "
                       "(MAX_JOB_STEPS): split the job")  # fmt: skip
-    return Job(path, points_file, points, pallets, steps, robot, start, shape, torque, payload, cell, carry, count,
-               dwell, lines)  # fmt: skip
+    return JobSpec(path, points_file, points, pallets, steps, robot, start, shape, torque, payload, cell, carry, count,
+                   dwell, lines)  # fmt: skip
 
 
 def _points(at: _At, job: Path) -> tuple[Path, PointSet]:

@@ -16,7 +16,7 @@ rest at both ends); a move it refuses is an error (exit 3), never an output.
 **In a cell** (:class:`~scara_pin.cell.Cell`: the job's ``cell`` file, the boxes placed so far, the part in the
 tool between a ``pick`` and a ``place``) every move keeps every checked pair at least the cell's margin apart:
 a jump is planned around and over the obstacles (``jump_move(..., cell=)``), a straight or joint move's path is
-fixed, verified against the cell (:func:`~scara_pin.motion.plan.clear_of`) and refused naming the pair. The
+fixed, verified against the cell (:func:`~scara_pin.motion.verify.clear_of`) and refused naming the pair. The
 clearance comes from the same verifier at 10 kHz (the planners run it with the cell's scene); a reversed jump is
 verified against the cell again. Each ``place`` leaves the part where the tool holds it (the carried shape
 moved by ``baseMtool``): an obstacle named ``box1``, ``box2``, ... for every move after it.
@@ -61,7 +61,7 @@ if TYPE_CHECKING:
     from ..description import JointLimits
     from ..model import RobotModel
     from ..motion.verify import Clearance
-    from .loading import Job
+    from .spec import JobSpec
 
 __all__ = ["BOX", "STILL", "PlannedMove", "Planner", "Source", "plan_job", "plan_move", "scaled_limits"]
 
@@ -307,12 +307,12 @@ def _hold(q: np.ndarray, seconds: float) -> PolynomialPiece:
     return PolynomialPiece(np.array([0.0, seconds]), np.asarray(q, dtype=float)[None, None, :])
 
 
-def plan_job(job: Job, robot: RobotModel, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
+def plan_job(job: JobSpec, robot: RobotModel, *, progress: Callable[[int, int], None] | None = None) -> JobResult:
     """Plan every move of ``job`` for ``robot`` (module docstring): the table, the total, the trajectory.
 
-    Everything the job file and the robot can tell is checked first (:meth:`Job.program`); then the moves are
-    planned in order, each from where the previous one ended. A Ctrl-C (or SIGTERM) swallowed by the solver
-    stops the job after the move it interrupted.
+    Everything the job file and the robot can tell is checked first
+    (:meth:`~scara_pin.job.spec.JobSpec.program`); then the moves are planned in order, each from where the
+    previous one ended. A Ctrl-C (or SIGTERM) swallowed by the solver stops the job after the move it interrupted.
 
     Args:
         job: the job.
@@ -389,7 +389,7 @@ def plan_job(job: Job, robot: RobotModel, *, progress: Callable[[int, int], None
                      tuple(boxes), cell, carry)  # fmt: skip
 
 
-def _job_cell(job: Job) -> Cell | None:
+def _job_cell(job: JobSpec) -> Cell | None:
     """The job's cell file, read (a refusal names the job's ``cell:`` line too), checked against the job's carry."""
     if job.cell is None:
         return None
@@ -411,7 +411,7 @@ def _job_cell(job: Job) -> Cell | None:
     return cell
 
 
-def _place(robot: RobotModel, planner: Planner, job: Job, action: Grip, index: int, q: np.ndarray,
+def _place(robot: RobotModel, planner: Planner, job: JobSpec, action: Grip, index: int, q: np.ndarray,
            placed: tuple[Obstacle, ...], t: float) -> PlacedBox:  # fmt: skip
     """The box a place leaves: the carried part moved by ``baseMtool`` at ``q``, an obstacle from time ``t``."""
     from ..cell import Obstacle
@@ -427,7 +427,7 @@ def _place(robot: RobotModel, planner: Planner, job: Job, action: Grip, index: i
     return out
 
 
-def _clear(robot: RobotModel, cell: Cell | None, q: np.ndarray, job: Job, action: Grip, what: str,
+def _clear(robot: RobotModel, cell: Cell | None, q: np.ndarray, job: JobSpec, action: Grip, what: str,
            box: str | None = None) -> None:  # fmt: skip
     """``q`` clear of ``cell`` (exit 2 at the grip's line, naming the pair, otherwise).
 

@@ -1,0 +1,120 @@
+"""A job's data: the taught points, pallets, steps and settings a job file holds, checked (docs/job.md).
+
+:mod:`~scara_pin.job.loading` reads a file into a :class:`JobSpec`; :mod:`~scara_pin.job.planning` plans one;
+:class:`~scara_pin.job.job.Job`, above both, is the one users hold (``Job.load(path).plan(robot)``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import JobFileError, ScaraError
+from ..motion.payload import Payload
+from .steps import JumpShape, Program, Step, Target, expand, located
+
+if TYPE_CHECKING:
+    from ..cell import Shape
+    from ..model import RobotModel
+    from ..motion.points import PointSet
+    from .pallets import Pallet
+
+__all__ = ["Carry", "JobSpec"]
+
+
+@dataclass(frozen=True)
+class Carry:
+    """The part the tool holds between a ``pick`` and a ``place``, in the tool frame (docs/job.md).
+
+    ``tool0``'s z axis points out of the flange (down): a box hanging under the flange has a positive z. By
+    default the box's top face is on the flange face (``xyz = (0, 0, size_z / 2)``); a gripper between them
+    is not modelled, and its height is the part's z beyond that (the flange must stay the margin away from
+    the box it has just left).
+
+    Attributes:
+        shape: ``"box"``.
+        size: [m] its edges along the tool frame's x, y, z.
+        xyz: [m] its centre in the tool frame.
+        rpy: [rad] its orientation in the tool frame (URDF's roll, pitch, yaw).
+    """
+
+    shape: str
+    size: tuple[float, float, float]
+    xyz: tuple[float, float, float] | None = None
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if self.xyz is None:
+            object.__setattr__(self, "xyz", (0.0, 0.0, self.size[2] / 2.0))
+
+    def part(self) -> Shape:
+        """The part as a cell's shape, placed in the tool frame (:class:`~scara_pin.cell.Shape`)."""
+        from ..cell import Shape
+
+        return Shape(self.shape, self.size, np.array(self.xyz, dtype=float), np.array(self.rpy, dtype=float),
+                     what="the carried part")  # fmt: skip
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (SI)."""
+        return {"shape": self.shape, "size": list(self.size), "xyz": list(self.xyz or ()), "rpy": list(self.rpy)}
+
+
+@dataclass(frozen=True, eq=False)
+class JobSpec:
+    """A job's data: taught points, pallets and steps, checked (:mod:`~scara_pin.job.loading` reads one).
+
+    Attributes:
+        path: the job file.
+        points_file: the points file (resolved relative to the job file).
+        points: the taught points.
+        pallets: the pallets by name.
+        steps: the steps.
+        robot: the robot's name the job is for, or None.
+        start: where the robot is when the job begins, or None (the first move's target).
+        jump: every jump's clearance unless a step overrides it.
+        torque: respect the effort limits too.
+        payload: the payload carried (for the torques).
+        cell: the cell file (obstacles), or None.
+        carry: what the tool carries, or None.
+        actions: the number of moves and dwells the steps expand to.
+        dwell: [s] the time of all its dwells: a lower bound of its total, known before any planning.
+        lines: the line of each top-level key, and of each pallet (``"pallets.NAME"``).
+    """
+
+    path: Path
+    points_file: Path
+    points: PointSet
+    pallets: Mapping[str, Pallet]
+    steps: tuple[Step, ...]
+    robot: str | None = None
+    start: Target | None = None
+    jump: JumpShape = field(default_factory=JumpShape)
+    torque: bool = False
+    payload: Payload = field(default_factory=Payload)
+    cell: Path | None = None
+    carry: Carry | None = None
+    actions: int = 0
+    dwell: float = 0.0
+    lines: Mapping[str, int | None] = field(default_factory=dict)
+
+    def program(self, robot: RobotModel) -> Program:
+        """The job for ``robot``, expanded (:func:`~scara_pin.job.steps.expand`), every target resolved.
+
+        Raises:
+            JobFileError: another robot, points that do not fit it, collinear corners (exit 2).
+            JobStepError: a place out of reach (exit 3).
+        """
+        if self.robot is not None and self.robot != robot.name:
+            raise JobFileError(self.path, self.lines.get("robot"), f"the job is for robot {self.robot!r}; this is "
+                               f"{robot.name!r}")  # fmt: skip
+        try:
+            self.points.check(robot, f"points file {self.points_file}")
+        except ScaraError as exc:
+            raise located(self.path, self.lines.get("points"), exc) from None
+        return expand(self.steps, robot=robot, points=self.points, pallets=self.pallets, start=self.start,
+                      shape=self.jump, path=self.path, start_line=self.lines.get("start"),
+                      pallet_lines={k[8:]: v for k, v in self.lines.items() if k.startswith("pallets.")})  # fmt: skip
