@@ -1,4 +1,4 @@
-"""The jump in a cell's warm starts and rows (scara_pin.motion.avoid) where a palletizing job needs them, and the
+"""The jump in a cell's warm starts and rows (scara_pin.motion.jump.candidates, .rows) where a palletizing job needs them, and the
 palletizer's wrist housing, whose collision shape must leave room for the part under the flange.
 
 Independent routes:
@@ -21,7 +21,8 @@ import pytest
 
 from scara_pin import load_robot
 from scara_pin.cell import Cell, Obstacle, Shape, scene
-from scara_pin.motion.avoid import CHECK_POINTS, CONVERGED, Rows, candidates
+from scara_pin.motion.jump.candidates import candidates
+from scara_pin.motion.jump.rows import CHECK_POINTS, CONVERGED, Rows
 from scara_pin.motion.polynomial import PolynomialPiece
 
 MARGIN = 0.002

@@ -49,7 +49,7 @@ if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..model import RobotModel
 
-__all__ = ["FAR", "GJK_TOLERANCE", "Distances", "InCollisionError", "Pair", "PairDistance", "Scene", "scene"]
+__all__ = ["FAR", "GJK_TOLERANCE", "Distances", "InCollisionError", "Pair", "PairDistance", "Scene", "Witness", "scene"]
 
 GJK_TOLERANCE = 1e-10
 FAR = 0.05
@@ -124,6 +124,25 @@ class PairDistance:
         """JSON-ready."""
         return {**self.pair.to_dict(), "distance": self.distance, "point_a": self.point_a.tolist(),
                 "point_b": self.point_b.tolist(), "normal": self.normal.tolist()}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Witness:
+    """One pair's coal distance with its witness points, normal and joints, in the model's world frame.
+
+    Attributes:
+        distance: [m] coal's signed distance.
+        normal: (3,) unit vector from the first shape to the second.
+        point_a, point_b: (3,) the witness points on each shape [m].
+        oMa, oMb: the placements of the joints carrying the two shapes (an obstacle's: the root, identity).
+    """
+
+    distance: float
+    normal: np.ndarray
+    point_a: np.ndarray
+    point_b: np.ndarray
+    oMa: pin.SE3
+    oMb: pin.SE3
 
 
 @dataclass(frozen=True)
@@ -474,6 +493,28 @@ class Scene:
                      - point_jacobian(ja, np.asarray(res.getNearestPoint1())))  # fmt: skip
             G[c] = g[: self.robot.dof] if model.nv == self.robot.dof else g
         return d, G
+
+    def witnesses(self, q: np.ndarray, pairs: list[int]) -> list[Witness]:
+        """Each of ``pairs`` at ``q`` as the planners' separating planes need it, with its joints' placements.
+
+        In the MODEL's world frame (the root link), where :meth:`distances` gives the base frame.
+        """
+        import pinocchio as pin
+
+        model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
+        pin.forwardKinematics(model, data, self.robot.to_pinocchio_q(q) if self.robot.has_continuous else q)
+        pin.updateGeometryPlacements(model, data, gm, gd)
+        objs = gm.geometryObjects
+        out = []
+        for k in pairs:
+            pr = self.pairs[k]
+            res = pin.computeDistance(gm, gd, pr.index)
+            n = np.asarray(res.normal, dtype=float)
+            points = (np.array(res.getNearestPoint1(), dtype=float), np.array(res.getNearestPoint2(), dtype=float))
+            out.append(Witness(float(res.min_distance), n / (np.linalg.norm(n) or 1.0), *points,
+                               pin.SE3(data.oMi[objs[pr.first].parentJoint]),
+                               pin.SE3(data.oMi[objs[pr.second].parentJoint])))  # fmt: skip
+        return out
 
     def check(self, q: ArrayLike, what: str) -> Distances:
         """The distances at ``q``; :class:`InCollisionError` (exit 2) naming the closest pair if below the margin."""

@@ -48,6 +48,7 @@ wall) cannot dip at all (the distance is then convex along the line).
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -151,10 +152,14 @@ class _Bounds:
         return np.flatnonzero(self.joint > 0)
 
 
+_BOUNDS: weakref.WeakKeyDictionary[Scene, _Bounds] = weakref.WeakKeyDictionary()
+"""Each scene's bounding shapes, made once."""
+
+
 def _bounds(scene: Scene) -> _Bounds:
-    cached = scene.__dict__.get("_sweep_bounds")
+    cached = _BOUNDS.get(scene)
     if cached is not None:
-        return cached  # type: ignore[no-any-return]
+        return cached
     import coal
 
     gm = scene.geometry_model
@@ -181,7 +186,7 @@ def _bounds(scene: Scene) -> _Bounds:
         capsule.append(around)
     out = _Bounds(np.array(joint, dtype=int), np.array(center).reshape(-1, 3), np.array(radius),
                   np.array(end0).reshape(-1, 3), np.array(end1).reshape(-1, 3), np.array(capsule))  # fmt: skip
-    scene.__dict__["_sweep_bounds"] = out
+    _BOUNDS[scene] = out
     return out
 
 

@@ -605,7 +605,8 @@ def _legs(
             worst[qty] = val if prev is None else max(prev, val)
             if val > best[2]:
                 best = (qty, j, val)
-        legs.append(Leg(name, move, float(ta), float(tb), best[0], robot.joint_names[best[1]], best[2]))
+        legs.append(Leg(name=name, move=move, t_start=float(ta), t_end=float(tb), active=best[0],
+                        joint=robot.joint_names[best[1]], ratio=best[2]))
     return tuple(legs), worst
 
 

@@ -56,8 +56,8 @@ class PolynomialPiece(Piece):
         object.__setattr__(self, "duration", float(t[-1]))
         h = np.diff(t)
         for order in range(min(2, c.shape[1])):  # q and qd continuous at the inner breakpoints
-            end = self._local(np.arange(len(h) - 1), h[:-1], order)
-            start = self._local(np.arange(1, len(h)), np.zeros(len(h) - 1), order)
+            end = self.local(np.arange(len(h) - 1), h[:-1], order)
+            start = self.local(np.arange(1, len(h)), np.zeros(len(h) - 1), order)
             jump = float(np.max(np.abs(end - start), initial=0.0))
             if jump > _CONTINUITY_TOL * max(1.0, float(np.max(np.abs(start), initial=0.0))):
                 raise ParameterError("polynomial piece", f"a jump of {jump:.3g} in derivative {order}",
@@ -68,7 +68,7 @@ class PolynomialPiece(Piece):
         """The polynomial degree (2: piecewise-constant acceleration, 3: piecewise-constant jerk)."""
         return int(self.coefficients.shape[1] - 1)
 
-    def _local(self, k: np.ndarray, tau: np.ndarray, order: int) -> np.ndarray:
+    def local(self, k: np.ndarray, tau: np.ndarray, order: int) -> np.ndarray:
         """The order-th derivative on intervals k at local times tau (Horner), (len(k), dof)."""
         c = self.coefficients[k]
         deg = c.shape[1] - 1
@@ -85,12 +85,12 @@ class PolynomialPiece(Piece):
     def evaluate(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(q, qd, qdd) at local times ``tau`` (the interval on the right at a breakpoint)."""
         k, dt = self._split(tau)
-        return self._local(k, dt, 0), self._local(k, dt, 1), self._local(k, dt, 2)
+        return self.local(k, dt, 0), self.local(k, dt, 1), self.local(k, dt, 2)
 
     def jerk(self, tau: np.ndarray) -> np.ndarray:
         """Joint jerk (n, dof) at local times ``tau`` (constant on each interval; zero at degree 2)."""
         k, dt = self._split(tau)
-        return self._local(k, dt, 3)
+        return self.local(k, dt, 3)
 
     def breakpoints(self) -> np.ndarray:
         """The breakpoint times [s] (where the acceleration, or the jerk, switches)."""
@@ -104,7 +104,7 @@ class PolynomialPiece(Piece):
         h = np.diff(self.breaks)
         k = np.arange(len(h))
         deg = self.degree
-        c = np.stack([self._local(k, h, i) * ((-1.0) ** i / math.factorial(i)) for i in range(deg + 1)], axis=1)
+        c = np.stack([self.local(k, h, i) * ((-1.0) ** i / math.factorial(i)) for i in range(deg + 1)], axis=1)
         breaks = np.concatenate([[0.0], np.cumsum(h[::-1])])
         return PolynomialPiece(breaks, c[::-1].copy())
 
