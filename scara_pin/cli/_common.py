@@ -223,8 +223,6 @@ _MAX_NAME = 4096
 
 
 def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
-    from ..robots import load_robot
-
     if args.robot is not None and getattr(args, "urdf", None) is not None:
         raise InvalidInputError("give either --robot NAME or --urdf FILE, not both")
     args.robot = "default" if args.robot is None else args.robot
@@ -235,15 +233,22 @@ def _load(args: argparse.Namespace, units: Units | None = None) -> Robot:
         from ..limits import check_input_file
 
         check_input_file(args.urdf, "URDF")
-    locks = _parse_locks(getattr(args, "lock", None))
-    robot = load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf, tool=args.tool, base=args.base,
-                       package_path=args.package_path or (), lock=locks)  # fmt: skip
+    robot = _load_robot(args)
     for note in (robot.frame_note, robot.lock_note):  # the tool chosen without a tool0, another arm locked
         if note is not None:
             print(f"info: {note}", file=sys.stderr)
     if units is not None:  # what each joint value measures, read from the model (any joint order)
         units.q = robot.joint_kinds
     return robot
+
+
+def _load_robot(args: argparse.Namespace, acceleration: Sequence[float] | None = None) -> Robot:
+    """:func:`scara_pin.robots.load_robot` with the robot options of ``args`` (``--lock`` read before ``--set``)."""
+    from ..robots import load_robot
+
+    locks = _parse_locks(getattr(args, "lock", None))
+    return load_robot(args.robot, _parse_sets(args.set), urdf=args.urdf, tool=args.tool, base=args.base,
+                      package_path=args.package_path or (), lock=locks, acceleration=acceleration)  # fmt: skip
 
 
 def _add_acceleration(p: Any) -> None:
@@ -253,15 +258,16 @@ def _add_acceleration(p: Any) -> None:
                    "for a robot loaded from a URDF file (URDF has none); replaces the configured ones")  # fmt: skip
 
 
-def _acceleration(robot: Robot, texts: Sequence[str] | None, units: Units) -> None:
-    """Set ``robot.limits.acceleration`` from ``--acceleration``; refuse a robot without them.
+def _acceleration(args: argparse.Namespace, robot: Robot, units: Units) -> Robot:
+    """The robot with the acceleration limits of ``--acceleration``; refuse a robot without any.
+
+    Given, they replace the robot's: the robot of :func:`_load` is loaded again with them
+    (``load_robot(acceleration=...)``), the one given is left as it is. Not given: ``robot`` itself.
 
     Raises:
         InvalidInputError: no acceleration limits known (a URDF file) and none given.
     """
-    from ..description import JointLimits
-
-    lim = robot.limits
+    texts: Sequence[str] | None = args.acceleration
     if texts:
         if len(texts) != len(units.q):
             raise ParameterError("--acceleration", " ".join(texts), f"must be {len(units.q)} values, one per joint")
@@ -270,10 +276,11 @@ def _acceleration(robot: Robot, texts: Sequence[str] | None, units: Units) -> No
         for name, value in zip(_Q_NAMES, acc):
             if not value > 0:
                 raise ParameterError(f"--acceleration {name}", value, "must be > 0")
-        robot.limits = JointLimits(lim.lower, lim.upper, lim.velocity, tuple(acc), lim.effort, validate=False)
-    elif not all(math.isfinite(v) for v in lim.acceleration):
+        return _load_robot(args, acc)
+    if not all(math.isfinite(v) for v in robot.limits.acceleration):
         raise InvalidInputError(f"robot {robot.name!r} has no acceleration limits (a URDF file has none): give "
                                 "--acceleration with one value per joint [rad/s^2, m/s^2]")  # fmt: skip
+    return robot
 
 
 def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:

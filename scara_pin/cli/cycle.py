@@ -76,7 +76,7 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     if args.from_pose is not None:
         start = _read_pose(args.from_pose, units, "--from")
     direction = None if args.direction is None else [_number("--direction", d) for d in args.direction]
-    _acceleration(robot, args.acceleration, units)  # a URDF file has none: given, or refused
+    robot = _acceleration(args, robot, units)  # a URDF file has none: given, or refused
     limits = robot.limits
     jerk = _jerk(args)
     cell = cell_from_args(args, units)

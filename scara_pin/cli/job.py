@@ -43,7 +43,7 @@ def cmd_job(args: argparse.Namespace) -> int:
     units = Units()  # a job's numbers are SI, and so is --acceleration here
     robot = _load(args, units)
     _needs_wrist(robot, "job")
-    _acceleration(robot, args.acceleration, units)
+    robot = _acceleration(args, robot, units)
     result = _plan(job, robot)
     written: dict[str, str] = {}
     if args.out:

@@ -55,7 +55,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     for flag in ("linear", "arch", "plot", "payload"):
         if getattr(args, flag, None):
             _needs_wrist(robot, f"traj --{flag}")  # 3-joint arms: joint-space trajectories (quintic, TOPP-RA)
-    _acceleration(robot, args.acceleration, units)
+    robot = _acceleration(args, robot, units)
     if (args.from_q is None) == (args.from_pose is None):
         raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
     if (args.to_q is None) == (args.to_pose is None):
@@ -298,7 +298,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     if robot.kind != "scara":
         raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     _needs_wrist(robot, "jog")
-    _acceleration(robot, args.acceleration, units)
+    robot = _acceleration(args, robot, units)
     q0 = _joint_arg(robot, args.from_q, units, "--from")
     direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
     if len(direction) not in (2, 3):
