@@ -8,14 +8,12 @@ import math
 import re
 import sys
 from collections.abc import Callable, Sequence
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 from .._checks import NUMBER_TEXT
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..files import write_text_atomic
 from ..limits import MAX_NUMBER
-from ..units import DisplayUnits, format_number, format_vector
+from ..units import DisplayUnits, format_number
 
 if TYPE_CHECKING:
     import numpy as np
@@ -122,6 +120,7 @@ class Units:
 
 
 _INTEGER_TEXT = re.compile(r"[+-]?\d+", re.ASCII)
+_T = TypeVar("_T")
 MIN_NUMBER = 1e-100
 """Smallest magnitude of a non-zero typed number (below it, 1 / x and x * x leave the float range)."""
 
@@ -159,26 +158,24 @@ def _integer(name: str, text: str, low: int, high: int) -> int:
 
 def number_type(name: str) -> Callable[[str], float]:
     """An argparse ``type=`` that parses with :func:`_number` (errors become the one-line usage error)."""
-
-    def parse(text: str) -> float:
-        try:
-            return _number(name, text)
-        except ParameterError as exc:  # argparse names the option: "argument --rate: got 'x'; it must ..."
-            raise argparse.ArgumentTypeError(f"got {exc.value!r}; it {exc.rule}") from None
-
-    return parse
+    return _argparse_type(lambda text: _number(name, text))
 
 
 def integer_type(name: str, low: int, high: int) -> Callable[[str], int]:
     """An argparse ``type=`` for a whole number in ``[low, high]``."""
+    return _argparse_type(lambda text: _integer(name, text, low, high))
 
-    def parse(text: str) -> int:
+
+def _argparse_type(parse: Callable[[str], _T]) -> Callable[[str], _T]:
+    """``parse`` with its ParameterError as argparse's, which names the option: "argument --rate: got 'x'; it ..."."""
+
+    def parsed(text: str) -> _T:
         try:
-            return _integer(name, text, low, high)
+            return parse(text)
         except ParameterError as exc:
             raise argparse.ArgumentTypeError(f"got {exc.value!r}; it {exc.rule}") from None
 
-    return parse
+    return parsed
 
 
 def _jerk(args: argparse.Namespace) -> list[float] | None:
@@ -205,11 +202,11 @@ def _parse_sets(items: Sequence[str] | None, option: str = "--set", form: str = 
         key = key.strip()
         if not sep or not key:
             raise InvalidInputError(f"{option} {item[:80]!r} must have the form {form}")
-        number = _number(f"{option} {key[:80]}", value)
+        parsed = _number(f"{option} {key[:80]}", value)
         if key in overrides:
-            raise InvalidInputError(f"{option} {key[:80]} is given twice ({_num(overrides[key])} and {_num(number)}); "
-                                    "give each once")  # fmt: skip
-        overrides[key] = number
+            raise InvalidInputError(f"{option} {key[:80]} is given twice ({format_number(overrides[key], 9)} and "
+                                    f"{format_number(parsed, 9)}); give each once")  # fmt: skip
+        overrides[key] = parsed
     return overrides
 
 
@@ -283,15 +280,6 @@ def _acceleration(args: argparse.Namespace, robot: Robot, units: Units) -> Robot
     return robot
 
 
-def _read_q(args: argparse.Namespace, units: Units) -> np.ndarray:
-    import numpy as np
-
-    n = len(units.q)  # the robot's joint count once loaded (_load): 4, or 3 without a wrist
-    if len(args.q) != n:
-        raise ParameterError("q", " ".join(args.q), f"must be {n} joint values (got {len(args.q)})")
-    return np.array(_q_values(args.q, units))
-
-
 def _needs_wrist(robot: Robot, what: str) -> None:
     """Refuse (exit 2) a command or option that supports 4-joint robots only, for a 3-joint SCARA."""
     if robot.dof != 4:
@@ -311,27 +299,16 @@ def _q_values(texts: Sequence[str], units: Units, what: str = "") -> list[float]
     return [_number(prefix + n, t) / sc for n, t, sc in zip(_Q_NAMES, texts, units.scale(units.q))]
 
 
-def _check_limits(robot: Robot, q: np.ndarray, strict: bool, units: Units) -> None:
-    robot.check_q(q)  # a q that cannot be computed is an error, never first a "computed anyway" warning
+def _check_limits(robot: Robot, values: Sequence[float], units: Units, strict: bool = False,
+                  warning: str = "%s (computed anyway; --strict refuses)") -> np.ndarray:
+    """``values`` as q; refused if they cannot be computed, each joint outside its limits a warning (or refused)."""
+    q = robot.check_q(values)  # a q that cannot be computed is an error, never first a "computed anyway" warning
     outside = robot.outside_limits(q, units=units.display)
     if outside and strict:
         raise InfeasibleError("q outside the joint limits (--strict): " + "; ".join(outside))
     for item in outside:
-        log.warning("%s (computed anyway; --strict refuses)", item)
-
-
-def _fmt(values: ArrayLike, decimals: int = 9) -> str:
-    """Plain numbers (no unit: directions, SI values labelled ``[SI]``) as ``[a, b, c]``, to ``decimals`` decimals."""
-    return format_vector(values, decimals)  # type: ignore[arg-type]
-
-
-def _num(value: float, decimals: int = 9) -> str:
-    """One plain number to ``decimals`` decimals (scara_pin.units.format_number: no -0, no 1e-17)."""
-    return format_number(value, decimals)
-
-
-def _scaled(values: ArrayLike, scale: Sequence[float]) -> list[float]:
-    return [float(v) * s for v, s in zip(values, scale)]
+        log.warning(warning, item)
+    return q
 
 
 def _read_pose(texts: Sequence[str], units: Units, what: str = "target", dof: int = 4) -> list[float]:
@@ -387,11 +364,6 @@ def check_command_outputs(args: argparse.Namespace, outputs: dict[str, str | Non
 
     stdout = "--json" if getattr(args, "json", False) else None
     check_outputs(outputs, _input_files(args), figures=figures, stdout=stdout)
-
-
-def write_atomic(path: Path, text: str) -> None:
-    """Write a text file atomically (see :mod:`scara_pin.files`)."""
-    write_text_atomic(path, text)
 
 
 def _add_units(

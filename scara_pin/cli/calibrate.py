@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidInputError
+from ..files import write_text_atomic
 from ._common import (
     Units,
     _add_robot_options,
@@ -23,7 +24,6 @@ from ._common import (
     integer_type,
     log,
     number_type,
-    write_atomic,
 )
 
 _GROUPS = ("offsets", "scale", "origins", "tool")
@@ -83,14 +83,14 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         if args.out == "-":
             sys.stdout.write(result.urdf)
             return 0
-        write_atomic(Path(args.out), result.urdf)
+        write_text_atomic(Path(args.out), result.urdf)
         written["urdf"] = args.out
     overlay = None
     if args.overlay is not None:
         from ..calibration.overlay import yaml_overlay
 
         overlay = yaml_overlay(result)
-        write_atomic(Path(args.overlay), overlay.to_yaml())
+        write_text_atomic(Path(args.overlay), overlay.to_yaml())
         written["overlay"] = args.overlay
     if args.plot is not None:
         from ..calibration.plot import plot_residuals
@@ -122,7 +122,7 @@ def _plan(args: argparse.Namespace, robot: Any, groups: frozenset[Any], frame: A
     plan = plan_experiment(robot, args.plan, criterion=Criterion(args.criterion), yaw=args.yaw, frame=frame,
                            groups=groups, seed=args.seed, candidates=args.candidates)  # fmt: skip
     if args.out not in (None, "-"):
-        write_atomic(Path(args.out), plan.to_csv())
+        write_text_atomic(Path(args.out), plan.to_csv())
     if args.json:
         doc = plan.to_dict()
         doc["written"] = {"plan": args.out} if args.out not in (None, "-") else {}
@@ -153,7 +153,7 @@ def _simulate(args: argparse.Namespace, robot: Any, units: Units) -> int:
     if args.out in (None, "-"):
         sys.stdout.write(text)
         return 0
-    write_atomic(Path(args.out), text)
+    write_text_atomic(Path(args.out), text)
     moved = float(np.linalg.norm(sim.measurements.position - plan.position, axis=1).max())
     if args.json:
         print(json.dumps({"robot": sim.robot, "units": {"length": "m", "angle": "rad"}, "poses": len(plan),

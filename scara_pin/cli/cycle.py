@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InvalidInputError, ParameterError
 from ._common import (
@@ -25,9 +25,6 @@ from ._common import (
     number_type,
 )
 from ._points import add_points_options, use_points
-
-if TYPE_CHECKING:
-    pass
 
 
 def _payload(args: argparse.Namespace, units: Units) -> Any:

@@ -6,22 +6,17 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InvalidInputError
+from ..files import write_text_atomic
 from ._common import (
     _add_frame_options,
     _add_robot_options,
     _parse_locks,
     _parse_sets,
     check_command_outputs,
-    write_atomic,
 )
-
-if TYPE_CHECKING:
-
-    pass
-
 
 PAYLOAD_GRID = 7
 """Values per joint of the grid the static payload is the minimum over (7^4 = 2401 configurations)."""
@@ -87,7 +82,7 @@ def cmd_urdf(args: argparse.Namespace) -> int:
     if args.output in (None, "-"):
         sys.stdout.write(text)
     else:
-        write_atomic(Path(args.output), text)
+        write_text_atomic(Path(args.output), text)
         print(f"wrote {args.output}", file=sys.stderr)
     return 0
 

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..units import decimals_for
+from ..units import decimals_for, format_number
 from ._common import (
     _POSE_KINDS,
     _Q_NAMES,
@@ -20,11 +20,8 @@ from ._common import (
     _check_limits,
     _load,
     _needs_wrist,
-    _num,
     _q_values,
     _read_pose,
-    _read_q,
-    _scaled,
     add_cell_options,
     cell_from_args,
     check_command_outputs,
@@ -47,8 +44,7 @@ def cmd_fk(args: argparse.Namespace) -> int:
     """Forward kinematics: the pose of tool0 in the base frame."""
     units = Units.from_args(args)
     robot = _load(args, units)
-    q = _read_q(args, units)
-    _check_limits(robot, q, args.strict, units)
+    q = _check_limits(robot, _q_values(args.q, units), units, args.strict)
     M = robot.tool_placement(q)
     from ..model import pose_from_placement
 
@@ -76,7 +72,8 @@ def cmd_fk(args: argparse.Namespace) -> int:
         print(f"geared    {_geared_text(robot, q, units)}")
     # the rotation (no unit) to 1e-9 and the translation in the user's length unit, in aligned columns
     H = M.homogeneous
-    cells = [[_num(v) for v in row[:3]] + [units.num(row[3], "length")] for row in H[:3]] + [[_num(v) for v in H[3]]]
+    cells = [[format_number(v, 9) for v in row[:3]] + [units.num(row[3], "length")] for row in H[:3]]
+    cells.append([format_number(v, 9) for v in H[3]])
     width = max(len(c) for row in cells for c in row)
     print(f"matrix    (rotation [-], translation [{units.length_name}])")
     for row in cells:
@@ -90,8 +87,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
 
     units = Units.from_args(args)
     robot = _load(args, units)
-    q = _read_q(args, units)
-    _check_limits(robot, q, args.strict, units)
+    q = _check_limits(robot, _q_values(args.q, units), units, args.strict)
     if args.reference == "task":
         if args.frame is not None:
             raise InvalidInputError("--frame goes with --reference world|local|local_world_aligned")
@@ -118,7 +114,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         return 0
     # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j), printed to 1e-9 SI in that unit
     ratio = np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
-    cells = [[_num(v, decimals_for(r)) for v, r in zip(row, rrow)] for row, rrow in zip(J * ratio, ratio)]
+    cells = [[format_number(v, decimals_for(r)) for v, r in zip(row, rrow)] for row, rrow in zip(J * ratio, ratio)]
     width = max(16, *(len(c) + 2 for row in cells for c in row))
     print(f"robot     {robot.name}: {args.reference} Jacobian of {args.frame or robot.tool_frame}")
     print(f"q         {units.fmt(q, units.q)}  [{', '.join(units.names(units.q))}]")
@@ -126,13 +122,8 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     print("          " + "".join(h.rjust(width) for h in heads))
     for name, unit, row in zip(rows, units.names(row_kinds), cells):
         print(f"{f'{name} [{unit}]':<10}" + "".join(c.rjust(width) for c in row))
-    print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {_num(w)}")
+    print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {format_number(w, 9)}")
     return 0
-
-
-def _solutions_json(q_list: Sequence[ArrayLike], branches: Sequence[str], units: Units) -> list[dict]:
-    scale = units.scale(units.q)
-    return [{"q": _scaled(q, scale), "branch": b} for q, b in zip(q_list, branches)]
 
 
 def _geared(robot: Robot, q: ArrayLike) -> dict[str, float]:
@@ -152,8 +143,8 @@ def _geared_text(robot: Robot, q: ArrayLike, units: Units) -> str:
     parts = []
     for g in robot.geared:
         unit = units.angle_name if g.kind == "angle" else units.length_name
-        parts.append(f"{g.name} = {units.num(values[g.name], g.kind)} {unit} ({_num(g.multiplier)} * {g.source_name} "
-                     f"+ {units.num(g.offset, g.kind)})")  # fmt: skip
+        parts.append(f"{g.name} = {units.num(values[g.name], g.kind)} {unit} ({format_number(g.multiplier, 9)} * "
+                     f"{g.source_name} + {units.num(g.offset, g.kind)})")  # fmt: skip
     return "; ".join(parts)
 
 
@@ -216,8 +207,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
             message = "every solution collides: " + "; ".join(f"{r['branch']}: {r['reason']}" for r in refused)
     code = 0 if status == "OK" else 3
     if args.json:  # always SI (docs/cli.md: "--json output is always SI")
-        si = Units(False, False)
-        solutions = _solutions_json(qs, branches, si)
+        solutions: list[dict[str, Any]] = [{"q": [float(v) for v in q], "branch": b} for q, b in zip(qs, branches)]
         for sol, t in zip(solutions, turns):
             sol["turns"] = t
         if robot.geared:  # the joints that follow (not degrees of freedom): their values at each solution
@@ -302,10 +292,8 @@ def _near(robot: Robot, texts: Sequence[str], units: Units) -> np.ndarray:
     """
     if len(texts) != robot.dof:
         raise ParameterError("--near", " ".join(texts), f"must be {robot.dof} joint values")
-    near = robot.check_q(_q_values(texts, units))
-    for item in robot.outside_limits(near, units=units.display):
-        log.warning("--near: %s (used as given: the solutions nearest to it are returned)", item)
-    return near
+    return _check_limits(robot, _q_values(texts, units), units,
+                         warning="--near: %s (used as given: the solutions nearest to it are returned)")
 
 
 def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:

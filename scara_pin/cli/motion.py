@@ -7,9 +7,11 @@ import json
 import logging
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..files import write_text_atomic
+from ..units import format_number, format_vector
 from ._common import (
     _POSE_KINDS,
     Units,
@@ -17,12 +19,10 @@ from ._common import (
     _add_acceleration,
     _add_robot_options,
     _add_units,
-    _fmt,
     _jerk,
     _joint_arg,
     _load,
     _needs_wrist,
-    _num,
     _number,
     _read_pose,
     add_cell_options,
@@ -30,14 +30,9 @@ from ._common import (
     check_command_outputs,
     log,
     number_type,
-    write_atomic,
 )
 from ._points import add_points_options, use_points
 from .cycle import _payload, cell_summary, cell_text
-
-if TYPE_CHECKING:
-
-    pass
 
 
 def cmd_traj(args: argparse.Namespace) -> int:
@@ -148,7 +143,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
     print(f"robot     {planned.name}: {method}", file=text)
     q_units = ", ".join(units.names(units.q))
-    print(f"duration  {_num(traj.duration)} s", file=text)
+    print(f"duration  {format_number(traj.duration, 9)} s", file=text)
     print(f"from      {units.fmt(traj.q_start, units.q)}  [{q_units}]", file=text)
     print(f"to        {units.fmt(traj.q_end, units.q)}  [{q_units}]", file=text)
     print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} "
@@ -206,7 +201,7 @@ def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Uni
     delays = [_number("--delays", d) for d in args.delays] if args.delays else None
     rate = args.setpoint_rate if args.setpoint_rate is not None else args.rate
     sp = traj.setpoints(rate, delays=delays, motor=motor)
-    write_atomic(Path(args.setpoints), sp.csv_text())
+    write_text_atomic(Path(args.setpoints), sp.csv_text())
 
 
 def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any,
@@ -250,11 +245,11 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
         return 0
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
     print(f"robot     {robot.name}: {method.value}", file=text)
-    print(f"duration  {_num(traj.duration)} s", file=text)
+    print(f"duration  {format_number(traj.duration, 9)} s", file=text)
     if jump:
         b, Ln = move.lower_bound, units.length_name
-        print(f"bound     {_num(b.duration, 6)} s ({b.reason}): no move under these limits is faster; this one is "
-              f"{100 * move.gap:.1f} % above it", file=text)  # fmt: skip
+        print(f"bound     {format_number(b.duration, 6)} s ({b.reason}): no move under these limits is faster; this "
+              f"one is {100 * move.gap:.1f} % above it", file=text)  # fmt: skip
         print(f"arch      up to {units.num(move.z_top + move.peak, 'length')} {Ln}, {units.num(move.bulge, 'length')} "
               f"{Ln} off the straight line in plan view; solved in {move.stats.seconds:.3g} s", file=text)  # fmt: skip
     for leg in move.legs:
@@ -265,7 +260,7 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
         print(cell_text(cell, move.distance, units).replace("cell        ", "cell      ", 1), file=text)
     if not jump:
         print("note      the straight-leg arch is slower than the jump (--path jump, the default)"
-              + (f", which takes {_num(faster, 6)} s" if faster is not None else ""), file=text)  # fmt: skip
+              + (f", which takes {format_number(faster, 6)} s" if faster is not None else ""), file=text)  # fmt: skip
     for kind, where in outputs.items():
         print(f"wrote     {kind}: {where}", file=text)
     return 0
@@ -321,7 +316,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
                           "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
         return 0
     text = sys.stderr if "-" in (args.out, args.plot) else sys.stdout  # stdout carries a file
-    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}", file=text)
+    print(f"robot     {robot.name}: jog to the edge along {format_vector(direction, 9)}", file=text)
     if jog.contact is not None:
         print(f"stop      {jog.stopped_by}, the margin of {args.cell}", file=text)
         print(f"edge      beyond: {jog.hit.description} [{jog.hit.limit.value}]", file=text)
@@ -329,8 +324,8 @@ def cmd_jog(args: argparse.Namespace) -> int:
         print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
         if cell is not None:
             print(f"cell      {cell.origin}: no contact before the edge (margin {cell.margin * 1e3:g} mm)", file=text)
-    print(f"travel    {units.num(jog.distance, 'length')} {units.length_name} in {_num(traj.duration, 6)} s (at rest "
-          "at both ends)", file=text)  # fmt: skip
+    print(f"travel    {units.num(jog.distance, 'length')} {units.length_name} in {format_number(traj.duration, 6)} s "
+          "(at rest at both ends)", file=text)  # fmt: skip
     print(f"end pose  {units.fmt(jog.end_pose, _POSE_KINDS)}  [{', '.join(units.names(_POSE_KINDS))}]", file=text)
     print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)", file=text)
     for what in (args.out, args.plot):

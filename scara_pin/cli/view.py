@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InvalidInputError
 from ..signals import Terminated, handled
@@ -12,17 +12,13 @@ from ._common import (
     Units,
     _add_robot_options,
     _add_units,
+    _check_limits,
     _load,
     _q_values,
     add_cell_options,
     cell_from_args,
     check_command_outputs,
-    log,
 )
-
-if TYPE_CHECKING:
-
-    pass
 
 
 def cmd_view(args: argparse.Namespace) -> int:
@@ -35,9 +31,7 @@ def cmd_view(args: argparse.Namespace) -> int:
     cell = cell_from_args(args, units)
     q = None
     if args.q:
-        q = robot.check_q(_q_values(args.q, units))
-        for item in robot.outside_limits(q, units=units.display):
-            log.warning("%s (shown anyway)", item)
+        q = _check_limits(robot, _q_values(args.q, units), units, warning="%s (shown anyway)")
     times = qs = None
     if args.traj and args.traj.lower().endswith(".json"):  # as `traj --out` writes it
         from ..motion.trajectory import load_samples

@@ -8,12 +8,11 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
-from ..units import decimals_for, format_number
+from ..units import decimals_for, format_number, format_vector
 from ._common import (
     Units,
     _add_robot_options,
     _add_units,
-    _fmt,
     _load,
     _number,
     add_cell_options,
@@ -75,7 +74,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         return 0
     n = units.length_name
     if hit is not None:
-        print(f"robot     {robot.name}: ray from {units.fmt(start, 'length')} [{n}] along {_fmt(direction)}")
+        print(f"robot     {robot.name}: ray from {units.fmt(start, 'length')} [{n}] along "
+              f"{format_vector(direction, 9)}")
         print(f"edge      {units.fmt(hit.point, 'length')} [{n}]")
         print(f"distance  {units.num(hit.distance, 'length')} {n}")
         print(f"stopped by {hit.description} [{hit.limit.value}]")
@@ -167,7 +167,7 @@ def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) 
     print(f"arcs      {len(env.arcs)} (centre, radius [{name}], phi from the vertical [rad])")
     for a in env.arcs:
         print(f"  {a.limit:<13} centre {units.fmt(a.center, 'length')} radius {units.num(a.radius, 'length')} "
-              f"phi {_fmt([a.start, a.start + a.sweep])}")  # fmt: skip
+              f"phi {format_vector([a.start, a.start + a.sweep], 9)}")  # fmt: skip
     if args.plot:
         print(f"wrote     {args.plot}")
     return 0
