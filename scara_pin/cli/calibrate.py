@@ -15,16 +15,11 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..files import write_text_atomic
-from ._common import (
-    Units,
-    _add_robot_options,
-    _add_units,
-    _load,
-    check_command_outputs,
-    integer_type,
-    log,
-    number_type,
-)
+from ._numbers import integer_type, number_type
+from ._options import add_robot_options, add_units
+from ._outputs import check_command_outputs, log
+from ._robot import robot_from_args
+from ._units import Units
 
 _GROUPS = ("offsets", "scale", "origins", "tool")
 
@@ -62,7 +57,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     groups = _groups(args.model)
     frame = MeasurementFrame(args.frame)
-    robot = _load(args, units)
+    robot = robot_from_args(args, units)
     if args.plan is not None:
         return _plan(args, robot, groups, frame)
     if args.simulate is not None:
@@ -225,6 +220,6 @@ def register(sub: Any) -> None:
                    "stdout")  # fmt: skip
     o.add_argument("--overlay", metavar="YAML", help="a configured robot's changed yaml parameters (flat names)")
     o.add_argument("--plot", metavar="PNG", help="each pose's position error before and after")
-    _add_units(p, inputs=False, json_help="print one JSON object (SI units)")
-    _add_robot_options(p)
+    add_units(p, inputs=False, json_help="print one JSON object (SI units)")
+    add_robot_options(p)
     p.set_defaults(func=cmd_calibrate)
