@@ -17,8 +17,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .description import RobotParameters
-from .errors import InvalidInputError
+from .description import JOINT_NAMES, RobotParameters, configured
+from .errors import InvalidInputError, ParameterError
 from .kinematics.kinds import kinematics_for
 from .model import RobotModel
 
@@ -98,6 +98,7 @@ def load_robot(
     base: str | None = None,
     package_path: Sequence[str | Path] = (),
     lock: Mapping[str, float] | None = None,
+    acceleration: Sequence[float] | None = None,
 ) -> Robot:
     """Load a robot with the kinematics of its kind: a configured one (name or folder) or a URDF / xacro file.
 
@@ -112,6 +113,8 @@ def load_robot(
         lock: joints to fix at a value [rad, m] (:mod:`scara_pin.chain`). Joints not on the chain from the
             root to ``tool`` (the other arm of a two-arm robot) are locked anyway, at 0 unless given here;
             ``robot.locked`` lists them all.
+        acceleration: joint acceleration limits [rad/s^2, m/s^2], in q order: a URDF file has none; they replace
+            a configured robot's (``joint_limits.yaml``; its generated URDF, which holds none, is the same).
 
     Raises:
         UrdfError: (exit code 2) among others a ``tool`` or ``base`` that is not a link of the robot.
@@ -122,10 +125,16 @@ def load_robot(
     if urdf is not None:
         if overrides:
             raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file")
-        return Robot.from_file(urdf, package_dirs=package_path, **kwargs)
+        return Robot.from_file(urdf, package_dirs=package_path, acceleration=acceleration, **kwargs)
     if package_path:
         raise InvalidInputError("--package-path applies to a URDF or xacro file (--urdf), not to a configured robot")
-    return Robot.from_config(robot, overrides, **kwargs)
+    if acceleration is None:
+        return Robot.from_config(robot, overrides, **kwargs)
+    params, text = configured(robot, overrides)
+    if len(acceleration) != len(JOINT_NAMES):
+        raise ParameterError("acceleration", list(acceleration), f"must hold {len(JOINT_NAMES)} values, one per joint")
+    params = params.with_overrides({f"{j}_acceleration": a for j, a in zip(JOINT_NAMES, acceleration)})
+    return Robot(text, parameters=params, origin=f"robot {params.name!r}", generated=True, **kwargs)
 
 
 def load_urdf(path: str | Path, **kwargs: Any) -> Robot:

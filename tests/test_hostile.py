@@ -31,7 +31,7 @@ from sigint import default_sigint
 
 from scara_pin import load_robot
 from scara_pin.cli import main
-from scara_pin.cli._common import _number
+from scara_pin.cli._numbers import number
 from scara_pin.description import generate_urdf
 from scara_pin.errors import InvalidInputError, ParameterError, UrdfError
 from scara_pin.files import atomic_output, write_text_atomic
@@ -524,7 +524,7 @@ def test_the_writer_refuses_devices_in_the_library_too(tmp_path: Path) -> None:
     ("0", 0.0), ("-0", 0.0), ("1e12", 1e12), ("1e-100", 1e-100),
 ])  # fmt: skip
 def test_numbers_a_robotics_user_types(text: str, value: float) -> None:
-    assert _number("x", text) == value
+    assert number("x", text) == value
 
 
 @pytest.mark.parametrize("text", [
@@ -533,7 +533,7 @@ def test_numbers_a_robotics_user_types(text: str, value: float) -> None:
 ])  # fmt: skip
 def test_numbers_refused(text: str) -> None:
     with pytest.raises(ParameterError) as info:
-        _number("x", text)
+        number("x", text)
     assert "\n" not in str(info.value)
 
 

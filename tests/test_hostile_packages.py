@@ -310,9 +310,9 @@ def test_rates_take_the_one_number_grammar(args: list[str], needle: str, tmp_pat
 def test_the_teach_port_takes_the_integer_grammar(port: str) -> None:
     """Parsed only (a port taken would start a server): 8_000 and Arabic-Indic digits are refused."""
     from scara_pin.cli import build_parser
-    from scara_pin.cli._common import _UsageError
+    from scara_pin.cli._options import UsageError
 
-    with pytest.raises(_UsageError, match="--port"):
+    with pytest.raises(UsageError, match="--port"):
         build_parser().parse_args(["teach", "--port", port])
     assert build_parser().parse_args(["teach", "--port", "8000"]).port == 8000
 

@@ -29,7 +29,8 @@ from typing import Any
 
 from ..errors import ScaraError
 from ..signals import Terminated, kept, raise_pending
-from ._common import _Parser, _UsageError, log
+from ._options import Parser, UsageError
+from ._outputs import log
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
@@ -60,7 +61,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """
     from .._version import __version__
 
-    parser = _Parser(
+    parser = Parser(
         prog="scara-pin",
         description="Kinematics of SCARA robots from one xacro/URDF description (Pinocchio inside). "
         "SI units unless --deg/--mm (JSON output always SI); exit codes: 0 ok, 2 invalid input, 3 infeasible, "
@@ -68,7 +69,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"scara-pin {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     target: Any = sub if command is None else _OneCommand(sub, command)
     names = list(dict.fromkeys(COMMANDS.values())) if command not in COMMANDS else [COMMANDS[command]]
     for name in names:
@@ -128,7 +129,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser = build_parser(_command_of(sys.argv[1:] if argv is None else argv))
         try:
             args = parser.parse_args(argv)
-        except _UsageError as exc:
+        except UsageError as exc:
             print(f"error: {exc} (see scara-pin --help)", file=sys.stderr)
             return 2
         except SystemExit as exc:  # --help, --version

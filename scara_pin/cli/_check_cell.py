@@ -6,7 +6,8 @@ import argparse
 import json
 from typing import TYPE_CHECKING, Any
 
-from ._common import add_cell_options, cell_from_args
+from ._options import add_cell_options
+from ._robot import cell_from_args
 
 if TYPE_CHECKING:
     from ..lint import CheckReport
@@ -59,10 +60,10 @@ def _cell_report(args: argparse.Namespace) -> Any:
     from ..cell import scene
     from ..cell.report import check_cell
     from ..robots import load_urdf
-    from ._common import _parse_locks
+    from ._numbers import parse_locks
 
     robot = load_urdf(args.file, tool=args.tool, base=args.base, package_path=args.package_path or (),
-                      lock=_parse_locks(args.lock))  # fmt: skip
+                      lock=parse_locks(args.lock))  # fmt: skip
     cell = cell_from_args(args)
     configurations: list[tuple[str, Any]] = []
     taught: list[tuple[str, Any]] = []

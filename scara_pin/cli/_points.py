@@ -18,7 +18,8 @@ import math
 from typing import TYPE_CHECKING
 
 from ..errors import InfeasibleError, InvalidInputError
-from ._common import MIN_NUMBER, Units
+from ._numbers import MIN_NUMBER
+from ._units import Units
 
 if TYPE_CHECKING:
     from ..motion.points import PointSet

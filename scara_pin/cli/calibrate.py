@@ -14,17 +14,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidInputError
-from ._common import (
-    Units,
-    _add_robot_options,
-    _add_units,
-    _load,
-    check_command_outputs,
-    integer_type,
-    log,
-    number_type,
-    write_atomic,
-)
+from ..files import write_text_atomic
+from ._numbers import integer_type, number_type
+from ._options import add_robot_options, add_units
+from ._outputs import check_command_outputs, log
+from ._robot import robot_from_args
+from ._units import Units
 
 _GROUPS = ("offsets", "scale", "origins", "tool")
 
@@ -62,7 +57,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     units = Units(args.deg, args.mm)
     groups = _groups(args.model)
     frame = MeasurementFrame(args.frame)
-    robot = _load(args, units)
+    robot = robot_from_args(args, units)
     if args.plan is not None:
         return _plan(args, robot, groups, frame)
     if args.simulate is not None:
@@ -83,14 +78,14 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         if args.out == "-":
             sys.stdout.write(result.urdf)
             return 0
-        write_atomic(Path(args.out), result.urdf)
+        write_text_atomic(Path(args.out), result.urdf)
         written["urdf"] = args.out
     overlay = None
     if args.overlay is not None:
         from ..calibration.overlay import yaml_overlay
 
         overlay = yaml_overlay(result)
-        write_atomic(Path(args.overlay), overlay.to_yaml())
+        write_text_atomic(Path(args.overlay), overlay.to_yaml())
         written["overlay"] = args.overlay
     if args.plot is not None:
         from ..calibration.plot import plot_residuals
@@ -122,7 +117,7 @@ def _plan(args: argparse.Namespace, robot: Any, groups: frozenset[Any], frame: A
     plan = plan_experiment(robot, args.plan, criterion=Criterion(args.criterion), yaw=args.yaw, frame=frame,
                            groups=groups, seed=args.seed, candidates=args.candidates)  # fmt: skip
     if args.out not in (None, "-"):
-        write_atomic(Path(args.out), plan.to_csv())
+        write_text_atomic(Path(args.out), plan.to_csv())
     if args.json:
         doc = plan.to_dict()
         doc["written"] = {"plan": args.out} if args.out not in (None, "-") else {}
@@ -153,7 +148,7 @@ def _simulate(args: argparse.Namespace, robot: Any, units: Units) -> int:
     if args.out in (None, "-"):
         sys.stdout.write(text)
         return 0
-    write_atomic(Path(args.out), text)
+    write_text_atomic(Path(args.out), text)
     moved = float(np.linalg.norm(sim.measurements.position - plan.position, axis=1).max())
     if args.json:
         print(json.dumps({"robot": sim.robot, "units": {"length": "m", "angle": "rad"}, "poses": len(plan),
@@ -225,6 +220,6 @@ def register(sub: Any) -> None:
                    "stdout")  # fmt: skip
     o.add_argument("--overlay", metavar="YAML", help="a configured robot's changed yaml parameters (flat names)")
     o.add_argument("--plot", metavar="PNG", help="each pose's position error before and after")
-    _add_units(p, inputs=False, json_help="print one JSON object (SI units)")
-    _add_robot_options(p)
+    add_units(p, inputs=False, json_help="print one JSON object (SI units)")
+    add_robot_options(p)
     p.set_defaults(func=cmd_calibrate)

@@ -5,41 +5,16 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InvalidInputError, ParameterError
-from ._common import (
-    Units,
-    _acceleration,
-    _add_acceleration,
-    _add_robot_options,
-    _add_units,
-    _jerk,
-    _load,
-    _needs_wrist,
-    _number,
-    _read_pose,
-    add_cell_options,
-    cell_from_args,
-    check_command_outputs,
-    number_type,
-)
+from ._joints import needs_wrist, read_pose
+from ._numbers import jerk_limits, number, number_type
+from ._options import add_acceleration, add_cell_options, add_robot_options, add_units
+from ._outputs import check_command_outputs
 from ._points import add_points_options, use_points
-
-if TYPE_CHECKING:
-    pass
-
-
-def _payload(args: argparse.Namespace, units: Units) -> Any:
-    from ..motion.payload import Payload
-
-    mass = 0.0 if args.payload is None else _number("--payload", args.payload)
-    if mass < 0.0:
-        raise ParameterError("--payload", mass, "must be >= 0", "kg")
-    com: tuple[float, ...] = (0.0, 0.0, 0.0)
-    if args.payload_com is not None:
-        com = tuple(units.value(f"--payload-com {n}", v, "length") for n, v in zip("XYZ", args.payload_com))
-    return Payload(mass, com)  # type: ignore[arg-type]
+from ._robot import cell_from_args, payload_from_args, robot_from_args, with_acceleration
+from ._units import Units
 
 
 def cmd_cycle(args: argparse.Namespace) -> int:
@@ -58,8 +33,8 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     elif args.clearance_radius is not None:
         raise InvalidInputError("--clearance-radius applies to the jump (--path jump): the straight-leg arch lifts "
                                 "vertically and blends its corners")  # fmt: skip
-    robot = _load(args, units)
-    _needs_wrist(robot, "cycle")
+    robot = robot_from_args(args, units)
+    needs_wrist(robot, "cycle")
     use_points(args, robot, units, "cycle")  # --points FILE --from-point P1 --to-point P2: --from, --direction, --span
     if not args.rate > 0:  # parsed by the one number grammar (number_type): finite, ASCII digits
         raise ParameterError("--rate", args.rate, "must be > 0", "Hz")
@@ -74,15 +49,15 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     ceiling = None if args.max_height is None else units.value("--max-height", args.max_height, "length")
     start = None
     if args.from_pose is not None:
-        start = _read_pose(args.from_pose, units, "--from")
-    direction = None if args.direction is None else [_number("--direction", d) for d in args.direction]
-    _acceleration(robot, args.acceleration, units)  # a URDF file has none: given, or refused
+        start = read_pose(args.from_pose, units, "--from")
+    direction = None if args.direction is None else [number("--direction", d) for d in args.direction]
+    robot = with_acceleration(args, robot, units)  # a URDF file has none: given, or refused
     limits = robot.limits
-    jerk = _jerk(args)
+    jerk = jerk_limits(args)
     cell = cell_from_args(args, units)
-    common = {"start": start, "direction": direction, "span": span, "rise": rise, "payload": _payload(args, units),
-              "jerk": jerk, "limits": limits, "max_height": ceiling, "cell": cell,
-              "torque": not args.no_torque}  # fmt: skip
+    common = {"start": start, "direction": direction, "span": span, "rise": rise,
+              "payload": payload_from_args(args, units), "jerk": jerk, "limits": limits, "max_height": ceiling,
+              "cell": cell, "torque": not args.no_torque}  # fmt: skip
     if path is CyclePath.JUMP:
         result = standard_cycle(robot, path=path, clearance_radius=radius, **common)  # type: ignore[arg-type]
     else:
@@ -203,14 +178,14 @@ def register(sub: Any) -> None:
     g.add_argument("--jerk-limit", nargs="+", metavar="J", help="joint jerk limit, one or 4 (rad/s^3, m/s^3)")
     g.add_argument("--no-torque", action="store_true",
                    help="leave the effort limits out (a URDF's placeholder efforts); said in the output")
-    _add_acceleration(g)
+    add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
     g.add_argument("--plot", metavar="PNG", help="side and plan view of the tool path; joint rates against limits")
-    _add_units(p, inputs=True, json_help='print one JSON object {"cycle_time", "legs", "limits", ...}')
-    _add_robot_options(p)
+    add_units(p, inputs=True, json_help='print one JSON object {"cycle_time", "legs", "limits", ...}')
+    add_robot_options(p)
     add_cell_options(p)
     add_points_options(p, "cycle")
     p.set_defaults(func=cmd_cycle)

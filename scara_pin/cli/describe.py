@@ -6,22 +6,13 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InvalidInputError
-from ._common import (
-    _add_frame_options,
-    _add_robot_options,
-    _parse_locks,
-    _parse_sets,
-    check_command_outputs,
-    write_atomic,
-)
-
-if TYPE_CHECKING:
-
-    pass
-
+from ..files import write_text_atomic
+from ._numbers import parse_locks, parse_sets
+from ._options import add_frame_options, add_robot_options
+from ._outputs import check_command_outputs
 
 PAYLOAD_GRID = 7
 """Values per joint of the grid the static payload is the minimum over (7^4 = 2401 configurations)."""
@@ -83,11 +74,11 @@ def cmd_urdf(args: argparse.Namespace) -> int:
     else:
         from ..description import generate_urdf
 
-        text = generate_urdf(args.robot or "default", _parse_sets(args.set), prefix=args.prefix)
+        text = generate_urdf(args.robot or "default", parse_sets(args.set), prefix=args.prefix)
     if args.output in (None, "-"):
         sys.stdout.write(text)
     else:
-        write_atomic(Path(args.output), text)
+        write_text_atomic(Path(args.output), text)
         print(f"wrote {args.output}", file=sys.stderr)
     return 0
 
@@ -111,7 +102,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     from ._check_cell import report_with_cell
 
     report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or (),
-                             lock=_parse_locks(args.lock))
+                             lock=parse_locks(args.lock))
     return report_with_cell(args, report)
 
 
@@ -125,13 +116,13 @@ def register(sub: Any) -> None:
     p.add_argument("--prefix", default="", help="prefix for every link and joint name (letters, digits, _)")
     p.add_argument("--dh", metavar="TABLE.yaml",
                    help="build the URDF from a D-H table (standard or modified; see urdf/examples/)")  # fmt: skip
-    _add_robot_options(p, urdf_file=False)
+    add_robot_options(p, urdf_file=False)
     p.set_defaults(func=cmd_urdf)
     p = sub.add_parser("check", help="lint a third-party SCARA URDF: exit 0 clean, 4 warnings, 2 unusable")
     p.add_argument("file", metavar="FILE.urdf", nargs="?", help="the URDF (or .xacro, expanded) to check")
     p.add_argument("--list-rules", action="store_true", help="print the rules of check, one line each, and exit")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    _add_frame_options(p.add_argument_group("robot"))
+    add_frame_options(p.add_argument_group("robot"))
     from ._check_cell import add_check_cell_options
 
     add_check_cell_options(p)

@@ -10,16 +10,12 @@ from typing import Any
 from ..errors import ParameterError
 from ..files import check_outputs
 from ..limits import MAX_SAMPLES, check_count
-from ._common import (
-    Units,
-    _acceleration,
-    _add_acceleration,
-    _add_robot_options,
-    _load,
-    _needs_wrist,
-    check_command_outputs,
-    number_type,
-)
+from ._joints import needs_wrist
+from ._numbers import number_type
+from ._options import add_acceleration, add_robot_options
+from ._outputs import check_command_outputs
+from ._robot import robot_from_args, with_acceleration
+from ._units import Units
 
 _VIEW_RATE = 200.0
 """[Hz] the samples handed to the viewer page (it interpolates between them)."""
@@ -41,9 +37,9 @@ def cmd_job(args: argparse.Namespace) -> int:
     if args.robot is None and args.urdf is None and job.robot is not None:
         args.robot = job.robot
     units = Units()  # a job's numbers are SI, and so is --acceleration here
-    robot = _load(args, units)
-    _needs_wrist(robot, "job")
-    _acceleration(robot, args.acceleration, units)
+    robot = robot_from_args(args, units)
+    needs_wrist(robot, "job")
+    robot = with_acceleration(args, robot, units)
     result = _plan(job, robot)
     written: dict[str, str] = {}
     if args.out:
@@ -99,6 +95,6 @@ def register(sub: Any) -> None:
                    "the boxes placed (.png, .svg, .pdf)")  # fmt: skip
     g.add_argument("--html", metavar="HTML", help="a self-contained viewer page that plays the job (with its cell, "
                    "the part while held and the boxes placed)")  # fmt: skip
-    _add_acceleration(p)
-    _add_robot_options(p)
+    add_acceleration(p)
+    add_robot_options(p)
     p.set_defaults(func=cmd_job)

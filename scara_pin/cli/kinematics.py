@@ -9,28 +9,13 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..units import decimals_for
-from ._common import (
-    _POSE_KINDS,
-    _Q_NAMES,
-    Units,
-    _add_q,
-    _add_robot_options,
-    _add_units,
-    _check_limits,
-    _load,
-    _needs_wrist,
-    _num,
-    _q_values,
-    _read_pose,
-    _read_q,
-    _scaled,
-    add_cell_options,
-    cell_from_args,
-    check_command_outputs,
-    integer_type,
-    log,
-)
+from ..units import decimals_for, format_number
+from ._joints import check_limits, needs_wrist, q_values, read_pose
+from ._numbers import integer_type
+from ._options import add_cell_options, add_q, add_robot_options, add_units
+from ._outputs import check_command_outputs, log
+from ._robot import cell_from_args, robot_from_args
+from ._units import POSE_KINDS, Q_NAMES, Units
 
 if TYPE_CHECKING:
     import numpy as np
@@ -46,9 +31,8 @@ _SI_UNITS = {"length": "m", "angle": "rad"}
 def cmd_fk(args: argparse.Namespace) -> int:
     """Forward kinematics: the pose of tool0 in the base frame."""
     units = Units.from_args(args)
-    robot = _load(args, units)
-    q = _read_q(args, units)
-    _check_limits(robot, q, args.strict, units)
+    robot = robot_from_args(args, units)
+    q = check_limits(robot, q_values(args.q, units), units, args.strict)
     M = robot.tool_placement(q)
     from ..model import pose_from_placement
 
@@ -76,7 +60,8 @@ def cmd_fk(args: argparse.Namespace) -> int:
         print(f"geared    {_geared_text(robot, q, units)}")
     # the rotation (no unit) to 1e-9 and the translation in the user's length unit, in aligned columns
     H = M.homogeneous
-    cells = [[_num(v) for v in row[:3]] + [units.num(row[3], "length")] for row in H[:3]] + [[_num(v) for v in H[3]]]
+    cells = [[format_number(v, 9) for v in row[:3]] + [units.num(row[3], "length")] for row in H[:3]]
+    cells.append([format_number(v, 9) for v in H[3]])
     width = max(len(c) for row in cells for c in row)
     print(f"matrix    (rotation [-], translation [{units.length_name}])")
     for row in cells:
@@ -89,15 +74,14 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     import numpy as np
 
     units = Units.from_args(args)
-    robot = _load(args, units)
-    q = _read_q(args, units)
-    _check_limits(robot, q, args.strict, units)
+    robot = robot_from_args(args, units)
+    q = check_limits(robot, q_values(args.q, units), units, args.strict)
     if args.reference == "task":
         if args.frame is not None:
             raise InvalidInputError("--frame goes with --reference world|local|local_world_aligned")
         J = robot.task_jacobian(q)
         rows = ["x", "y", "z", "yaw"]
-        row_kinds: tuple[str, ...] = _POSE_KINDS
+        row_kinds: tuple[str, ...] = POSE_KINDS
     else:
         J = robot.frame_jacobian(q, args.frame, args.reference)
         rows = ["vx", "vy", "vz", "wx", "wy", "wz"]
@@ -118,7 +102,7 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
         return 0
     # J_user[i, j] = J[i, j] * (unit of row i) / (unit of column j), printed to 1e-9 SI in that unit
     ratio = np.array(units.scale(row_kinds))[:, None] / np.array(units.scale(units.q))[None, :]
-    cells = [[_num(v, decimals_for(r)) for v, r in zip(row, rrow)] for row, rrow in zip(J * ratio, ratio)]
+    cells = [[format_number(v, decimals_for(r)) for v, r in zip(row, rrow)] for row, rrow in zip(J * ratio, ratio)]
     width = max(16, *(len(c) + 2 for row in cells for c in row))
     print(f"robot     {robot.name}: {args.reference} Jacobian of {args.frame or robot.tool_frame}")
     print(f"q         {units.fmt(q, units.q)}  [{', '.join(units.names(units.q))}]")
@@ -126,13 +110,8 @@ def cmd_jacobian(args: argparse.Namespace) -> int:
     print("          " + "".join(h.rjust(width) for h in heads))
     for name, unit, row in zip(rows, units.names(row_kinds), cells):
         print(f"{f'{name} [{unit}]':<10}" + "".join(c.rjust(width) for c in row))
-    print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {_num(w)}")
+    print(f"manipulability sqrt(det(J J^T)) of the task Jacobian (SI): {format_number(w, 9)}")
     return 0
-
-
-def _solutions_json(q_list: Sequence[ArrayLike], branches: Sequence[str], units: Units) -> list[dict]:
-    scale = units.scale(units.q)
-    return [{"q": _scaled(q, scale), "branch": b} for q, b in zip(q_list, branches)]
 
 
 def _geared(robot: Robot, q: ArrayLike) -> dict[str, float]:
@@ -152,8 +131,8 @@ def _geared_text(robot: Robot, q: ArrayLike, units: Units) -> str:
     parts = []
     for g in robot.geared:
         unit = units.angle_name if g.kind == "angle" else units.length_name
-        parts.append(f"{g.name} = {units.num(values[g.name], g.kind)} {unit} ({_num(g.multiplier)} * {g.source_name} "
-                     f"+ {units.num(g.offset, g.kind)})")  # fmt: skip
+        parts.append(f"{g.name} = {units.num(values[g.name], g.kind)} {unit} ({format_number(g.multiplier, 9)} * "
+                     f"{g.source_name} + {units.num(g.offset, g.kind)})")  # fmt: skip
     return "; ".join(parts)
 
 
@@ -162,14 +141,14 @@ def cmd_ik(args: argparse.Namespace) -> int:
     units = Units.from_args(args)
     if args.input:  # refused before any work: --output must not be --input (nor a device)
         check_command_outputs(args, {"--output": args.output})
-    robot = _load(args, units)
+    robot = robot_from_args(args, units)
     if args.input:
         if args.numeric:
             raise InvalidInputError("--numeric goes with one target X Y Z YAW; ik --input (batch) is closed-form only")
         return _ik_batch(args, robot, units)
     if args.input is None and args.output:
         raise InvalidInputError("--output goes with --input (batch mode)")
-    target = _read_pose(args.target, units, dof=robot.dof)
+    target = read_pose(args.target, units, dof=robot.dof)
     near = _near(robot, args.near, units) if args.near else None
     numeric = args.numeric
     if robot.kind == "palletizer":
@@ -216,8 +195,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
             message = "every solution collides: " + "; ".join(f"{r['branch']}: {r['reason']}" for r in refused)
     code = 0 if status == "OK" else 3
     if args.json:  # always SI (docs/cli.md: "--json output is always SI")
-        si = Units(False, False)
-        solutions = _solutions_json(qs, branches, si)
+        solutions: list[dict[str, Any]] = [{"q": [float(v) for v in q], "branch": b} for q, b in zip(qs, branches)]
         for sol, t in zip(solutions, turns):
             sol["turns"] = t
         if robot.geared:  # the joints that follow (not degrees of freedom): their values at each solution
@@ -234,13 +212,13 @@ def cmd_ik(args: argparse.Namespace) -> int:
         raise InfeasibleError(f"{status}: {message}")
     method = "numeric" if numeric else "closed-form"
     print(f"robot     {robot.name}: {method} IK of {robot.tool_frame} in {robot.base_frame}")
-    kinds = _POSE_KINDS[: len(target)]
+    kinds = POSE_KINDS[: len(target)]
     print(f"target    {units.fmt(target, kinds)}  [{', '.join(units.names(kinds))}]")
     print(f"units     q = [{', '.join(units.names(units.q))}]")
     for i, (q, b) in enumerate(zip(qs, branches)):
         extra = ""
         if turns and not args.all_turns and any(t is None or t != [0, 0] for t in turns[i]):
-            extra = "  turns " + " ".join(f"{n}:{'any' if t is None else t}" for n, t in zip(_Q_NAMES, turns[i])
+            extra = "  turns " + " ".join(f"{n}:{'any' if t is None else t}" for n, t in zip(Q_NAMES, turns[i])
                                           if t != [0, 0])  # fmt: skip
         print(f"{b:<9} {units.fmt(q, units.q)}{extra}")
         if robot.geared:
@@ -302,22 +280,20 @@ def _near(robot: Robot, texts: Sequence[str], units: Units) -> np.ndarray:
     """
     if len(texts) != robot.dof:
         raise ParameterError("--near", " ".join(texts), f"must be {robot.dof} joint values")
-    near = robot.check_q(_q_values(texts, units))
-    for item in robot.outside_limits(near, units=units.display):
-        log.warning("--near: %s (used as given: the solutions nearest to it are returned)", item)
-    return near
+    return check_limits(robot, q_values(texts, units), units,
+                        warning="--near: %s (used as given: the solutions nearest to it are returned)")
 
 
 def _ik_batch(args: argparse.Namespace, robot: Robot, units: Units) -> int:
     """``ik --input CSV --output CSV``: :func:`scara_pin.kinematics.batch_io.solve_csv`, then one line."""
     from ..kinematics.batch_io import solve_csv
 
-    _needs_wrist(robot, "ik --input (batch)")
+    needs_wrist(robot, "ik --input (batch)")
     if args.target:
         raise InvalidInputError("give either X Y Z YAW or --input FILE, not both")
     if not args.output:
         raise InvalidInputError("--input needs --output FILE")
-    summary = solve_csv(robot, args.input, args.output, pose_scale=units.scale(_POSE_KINDS),
+    summary = solve_csv(robot, args.input, args.output, pose_scale=units.scale(POSE_KINDS),
                         q_scale=units.scale(units.q), branch=None if args.branch == "all" else args.branch,
                         reference=_near(robot, args.near, units) if args.near else None, progress=True)  # fmt: skip
     print(f"wrote {summary.output}: {summary.total} targets, {summary.solved} solved, {summary.failed} without "
@@ -336,8 +312,8 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
 
     from ..kinematics.validate import validate_ik
 
-    robot = _load(args)
-    _needs_wrist(robot, "validate-ik")
+    robot = robot_from_args(args)
+    needs_wrist(robot, "validate-ik")
     # a progress bar on a terminal only (tqdm's own test of stderr)
     with tqdm(total=args.samples, desc="validate-ik", file=sys.stderr, disable=None, leave=False) as bar:
         report = validate_ik(robot, args.samples, args.seed, progress=bar.update)
@@ -353,10 +329,10 @@ def cmd_validate_ik(args: argparse.Namespace) -> int:
 def register(sub: Any) -> None:
     """Add the commands of this module to the ``scara-pin`` subparsers."""
     p = sub.add_parser("fk", help="forward kinematics: pose of the tool frame (tool0; --tool) in the base frame")
-    _add_q(p)
+    add_q(p)
     p.set_defaults(func=cmd_fk)
     p = sub.add_parser("jacobian", help="task Jacobian d(x, y, z, yaw)/dq (or a 6 x 4 frame Jacobian)")
-    _add_q(p)
+    add_q(p)
     p.add_argument("--reference", default="task", choices=["task", "world", "local", "local_world_aligned"],
                    help="task (4 x 4, default) or a Pinocchio reference frame for the 6 x 4 Jacobian")  # fmt: skip
     p.add_argument("--frame", default=None, help="frame of the 6 x 4 Jacobian (default: tool0)")
@@ -376,8 +352,8 @@ def register(sub: Any) -> None:
                    "with the range of turns that fit)")  # fmt: skip
     p.add_argument("--input", metavar="CSV", help="batch: targets with header x,y,z,yaw (one solution per row)")
     p.add_argument("--output", metavar="CSV", help="batch: joints written here (atomically), with a status column")
-    _add_units(p)
-    _add_robot_options(p)
+    add_units(p)
+    add_robot_options(p)
     add_cell_options(p)
     p.set_defaults(func=cmd_ik)
     p = sub.add_parser("validate-ik", help="cross-validate closed-form IK against Pinocchio FK and numeric IK")
@@ -386,5 +362,5 @@ def register(sub: Any) -> None:
     p.add_argument("--seed", type=integer_type("--seed", 0, 2**63 - 1), default=0,
                    help="sampling seed, >= 0 (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    _add_robot_options(p)
+    add_robot_options(p)
     p.set_defaults(func=cmd_validate_ik)

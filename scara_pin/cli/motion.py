@@ -7,37 +7,19 @@ import json
 import logging
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ._common import (
-    _POSE_KINDS,
-    Units,
-    _acceleration,
-    _add_acceleration,
-    _add_robot_options,
-    _add_units,
-    _fmt,
-    _jerk,
-    _joint_arg,
-    _load,
-    _needs_wrist,
-    _num,
-    _number,
-    _read_pose,
-    add_cell_options,
-    cell_from_args,
-    check_command_outputs,
-    log,
-    number_type,
-    write_atomic,
-)
+from ..files import write_text_atomic
+from ..units import format_number, format_vector
+from ._joints import joint_arg, needs_wrist, read_pose
+from ._numbers import jerk_limits, number, number_type
+from ._options import add_acceleration, add_cell_options, add_robot_options, add_units
+from ._outputs import check_command_outputs, log
 from ._points import add_points_options, use_points
-from .cycle import _payload, cell_summary, cell_text
-
-if TYPE_CHECKING:
-
-    pass
+from ._robot import cell_from_args, payload_from_args, robot_from_args, with_acceleration
+from ._units import POSE_KINDS, Units
+from .cycle import cell_summary, cell_text
 
 
 def cmd_traj(args: argparse.Namespace) -> int:
@@ -50,12 +32,12 @@ def cmd_traj(args: argparse.Namespace) -> int:
     units = Units.from_args(args)
     check_command_outputs(args, {"--out": args.out, "--setpoints": args.setpoints, "--plot": args.plot},
                           figures=("--plot",))  # before any work  # fmt: skip
-    robot = _load(args, units)
+    robot = robot_from_args(args, units)
     use_points(args, robot, units, "traj")  # --points FILE --through P1 .. Pn: their q as --from, --via, --to
     for flag in ("linear", "arch", "plot", "payload"):
         if getattr(args, flag, None):
-            _needs_wrist(robot, f"traj --{flag}")  # 3-joint arms: joint-space trajectories (quintic, TOPP-RA)
-    _acceleration(robot, args.acceleration, units)
+            needs_wrist(robot, f"traj --{flag}")  # 3-joint arms: joint-space trajectories (quintic, TOPP-RA)
+    robot = with_acceleration(args, robot, units)
     if (args.from_q is None) == (args.from_pose is None):
         raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
     if (args.to_q is None) == (args.to_pose is None):
@@ -67,10 +49,10 @@ def cmd_traj(args: argparse.Namespace) -> int:
     for name, rate in (("--rate", args.rate), ("--setpoint-rate", args.setpoint_rate)):
         if rate is not None and not rate > 0:
             raise ParameterError(name, rate, "must be > 0", "Hz")
-    vias = [_joint_arg(robot, v, units, f"--via #{i + 1}") for i, v in enumerate(args.via or [])]
-    pose_from = _read_pose(args.from_pose, units, "--from-pose", robot.dof) if args.from_pose else None
-    pose_to = _read_pose(args.to_pose, units, "--to-pose", robot.dof) if args.to_pose else None
-    q_from = _joint_arg(robot, args.from_q, units, "--from") if args.from_q else None
+    vias = [joint_arg(robot, v, units, f"--via #{i + 1}") for i, v in enumerate(args.via or [])]
+    pose_from = read_pose(args.from_pose, units, "--from-pose", robot.dof) if args.from_pose else None
+    pose_to = read_pose(args.to_pose, units, "--to-pose", robot.dof) if args.to_pose else None
+    q_from = joint_arg(robot, args.from_q, units, "--from") if args.from_q else None
     tool_speed = None
     if args.tool_speed is not None:
         if not args.tool_speed > 0:
@@ -83,14 +65,15 @@ def cmd_traj(args: argparse.Namespace) -> int:
             raise InvalidInputError("--arch takes no --via (one arch between two poses)")
         if args.duration is not None:
             raise InvalidInputError("--arch is time-optimal: --duration does not apply")
-    jerk = _jerk(args)
+    jerk = jerk_limits(args)
     if jerk is not None and robot.dof != 4:
         raise InvalidInputError("--jerk-limit needs a 4-joint robot for now")
     request = MotionRequest(
-        start_q=q_from, end_q=_joint_arg(robot, args.to_q, units, "--to") if args.to_q else None,
+        start_q=q_from, end_q=joint_arg(robot, args.to_q, units, "--to") if args.to_q else None,
         start_pose=None if pose_from is None else np.array(pose_from),
         end_pose=None if pose_to is None else np.array(pose_to), vias=tuple(vias), duration=args.duration,
-        linear=args.linear, arch=args.arch, tool_speed=tool_speed, torque=args.torque, payload=_payload(args, units),
+        linear=args.linear, arch=args.arch, tool_speed=tool_speed, torque=args.torque,
+        payload=payload_from_args(args, units),
         rise=None if args.rise is None else units.value("--rise", args.rise, "length"),
         blend=None if args.blend is None else units.value("--blend", args.blend, "length"),
         jerk=None if jerk is None else tuple(jerk),
@@ -148,7 +131,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
     print(f"robot     {planned.name}: {method}", file=text)
     q_units = ", ".join(units.names(units.q))
-    print(f"duration  {_num(traj.duration)} s", file=text)
+    print(f"duration  {format_number(traj.duration, 9)} s", file=text)
     print(f"from      {units.fmt(traj.q_start, units.q)}  [{q_units}]", file=text)
     print(f"to        {units.fmt(traj.q_end, units.q)}  [{q_units}]", file=text)
     print(f"limits    worst |v|/vmax {ratios.velocity:.6f}, |a|/amax {ratios.acceleration:.6f} "
@@ -198,15 +181,15 @@ def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Uni
         if not (args.gear and args.steps_per_rev and args.screw_lead is not None):
             raise InvalidInputError("motor steps need --gear G1..G4, --steps-per-rev S1..S4 and --screw-lead L")
         motor = tr.MotorUnits.from_drive(
-            [_number("--gear", g) for g in args.gear],
-            [_number("--steps-per-rev", v) for v in args.steps_per_rev],
+            [number("--gear", g) for g in args.gear],
+            [number("--steps-per-rev", v) for v in args.steps_per_rev],
             units.value("--screw-lead", args.screw_lead, "length"),
             prismatic=robot.joint_kinds.index("length"),
         )
-    delays = [_number("--delays", d) for d in args.delays] if args.delays else None
+    delays = [number("--delays", d) for d in args.delays] if args.delays else None
     rate = args.setpoint_rate if args.setpoint_rate is not None else args.rate
     sp = traj.setpoints(rate, delays=delays, motor=motor)
-    write_atomic(Path(args.setpoints), sp.csv_text())
+    write_text_atomic(Path(args.setpoints), sp.csv_text())
 
 
 def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any,
@@ -250,11 +233,11 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
         return 0
     text = sys.stderr if "-" in outputs.values() else sys.stdout  # stdout carries a file: the summary goes aside
     print(f"robot     {robot.name}: {method.value}", file=text)
-    print(f"duration  {_num(traj.duration)} s", file=text)
+    print(f"duration  {format_number(traj.duration, 9)} s", file=text)
     if jump:
         b, Ln = move.lower_bound, units.length_name
-        print(f"bound     {_num(b.duration, 6)} s ({b.reason}): no move under these limits is faster; this one is "
-              f"{100 * move.gap:.1f} % above it", file=text)  # fmt: skip
+        print(f"bound     {format_number(b.duration, 6)} s ({b.reason}): no move under these limits is faster; this "
+              f"one is {100 * move.gap:.1f} % above it", file=text)  # fmt: skip
         print(f"arch      up to {units.num(move.z_top + move.peak, 'length')} {Ln}, {units.num(move.bulge, 'length')} "
               f"{Ln} off the straight line in plan view; solved in {move.stats.seconds:.3g} s", file=text)  # fmt: skip
     for leg in move.legs:
@@ -265,7 +248,7 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
         print(cell_text(cell, move.distance, units).replace("cell        ", "cell      ", 1), file=text)
     if not jump:
         print("note      the straight-leg arch is slower than the jump (--path jump, the default)"
-              + (f", which takes {_num(faster, 6)} s" if faster is not None else ""), file=text)  # fmt: skip
+              + (f", which takes {format_number(faster, 6)} s" if faster is not None else ""), file=text)  # fmt: skip
     for kind, where in outputs.items():
         print(f"wrote     {kind}: {where}", file=text)
     return 0
@@ -277,8 +260,8 @@ def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) ->
     from ..motion.jump import STANDARD_RISE, jump_move
 
     q0, q1 = move.trajectory.q_start, move.trajectory.q_end
-    rise = STANDARD_RISE if args.rise is None else _number("--rise", args.rise) / units.length
-    ceiling = None if args.max_height is None else _number("--max-height", args.max_height) / units.length
+    rise = STANDARD_RISE if args.rise is None else number("--rise", args.rise) / units.length
+    ceiling = None if args.max_height is None else number("--max-height", args.max_height) / units.length
     tool_speed = None if args.tool_speed is None else args.tool_speed / units.length
     try:
         return jump_move(robot, robot.tool_pose(q0), robot.tool_pose(q1), rise=rise, max_height=ceiling,
@@ -294,13 +277,13 @@ def cmd_jog(args: argparse.Namespace) -> int:
 
     units = Units.from_args(args)
     check_command_outputs(args, {"--out": args.out, "--plot": args.plot}, figures=("--plot",))  # before any work
-    robot = _load(args, units)
+    robot = robot_from_args(args, units)
     if robot.kind != "scara":
         raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
-    _needs_wrist(robot, "jog")
-    _acceleration(robot, args.acceleration, units)
-    q0 = _joint_arg(robot, args.from_q, units, "--from")
-    direction = [_number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
+    needs_wrist(robot, "jog")
+    robot = with_acceleration(args, robot, units)
+    q0 = joint_arg(robot, args.from_q, units, "--from")
+    direction = [number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
     if len(direction) not in (2, 3):
         raise ParameterError("--direction", " ".join(args.direction), "must be DX DY or DX DY DZ")
     margin = 0.0 if args.margin is None else units.value("--margin", args.margin, "length")
@@ -321,7 +304,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
                           "units": {"length": "m", "angle": "rad", "time": "s"}}))  # fmt: skip
         return 0
     text = sys.stderr if "-" in (args.out, args.plot) else sys.stdout  # stdout carries a file
-    print(f"robot     {robot.name}: jog to the edge along {_fmt(direction)}", file=text)
+    print(f"robot     {robot.name}: jog to the edge along {format_vector(direction, 9)}", file=text)
     if jog.contact is not None:
         print(f"stop      {jog.stopped_by}, the margin of {args.cell}", file=text)
         print(f"edge      beyond: {jog.hit.description} [{jog.hit.limit.value}]", file=text)
@@ -329,9 +312,9 @@ def cmd_jog(args: argparse.Namespace) -> int:
         print(f"edge      {jog.hit.description} [{jog.hit.limit.value}]", file=text)
         if cell is not None:
             print(f"cell      {cell.origin}: no contact before the edge (margin {cell.margin * 1e3:g} mm)", file=text)
-    print(f"travel    {units.num(jog.distance, 'length')} {units.length_name} in {_num(traj.duration, 6)} s (at rest "
-          "at both ends)", file=text)  # fmt: skip
-    print(f"end pose  {units.fmt(jog.end_pose, _POSE_KINDS)}  [{', '.join(units.names(_POSE_KINDS))}]", file=text)
+    print(f"travel    {units.num(jog.distance, 'length')} {units.length_name} in {format_number(traj.duration, 6)} s "
+          "(at rest at both ends)", file=text)  # fmt: skip
+    print(f"end pose  {units.fmt(jog.end_pose, POSE_KINDS)}  [{', '.join(units.names(POSE_KINDS))}]", file=text)
     print(f"limits    worst ratio {jog.ratio:.6f} (sampled at 10 kHz)", file=text)
     for what in (args.out, args.plot):
         if what:
@@ -373,7 +356,7 @@ def register(sub: Any) -> None:
                    help="jump: within R of an end (horizontally) the tool may be lower (default 0.005 m)")
     g.add_argument("--max-height", metavar="Z", help="a ceiling for the tool's z (base frame)")
     g.add_argument("--blend", metavar="B", help="lines: blend distance at each corner (default: as large as allowed)")
-    _add_acceleration(g)
+    add_acceleration(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out and --json (default 1000)")  # fmt: skip
@@ -387,8 +370,8 @@ def register(sub: Any) -> None:
     g.add_argument("--gear", nargs=4, metavar="G", help="gear ratios (motor turns per joint/screw turn)")
     g.add_argument("--steps-per-rev", nargs=4, metavar="N", help="motor steps per motor turn")
     g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")
-    _add_units(p, inputs=True, json_help="print one JSON object (with the samples unless --out)")
-    _add_robot_options(p)
+    add_units(p, inputs=True, json_help="print one JSON object (with the samples unless --out)")
+    add_robot_options(p)
     add_cell_options(p)
     add_points_options(p, "traj")
     p.set_defaults(func=cmd_traj)
@@ -399,10 +382,10 @@ def register(sub: Any) -> None:
                    "with --cell, also the cell's margin (instead of its file's)")
     p.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip
-    _add_acceleration(p)
+    add_acceleration(p)
     p.add_argument("--out", metavar="FILE", help="samples as CSV (or JSON for *.json), atomically")
     p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
-    _add_units(p, inputs=True)
-    _add_robot_options(p)
+    add_units(p, inputs=True)
+    add_robot_options(p)
     add_cell_options(p, margin=False)  # --margin above: the jog's own, and the cell's when given
     p.set_defaults(func=cmd_jog)

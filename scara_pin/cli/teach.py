@@ -7,16 +7,11 @@ import sys
 from typing import Any
 
 from ..signals import Terminated, handled
-from ._common import (
-    Units,
-    _add_robot_options,
-    _add_units,
-    _load,
-    _q_values,
-    add_cell_options,
-    cell_from_args,
-    integer_type,
-)
+from ._joints import q_values
+from ._numbers import integer_type
+from ._options import add_cell_options, add_robot_options, add_units
+from ._robot import cell_from_args, robot_from_args
+from ._units import Units
 
 
 def cmd_teach(args: argparse.Namespace) -> int:
@@ -24,8 +19,8 @@ def cmd_teach(args: argparse.Namespace) -> int:
     from ..viz.teach import TeachServer
 
     units = Units.from_args(args)
-    robot = _load(args, units)
-    q = _q_values(args.q, units) if args.q else None
+    robot = robot_from_args(args, units)
+    q = q_values(args.q, units) if args.q else None
     cell = cell_from_args(args, units)
     server = TeachServer(robot, port=args.port, q=q, points_file=args.points, controls=args.controls, cell=cell)
     try:  # from the line that says so on, Ctrl-C stops the server
@@ -56,7 +51,7 @@ def register(sub: Any) -> None:
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
     p.add_argument("--points", metavar="FILE", help="points file (.yaml or .csv) the page saves; read if it exists")
     p.add_argument("--controls", action="store_true", help="show meshcat's own control panel (hidden by default)")
-    _add_units(p, json_help=None)
-    _add_robot_options(p)
+    add_units(p, json_help=None)
+    add_robot_options(p)
     add_cell_options(p)
     p.set_defaults(func=cmd_teach)

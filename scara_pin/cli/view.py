@@ -4,25 +4,15 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import InvalidInputError
 from ..signals import Terminated, handled
-from ._common import (
-    Units,
-    _add_robot_options,
-    _add_units,
-    _load,
-    _q_values,
-    add_cell_options,
-    cell_from_args,
-    check_command_outputs,
-    log,
-)
-
-if TYPE_CHECKING:
-
-    pass
+from ._joints import check_limits, q_values
+from ._options import add_cell_options, add_robot_options, add_units
+from ._outputs import check_command_outputs
+from ._robot import cell_from_args, robot_from_args
+from ._units import Units
 
 
 def cmd_view(args: argparse.Namespace) -> int:
@@ -31,13 +21,11 @@ def cmd_view(args: argparse.Namespace) -> int:
 
     units = Units.from_args(args)
     check_command_outputs(args, {"--html": args.html})  # before any work: not --traj, --urdf, ...
-    robot = _load(args, units)
+    robot = robot_from_args(args, units)
     cell = cell_from_args(args, units)
     q = None
     if args.q:
-        q = robot.check_q(_q_values(args.q, units))
-        for item in robot.outside_limits(q, units=units.display):
-            log.warning("%s (shown anyway)", item)
+        q = check_limits(robot, q_values(args.q, units), units, warning="%s (shown anyway)")
     times = qs = None
     if args.traj and args.traj.lower().endswith(".json"):  # as `traj --out` writes it
         from ..motion.trajectory import load_samples
@@ -90,7 +78,7 @@ def register(sub: Any) -> None:
                    help="draw the workspace boundary (SCARA: on the floor; palletizer: its envelope in 3-D)")
     p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
-    _add_units(p, json_help=None)
-    _add_robot_options(p)
+    add_units(p, json_help=None)
+    add_robot_options(p)
     add_cell_options(p, margin=False)
     p.set_defaults(func=cmd_view)

@@ -8,18 +8,12 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
-from ..units import decimals_for, format_number
-from ._common import (
-    Units,
-    _add_robot_options,
-    _add_units,
-    _fmt,
-    _load,
-    _number,
-    add_cell_options,
-    cell_from_args,
-    check_command_outputs,
-)
+from ..units import decimals_for, format_number, format_vector
+from ._numbers import number
+from ._options import add_cell_options, add_robot_options, add_units
+from ._outputs import check_command_outputs
+from ._robot import cell_from_args, robot_from_args
+from ._units import Units
 
 _TABLE_RESOLUTION = 1e-6
 """The arc table of ``workspace`` prints centres and radii to 1 um (a summary; --json gives every bit)."""
@@ -41,7 +35,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     units = Units.from_args(args)
     L = units.length
     check_command_outputs(args, {"--plot": args.plot}, figures=("--plot",))  # before any work
-    robot = _load(args, units)
+    robot = robot_from_args(args, units)
     cell = cell_from_args(args, units)
     if cell is not None or args.height is not None:
         return _free_workspace(args, robot, units, cell)
@@ -51,12 +45,12 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     hit = None
     if args.ray:
         start = [units.value(n, t, "length") for n, t in zip(("x", "y"), args.ray[:2])]
-        direction = [_number(n, t) for n, t in zip(("dx", "dy"), args.ray[2:])]
+        direction = [number(n, t) for n, t in zip(("dx", "dy"), args.ray[2:])]
         if (args.z is None) != (args.dz is None):
             raise InvalidInputError("--z and --dz go together (a 3-D ray also meets the vertical stroke)")
         if args.z is not None:
             start.append(units.value("--z", args.z, "length"))
-            direction.append(_number("--dz", args.dz))
+            direction.append(number("--dz", args.dz))
         hit = ws.ray(start, direction)
     elif args.z is not None or args.dz is not None:
         raise InvalidInputError("--z/--dz go with --ray")
@@ -75,7 +69,8 @@ def cmd_workspace(args: argparse.Namespace) -> int:
         return 0
     n = units.length_name
     if hit is not None:
-        print(f"robot     {robot.name}: ray from {units.fmt(start, 'length')} [{n}] along {_fmt(direction)}")
+        print(f"robot     {robot.name}: ray from {units.fmt(start, 'length')} [{n}] along "
+              f"{format_vector(direction, 9)}")
         print(f"edge      {units.fmt(hit.point, 'length')} [{n}]")
         print(f"distance  {units.num(hit.distance, 'length')} {n}")
         print(f"stopped by {hit.description} [{hit.limit.value}]")
@@ -118,7 +113,7 @@ def _free_workspace(args: argparse.Namespace, robot: Robot, units: Units, cell: 
         raise InvalidInputError("--ray/--z/--dz do not go with --cell (the ray meets the joint limits' edge only)")
     z = units.value("--height", args.height, "length")
     h = None if args.resolution is None else units.value("--resolution", args.resolution, "length")
-    yaw = None if args.yaw is None else _number("--yaw", args.yaw)
+    yaw = None if args.yaw is None else number("--yaw", args.yaw)
     region = free_region(robot, cell, z, resolution=h, yaw=yaw)
     if args.plot:
         plot_free_region(region, args.plot, units=units.display, robot_name=robot.name)
@@ -167,7 +162,7 @@ def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) 
     print(f"arcs      {len(env.arcs)} (centre, radius [{name}], phi from the vertical [rad])")
     for a in env.arcs:
         print(f"  {a.limit:<13} centre {units.fmt(a.center, 'length')} radius {units.num(a.radius, 'length')} "
-              f"phi {_fmt([a.start, a.start + a.sweep])}")  # fmt: skip
+              f"phi {format_vector([a.start, a.start + a.sweep], 9)}")  # fmt: skip
     if args.plot:
         print(f"wrote     {args.plot}")
     return 0
@@ -187,7 +182,7 @@ def register(sub: Any) -> None:
                    "workspace's width / 200)")  # fmt: skip
     g.add_argument("--yaw", metavar="A", help="one tool yaw for every point [rad] (default: free with a carried "
                    "part, the first of 12 that clears; else 0)")  # fmt: skip
-    _add_units(p, deg=False)
-    _add_robot_options(p)
+    add_units(p, deg=False)
+    add_robot_options(p)
     add_cell_options(p)
     p.set_defaults(func=cmd_workspace)
