@@ -1,5 +1,5 @@
-"""The jump in a cell's warm starts and rows (scara_pin.motion.jump.candidates, .rows) where a palletizing job needs them, and the
-palletizer's wrist housing, whose collision shape must leave room for the part under the flange.
+"""The jump in a cell's warm starts and rows (scara_pin.motion.jump.candidates, .rows) where a palletizing job
+needs them, and the palletizer's wrist housing, whose collision shape must leave room for the part under the flange.
 
 Independent routes:
 
