@@ -10,8 +10,8 @@
 Nothing heavy is imported here: meshcat and matplotlib load inside the functions that draw.
 """
 
-from .stick import plot_robot
 from .inline import SceneView, show
 from .meshcat import Viewer
+from .stick import plot_robot
 
 __all__ = ["SceneView", "Viewer", "plot_robot", "show"]
