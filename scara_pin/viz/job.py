@@ -213,8 +213,8 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
         rate: [Hz] the samples handed to the page (it interpolates between them).
     """
     from ..cell import Cell
-    from ..files import write_atomic_with
-    from .meshcat import CELL_NODE, _page, _Scene, _scene, _Window
+    from ..files import write_text_atomic
+    from .scene import CELL_NODE, recorded_scene
 
     traj = result.trajectory
     samples = traj.resample(min(rate, 1e5 / max(traj.duration, 1e-9)))
@@ -225,10 +225,7 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
     if result.cell is not None or result.boxes or result.carry is not None:
         base = result.cell if result.cell is not None else Cell(origin="the job's boxes")
         cell = base.with_obstacles(boxes).with_carried(result.carry if result.carry is not None else base.carried)
-    window = _Window()
-    scene = _Scene(robot, window)
-    data = _scene(scene, None, samples.t, samples.q, None, None, targets, draw_tool_path=True, fps=30, loop=True,
-                  cell=cell)  # fmt: skip
+    scene, data = recorded_scene(robot, None, samples.t, samples.q, targets=targets, cell=cell)
     T = traj.duration
     shown: list[dict[str, object]] = []
     for b in result.boxes:
@@ -237,8 +234,7 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
         scene.vis[node].set_property("visible", False)
         shown.append({"path": f"meshcat/{node}", "spans": [[b.time, T + 1.0]]})
     if result.carry is not None:
-        frame = robot.model.frames[robot.tool_id]
-        node = f"{scene.paths[frame.parentJoint]}/cell_carried"
+        node = scene.carried_path
         scene.vis[node].set_property("color", [*_PAGE_BOX, 1.0])
         scene.vis[node].set_property("visible", False)
         held = [(s.t_start, s.t_end) for s in result.steps if s.carrying or (s.kind == "place")]
@@ -246,9 +242,7 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
     if shown and "motion" in data:
         data["motion"]["shown"] = shown
     rate_text = f", {result.boxes_per_hour:,.0f} boxes per hour" if result.boxes else ""
-    text = _page(f"scara-pin job {result.path.name}: {result.total:.4f} s{rate_text}", window.recorder.commands(),
-                 data)  # fmt: skip
-    write_atomic_with(path, lambda handle: handle.write(text))
+    write_text_atomic(path, scene.page(f"scara-pin job {result.path.name}: {result.total:.4f} s{rate_text}", data))
 
 
 def _merged(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:

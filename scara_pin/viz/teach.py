@@ -834,15 +834,9 @@ def _cell_words(cell: Cell) -> str:
 
 def _teach_page(robot: RobotModel, session: TeachSession, controls: bool = False) -> str:
     """The pendant page of the live teach server (no motion player; a ``teach`` section)."""
-    from .meshcat import _page, _Scene, _Window, draw_cell
+    from .scene import recorded_scene
 
-    window = _Window()
-    scene = _Scene(robot, window)
-    scene.display(session.q)
-    if session.cell is not None:
-        draw_cell(scene, session.cell)
-    data = scene.page_data()
-    data["q"] = [float(v) for v in session.q]
+    scene, data = recorded_scene(robot, session.q, cell=session.cell)
     data["controls"] = bool(controls)
     labels = {"all": "nearest (any branch)"}
     data["teach"] = {
@@ -856,4 +850,4 @@ def _teach_page(robot: RobotModel, session: TeachSession, controls: bool = False
         "step_tol": STEP_TOL,
         "cell": "" if session.cell is None else _cell_words(session.cell),
     }
-    return _page(f"scara-pin teach: {robot.name}", window.recorder.commands(), data)
+    return scene.page(f"scara-pin teach: {robot.name}", data)
