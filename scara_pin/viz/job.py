@@ -24,7 +24,7 @@ import numpy as np
 
 from ..description import JOINT_NAMES
 from ..units import SI, DisplayUnits
-from .plots import COLORS, LIMIT_GID, finish, new_figure
+from .plots import COLORS, LIMIT_GID, finish, hull, new_figure, shape_points
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -143,8 +143,6 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
     """The plan and side views of the job: obstacles, boxes placed (numbered), the tool path by gripper state."""
     from matplotlib.patches import Polygon, Rectangle
 
-    from .cycle import _hull, _shape_points
-
     poses, carrying = _tool_path(result, robot)
     shapes: list[tuple[Shape, str, str]] = []
     if result.cell is not None:
@@ -156,10 +154,10 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
     names = "xy"
     labels: dict[tuple[float, float], list[str]] = {}
     for shape, color, name in shapes:
-        pts = _shape_points(shape)
+        pts = shape_points(shape)
         is_box = color == BOX_COLOR
         edge = "#8b5a2b" if is_box else "0.35"
-        plan.add_patch(Polygon(_hull(pts[:, :2]), closed=True, facecolor=color, edgecolor=edge, lw=0.8,
+        plan.add_patch(Polygon(hull(pts[:, :2]), closed=True, facecolor=color, edgecolor=edge, lw=0.8,
                                alpha=0.9 if is_box else 1.0, zorder=2 if is_box else 1))  # fmt: skip
         side.add_patch(Rectangle((pts[:, along].min(), pts[:, 2].min()), float(np.ptp(pts[:, along])),
                                  float(np.ptp(pts[:, 2])), facecolor=color, edgecolor=edge, lw=0.8,
@@ -184,7 +182,7 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
     plan.set_aspect("equal", adjustable="datalim")
     what = "the job"
     if result.boxes:  # the side view frames the stack: the boxes and the tool path above them
-        pts = np.concatenate([_shape_points(b.shape) for b in result.boxes])
+        pts = np.concatenate([shape_points(b.shape) for b in result.boxes])
         lo, hi = pts[:, along].min() - 0.25, pts[:, along].max() + 0.25
         near = (poses[:, along] >= lo) & (poses[:, along] <= hi)
         z_hi = max(float(pts[:, 2].max()), float(poses[near, 2].max(initial=-np.inf))) + 0.1
