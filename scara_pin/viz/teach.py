@@ -295,9 +295,7 @@ class TeachSession:
 
     def state(self) -> TeachReply:
         """The current state and the points (moved is False); after a hold ended, how it ended."""
-        if self._hold is None and self._last_end is not None:
-            return self._ended_reply(points=True)
-        return self._reply(False, points=True)
+        return self._ended_reply(points=True) if self._hold is None else self._reply(False, points=True)
 
     # ----------------------------------------------------------------- moves
     def set_q(self, q: object) -> TeachReply:
@@ -493,13 +491,11 @@ class TeachSession:
         self._last_end = None
 
     def _ended_reply(self, points: bool = False) -> TeachReply:
-        ended = self._last_end
+        ended = self._last_end  # how the last hold ended, with the current state (kept until the next move)
         if ended is None:
             return self._reply(False, points=points)
-        q = self.q  # how the last hold ended, with the current state (kept until the next move)
-        return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), False, ended.status, ended.reason.text,
-                          ended.solver, ended.reason, ended.travelled, 0.0, ended.angle, self.holding,
-                          self._points if points else None, ended.contact)  # fmt: skip
+        reply = self._reply(False, ended.status, ended.reason.text, ended.solver, points=points)
+        return replace(reply, reason=ended.reason, travelled=ended.travelled, angle=ended.angle, contact=ended.contact)
 
     # ----------------------------------------------------------------- points
     def _adopt(self, points: PointSet) -> PointSet:
