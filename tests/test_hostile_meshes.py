@@ -455,16 +455,17 @@ def test_the_live_viewer_sends_copies_counted_against_the_cap(tmp_path: Path, mo
                                                              caplog: pytest.LogCaptureFixture) -> None:  # fmt: skip
     """meshcat's server has no shared geometry: each visual gets a copy, and the copies count together."""
     import scara_pin.limits
-    from scara_pin.viz.meshcat import _draw_meshes, _Scene, _Window
+    from scara_pin.viz.scene import MeshcatScene, draw_meshes
+    from scara_pin.viz.window import Window
 
     (tmp_path / "meshes").mkdir()
     (tmp_path / "meshes" / "a.stl").write_bytes(ascii_stl((0.01, 0.02, 0.03), b"a"))
     robot = Robot.from_file(write_package(tmp_path, {"tool0": visual("a.stl") * 5}))
-    scene = _Scene(robot, _Window())  # a recorded page: one copy, four shares
+    scene = MeshcatScene(robot, Window())  # a recorded page: one copy, four shares
     assert len(scene.vis.window.recorder.shares) == 4
     monkeypatch.setattr(scara_pin.limits, "MAX_PAGE_MESH_BYTES", 3 * (8 * 12 + 12 * 12))  # three copies of the box
-    window = _Window()  # the meshes drawn again, as for the live server (the scene's node names)
-    _draw_meshes(type(scene.vis)(window=window), robot, scene.viz, share=False)
+    window = Window()  # the meshes drawn again, as for the live server (the scene's node names)
+    draw_meshes(type(scene.vis)(window=window), robot, scene.viz, share=False)
     copies = [p for p in window.recorder.objects if "/visuals/tool0_" in p]
     assert len(copies) == 3 and not window.recorder.shares
     (record,) = [r for r in caplog.records if "the cap" in r.getMessage()]

@@ -11,13 +11,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..units import SI, DisplayUnits
-from .plots import finish, new_figure
+from .plots import COLORS, finish, hull, new_figure, shape_points
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from ..cell import Cell
-    from ..cell.shapes import Shape
     from ..description import JointLimits
     from ..model import RobotModel
     from ..motion.cycle import ArchMove, CycleResult
@@ -29,7 +28,6 @@ __all__ = ["TORQUE_LABEL", "plot_cycle"]
 TORQUE_LABEL = "|tau| / effort"
 """The y label of the torque panel (joint torque, or force for the prismatic joint, over its effort limit)."""
 
-_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
 _LEG_COLORS = {"lift": "tab:gray", "blend up": "tab:purple", "traverse": "tab:blue", "blend down": "tab:purple",
                "descend": "tab:gray"}  # fmt: skip
 
@@ -116,7 +114,7 @@ def plot_cycle(
     for k, (name, ratio) in enumerate(quantities):
         ax = fig.add_subplot(grid[1 + k, :])
         for j in range(4):
-            ax.plot(t, ratio[:, j], color=_COLORS[j], label=robot.joint_names[j])
+            ax.plot(t, ratio[:, j], color=COLORS[j], label=robot.joint_names[j])
         ax.axhline(1.0, color="k", ls="--", lw=1)
         for leg in move.legs:
             ax.axvline(leg.t_start, color="0.85", lw=0.8, zorder=0)
@@ -138,10 +136,10 @@ def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarra
 
     for i, o in enumerate(cell.obstacles):
         shape = o.shape
-        pts = _shape_points(shape)
-        hull = _hull(pts[:, :2])
+        pts = shape_points(shape)
+        outline = hull(pts[:, :2])
         label = "obstacles" if i == 0 else None
-        plan.add_patch(Polygon(hull * k, closed=True, facecolor="0.75", edgecolor="0.35", lw=1, label=label))
+        plan.add_patch(Polygon(outline * k, closed=True, facecolor="0.75", edgecolor="0.35", lw=1, label=label))
         plan.annotate(o.name, shape.xyz[:2] * k, fontsize="x-small", ha="center", va="center")
         along = (pts[:, :2] - start) @ u
         side.add_patch(Rectangle((along.min() * k, pts[:, 2].min() * k), float(np.ptp(along)) * k,
@@ -149,32 +147,6 @@ def _draw_cell(side: Any, plan: Any, cell: Cell, start: np.ndarray, u: np.ndarra
                                  label=label))  # fmt: skip
     side.autoscale_view()
     plan.autoscale_view()
-
-
-def _shape_points(shape: Shape) -> np.ndarray:
-    """(k, 3) points of ``shape`` whose convex hull outlines it, in its frame's axes.
-
-    A vertical cylinder's or a sphere's rings (a circle in plan view), else the corners of the box around it
-    (:meth:`~scara_pin.cell.Shape.corners`).
-    """
-    if shape.kind in ("cylinder", "sphere") and abs(shape.rotation[2, 2]) > 1.0 - 1e-9:
-        angle = np.linspace(0.0, 2.0 * np.pi, 73)
-        r = shape.size[0]
-        ring = shape.xyz[:2] + r * np.column_stack([np.cos(angle), np.sin(angle)])
-        half = shape.size[1] / 2.0 if shape.kind == "cylinder" else r
-        return np.column_stack([np.repeat(ring, 2, axis=0), np.tile([shape.xyz[2] - half, shape.xyz[2] + half],
-                                                                    len(ring))])  # fmt: skip
-    return shape.corners()
-
-
-def _hull(points: np.ndarray) -> np.ndarray:
-    """The convex hull of 2-D points (scipy's Qhull), counterclockwise."""
-    from scipy.spatial import ConvexHull
-
-    pts = np.unique(points, axis=0)
-    if len(pts) < 3:
-        return pts
-    return pts[ConvexHull(pts).vertices]
 
 
 def _jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:

@@ -24,15 +24,13 @@ from ..errors import ParameterError
 from ..files import write_text_atomic
 from ..limits import MAX_FRAMES, check_count
 from ..summary import Summarized
+from .scene import DEFAULT_FPS
 
 if TYPE_CHECKING:
     from ..model import RobotModel
     from ..motion.trajectory import Trajectory
 
 __all__ = ["SceneView", "show", "workspace_polylines"]
-
-_FPS = 30
-"""Samples per second of a trajectory handed to the page's player."""
 
 
 @dataclass(frozen=True, repr=False)
@@ -62,8 +60,7 @@ class SceneView(Summarized):
 
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the page to ``path`` (atomically); it opens offline from disk."""
-        write_text_atomic(Path(path), self.html)
-        return Path(path)
+        return write_text_atomic(path, self.html)
 
 
 def workspace_polylines(robot: RobotModel) -> list[np.ndarray]:
@@ -111,9 +108,9 @@ def show(
         raise ParameterError("height", height, "must be a whole number of pixels within [100, 4000]")
     times = qs = None
     if trajectory is not None:  # the frame count sized before any sample is made
-        check_count(f"animation frames ({trajectory.duration:.6g} s at {_FPS} fps)", trajectory.duration * _FPS + 2.0,
-                    MAX_FRAMES)  # fmt: skip
-        times = np.linspace(0.0, trajectory.duration, max(2, int(math.ceil(trajectory.duration * _FPS)) + 1))
+        check_count(f"animation frames ({trajectory.duration:.6g} s at {DEFAULT_FPS} fps)",
+                    trajectory.duration * DEFAULT_FPS + 2.0, MAX_FRAMES)  # fmt: skip
+        times = np.linspace(0.0, trajectory.duration, max(2, int(math.ceil(trajectory.duration * DEFAULT_FPS)) + 1))
         qs = trajectory.sample(times)[0]
     polylines = workspace_polylines(robot) if workspace else None
     title = f"scara-pin: {robot.name}"

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..description import JOINT_NAMES
 from ..units import SI, DisplayUnits
-from .plots import COLORS, LIMIT_GID, finish, new_figure
+from .plots import COLORS, LIMIT_GID, finish, hull, new_figure, shape_points
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -143,8 +143,6 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
     """The plan and side views of the job: obstacles, boxes placed (numbered), the tool path by gripper state."""
     from matplotlib.patches import Polygon, Rectangle
 
-    from .cycle import _hull, _shape_points
-
     poses, carrying = _tool_path(result, robot)
     shapes: list[tuple[Shape, str, str]] = []
     if result.cell is not None:
@@ -156,10 +154,10 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
     names = "xy"
     labels: dict[tuple[float, float], list[str]] = {}
     for shape, color, name in shapes:
-        pts = _shape_points(shape)
+        pts = shape_points(shape)
         is_box = color == BOX_COLOR
         edge = "#8b5a2b" if is_box else "0.35"
-        plan.add_patch(Polygon(_hull(pts[:, :2]), closed=True, facecolor=color, edgecolor=edge, lw=0.8,
+        plan.add_patch(Polygon(hull(pts[:, :2]), closed=True, facecolor=color, edgecolor=edge, lw=0.8,
                                alpha=0.9 if is_box else 1.0, zorder=2 if is_box else 1))  # fmt: skip
         side.add_patch(Rectangle((pts[:, along].min(), pts[:, 2].min()), float(np.ptp(pts[:, along])),
                                  float(np.ptp(pts[:, 2])), facecolor=color, edgecolor=edge, lw=0.8,
@@ -184,7 +182,7 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
     plan.set_aspect("equal", adjustable="datalim")
     what = "the job"
     if result.boxes:  # the side view frames the stack: the boxes and the tool path above them
-        pts = np.concatenate([_shape_points(b.shape) for b in result.boxes])
+        pts = np.concatenate([shape_points(b.shape) for b in result.boxes])
         lo, hi = pts[:, along].min() - 0.25, pts[:, along].max() + 0.25
         near = (poses[:, along] >= lo) & (poses[:, along] <= hi)
         z_hi = max(float(pts[:, 2].max()), float(poses[near, 2].max(initial=-np.inf))) + 0.1
@@ -213,8 +211,8 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
         rate: [Hz] the samples handed to the page (it interpolates between them).
     """
     from ..cell import Cell
-    from ..files import write_atomic_with
-    from .meshcat import CELL_NODE, _page, _Scene, _scene, _Window
+    from ..files import write_text_atomic
+    from .scene import CELL_NODE, recorded_scene
 
     traj = result.trajectory
     samples = traj.resample(min(rate, 1e5 / max(traj.duration, 1e-9)))
@@ -225,10 +223,7 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
     if result.cell is not None or result.boxes or result.carry is not None:
         base = result.cell if result.cell is not None else Cell(origin="the job's boxes")
         cell = base.with_obstacles(boxes).with_carried(result.carry if result.carry is not None else base.carried)
-    window = _Window()
-    scene = _Scene(robot, window)
-    data = _scene(scene, None, samples.t, samples.q, None, None, targets, draw_tool_path=True, fps=30, loop=True,
-                  cell=cell)  # fmt: skip
+    scene, data = recorded_scene(robot, None, samples.t, samples.q, targets=targets, cell=cell)
     T = traj.duration
     shown: list[dict[str, object]] = []
     for b in result.boxes:
@@ -237,8 +232,7 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
         scene.vis[node].set_property("visible", False)
         shown.append({"path": f"meshcat/{node}", "spans": [[b.time, T + 1.0]]})
     if result.carry is not None:
-        frame = robot.model.frames[robot.tool_id]
-        node = f"{scene.paths[frame.parentJoint]}/cell_carried"
+        node = scene.carried_path
         scene.vis[node].set_property("color", [*_PAGE_BOX, 1.0])
         scene.vis[node].set_property("visible", False)
         held = [(s.t_start, s.t_end) for s in result.steps if s.carrying or (s.kind == "place")]
@@ -246,9 +240,7 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
     if shown and "motion" in data:
         data["motion"]["shown"] = shown
     rate_text = f", {result.boxes_per_hour:,.0f} boxes per hour" if result.boxes else ""
-    text = _page(f"scara-pin job {result.path.name}: {result.total:.4f} s{rate_text}", window.recorder.commands(),
-                 data)  # fmt: skip
-    write_atomic_with(path, lambda handle: handle.write(text))
+    write_text_atomic(path, scene.page(f"scara-pin job {result.path.name}: {result.total:.4f} s{rate_text}", data))
 
 
 def _merged(spans: list[tuple[float, float]]) -> list[tuple[float, float]]:

@@ -184,7 +184,6 @@ def render(title: str, viewer_js: str, commands: list[bytes], data: dict[str, An
         data: the panel's data (the scene's joints, tool and limits, plus ``q``, and ``motion``
             or ``teach``); None for a page without a panel.
     """
-    share = SHARE_GEOMETRY
     encoded = ",\n".join(f'"{base64.b64encode(c).decode("ascii")}"' for c in commands)
     panel = script = ""
     if data is not None:
@@ -219,7 +218,7 @@ viewer.gui.domElement.style.display = /[?&]controls=1(&|$)/.test(location.search
     return viewer.scene_tree.find(names.concat(["<object>"])).object;
   }}
   viewer.handle_command = function (command) {{
-    if (command.type !== "{share}") return handle(command);
+    if (command.type !== "{SHARE_GEOMETRY}") return handle(command);
     var target = object(command.path), source = object(command.source);
     if (target.isMesh && source.isMesh) {{
       target.geometry.dispose();

@@ -12,6 +12,7 @@ view) and the tool speed. The shared helpers give every figure the same conventi
   far outside the plotted values (it would squash the curve);
 - :func:`finish`: writes the figure (atomically, PNG/SVG/PDF by its ending) only when given a path, and
   returns it.
+- :func:`shape_points` and :func:`hull`: a cell shape's outline in plan view (the cycle's and the job's).
 
 matplotlib is imported inside the functions, so importing this module costs nothing.
 """
@@ -35,6 +36,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from ..cell.shapes import Shape
     from ..model import RobotModel
 
 __all__ = [
@@ -42,11 +44,13 @@ __all__ = [
     "LIMIT_GID",
     "draw_limits",
     "finish",
+    "hull",
     "joint_kinds",
     "new_figure",
     "plot_trajectory",
     "quantity_label",
     "rate_unit",
+    "shape_points",
 ]
 
 COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
@@ -133,6 +137,32 @@ def draw_limits(ax: Axes, limits: Sequence[float], values: np.ndarray, color: st
                 fontsize=7, color=color, gid="limit-note")  # fmt: skip
     ax.set_ylim(*view)
     return drawn
+
+
+def shape_points(shape: Shape) -> np.ndarray:
+    """(k, 3) points of ``shape`` whose convex hull outlines it, in its frame's axes.
+
+    A vertical cylinder's or a sphere's rings (a circle in plan view), else the corners of the box around it
+    (:meth:`~scara_pin.cell.Shape.corners`).
+    """
+    if shape.kind in ("cylinder", "sphere") and abs(shape.rotation[2, 2]) > 1.0 - 1e-9:
+        angle = np.linspace(0.0, 2.0 * np.pi, 73)
+        r = shape.size[0]
+        ring = shape.xyz[:2] + r * np.column_stack([np.cos(angle), np.sin(angle)])
+        half = shape.size[1] / 2.0 if shape.kind == "cylinder" else r
+        return np.column_stack([np.repeat(ring, 2, axis=0), np.tile([shape.xyz[2] - half, shape.xyz[2] + half],
+                                                                    len(ring))])  # fmt: skip
+    return shape.corners()
+
+
+def hull(points: np.ndarray) -> np.ndarray:
+    """The convex hull of 2-D points (scipy's Qhull), counterclockwise."""
+    from scipy.spatial import ConvexHull
+
+    pts = np.unique(points, axis=0)
+    if len(pts) < 3:
+        return pts
+    return pts[ConvexHull(pts).vertices]
 
 
 def plot_trajectory(

@@ -81,7 +81,7 @@ def plot_robot(
     Raises:
         ParameterError: a ``q`` that is not ``robot.dof`` finite numbers, or an unknown ``view``.
     """
-    from ..files import save_figure
+    from .plots import finish, new_figure
 
     if view not in _VIEWS:
         raise ParameterError("view", view, f"must be one of {', '.join(_VIEWS)}")
@@ -94,7 +94,7 @@ def plot_robot(
     tool = robot.frame_placement(qv, robot.model.frames[robot.tool_id].name)
     size = 0.15 * max(float(np.ptp(pts, axis=0).max()), 1e-3 * k)
     if ax is None:
-        fig = _figure()
+        fig = new_figure(6.4, 5.6)
         ax = fig.add_subplot(projection="3d" if view == "3d" else None)
     fig = ax.get_figure()  # type: ignore[assignment]
     cols = {"3d": (0, 1, 2), "top": (0, 1), "side": (0, 2)}[view]
@@ -121,15 +121,4 @@ def plot_robot(
     shown = units.format_vector(qv, robot.joint_kinds)
     ax.set_title(title if title is not None else f"{robot.name} at q = {shown} "
                  f"[{', '.join(units.name(kind) for kind in robot.joint_kinds)}]", fontsize=9)  # fmt: skip
-    if path is not None:
-        save_figure(fig, path, dpi=dpi)
-    return fig  # type: ignore[return-value]
-
-
-def _figure() -> Figure:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(6.4, 5.6), layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
+    return finish(fig, path, dpi)  # type: ignore[arg-type]

@@ -295,9 +295,7 @@ class TeachSession:
 
     def state(self) -> TeachReply:
         """The current state and the points (moved is False); after a hold ended, how it ended."""
-        if self._hold is None and self._last_end is not None:
-            return self._ended_reply(points=True)
-        return self._reply(False, points=True)
+        return self._ended_reply(points=True) if self._hold is None else self._reply(False, points=True)
 
     # ----------------------------------------------------------------- moves
     def set_q(self, q: object) -> TeachReply:
@@ -493,13 +491,11 @@ class TeachSession:
         self._last_end = None
 
     def _ended_reply(self, points: bool = False) -> TeachReply:
-        ended = self._last_end
+        ended = self._last_end  # how the last hold ended, with the current state (kept until the next move)
         if ended is None:
             return self._reply(False, points=points)
-        q = self.q  # how the last hold ended, with the current state (kept until the next move)
-        return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), False, ended.status, ended.reason.text,
-                          ended.solver, ended.reason, ended.travelled, 0.0, ended.angle, self.holding,
-                          self._points if points else None, ended.contact)  # fmt: skip
+        reply = self._reply(False, ended.status, ended.reason.text, ended.solver, points=points)
+        return replace(reply, reason=ended.reason, travelled=ended.travelled, angle=ended.angle, contact=ended.contact)
 
     # ----------------------------------------------------------------- points
     def _adopt(self, points: PointSet) -> PointSet:
@@ -834,15 +830,9 @@ def _cell_words(cell: Cell) -> str:
 
 def _teach_page(robot: RobotModel, session: TeachSession, controls: bool = False) -> str:
     """The pendant page of the live teach server (no motion player; a ``teach`` section)."""
-    from .meshcat import _page, _Scene, _Window, draw_cell
+    from .scene import recorded_scene
 
-    window = _Window()
-    scene = _Scene(robot, window)
-    scene.display(session.q)
-    if session.cell is not None:
-        draw_cell(scene, session.cell)
-    data = scene.page_data()
-    data["q"] = [float(v) for v in session.q]
+    scene, data = recorded_scene(robot, session.q, cell=session.cell)
     data["controls"] = bool(controls)
     labels = {"all": "nearest (any branch)"}
     data["teach"] = {
@@ -856,4 +846,4 @@ def _teach_page(robot: RobotModel, session: TeachSession, controls: bool = False
         "step_tol": STEP_TOL,
         "cell": "" if session.cell is None else _cell_words(session.cell),
     }
-    return _page(f"scara-pin teach: {robot.name}", window.recorder.commands(), data)
+    return scene.page(f"scara-pin teach: {robot.name}", data)
