@@ -38,7 +38,7 @@ if TYPE_CHECKING:
     from ._typing import ArrayLike
     from .chain import GearedJoint, JointAxis, LockedJoint
     from .description.packages import PackagePath
-    from .kinematics.results import BatchIKResult, IKResult
+    from .ik_results import BatchIKResult, IKResult
 
 __all__ = ["Kinematics", "KinematicsFactory", "RobotModel", "pose_from_placement"]
 

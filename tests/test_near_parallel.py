@@ -19,8 +19,8 @@ import pytest
 
 from scara_pin import NoSolutionError
 from scara_pin.cli import main
+from scara_pin.ik_results import IKResult, IKSolution
 from scara_pin.kinematics.polish import polish_result
-from scara_pin.kinematics.results import IKResult, IKSolution
 from scara_pin.kinematics.scara import EXACT_TILT, NEAR_PARALLEL_TOL, IKStatus, NotScaraError
 from scara_pin.kinematics.scara_kinematics import ScaraKinematics
 from scara_pin.robots import load_robot, robot_from_urdf

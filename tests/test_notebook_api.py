@@ -20,8 +20,8 @@ import pytest
 
 import scara_pin
 from scara_pin import ParameterError, load_robot
+from scara_pin.ik_results import BatchBranch
 from scara_pin.kinematics.palletizer import PalletizerIKStatus
-from scara_pin.kinematics.results import BatchBranch
 from scara_pin.kinematics.scara_geometry import IKStatus
 
 ROOT = Path(__file__).resolve().parents[1]

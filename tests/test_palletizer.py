@@ -29,6 +29,7 @@ from scara_pin import ParameterError, Robot, generate_urdf, load_parameters, loa
 from scara_pin.cli import main
 from scara_pin.description import PALLETIZER_PARAMETER_NAMES, PARAMETER_NAMES, parameter_names
 from scara_pin.errors import UnknownRobotError
+from scara_pin.ik_results import IKResult
 from scara_pin.kinematics.numeric import solve_numeric
 from scara_pin.kinematics.palletizer import (
     NotPalletizerError,
@@ -42,7 +43,6 @@ from scara_pin.kinematics.palletizer import (
     wrist_pitch,
 )
 from scara_pin.kinematics.palletizer_model import read as read_palletizer
-from scara_pin.kinematics.results import IKResult
 from scara_pin.kinematics.validate import validate_ik
 from scara_pin.workspace import workspace_of
 

@@ -55,6 +55,7 @@ import pinocchio as pin
 
 from .._checks import as_vector
 from ..errors import InvalidInputError, NoSolutionError, ParameterError, UrdfError
+from ..ik_results import BatchIKResult, IKResult, result_of
 from .planar2r import (
     FREE_R,
     LIMIT_TOL,
@@ -67,7 +68,6 @@ from .planar2r import (
     turn_edge,
     wrap,
 )
-from .results import BatchIKResult, IKResult, result_of
 from .targets import batch_inputs, parse_target, reference_floats, weight_floats
 
 if TYPE_CHECKING:

@@ -12,9 +12,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..ik_results import BatchIKResult, IKResult
 from . import palletizer
 from .palletizer_model import read
-from .results import BatchIKResult, IKResult
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike

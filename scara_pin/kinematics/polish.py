@@ -33,16 +33,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..ik_results import IKResult, IKSolution
 from .planar2r import LIMIT_TOL, TWO_PI, nearest_turn
-from .results import IKResult, IKSolution
 from .scara_geometry import BRANCHES, IKStatus, ScaraGeometry, branch_of, wrist_point
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from .._typing import ArrayLike
+    from ..ik_results import BatchIKResult
     from ..model import RobotModel
-    from .results import BatchIKResult
 
 __all__ = [
     "HALVINGS",

@@ -18,7 +18,7 @@ Branches (as on industrial controllers' lefty/righty arms):
 
 Turns: each branch is ONE solution, every revolute joint at its 2 pi turn nearest the reference (default
 q = 0; chosen per joint, in O(1) whatever the range), with the range of turns that also fit
-(:class:`~scara_pin.kinematics.results.IKSolution`); :meth:`IKResult.expand` lists every turn on request.
+(:class:`~scara_pin.ik_results.IKSolution`); :meth:`IKResult.expand` lists every turn on request.
 Continuous joints take the turn nearest the reference (distances wrapped).
 
 Limits and rounding: a joint within ``LIMIT_TOL`` outside a limit is clamped onto it. Near the stretched
@@ -43,6 +43,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInputError, NoSolutionError
+from ..ik_results import IKResult, result_of
 from .planar2r import (
     FREE_R,
     LIMIT_TOL,
@@ -53,7 +54,6 @@ from .planar2r import (
     turn_edge,
     wrap,
 )
-from .results import IKResult, result_of
 from .scara_geometry import (
     BRANCHES,
     EXACT_TILT,

@@ -13,10 +13,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InvalidInputError, ParameterError
+from ..ik_results import BatchIKResult, IKResult
 from . import scara
 from .polish import polish_batch, row_solver, solve_refined
-from .results import BatchIKResult, IKResult, nearest_q
 from .scara_batch import solve_batch
+from .targets import nearest_q
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike

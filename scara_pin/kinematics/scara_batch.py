@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..ik_results import BatchIKResult
 from .planar2r import (
     FREE_R,
     LIMIT_TOL,
@@ -19,7 +20,6 @@ from .planar2r import (
     TWO_PI,
     nearest_turn_array,
 )
-from .results import BatchIKResult
 from .scara_geometry import BRANCHES, IKStatus, ScaraGeometry
 from .targets import batch_inputs
 

@@ -18,11 +18,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from ..ik_results import BatchIKResult, IKResult
 from ..model import pose_from_placement
 from . import scara
 from .polish import polish_batch, row_solver, seed_geometry, solve_refined
-from .results import BatchIKResult, IKResult, nearest_q
 from .scara_batch import solve_batch
+from .targets import nearest_q
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike

@@ -9,10 +9,11 @@ import numpy as np
 import pinocchio as pin
 
 from .._checks import MAGNITUDE_MAX, as_floats, as_vector
-from ..errors import ParameterError
+from ..errors import NoSolutionError, ParameterError
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
+    from ..ik_results import IKResult
 
 __all__ = ["batch_inputs", "check_magnitude", "parse_target", "placement_matrix", "reference_floats", "weight_floats"]
 
@@ -136,3 +137,18 @@ def batch_inputs(targets: object, reference: object, branch: str, branches: tupl
     if ref.shape not in ((4,), (T.shape[0], 4)) or not np.isfinite(ref).all():
         raise ParameterError("reference", f"array of shape {ref.shape}", "must be 4 finite values or (N, 4)")
     return T, ref
+
+
+def nearest_q(res: IKResult, reference: ArrayLike | None, weights: ArrayLike | None, branch: str,
+                n: int) -> np.ndarray:  # fmt: skip
+    """The solution of ``res`` nearest ``reference`` (weighted, ``n`` joints), as a new array.
+
+    Raises:
+        NoSolutionError: ``res`` has no solution (on ``branch``).
+    """
+    ref = reference_floats(reference, n)
+    w = None if weights is None else weight_floats(weights, n)
+    best = res.nearest(ref, w, branch) if res.success else None
+    if best is None:
+        raise NoSolutionError(res.status, res.message if not res.success else f"no {branch} solution")
+    return best.q.copy()

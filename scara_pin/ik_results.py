@@ -16,12 +16,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import InvalidInputError, NoSolutionError
-from ..summary import Summarized
+from .errors import InvalidInputError
+from .summary import Summarized
 
 if TYPE_CHECKING:
-    from .._typing import ArrayLike
-    from ..units import DisplayUnits
+    from ._typing import ArrayLike
+    from .units import DisplayUnits
 
 __all__ = ["MAX_SOLUTIONS", "BatchBranch", "BatchIKResult", "IKResult", "IKSolution", "joint_distance", "result_of"]
 
@@ -268,20 +268,3 @@ class BatchIKResult:
         counts = ", ".join(f"{k} {v}" for k, v in self.counts().items())
         return (f"BatchIKResult({len(self)} targets: {counts}; branches {self.branches[0]} {first}, "
                 f"{self.branches[1]} {solved - first})")  # fmt: skip
-
-
-def nearest_q(res: IKResult, reference: ArrayLike | None, weights: ArrayLike | None, branch: str,
-                n: int) -> np.ndarray:  # fmt: skip
-    """The solution of ``res`` nearest ``reference`` (weighted, ``n`` joints), as a new array.
-
-    Raises:
-        NoSolutionError: ``res`` has no solution (on ``branch``).
-    """
-    from .targets import reference_floats, weight_floats  # (targets imports pinocchio: on first use)
-
-    ref = reference_floats(reference, n)
-    w = None if weights is None else weight_floats(weights, n)
-    best = res.nearest(ref, w, branch) if res.success else None
-    if best is None:
-        raise NoSolutionError(res.status, res.message if not res.success else f"no {branch} solution")
-    return best.q.copy()
