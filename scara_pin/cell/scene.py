@@ -52,12 +52,12 @@ if TYPE_CHECKING:
 __all__ = ["FAR", "GJK_TOLERANCE", "Distances", "InCollisionError", "Pair", "PairDistance", "Scene", "Witness", "scene"]
 
 GJK_TOLERANCE = 1e-10
+"""coal's GJK and EPA tolerances used here [m] (distances then agree with closed forms to about 4e-11 m)."""
 FAR = 0.05
 """[m] a pair with a non-convex mesh whose bounding spheres are farther apart than this takes that bound as its
 distance in :meth:`Scene.distance_array` (not coal's exact one, which costs about 2 ms there)."""
 EPA_ITERATIONS = 1000
 """coal's EPA iterations (its default, 64, leaves penetration depths of parallel cylinders wrong)."""
-"""coal's GJK and EPA tolerances used here [m] (distances then agree with closed forms to about 4e-11 m)."""
 
 
 class InCollisionError(InvalidInputError):
@@ -217,60 +217,83 @@ class Scene:
     def __post_init__(self) -> None:
         import pinocchio as pin
 
+        gm, names, n_robot, carried = self._geometry()
+        allowed = self._allowed(set(names))
+        movers = list(range(n_robot)) + ([carried] if carried is not None else [])
+        candidates = [(i, j, "obstacle") for i in movers for j in range(n_robot + (carried is not None), gm.ngeoms)]
+        checked_self, disabled = self._self_pairs(gm, names, n_robot, carried)
+        pairs: list[Pair] = []
+        for i, j, kind in candidates + [(a, b, "self") for a, b in checked_self]:
+            na, nb = names[i], names[j]
+            if kind == "self" and j == carried:
+                na, nb, i, j = nb, na, j, i  # carried first
+            if frozenset((na, nb)) not in allowed:
+                pairs.append(Pair(len(pairs), na, nb, kind, int(i), int(j)))
+        gm.removeAllCollisionPairs()
+        for pr in pairs:
+            gm.addCollisionPair(pin.CollisionPair(pr.first, pr.second))
+        self.pairs = tuple(pairs)
+        self._configure(gm)
+        checked = [(names[a], names[b]) for a, b in checked_self]
+        disabled += [(na, nb, "allowed by the cell") for na, nb in checked if frozenset((na, nb)) in allowed]
+        self.self_pairs = SelfPairs(tuple(p for p in checked if frozenset(p) not in allowed), tuple(disabled))
+        self.margin = self.cell.margin
+        self._names = tuple(names)
+
+    def _geometry(self) -> tuple[pin.GeometryModel, list[str], int, int | None]:
+        """(geometry model, each geometry's name, how many are the robot's, the carried part's index or None).
+
+        The robot's collision geometry, the carried part on the tool frame, the obstacles on the root.
+        """
+        import pinocchio as pin
+
         robot, cell = self.robot, self.cell
         geo = robot_geometry(robot)
         gm = pin.GeometryModel(geo.model)
         names = list(geo.links)
-        n_robot = len(names)
-        model = robot.model
-        base = robot.data.oMf[robot.base_id]  # fixed to the root (Robot keeps it from its neutral FK)
+        base = robot.data.oMf[robot.base_id]  # fixed to the root (the model keeps it from its neutral FK)
         self._oMbase = pin.SE3(base)
-        carried_index = None
+        carried = None
         if cell.carried is not None:
-            frame = model.frames[robot.tool_id]
-            obj = pin.GeometryObject(CARRIED, int(frame.parentJoint), int(robot.tool_id),
-                                     frame.placement * cell.carried.placement(), cell.carried.geometry())  # fmt: skip
-            carried_index = gm.addGeometryObject(obj)
+            frame = robot.model.frames[robot.tool_id]
+            carried = gm.addGeometryObject(pin.GeometryObject(CARRIED, int(frame.parentJoint), int(robot.tool_id),
+                                                              frame.placement * cell.carried.placement(),
+                                                              cell.carried.geometry()))  # fmt: skip
             names.append(CARRIED)
-        first_obstacle = gm.ngeoms
         for o in cell.obstacles:
             gm.addGeometryObject(pin.GeometryObject(f"obstacle:{o.name}", 0, 0, base * o.shape.placement(),
                                                     o.shape.geometry()))  # fmt: skip
             names.append(o.name)
-        known = set(names)
-        allowed: set[frozenset[str]] = set()
-        for first, second in cell.allow:
+        return gm, names, len(geo.links), carried
+
+    def _allowed(self, known: set[str]) -> set[frozenset[str]]:
+        """The cell's ``allow`` pairs, each name a link with collision geometry, ``carried`` or an obstacle."""
+        for first, second in self.cell.allow:
             for n in (first, second):
                 if n not in known:
-                    raise InvalidInputError(f"{cell.origin}: allow names {n!r}, neither a link with collision geometry "
-                                            f"nor an obstacle (known: {', '.join(sorted(known))})")  # fmt: skip
-            allowed.add(frozenset((first, second)))
-        movers = list(range(n_robot)) + ([carried_index] if carried_index is not None else [])
-        candidates = []  # (i, j, kind)
-        for i in movers:
-            for j in range(first_obstacle, gm.ngeoms):
-                candidates.append((i, j, "obstacle"))
-        self_candidates = []
-        for i in movers:
-            for j in range(n_robot):
-                if j >= i and i < n_robot:
-                    continue
-                if i < n_robot and j < n_robot:
-                    a, b = (j, i) if j < i else (i, j)
-                else:
-                    a, b = j, i  # (link, carried)
-                self_candidates.append((a, b))
-        self_candidates = sorted(set(self_candidates))
-        adjacent = set(geo.adjacent)
-        if carried_index is not None:  # the carried part is on the tool's joint: adjacent to the links there
-            tool_joint = int(model.frames[robot.tool_id].parentJoint)
-            for j in range(n_robot):
-                gj = gm.geometryObjects[j].parentJoint
-                if gj == tool_joint or model.parents[tool_joint] == gj:
-                    adjacent.add((j, carried_index))
+                    raise InvalidInputError(f"{self.cell.origin}: allow names {n!r}, neither a link with collision "
+                                            f"geometry nor an obstacle (known: {', '.join(sorted(known))})")
+        return {frozenset(pair) for pair in self.cell.allow}
+
+    def _self_pairs(self, gm: pin.GeometryModel, names: list[str], n_robot: int,
+                    carried: int | None) -> tuple[list[tuple[int, int]], list[tuple[str, str, str]]]:  # fmt: skip
+        """(the self pairs checked, those disabled with the reason).
+
+        All but adjacent ones and those in contact at every sampled configuration (module docstring); the carried
+        part is adjacent to the links on the tool's joint and its parent.
+        """
+        model = self.robot.model
+        movers = list(range(n_robot)) + ([carried] if carried is not None else [])
+        found = {(min(i, j), max(i, j)) if i < n_robot else (j, i) for i in movers for j in range(n_robot)
+                 if not (j >= i and i < n_robot)}  # fmt: skip
+        adjacent = set(robot_geometry(self.robot).adjacent)
+        if carried is not None:
+            tool_joint = int(model.frames[self.robot.tool_id].parentJoint)
+            adjacent |= {(j, carried) for j in range(n_robot)
+                         if gm.geometryObjects[j].parentJoint in (tool_joint, model.parents[tool_joint])}  # fmt: skip
         disabled: list[tuple[str, str, str]] = []
         to_sample = []
-        for a, b in self_candidates:
+        for a, b in sorted(found):
             if names[a] == names[b]:
                 continue
             if (a, b) in adjacent:
@@ -278,23 +301,16 @@ class Scene:
             else:
                 to_sample.append((a, b))
         always = self._always_in_contact(gm, to_sample)
-        checked_self = []
-        for a, b in to_sample:
-            if (a, b) in always:
-                disabled.append((names[a], names[b], "always in contact"))
-            else:
-                checked_self.append((a, b))
-        pairs: list[Pair] = []
-        for i, j, kind in candidates + [(a, b, "self") for a, b in checked_self]:
-            na, nb = names[i], names[j]
-            if kind == "self" and j == carried_index:
-                na, nb, i, j = nb, na, j, i  # carried first
-            if frozenset((na, nb)) in allowed:
-                continue
-            pairs.append(Pair(len(pairs), na, nb, kind, int(i), int(j)))
-        gm.removeAllCollisionPairs()
-        for p in pairs:
-            gm.addCollisionPair(pin.CollisionPair(p.first, p.second))
+        disabled += [(names[a], names[b], "always in contact") for a, b in to_sample if (a, b) in always]
+        return [ab for ab in to_sample if ab not in always], disabled
+
+    def _configure(self, gm: pin.GeometryModel) -> None:
+        """The geometry data and its distance requests (:data:`GJK_TOLERANCE`, :data:`EPA_ITERATIONS`, fresh guesses).
+
+        The pairs with a mesh that is a surface (a bounding-volume tree) are bounded by their spheres when far.
+        """
+        import coal
+
         self._gm = gm
         self._gd = gm.createData()
         _fresh_guesses(self._gd)
@@ -303,24 +319,15 @@ class Scene:
             req.epa_tolerance = GJK_TOLERANCE
             req.enable_signed_distance = True
             req.epa_max_iterations = EPA_ITERATIONS
-        self._data = model.createData()
-        self.pairs = tuple(pairs)
-        # pairs with a mesh that is a surface (a bounding-volume tree): bounded by bounding spheres when far
-        import coal
-
-        bvh = [p.index for p in pairs if isinstance(gm.geometryObjects[p.second].geometry, coal.BVHModelBase)
-               or isinstance(gm.geometryObjects[p.first].geometry, coal.BVHModelBase)]  # fmt: skip
-        self._far_pairs = tuple(bvh)
+        self._data = self.robot.model.createData()
+        objs = gm.geometryObjects
+        self._far_pairs = tuple(p.index for p in self.pairs if isinstance(objs[p.second].geometry, coal.BVHModelBase)
+                                or isinstance(objs[p.first].geometry, coal.BVHModelBase))  # fmt: skip
         self._spheres = {}
-        for i in {k for p in bvh for k in (self.pairs[p].first, self.pairs[p].second)}:
-            geo = gm.geometryObjects[i].geometry
-            geo.computeLocalAABB()
-            self._spheres[i] = (np.asarray(geo.aabb_center, dtype=float).copy(), float(geo.aabb_radius))
-        checked = [(names[a], names[b]) for a, b in checked_self]
-        disabled += [(na, nb, "allowed by the cell") for na, nb in checked if frozenset((na, nb)) in allowed]
-        self.self_pairs = SelfPairs(tuple(p for p in checked if frozenset(p) not in allowed), tuple(disabled))
-        self.margin = cell.margin
-        self._names = tuple(names)
+        for i in {k for p in self._far_pairs for k in (self.pairs[p].first, self.pairs[p].second)}:
+            geometry = objs[i].geometry
+            geometry.computeLocalAABB()
+            self._spheres[i] = (np.asarray(geometry.aabb_center, dtype=float).copy(), float(geometry.aabb_radius))
 
     # ------------------------------------------------------------------ building
     def _always_in_contact(self, gm: pin.GeometryModel, candidates: list[tuple[int, int]]) -> set[tuple[int, int]]:
