@@ -33,7 +33,7 @@ CasADi is imported inside :func:`symbolic_model` only (``scara-pin fk``/``ik`` n
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -80,6 +80,10 @@ class SymbolicModel:
         joint_frames: ``F = joint_frames(q)``, (12, njoints): column j is Pinocchio's ``oMi[j]`` (the rotation
             column by column, then the translation) in the model's world frame (the root link), as
             ``pinocchio.forwardKinematics`` gives it; column 0 is the root's identity.
+        twists: (njoints, 6) each joint's unit motion (linear part first) in its own frame, at its origin: joint j
+            moves its subtree at ``scalings[j] * qd[sources[j]]`` times it (row 0, the root: zero).
+        sources: (njoints,) the index in q each joint follows (-1 for the root).
+        scalings: (njoints,) its ratio to that joint (1, or a mimic's multiplier).
     """
 
     tool_position: Any
@@ -87,6 +91,9 @@ class SymbolicModel:
     inverse_dynamics: Any
     dof: int
     joint_frames: Any = None
+    twists: np.ndarray = field(default_factory=lambda: np.zeros((1, 6)))
+    sources: np.ndarray = field(default_factory=lambda: np.full(1, -1))
+    scalings: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
 
 def _joints(robot: RobotModel) -> tuple[list[_Joint], pin.SE3]:
@@ -119,6 +126,58 @@ def _joints(robot: RobotModel) -> tuple[list[_Joint], pin.SE3]:
                           int(jm.idx_v), scaling, offset, float(inertia.mass), inertia.lever.copy(),
                           inertia.inertia.copy()))  # fmt: skip
     return out, data.oMf[robot.base_id].inverse()
+
+
+def frames_at(sym: SymbolicModel, Q: np.ndarray) -> np.ndarray:
+    """(n, njoints, 12): :attr:`SymbolicModel.joint_frames` at each row of ``Q``, evaluated into numpy directly.
+
+    In blocks of :data:`_BLOCK` columns of one mapped function through CasADi's buffer interface (its DM results
+    would cost ten times the evaluation to convert); the last block padded.
+    """
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    n = len(Q)
+    nj = int(sym.joint_frames.size2_out(0))
+    out = np.empty((n, nj, 12))
+    block = _evaluator(sym.joint_frames)
+    for lo in range(0, n, _BLOCK):
+        m = min(_BLOCK, n - lo)
+        block.arg[:m] = Q[lo : lo + m]
+        block.arg[m:] = Q[lo + m - 1]
+        block.trigger()
+        out[lo : lo + m] = block.res[: m * nj].reshape(m, nj, 12)
+    return out
+
+
+_BLOCK = 1024
+"""Configurations per evaluation of the joint frames (:func:`frames_at`)."""
+
+
+@dataclass(eq=False)
+class _Evaluator:
+    function: Any
+    buffer: Any
+    trigger: Any
+    arg: np.ndarray
+    res: np.ndarray
+
+
+_EVALUATORS: dict[int, _Evaluator] = {}
+
+
+def _evaluator(f: Any) -> _Evaluator:
+    """The mapped ``f`` over :data:`_BLOCK` columns with its numpy buffers, made once per function."""
+    hit = _EVALUATORS.get(id(f))
+    if hit is None or hit.function is not f:
+        mapped = f.map(_BLOCK)
+        buffer, trigger = mapped.buffer()
+        arg = np.zeros((_BLOCK, int(f.size1_in(0))))  # column-major (dof, block) is row-major (block, dof)
+        res = np.zeros((int(mapped.size2_out(0)), int(mapped.size1_out(0))))
+        buffer.set_arg(0, arg.data)
+        buffer.set_res(0, res.data)
+        if len(_EVALUATORS) >= 16:
+            _EVALUATORS.clear()
+        hit = _EVALUATORS[id(f)] = _Evaluator(f, buffer, trigger, arg, res)
+    return hit
 
 
 _BUILT: weakref.WeakKeyDictionary[pin.Model, dict[tuple[int, int], SymbolicModel]] = weakref.WeakKeyDictionary()
@@ -217,6 +276,9 @@ def _build(robot: RobotModel) -> SymbolicModel:
             force[joint.parent][0] = force[joint.parent][0] + F
             force[joint.parent][1] = force[joint.parent][1] + ca.cross(lp[k], F) + lR[k] @ m_
     rnea = ca.Function("inverse_dynamics", [q, qd, qdd], [ca.vertcat(*tau)], ["q", "qd", "qdd"], ["tau"])
-    frames = ca.Function("joint_frames", [q], [ca.horzcat(*[ca.vertcat(ca.vec(oR[k]), op[k]) for k in range(n + 1)])],
-                         ["q"], ["frames"])  # fmt: skip
-    return SymbolicModel(tool, tool_velocity, rnea, dof, frames)
+    placements = ca.densify(ca.horzcat(*[ca.vertcat(ca.vec(oR[k]), op[k]) for k in range(n + 1)]))
+    frames = ca.Function("joint_frames", [q], [placements], ["q"], ["frames"])
+    twists = np.vstack([np.zeros(6)] + [j.twist for j in joints])
+    sources = np.array([-1] + [j.source for j in joints])
+    scalings = np.array([0.0] + [j.scaling for j in joints])
+    return SymbolicModel(tool, tool_velocity, rnea, dof, frames, twists, sources, scalings)

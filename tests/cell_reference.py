@@ -12,8 +12,10 @@ to the obstacles in closed form:
   distance of their sections (``max(rho - rc - rp, 0)`` for two circles, rho the axes' distance;
   ``max(d_rect - rp, 0)`` for a rectangle, d_rect the distance from the post's axis to it), d_z the gap
   between their height ranges (0 when they overlap);
-- the robot's own self-collision pair that the jump can reach: the flange rising into link2 (the flange's
-  top at z + 0.01 must stay margin below link2's bottom, z = -0.03);
+- link2 is a box from the elbow to 5 mm short of the flange's edge (0.17 m long) and its end, from there to the
+  quill's axis, from z = 0.015 to 0.03 only (5 mm above the flange's top at the top of the stroke): the robot's own
+  self-collision pair the jump could reach, the flange rising into link2's end, keeps the flange's top at z + 0.01
+  margin below 0.015;
 - a low axis-aligned WALL across the path under the links (long in x: the tool stays within its x extent,
   asserted after the solve): the flange's distance is ``sqrt(max(|y - yc| - hy - r, 0)^2 + max(dz, 0)^2)``
   (dz: the flange's bottom above the wall's top); the quill is above the flange and narrower, and the links
@@ -35,6 +37,8 @@ import numpy as np
 
 L1 = L2 = 0.2
 LINK_HALF = (0.04, 0.03)  # half-width = half-height of link1's and link2's boxes [m]
+LINK2_BODY = 0.17  # link2's box: from the elbow, 0.2 - 0.025 - 0.005 m long [m]
+END = (0.015, 0.03)  # link2's end (from LINK2_BODY to the quill's axis): its bottom and top z [m]
 FLANGE_R, FLANGE_H = 0.025, 0.01
 QUILL_R, QUILL_H = 0.01, 0.25
 R_CLEAR = 0.005
@@ -97,7 +101,8 @@ def distances(q, posts, boxes, margin):
     elbow, tool = fk_points(q)
     out = []
     z = tool[2]
-    links = ((0.0, 0.0, elbow[0], elbow[1], LINK_HALF[0]), (elbow[0], elbow[1], tool[0], tool[1], LINK_HALF[1]))
+    body = elbow + (tool[:2] - elbow) * (LINK2_BODY / L2)  # link2's box ends 0.17 m along the arm
+    links = ((0.0, 0.0, elbow[0], elbow[1], LINK_HALF[0]), (elbow[0], elbow[1], body[0], body[1], LINK_HALF[1]))
     for p in posts:
 
         def gap(lo, hi, p=p):
@@ -109,8 +114,10 @@ def distances(q, posts, boxes, margin):
         for ax, ay, bx, by, half in links:
             d_rect = ca.sqrt(_rect_d2(p.x, p.y, ax, ay, bx, by, half) + 1e-18)
             out.append(ca.fmax(d_rect - p.radius, 0.0) ** 2 + gap(-half, half) ** 2 - margin**2)
-    # the flange under link2 (a self-collision pair of the robot: the quill slides through the arm's end)
-    out.append(-LINK_HALF[1] - (tool[2] + FLANGE_H) - margin)
+        d_end = ca.sqrt(_rect_d2(p.x, p.y, body[0], body[1], tool[0], tool[1], LINK_HALF[1]) + 1e-18)
+        out.append(ca.fmax(d_end - p.radius, 0.0) ** 2 + gap(*END) ** 2 - margin**2)  # link2's end
+    # the flange under link2's end (a self-collision pair of the robot: the quill slides through the arm's end)
+    out.append(END[0] - (tool[2] + FLANGE_H) - margin)
     for b in boxes:  # a wall across the path: the tool stays within its x extent (checked after the solve)
         dy = ca.fmax(ca.fabs(tool[1] - b.y) - b.hy - FLANGE_R, 0.0)
         dz = ca.fmax(tool[2] - b.top, 0.0)

@@ -76,8 +76,14 @@ def _obstacle(shape, size, xyz, name="o"):
 
 
 def _distance(robot, q, cell, a, b):
-    found = {(p.pair.a, p.pair.b): p.distance for p in robot.distances(q, cell).pairs}
-    return found[(a, b)]
+    """The distance of link ``a`` (all its shapes) to ``b``."""
+    return min(p.distance for p in robot.distances(q, cell).pairs if (p.pair.a, p.pair.b) == (a, b))
+
+
+# link2's collision shapes (URDF): a box from the elbow up to 5 mm short of the flange's edge (0.2 - 0.025 - 0.005
+# = 0.17 m long, half width and height 0.03) and its end, from there to the quill's axis, only from 5 mm above the
+# flange's top at the top of the stroke (z = 0.01 + 0.005) up to the arm's top (z = 0.03)
+LINK2_BODY, LINK2_END = 0.17, (0.015, 0.03)
 
 
 # ---------------------------------------------------------------------------------------------- closed forms
@@ -91,8 +97,12 @@ def test_sphere_against_the_links(robot, rng):
         cell = Cell((_obstacle("sphere", (r,), c, "ball"),), MARGIN)
         flange = _cyl_point(c, tool, 0.025, 0.01) - r
         link1 = _box_point(c, np.array([*(elbow / 2), 0.0]), a1, np.array([0.1, 0.04, 0.04])) - r
-        mid2 = (elbow + tool[:2]) / 2
-        link2 = _box_point(c, np.array([*mid2, 0.0]), a12, np.array([0.1, 0.03, 0.03])) - r
+        mid2 = elbow + (LINK2_BODY / 2) * np.array([math.cos(a12), math.sin(a12)])
+        body = _box_point(c, np.array([*mid2, 0.0]), a12, np.array([LINK2_BODY / 2, 0.03, 0.03])) - r
+        mid_end = elbow + (0.1 + LINK2_BODY / 2) * np.array([math.cos(a12), math.sin(a12)])
+        half_end = np.array([(0.2 - LINK2_BODY) / 2, 0.03, (LINK2_END[1] - LINK2_END[0]) / 2])
+        end = _box_point(c, np.array([*mid_end, sum(LINK2_END) / 2]), a12, half_end) - r
+        link2 = min(body, end)
         for name, expected in (("flange", flange), ("link1", link1), ("link2", link2)):
             if expected > 1e-4:  # separated: the closed form is the distance (inside, coal gives a depth)
                 assert _distance(robot, q, cell, name, "ball") == pytest.approx(expected, abs=TOL), name
@@ -116,9 +126,14 @@ def test_parallel_cylinders_and_prisms(robot, rng):
         quill = prisms(rho - 0.01 - rp, tool[2], tool[2] + 0.25)
         flange = prisms(rho - 0.025 - rp, tool[2], tool[2] + 0.01)
         c, s = math.cos(a12), math.sin(a12)
-        d = np.array([x, y]) - (elbow + tool[:2]) / 2
+        d = np.array([x, y]) - (elbow + (LINK2_BODY / 2) * np.array([c, s]))
         local = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
-        link2 = prisms(float(np.linalg.norm(np.maximum(np.abs(local) - [0.1, 0.03], 0.0))) - rp, -0.03, 0.03)
+        body = prisms(float(np.linalg.norm(np.maximum(np.abs(local) - [LINK2_BODY / 2, 0.03], 0.0))) - rp, -0.03, 0.03)
+        d = np.array([x, y]) - (elbow + (0.1 + LINK2_BODY / 2) * np.array([c, s]))
+        local = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+        end = prisms(float(np.linalg.norm(np.maximum(np.abs(local) - [(0.2 - LINK2_BODY) / 2, 0.03], 0.0))) - rp,
+                     *LINK2_END)
+        link2 = min(body, end)
         for name, expected in (("quill", quill), ("flange", flange), ("link2", link2)):
             if expected > 1e-4:
                 checked += 1

@@ -35,7 +35,7 @@ def planar(q: np.ndarray) -> np.ndarray:
     return np.stack([0.2 * np.cos(a) + 0.2 * np.cos(b), 0.2 * np.sin(a) + 0.2 * np.sin(b)], -1)
 
 
-def test_a_dip_between_the_checked_points_gets_a_row_where_the_verifier_sees_it() -> None:
+def test_a_dip_between_the_checked_points_gets_a_row_where_the_certificate_finds_it() -> None:
     robot = load_robot("default")
     q0, q1 = np.array([-0.7, 1.6, 0.05, 0.0]), np.array([0.9, 1.2, 0.05, 0.0])  # tool at z = -0.10 m throughout
     star = 0.5 + 0.5 / CHECK_POINTS  # halfway between two checked points
@@ -54,14 +54,15 @@ def test_a_dip_between_the_checked_points_gets_a_row_where_the_verifier_sees_it(
     rows = Rows(scene(robot, Cell((post,), MARGIN)), None)
     _, worst = rows.check(piece)
     assert worst >= -CONVERGED  # the dense check sees nothing
-    found = rows.fine(piece)
+    accel = 2.0 * np.array(robot.limits.acceleration)  # a bound of |qdd| (this piece's is 0)
+    found = rows.fine(piece, accel)
     assert len(found) == 1
     row = found[0]
     assert rows.scene.pairs[row.pair].label == "flange - post"
-    assert abs(row.sigma - s[np.argmin(d)]) <= 1e-4  # at the verifier's worst sample (10 kHz over 1 s)
-    assert rows.fine(piece) == found  # asked again: the same row (not yet added)
+    assert abs(row.sigma - s[np.argmin(d)]) <= 1e-4  # at the dip (within 10 kHz over 1 s of the closed form's minimum)
+    assert rows.fine(piece, accel) == found  # asked again: the same row (not yet added)
     rows.add(found)
-    assert rows.fine(piece) == []  # added once
+    assert rows.fine(piece, accel) == []  # added once
 
 
 def test_a_robot_that_lifts_by_turning_gets_its_traverse_raised_over_a_wall() -> None:

@@ -30,7 +30,8 @@ from scara_pin.motion.jog import jog_to_edge
 FLANGE_R = 0.025
 MARGIN = 0.002
 POST = (0.35, -0.1, 0.02)  # x, y, radius [m]
-LINK2_HALF = (0.1, 0.03, 0.03)  # link2's collision box: half sizes, centred 0.1 m along link2's x (URDF)
+LINK2_HALF = (0.085, 0.03, 0.03)  # link2's collision box: half sizes, centred 0.085 m along link2's x (URDF: it ends
+# 5 mm short of the flange's edge, 0.2 - 0.025 - 0.005 m from the elbow; the cap over the quill is not near the post)
 
 
 @pytest.fixture(scope="module")

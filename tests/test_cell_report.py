@@ -90,16 +90,16 @@ def test_obstacles_out_of_reach_are_found_and_never_reached(robot) -> None:
 
 
 def test_home_and_points_in_collision_name_the_pair_and_the_depth(robot) -> None:
-    # at q = 0 link2's box spans x 0.2 .. 0.4, |y| <= 0.03, |z| <= 0.03; a wall x 0.30 .. 0.32, |y|, |z| <= 0.5
-    # crossing it: the shortest move that separates them is along x, min(0.4 - 0.30, 0.32 - 0.2) = 0.1 m deep
-    # (along y or z: 0.53 m)
+    # at q = 0 link2's box spans x 0.2 .. 0.37 (it ends 5 mm short of the flange's edge), |y|, |z| <= 0.03; a wall
+    # x 0.30 .. 0.32, |y|, |z| <= 0.5 crossing it: the shortest move that separates them is along x,
+    # min(0.37 - 0.30, 0.32 - 0.2) = 0.07 m deep (along y or z: 0.53 m); link2's cap over the quill starts at x 0.37
     wall = Obstacle("wall", Shape("box", (0.02, 1.0, 1.0), np.array([0.31, 0.0, 0.0]), np.zeros(3)))
     sc = scene(robot, Cell((wall,), MARGIN))
     report = check_cell(sc, [("home (q = 0)", np.zeros(4)), ("P1", [1.5, 0.5, 0.0, 0.0]), ("P2", [0.0, 0.0, 0.0, 0.0])])
     home = report.find("home-in-collision")
     assert len(home) == 1 and home[0].data["pair"] == ["link2", "wall"]
-    assert home[0].data["distance"] == pytest.approx(-0.1, abs=1e-9)
-    assert "link2 is 100 mm deep in wall" in home[0].message
+    assert home[0].data["distance"] == pytest.approx(-0.07, abs=1e-9)
+    assert "link2 is 70 mm deep in wall" in home[0].message
     points = report.find("point-in-collision")
     assert [f.data["point"] for f in points] == ["P2"]  # P1 turns the arm away from the wall
     disabled = {tuple(f.data["pair"]): f.data["reason"] for f in report.find("self-pair-disabled")}
@@ -137,7 +137,7 @@ def test_check_cell_cli(urdf, capsys, tmp_path: Path) -> None:
     rc, out, err = run(capsys, ["check", str(urdf), "--cell", str(cell), "--points", str(points)])
     assert rc == 4, err
     assert f"{cell}: warning: obstacle shelf is out of reach" in out
-    assert f"{cell}: warning: point P2 is in collision: link2 is 100 mm deep in wall" in out
+    assert f"{cell}: warning: point P2 is in collision: link2 is 70 mm deep in wall" in out
     assert "home-in-collision" not in out  # the points file's home turns the arm away
     assert out.rstrip().endswith(f"{cell}: warnings")
     rc, out, err = run(capsys, ["check", str(urdf), "--cell", str(cell), "--json"])

@@ -53,21 +53,28 @@ def test_a_jump_in_a_cell_is_the_jump_planned_alone_in_it_and_a_line_through_it_
     (tmp_path / "cell.yaml").write_text(POST)
     body = "cell: cell.yaml\nstart: feeder\nsteps:\n  - jump: T11\n  - jump: feeder\n"
     job = write_job(tmp_path, body, robot_default)
-    out = _json(capsys, ["job", str(job), "--json"])
-    there, back = out["steps"]
     points = Job.load(job).points
     qf, qt = points["feeder"].q, points["T11"].q
-    post = Obstacle("post", Shape("cylinder", (0.01, 0.2), np.array([0.135, -0.18, -0.15]), np.zeros(3)))
-    alone = jump_move(robot_default, robot_default.tool_pose(qf), robot_default.tool_pose(qt), start=qf, end=qt,
-                      torque=False, cell=Cell((post,), MARGIN))  # fmt: skip
     free = jump_move(robot_default, robot_default.tool_pose(qf), robot_default.tool_pose(qt), start=qf, end=qt,
                      torque=False)  # fmt: skip
+    # a second post where the free jump's tool is at half time, its top 10 mm above the tool there: the jump must
+    # bend for it (the first post, on the straight line, is for the straight move below)
+    mid = [float(v) for v in scara_xyz(free.trajectory.sample(np.array([free.duration / 2]))[0][0])]
+    top = mid[2] + 0.01
+    (tmp_path / "cell.yaml").write_text(POST + f"  - {{name: stake, shape: cylinder, radius: 0.01, length: 0.2, "
+                                        f"xyz: [{mid[0]!r}, {mid[1]!r}, {top - 0.1!r}]}}\n")  # fmt: skip
+    out = _json(capsys, ["job", str(job), "--json"])
+    there, back = out["steps"]
+    post = Obstacle("post", Shape("cylinder", (0.01, 0.2), np.array([0.135, -0.18, -0.15]), np.zeros(3)))
+    stake = Obstacle("stake", Shape("cylinder", (0.01, 0.2), np.array([mid[0], mid[1], top - 0.1]), np.zeros(3)))
+    alone = jump_move(robot_default, robot_default.tool_pose(qf), robot_default.tool_pose(qt), start=qf, end=qt,
+                      torque=False, cell=Cell((post, stake), MARGIN))  # fmt: skip
     assert abs(there["duration"] - alone.duration) <= 1e-9
-    assert there["duration"] > free.duration + 1e-4  # the post binds: the jump bends for it
+    assert there["duration"] > free.duration + 1e-4  # the stake binds: the jump bends for it
     assert there["clearance"]["distance"] >= MARGIN - 1e-6  # every checked pair, the robot's own too
     assert back["planned"] == "an earlier jump reversed" and abs(back["duration"] - there["duration"]) <= 1e-12
     assert back["clearance"] is not None and back["clearance"]["distance"] >= MARGIN - 1e-6  # verified in the cell
-    assert out["cell"]["margin"] == MARGIN and [o["name"] for o in out["cell"]["obstacles"]] == ["post"]
+    assert out["cell"]["margin"] == MARGIN and [o["name"] for o in out["cell"]["obstacles"]] == ["post", "stake"]
     # a straight line is a fixed path: through the post, refused (exit 3), naming the pair, at the move's line
     job.write_text(job.read_text().replace("  - jump: feeder\n", "  - move: feeder\n"))
     assert main(["job", str(job)]) == 3

@@ -62,6 +62,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BOUND_GROWTH",
+    "BoundingShapes",
     "CONTACT_TOL",
     "MAX_STEPS",
     "SLIDE_BAND",
@@ -69,7 +70,10 @@ __all__ = [
     "Contact",
     "JointPath",
     "clear_mask",
+    "clearance_bound",
     "first_contact",
+    "bounding_shapes",
+    "geometry_speeds",
     "joint_motion",
     "joint_placements",
     "segment_distance",
@@ -130,7 +134,7 @@ class Contact:
 
 
 @dataclass(frozen=True, eq=False)
-class _Bounds:
+class BoundingShapes:
     """Shapes that hold each geometry of a scene, in its joint's frame (the world's for joint 0).
 
     Per geometry (index into the scene's ``GeometryModel``): its joint, a bounding sphere (centre, radius) and a
@@ -152,11 +156,12 @@ class _Bounds:
         return np.flatnonzero(self.joint > 0)
 
 
-_BOUNDS: weakref.WeakKeyDictionary[Scene, _Bounds] = weakref.WeakKeyDictionary()
+_BOUNDS: weakref.WeakKeyDictionary[Scene, BoundingShapes] = weakref.WeakKeyDictionary()
 """Each scene's bounding shapes, made once."""
 
 
-def _bounds(scene: Scene) -> _Bounds:
+def bounding_shapes(scene: Scene) -> BoundingShapes:
+    """The scene's bounding sphere and capsule of each geometry (:class:`BoundingShapes`), made once per scene."""
     cached = _BOUNDS.get(scene)
     if cached is not None:
         return cached
@@ -184,39 +189,67 @@ def _bounds(scene: Scene) -> _Bounds:
         end0.append(M.act(mid - along))
         end1.append(M.act(mid + along))
         capsule.append(around)
-    out = _Bounds(np.array(joint, dtype=int), np.array(center).reshape(-1, 3), np.array(radius),
+    out = BoundingShapes(np.array(joint, dtype=int), np.array(center).reshape(-1, 3), np.array(radius),
                   np.array(end0).reshape(-1, 3), np.array(end1).reshape(-1, 3), np.array(capsule))  # fmt: skip
     _BOUNDS[scene] = out
     return out
 
 
 # ---------------------------------------------------------------------------------------------- many configurations
-def clear_mask(scene: Scene, Q: ArrayLike) -> np.ndarray:
+def clear_mask(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margin: float | None = None) -> np.ndarray:
     """(n,) whether each configuration (row of ``Q``) has every checked pair at least the margin apart.
 
-    Pairs whose bounding capsules are farther apart than the margin are clear without a distance query (module
-    docstring); the others get coal's exact distance, pair by pair, and a configuration already found in
-    collision is not asked again.
+    Pairs whose bounding spheres, then capsules, are farther apart than the margin are clear without a distance
+    query (module docstring); the others get coal's exact distance, pair by pair, and a configuration already
+    found in collision is not asked again. ``pairs``: only these (indices; default every checked pair);
+    ``margin``: another distance than the cell's.
     """
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
     n = len(Q)
     ok = np.ones(n, dtype=bool)
     if not scene.pairs or n == 0:
         return ok
-    b = _bounds(scene)
+    b = bounding_shapes(scene)
     R, p = joint_placements(scene.robot, Q)
     Rg, pg = R[:, b.joint], p[:, b.joint]  # (n, g, 3, 3), (n, g, 3): each geometry's joint (joint 0: identity)
+    c = np.einsum("ngab,gb->nga", Rg, b.center) + pg
     e0 = np.einsum("ngab,gb->nga", Rg, b.end0) + pg
     e1 = np.einsum("ngab,gb->nga", Rg, b.end1) + pg
-    margin = scene.margin
-    for pair in scene.pairs:
+    margin = scene.margin if margin is None else margin
+    for pair in scene.pairs if pairs is None else [scene.pairs[k] for k in pairs]:
         i, j = pair.first, pair.second
-        gap = segment_distance(e0[:, i], e1[:, i], e0[:, j], e1[:, j]) - b.capsule[i] - b.capsule[j]
-        rows = np.flatnonzero((gap <= margin) & ok)
+        near = ok & (np.linalg.norm(c[:, i] - c[:, j], axis=1) - b.radius[i] - b.radius[j] <= margin)
+        if not near.any():
+            continue
+        rows = np.flatnonzero(near)
+        gap = segment_distance(e0[rows, i], e1[rows, i], e0[rows, j], e1[rows, j]) - b.capsule[i] - b.capsule[j]
+        rows = rows[gap <= margin]
         if len(rows):
             d = scene.distance_array(Q[rows], pairs=[pair.index])[:, 0]
             ok[rows[d < margin]] = False
     return ok
+
+
+def clearance_bound(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None) -> np.ndarray:
+    """(n,) a lower bound of the smallest distance of ``pairs`` (default: every checked pair) at each row of ``Q``.
+
+    The pairs' bounding capsules' distance (each capsule holds its shape): no distance query, so cheap enough for
+    many configurations; +inf without pairs.
+    """
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    out = np.full(len(Q), np.inf)
+    if not scene.pairs or len(Q) == 0:
+        return out
+    b = bounding_shapes(scene)
+    R, p = joint_placements(scene.robot, Q)
+    Rg, pg = R[:, b.joint], p[:, b.joint]
+    e0 = np.einsum("ngab,gb->nga", Rg, b.end0) + pg
+    e1 = np.einsum("ngab,gb->nga", Rg, b.end1) + pg
+    for pair in scene.pairs if pairs is None else [scene.pairs[k] for k in pairs]:
+        i, j = pair.first, pair.second
+        gap = segment_distance(e0[:, i], e1[:, i], e0[:, j], e1[:, j]) - b.capsule[i] - b.capsule[j]
+        np.minimum(out, gap, out=out)
+    return out
 
 
 def segment_distance(a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray) -> np.ndarray:
@@ -270,17 +303,54 @@ def joint_placements(robot: Any, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     Pinocchio's ``oMi`` at every row in one call: the robot's symbolic model (:mod:`scara_pin.symbolic`, built
     from the loaded Pinocchio model, mimic joints included) evaluated on numbers, ``joint_frames.map(n)``.
     """
-    from ..symbolic import symbolic_model
+    from ..symbolic import frames_at, symbolic_model
 
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
     n, nj = len(Q), robot.model.njoints
     if n == 0:
         return np.empty((0, nj, 3, 3)), np.empty((0, nj, 3))
-    # column i * nj + j: oMi[j] at row i
-    F = np.asarray(symbolic_model(robot).joint_frames.map(n)(Q.T)).reshape(12, n, nj)
-    R = F[:9].reshape(3, 3, n, nj, order="F").transpose(2, 3, 0, 1)  # each rotation stored column by column
-    p = F[9:].transpose(1, 2, 0)
+    F = frames_at(symbolic_model(robot), Q)  # (n, nj, 12): each rotation column by column, then the translation
+    R = F[:, :, :9].reshape(n, nj, 3, 3).transpose(0, 1, 3, 2)
+    p = F[:, :, 9:]
     return np.ascontiguousarray(R), np.ascontiguousarray(p)
+
+
+def geometry_speeds(scene: Scene, Q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(lin, rot), each (n, g): the speed bound of each geometry's points at each row of ``Q`` (module docstring).
+
+    ``speeds`` (n, dof): a bound of |qd| per joint. With (v_i, w_i) joint i's column of the world Jacobian (every
+    Pinocchio joint that follows joint i summed, a mimic with its multiplier), ``lin[k, g] = sum_i speeds_i
+    |v_i + w_i x c_g|`` (c_g the centre of geometry g's bounding sphere) and ``rot[k, g] = sum_i speeds_i |w_i|``:
+    every point of geometry g moves at most at ``lin + rot (rho_g + e)`` while its sphere's centre stays within e
+    of where it is. An obstacle: 0. Pinocchio's ``getJointJacobian`` gives the same columns (the tests).
+    """
+    from ..symbolic import symbolic_model
+
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    speeds = np.broadcast_to(np.abs(np.asarray(speeds, dtype=float)), Q.shape)
+    b = bounding_shapes(scene)
+    n, g = len(Q), len(b.joint)
+    lin, rot = np.zeros((n, g)), np.zeros((n, g))
+    if n == 0:
+        return lin, rot
+    robot = scene.robot
+    sym = symbolic_model(robot)
+    R, p = joint_placements(robot, Q)  # (n, nj, 3, 3), (n, nj, 3)
+    v = np.einsum("njab,jb->nja", R, sym.twists[:, :3])  # each joint's unit twist in the world, at its origin
+    w = np.einsum("njab,jb->nja", R, sym.twists[:, 3:])
+    supports = robot.model.supports
+    for k in b.moving.tolist():
+        j0 = int(b.joint[k])
+        c = np.einsum("nab,b->na", R[:, j0], b.center[k]) + p[:, j0]
+        col_v = np.zeros((n, robot.dof, 3))
+        col_w = np.zeros((n, robot.dof, 3))
+        for j in list(supports[j0])[1:]:
+            i, s = int(sym.sources[j]), float(sym.scalings[j])
+            col_v[:, i] += s * (v[:, j] + np.cross(w[:, j], c - p[:, j]))
+            col_w[:, i] += s * w[:, j]
+        lin[:, k] = np.einsum("ni,ni->n", speeds, np.linalg.norm(col_v, axis=2))
+        rot[:, k] = np.einsum("ni,ni->n", speeds, np.linalg.norm(col_w, axis=2))
+    return lin, rot
 
 
 # ---------------------------------------------------------------------------------------------- along a path
@@ -299,20 +369,14 @@ def first_contact(scene: Scene, path: JointPath, s_end: float = 1.0) -> Contact 
     Raises:
         InCollisionError: the path starts closer than the margin (exit code 2), naming the pair.
     """
-    import pinocchio as pin
-
     robot = scene.robot
-    model = robot.model
-    data = model.createData()
-    b = _bounds(scene)
-    moving = b.moving
+    b = bounding_shapes(scene)
     margin = scene.margin
     n_pairs = len(scene.pairs)
     if n_pairs == 0:
         return None
     first = np.array([p.first for p in scene.pairs])
     second = np.array([p.second for p in scene.pairs])
-    convert = robot.to_pinocchio_q if robot.has_continuous else None
 
     def at(s: float) -> tuple[np.ndarray, np.ndarray]:
         q, dq = path.evaluate(np.array([s]), 1)[:2]
@@ -321,20 +385,9 @@ def first_contact(scene: Scene, path: JointPath, s_end: float = 1.0) -> Contact 
     def gaps(q: np.ndarray) -> np.ndarray:
         return scene.distance_array(q[None, :])[0] - margin
 
-    # per geometry: |q'| . (speed of its sphere's centre, angular speed); per pair: both shapes' bounds
+    # per pair: both shapes' speed bounds (geometry_speeds), the spheres' centres moving at most the gap
     def pair_speeds(q: np.ndarray, dq: np.ndarray, g: np.ndarray) -> np.ndarray:
-        pin.computeJointJacobians(model, data, convert(q) if convert else q)
-        lin = np.zeros(len(b.joint))
-        rot = np.zeros(len(b.joint))
-        adq = np.abs(dq[: robot.dof])
-        for k in moving.tolist():
-            j, c = int(b.joint[k]), b.center[k]
-            J = pin.getJointJacobian(model, data, j, pin.WORLD)
-            M = data.oMi[j]
-            p = M.rotation @ c + M.translation
-            v, w = J[:3, : robot.dof], J[3:, : robot.dof]
-            lin[k] = adq @ np.linalg.norm(v + np.cross(w.T, p).T, axis=0)
-            rot[k] = adq @ np.linalg.norm(w, axis=0)
+        lin, rot = (x[0] for x in geometry_speeds(scene, q[None, :], np.abs(dq[None, : robot.dof])))
         grow = np.maximum(g, 0.0)
         return (lin[first] + rot[first] * (b.radius[first] + grow)
                 + lin[second] + rot[second] * (b.radius[second] + grow))  # fmt: skip

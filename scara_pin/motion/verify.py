@@ -68,6 +68,7 @@ from .trajectory import Motion, Trajectory
 if TYPE_CHECKING:
     from .._typing import ArrayLike
     from ..cell import Cell, Scene
+    from ..cell.certify import Certificate
     from ..model import RobotModel
     from ..units import DisplayUnits
 
@@ -110,6 +111,9 @@ REST_TOL = 1e-9
 """|qd| / vmax (and |qdd| / amax with a jerk limit) at t = 0 and t = T above which the ends are not at rest."""
 ENDPOINT_TOL = 1e-9
 """[rad or m] the largest |q(0) - q_start| and |q(T) - q_end| accepted."""
+CERTIFY_ACCELERATION = 2.0
+"""The certificate of a motion's clearance (:func:`~scara_pin.cell.certify.certify`) takes each joint's acceleration
+between samples to be within this times its limit (the samples themselves hold 1 + :data:`TOLERANCE`)."""
 PIECE_POINTS = 65
 """Points checked inside every piece, however short (besides the rate grid)."""
 _CHUNK = 50_000
@@ -174,6 +178,10 @@ class Clearance:
         time: [s] where it occurs.
         samples: (t, smallest distance at t, index of that pair) of every verified sample, time-sorted (for
             per-leg reports).
+        where: the closest point (between the two shapes' witness points) in the base frame [m], or None.
+        certified: the certificate of the whole motion, between the samples too
+            (:func:`~scara_pin.cell.certify.certify`; None when not asked for).
+        labels: the scene's pair labels, by index (the certificate names pairs by index).
     """
 
     distance: float
@@ -182,6 +190,16 @@ class Clearance:
     time: float
     samples: tuple[np.ndarray, np.ndarray, np.ndarray] = field(repr=False, compare=False)
     where: tuple[float, float, float] | None = None
+    certified: Certificate | None = field(default=None, repr=False, compare=False)
+    labels: tuple[str, ...] = field(default=(), repr=False, compare=False)
+
+    @property
+    def bound(self) -> float:
+        """[m] every checked pair's distance is at least this over the whole motion.
+
+        The samples' smallest when the motion was not certified.
+        """
+        return self.distance if self.certified is None else min(self.distance, self.certified.bound)
 
     def describe(self) -> str:
         """``link2 - post 1.2 mm deep at t = 0.1234 s near (290, -52, 0) mm in base (margin 2 mm)``."""
@@ -193,7 +211,7 @@ class Clearance:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {"distance": self.distance, "margin": self.margin, "pair": self.pair, "time": self.time,
-                "where": None if self.where is None else list(self.where)}  # fmt: skip
+                "where": None if self.where is None else list(self.where), "certified": self.bound}  # fmt: skip
 
 
 class LimitViolation(InfeasibleError):
@@ -315,6 +333,17 @@ class Verification(Summarized):
         c = self.clearance
         if c is not None and not c.distance >= c.margin - DISTANCE_TOL:
             raise LimitViolation(f"the motion comes closer than the margin: {c.describe()}")
+        cert = None if c is None else c.certified
+        if c is not None and cert is not None and not cert.bound >= c.margin - DISTANCE_TOL:
+            t, _, low = cert.lowest
+            if low < c.margin - DISTANCE_TOL:
+                raise LimitViolation(f"the motion comes closer than the margin between the verified samples: "
+                                     f"{c.labels[cert.lowest[1]]} {low * 1e3:.4g} mm apart at t = {t:.9g} s (margin "
+                                     f"{c.margin * 1e3:g} mm)")  # fmt: skip
+            raise LimitViolation(f"the motion is not certified clear between the verified samples near t = "
+                                 f"{cert.time:.6g} s: {c.labels[cert.pair]} could come within "
+                                 f"{cert.bound * 1e3:.4g} mm (margin {c.margin * 1e3:g} mm; {cert.evaluations} "
+                                 "distances evaluated)")  # fmt: skip
         return self
 
 
@@ -740,14 +769,18 @@ def verify(
         raise ParameterError("trajectory", "no samples", "must have a duration > 0")
     clearance = None
     if scene is not None and nearest is not None and scene.pairs:
+        from ..cell.certify import certify
+
         within = (times >= 0.0) & (times <= T)
         order = np.argsort(times[within], kind="stable")
         ts, ds, ps = times[within][order], nearest[within][order], nearest_pair[within][order]
         i = int(np.argmin(ds))
         closest = scene.distances(trajectory.sample(np.array([ts[i]]))[0][0]).closest
         where = None if closest is None else tuple(float(v) for v in (closest.point_a + closest.point_b) / 2.0)
+        cert = certify(scene, lambda tt: trajectory.sample(tt)[:2], ts, ds, ps, CERTIFY_ACCELERATION * lim.acceleration,
+                       scene.margin - DISTANCE_TOL)  # fmt: skip
         clearance = Clearance(float(ds[i]), scene.margin, scene.pairs[int(ps[i])].label, float(ts[i]), (ts, ds, ps),
-                              where)  # type: ignore[arg-type]
+                              where, cert, tuple(p.label for p in scene.pairs))  # type: ignore[arg-type]
     return Verification(T, rate, len(times), v, a, worst.get(Quantity.JERK), worst.get(Quantity.JERK_DIFFERENCES),
                         floor, worst.get(Quantity.TORQUE), worst.get(Quantity.TOOL_SPEED), start_err, end_err,
                         rest, clearance)  # fmt: skip

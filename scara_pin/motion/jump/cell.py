@@ -9,14 +9,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...cell.sweep import clear_mask
 from ...errors import InfeasibleError
 from ..polynomial import PolynomialPiece
-from ..trajectory import Trajectory
-from .candidates import MAX_OFFSET, SECOND_WITHIN, Candidate, candidates, line_samples
+from ..trajectory import Trajectory, line_optimal_duration
+from ..verify import CERTIFY_ACCELERATION, DISTANCE_TOL
+from .candidates import SECOND_WITHIN, Candidate, candidates, line_samples, score
 from .nlp import Transcription
 from .problem import ConstraintPoint, Problem
 from .refine import failure, rebuild, violations, warm_start
-from .rows import CONVERGED, CONVERGED_TIME, DEEP, RESOLVE_ITERATIONS, Rows
+from .rows import BUFFER, CONVERGED, CONVERGED_TIME, DEEP, NEAR_MISS, RETRY_BUFFER, DistanceRow, Rows
+from .search import Search, Way, search
 from .types import JumpError, JumpOptions, SolverStats
 from .verification import Check, verify_move
 
@@ -46,18 +49,38 @@ def blocking(scene: Scene, piece: PolynomialPiece) -> str:
     return describe(found, scene.margin) + f" at t = {piece.breaks[k[i]] + s[i] * h[k[i]]:.4g} s"
 
 
-def blocked(scene: Scene, tried: list[Candidate], status: str) -> InfeasibleError:
-    """The error of a jump for which no way around or over clears the cell (exit 3): each way and what blocks it."""
+def where_blocked(scene: Scene, cand: Candidate, velocity: np.ndarray, acceleration: np.ndarray) -> str:
+    """What blocks a warm start's joint lines most, where and when (the lines timed from rest to rest), in words."""
     from ...cell import describe
 
-    parts = []
-    for c in tried:
-        _, found = closest(scene, line_samples(c.waypoints))
-        if found is not None:
-            parts.append(f"{c.way}: {describe(found, scene.margin)}")
-    return JumpError(status, "no collision-free motion found within the limits: " + "; ".join(parts)
-                     + f"; neither the traverse raised up to the stroke's top nor via points up to {MAX_OFFSET:g} m "
-                     "to either side clear it, and the solver found no way from there")  # fmt: skip
+    Q = line_samples(cand.waypoints)
+    i = int(np.argmin(scene.minimum_array(Q)))
+    found = scene.distances(Q[i]).closest
+    if found is None:  # pragma: no cover - a scene without pairs blocks nothing
+        return f"{cand.way}: clear"
+    per_line = len(Q) // (len(cand.waypoints) - 1)
+    line, frac = divmod(i, per_line)
+    durations = [line_optimal_duration(a, b, velocity, acceleration) for a, b in zip(cand.waypoints[:-1],
+                                                                                      cand.waypoints[1:])]  # fmt: skip
+    when = float(sum(durations[:line]) + durations[line] * frac / max(per_line - 1, 1))
+    return f"{cand.way}: {describe(found, scene.margin)} at t = {when:.3g} s of its joint lines"
+
+
+def blocked(scene: Scene, tried: list[Candidate], status: str, found: Search | None, velocity: np.ndarray,
+            acceleration: np.ndarray) -> InfeasibleError:  # fmt: skip
+    """The error of a jump for which no way clears the cell (exit 3).
+
+    The search's verdict, each way tried and what blocks it first, where and when.
+    """
+    parts = [where_blocked(scene, c, velocity, acceleration) for c in tried]
+    if found is not None and not found.ways:
+        verdict = (f"no way through the cell on a lattice of {math.degrees(found.steps[0]):g} deg and "
+                   f"{found.steps[1] * 1e3:g} mm steps ({found.valid:,} of {found.nodes:,} configurations at the "
+                   f"traverse height clear; {found.why}): a passage narrower than a step is not searched (via points "
+                   "give one by hand)")  # fmt: skip
+    else:
+        verdict = "the local solves from every way found failed"
+    return JumpError(status, f"no collision-free motion found within the limits: {verdict}; " + "; ".join(parts))
 
 
 def infeasible(scene: Scene, piece: PolynomialPiece, status: str) -> InfeasibleError:
@@ -65,14 +88,15 @@ def infeasible(scene: Scene, piece: PolynomialPiece, status: str) -> InfeasibleE
     return JumpError(status, f"no collision-free motion found within the limits: {blocking(scene, piece)}")
 
 
-def solve_avoiding(prob: Problem, options: JumpOptions,
-                   waypoints: np.ndarray) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:  # fmt: skip
+def solve_avoiding(prob: Problem, options: JumpOptions, waypoints: np.ndarray, *, buffer: float = BUFFER,
+                   seed: tuple[DistanceRow, ...] = ()) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:  # fmt: skip
     """The jump's solve (the jump's own solve) with the distance rows (module docstring).
 
     From the warm start ``waypoints``: solve; check densely; add rows; re-set every row's plane; solve again,
     warm-started, until nothing is added, the dense check holds and the duration has settled. A re-solve the
     solver finds infeasible (the planes taken from the last solution conflict) is retried once from the
     last motion that was clear of the cell, with every plane taken there: that motion satisfies them all.
+    ``buffer``: the rows keep margin + buffer; ``seed``: rows there from the start (a near miss solved again).
 
     Returns:
         (piece, phase durations, solver statistics) as ``solve``.
@@ -85,10 +109,10 @@ def solve_avoiding(prob: Problem, options: JumpOptions,
         raise ValueError("solve_avoiding takes a problem in a cell")
     points: tuple[ConstraintPoint, ...] = ()
     warm = warm_start(prob, waypoints)
-    rows = Rows(scene, prob.sym)
+    rows = Rows(scene, prob.sym, buffer)
     piece = rebuild(prob, warm[0], warm[2])
     fresh, worst = rows.check(piece)
-    rows.add(fresh)
+    rows.add(list(seed) + fresh)
     params = rows.parameters(piece)
     tr = Transcription(prob, points, options, rows.rows, rows)
     x0 = tr.pack(*warm)
@@ -97,6 +121,7 @@ def solve_avoiding(prob: Problem, options: JumpOptions,
     iterations = solves = 0
     duration = math.inf
     last_clear: tuple[PolynomialPiece, np.ndarray, np.ndarray] | None = None  # a solved motion clear of the cell
+    near: tuple[PolynomialPiece, np.ndarray] | None = None  # a solved motion within NEAR_MISS of the margin
     while True:
         sol = tr.solve(x0, None, None, params)
         iterations += sol["iterations"]
@@ -110,9 +135,10 @@ def solve_avoiding(prob: Problem, options: JumpOptions,
                 params = rows.parameters(clear[0], rebase=True)
                 x0 = clear[1][: tr.n_x]
                 continue
-            if last_clear is not None:  # the planes stopped moving it: the last solved clear motion stands
-                log.debug("jump in a cell: re-solve %s; keeping the last clear solution", sol["status"])
-                piece, T = last_clear[0], last_clear[2]
+            if last_clear is not None or near is not None:  # the planes stopped moving it: the last solved clear
+                log.debug("jump in a cell: re-solve %s; keeping the last clear (or nearly clear) solution",
+                          sol["status"])  # fmt: skip
+                piece, T = (last_clear[0], last_clear[2]) if last_clear is not None else near  # type: ignore[misc]
                 break
             if sol["status"] in ("Infeasible_Problem_Detected", "Restoration_Failed", "Maximum_Iterations_Exceeded"):
                 raise infeasible(scene, rebuild(prob, T, U) if clear is None else clear[0], sol["status"])
@@ -129,18 +155,21 @@ def solve_avoiding(prob: Problem, options: JumpOptions,
             if not new:
                 last_clear = (piece, sol["x"], T)
             retried = False
+        if worst >= -NEAR_MISS and not new:
+            near = (piece, T)
         settled = worst >= -CONVERGED and abs(piece.duration - duration) <= CONVERGED_TIME * piece.duration
         duration = piece.duration
         if not new and not added and settled:
-            finer = rows.fine(piece)  # converged: what the verifier's grid would see between the checked points
+            # converged: what the certificate of each near pair finds between the checked points
+            finer = rows.fine(piece, CERTIFY_ACCELERATION * prob.acceleration)
             if not finer:
                 break
             rows.add(finer)
             added = True
             params = rows.parameters(piece, None if clear is None else clear[0])
         if solves > options.refinements + options.avoid_iterations:
-            if last_clear is not None:
-                piece, T = last_clear[0], last_clear[2]
+            if last_clear is not None or near is not None:
+                piece, T = (last_clear[0], last_clear[2]) if last_clear is not None else near  # type: ignore[misc]
                 break
             raise infeasible(scene, piece, "Not_Converged")
         # from a motion deep in an obstacle the re-solve struggles: start again from the last clear one
@@ -153,38 +182,142 @@ def solve_avoiding(prob: Problem, options: JumpOptions,
     return piece, T, stats
 
 
-def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: float | None
-                   ) -> tuple[PolynomialPiece, np.ndarray, SolverStats, Trajectory, Check]:  # fmt: skip
-    """The best warm starts around or over the obstacles, each solved and verified; the fastest wins."""
-    found = candidates(scene, prob.qA, prob.qB, prob.q_tops, prob.A, prob.B, prob.z_top, ceiling, prob.velocity,
-                       prob.acceleration)  # fmt: skip
-    if found[0].clearance < 0.0:  # no way tried clears: one attempt from the least colliding, on a short budget
-        short = replace(options, max_iterations=min(options.max_iterations, RESOLVE_ITERATIONS))
-        try:
-            piece, T, stats = solve_avoiding(prob, short, found[0].waypoints)
-            traj = Trajectory((piece,))
-            return piece, T, stats, traj, verify_move(prob, traj)
-        except JumpError as exc:
-            raise blocked(scene, found, exc.status) from None
-    way = found[0].way.split(",")[0]  # over, left or right
-    tries = found[:1] + [c for c in found[1:] if c.way.split(",")[0] != way and c.duration <= SECOND_WITHIN
-                         * found[0].duration][:1]  # fmt: skip
+def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: float | None,
+                  hints: tuple[np.ndarray, ...] = ()) -> tuple[PolynomialPiece, np.ndarray, SolverStats, Trajectory,
+                                                               Check]:  # fmt: skip
+    """The jump in the cell (module docstring of :mod:`scara_pin.motion.jump`, "In a cell").
+
+    The direct warm start when its joint lines clear the cell; else the ways of the global search
+    (:mod:`.search`) with the local ones (over, around: :mod:`.candidates`) and the user's via points
+    (``hints``, joint configurations between above A and above B): the fastest few solved, each verified, the
+    fastest verified kept. A motion a few micrometres under the margin is solved again with a larger buffer
+    (:data:`.rows.RETRY_BUFFER`) from a row where it failed.
+    """
+    vel, acc = prob.velocity, prob.acceleration
+    found = candidates(scene, prob.qA, prob.qB, prob.q_tops, prob.A, prob.B, prob.z_top, ceiling, vel, acc)
+    hinted = [_hinted(scene, prob, h, i) for i, h in enumerate(hints)]
+    verdict: Search | None = None
+    if found[0].way == "straight" and found[0].clearance >= 0.0 and not hinted:
+        tries = found[:1]
+    else:
+        verdict = search(scene, prob.q_tops[0], prob.q_tops[1], prob.z_top, ceiling, vel)
+        ways = [_way(scene, prob, w, i) for i, w in enumerate(verdict.ways)]
+        tries = hinted + sorted([c for c in found if c.clearance >= 0.0] + ways, key=lambda c: c.duration)
+        if not tries:
+            raise blocked(scene, [c for c in found if c.way == "straight"] or found[:1], "No_Way", verdict, vel, acc)
     best = None
     error: Exception | None = None
-    iterations = 0
+    iterations = failures = 0
+    solved: list[np.ndarray] = []
     for cand in tries:
+        if best is not None and (len(solved) >= SOLVED_WAYS or cand.duration > SECOND_WITHIN * tries[0].duration):
+            break
+        if failures >= FAILED_WAYS:
+            break
+        if any(_same_way(scene, cand.waypoints, path, prob.velocity) for path in solved):
+            log.debug("jump in a cell: warm start %s goes the way of one solved already", cand.way)
+            continue
         log.debug("jump in a cell: warm start %s (%.4g s, clearance %.3g m)", cand.way, cand.duration,
-                     cand.clearance)  # fmt: skip
+                  cand.clearance)  # fmt: skip
         try:
-            piece, T, stats = solve_avoiding(prob, options, cand.waypoints)
-            traj = Trajectory((piece,))
-            check = verify_move(prob, traj)
+            piece, T, stats, traj, check = _solved(prob, options, cand.waypoints)
         except JumpError as exc:
             error = exc
+            failures += 1
             continue
         iterations += stats.iterations
+        solved.append(piece.evaluate(np.linspace(0.0, piece.duration, _LADDER))[0])
         if best is None or traj.duration < best[3].duration:
             best = (piece, T, stats, traj, check)
     if best is None:
-        raise error if error is not None else JumpError("Not_Solved", "no warm start")
+        if isinstance(error, JumpError) and error.status == "VerificationFailed":
+            raise error
+        raise blocked(scene, tries[:failures] or tries[:1], error.status if isinstance(error, JumpError)
+                      else "Not_Solved", verdict, vel, acc) from None  # fmt: skip
     return best[0], best[1], replace(best[2], iterations=iterations), best[3], best[4]
+
+
+def _solved(prob: Problem, options: JumpOptions,
+            waypoints: np.ndarray) -> tuple[PolynomialPiece, np.ndarray, SolverStats, Trajectory, Check]:  # fmt: skip
+    """One warm start solved and verified.
+
+    A near miss (its certificate fails by micrometres) is solved again with a larger buffer and a row where it failed.
+    """
+    buffer = BUFFER
+    seed: tuple[DistanceRow, ...] = ()
+    for attempt in range(2):
+        piece, T, stats = solve_avoiding(prob, options, waypoints, buffer=buffer, seed=seed)
+        traj = Trajectory((piece,))
+        try:
+            return piece, T, stats, traj, verify_move(prob, traj)
+        except JumpError as exc:
+            miss = _missed(prob, traj)
+            if attempt or miss is None:
+                raise exc from None
+            log.debug("jump in a cell: a near miss (%s); solved again with a larger buffer", exc.reason)
+            buffer, seed = buffer * RETRY_BUFFER, (miss,)
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def _missed(prob: Problem, traj: Trajectory) -> DistanceRow | None:
+    """Where a verified motion came closer than the margin, as a row of the transcription (None: it failed otherwise).
+
+    Its lowest sample, or its certificate's weakest point.
+    """
+    from ..verify import verify
+
+    scene = prob.scene
+    if scene is None:  # pragma: no cover - in a cell only
+        return None
+    c = verify(prob.base, traj, limits=prob.limits, scene=scene).clearance
+    if c is None or c.certified is None or c.bound >= c.margin - DISTANCE_TOL:
+        return None
+    t, pair = (c.certified.lowest[0], c.certified.lowest[1]) if c.distance >= c.certified.lowest[2] \
+        else (c.time, int(np.flatnonzero(np.array(c.labels) == c.pair)[0]))  # fmt: skip
+    piece = traj.pieces[0]
+    if not isinstance(piece, PolynomialPiece):  # pragma: no cover - jump pieces
+        return None
+    k = int(np.clip(np.searchsorted(piece.breaks, t, side="right") - 1, 0, len(piece.breaks) - 2))
+    h = piece.breaks[k + 1] - piece.breaks[k]
+    return DistanceRow(k, float(np.clip((t - piece.breaks[k]) / h, 0.0, 1.0)), pair)
+
+
+SOLVED_WAYS = 2
+"""Ways (distinct: :func:`_same_way`) solved to the end before the fastest is kept."""
+FAILED_WAYS = 4
+"""Warm starts whose local solve may fail before the jump is given up."""
+_LADDER = 24
+"""Rungs of the ladder between a warm start and a motion solved already (:func:`_same_way`)."""
+
+
+def _same_way(scene: Scene, waypoints: np.ndarray, path: np.ndarray, velocity: np.ndarray) -> bool:
+    """Whether a warm start goes the way of a solved motion (the local solve would find the same motion again).
+
+    The ladder between them (corresponding points at the same fraction of their joint-space length joined by straight
+    joint lines) is clear of the cell: one deforms into the other through free space.
+    """
+    a, b = _resampled(waypoints, velocity), _resampled(path, velocity)
+    s = np.linspace(0.0, 1.0, 12)[None, :, None]
+    rungs = (a[:, None, :] + s * (b - a)[:, None, :]).reshape(-1, a.shape[1])
+    return bool(clear_mask(scene, rungs).all())
+
+
+def _resampled(points: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+    """:data:`_LADDER` points along a joint polyline, evenly spaced in its length (each joint over its velocity)."""
+    run = np.concatenate([[0.0], np.cumsum(np.sum(np.abs(np.diff(points, axis=0)) / velocity, axis=1))])
+    u = np.linspace(0.0, run[-1], _LADDER)
+    return np.column_stack([np.interp(u, run, points[:, j]) for j in range(points.shape[1])])
+
+
+def _way(scene: Scene, prob: Problem, way: Way, i: int) -> Candidate:
+    """A way of the search as a warm start (its joint lines from A and to B added)."""
+    waypoints = np.vstack([prob.qA, way.waypoints, prob.qB])
+    t, clear = score(scene, waypoints, prob.velocity, prob.acceleration)
+    return Candidate(f"search {i + 1}", waypoints, t, clear)
+
+
+def _hinted(scene: Scene, prob: Problem, via: np.ndarray, i: int) -> Candidate:
+    """A user's via configurations as a warm start."""
+    waypoints = np.vstack([prob.qA, prob.q_tops[0], np.atleast_2d(via), prob.q_tops[1], prob.qB])
+    t, clear = score(scene, waypoints, prob.velocity, prob.acceleration)
+    return Candidate(f"via {i + 1}", waypoints, t, clear)

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from .problem import NODES, ConstraintPoint, Problem, propagate
-from .rows import BUFFER, DISTANCE_SCALE, RESOLVE_ITERATIONS, DistanceRow, Rows
+from .rows import DISTANCE_SCALE, RESOLVE_ITERATIONS, DistanceRow, Rows
 from .types import JumpOptions
 
 _TIE_VELOCITY = 1e-4
@@ -199,7 +199,7 @@ class Transcription:
             c = where[(r.k, r.sigma)]
             seps.append(avoid.function(r.pair)(frames[:, c * nj + ja], frames[:, c * nj + jb], par[0:3, i],
                                                par[3:6, i], par[6:9, i]))  # fmt: skip
-        g_rows = (ca.vertcat(*seps) - (avoid.margin + BUFFER)) / DISTANCE_SCALE
+        g_rows = (ca.vertcat(*seps) - (avoid.margin + avoid.buffer)) / DISTANCE_SCALE
         return {"x": w, "f": nlp["f"], "g": ca.vertcat(nlp["g"], g_rows), "p": Pd}
 
     def solve(self, x0: np.ndarray, lam_x: np.ndarray | None, lam_g: np.ndarray | None,

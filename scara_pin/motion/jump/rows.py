@@ -61,8 +61,18 @@ DISTANCE_SCALE = 0.01
 """[m] the scale of the distance rows in the NLP (their values over it are of order 1)."""
 
 
-BUFFER = 1e-6
-"""[m] the rows keep margin + BUFFER: the verified distance then stays above margin - 1e-6 between rows."""
+BUFFER = 5e-6
+"""[m] the rows keep margin + BUFFER: the motion then keeps the margin between rows too, and its certificate
+(:mod:`~scara_pin.cell.certify`) needs few samples where it slides along an obstacle; a near miss is solved again
+with a larger buffer (:data:`RETRY_BUFFER`)."""
+NEAR_MISS = 1e-5
+"""[m] a solved motion this close to the margin (but under it) is kept when the re-solves stop converging: it is
+then solved again with a larger buffer (a near miss is refined, not refused)."""
+RETRY_BUFFER = 4.0
+"""A motion whose certificate still fails after the iterations is solved again with the buffer this many times
+larger (and a row where it failed): a near miss is refined, not refused."""
+FINE_FLOOR = 5e-7
+"""[m] :meth:`Rows.fine` certifies the near pairs down to margin - FINE_FLOOR (the verifier's: margin - 1e-6)."""
 
 
 ACTIVATION = 0.005
@@ -122,10 +132,11 @@ class Rows:
     PARAMETERS = 9
     """Per row: the plane's normal and point in the second shape's joint frame, the witness point on the first."""
 
-    def __init__(self, scene: Scene, sym: SymbolicModel) -> None:
+    def __init__(self, scene: Scene, sym: SymbolicModel, buffer: float = BUFFER) -> None:
         self.scene = scene
         self.sym = sym
         self.margin = scene.margin
+        self.buffer = buffer
         self.rows: tuple[DistanceRow, ...] = ()
         self._index: set[tuple[int, float, int]] = set()
         self._functions: dict[int, Any] = {}
@@ -275,24 +286,40 @@ class Rows:
             (D < FINE_WITHIN).reshape(n, CHECK_POINTS, -1).any(axis=1)))}  # fmt: skip
         return new, worst
 
-    def fine(self, piece: PolynomialPiece) -> list[DistanceRow]:
-        """Rows where the verifier's grid finds a pair below the margin that :meth:`check`'s points missed.
+    def fine(self, piece: PolynomialPiece, acceleration: np.ndarray) -> list[DistanceRow]:
+        """Rows where a pair that came near the margin is not certified clear between :meth:`check`'s points.
 
         Only the pairs that came within :data:`FINE_WITHIN` of the margin in an interval at the last
-        :meth:`check` are sampled there, at the verifier's rate (:data:`~scara_pin.motion.verify.VERIFY_RATE`);
-        each (interval, pair) below the margin by more than :data:`CONVERGED` gets a row at its worst sample.
+        :meth:`check`: each such (interval, pair) is sampled at the verifier's rate
+        (:data:`~scara_pin.motion.verify.VERIFY_RATE`) and certified between the samples
+        (:func:`~scara_pin.cell.certify.certify`, ``acceleration`` bounding |qdd|) down to margin - :data:`FINE_FLOOR`;
+        where it is not, a row goes at its lowest sample (a dip found), or where the certificate is weakest.
         Between :meth:`check`'s points, an edge passing an edge (two boxes) can dip below the margin unseen.
         """
+        from ...cell.certify import certify
         from ..verify import VERIFY_RATE
 
         h = np.diff(piece.breaks)
+        floor = self.margin - FINE_FLOOR
         new: list[DistanceRow] = []
+
+        def sample(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            q, qd, _ = piece.evaluate(tt)
+            return q, qd
+
         for kk, p in sorted(self._near):
             m = max(CHECK_POINTS, math.ceil(h[kk] * VERIFY_RATE) + 1)
-            s = np.arange(1, m) / m
-            q = piece.local(np.full(len(s), kk), s * h[kk], 0)
-            d = self.scene.distance_array(q, [p])[:, 0] - self.margin
-            i = int(np.argmin(d))
-            if d[i] < -CONVERGED and (kk, float(s[i]), p) not in self._index:
-                new.append(DistanceRow(kk, float(s[i]), p))
+            tt = piece.breaks[kk] + h[kk] * (np.arange(m + 1) / m)
+            d = self.scene.distance_array(sample(tt)[0], [p])[:, 0]
+            cert = certify(self.scene, sample, tt, d, np.full(len(tt), p), acceleration, floor, pairs=[p])
+            if cert.certified:
+                continue
+            at = cert.lowest[0] if cert.lowest[2] < floor else cert.time
+            sigma = float(np.clip((at - piece.breaks[kk]) / h[kk], 0.0, 1.0))
+            if sigma >= 1.0 and kk + 1 < len(h):  # the interval's end is the next one's start node
+                row = DistanceRow(kk + 1, 0.0, p)
+            else:
+                row = DistanceRow(kk, sigma, p)
+            if (row.k, row.sigma, row.pair) not in self._index:
+                new.append(row)
         return new
