@@ -17,7 +17,7 @@ from ..verify import CERTIFY_ACCELERATION, DISTANCE_TOL
 from .candidates import SECOND_WITHIN, Candidate, candidates, line_samples, score
 from .nlp import Transcription
 from .problem import ConstraintPoint, Problem
-from .refine import failure, rebuild, violations, warm_start
+from .refine import failure, rebuild, solve, violations, warm_start
 from .rows import BUFFER, CONVERGED, CONVERGED_TIME, DEEP, NEAR_MISS, RETRY_BUFFER, DistanceRow, Rows
 from .search import Search, Way, search
 from .types import JumpError, JumpOptions, SolverStats
@@ -194,6 +194,16 @@ def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: fl
     (:data:`.rows.RETRY_BUFFER`) from a row where it failed.
     """
     vel, acc = prob.velocity, prob.acceleration
+    # the fastest motion without the cell bounds every motion in it from below; when it is clear, it is the answer
+    piece, T, stats = solve(replace(prob, scene=None), options)
+    free = piece.duration
+    if not hints and float(scene.minimum_array(piece.evaluate(np.linspace(0.0, free, _FREE_CHECK))[0]).min()) \
+            >= scene.margin:  # fmt: skip
+        traj = Trajectory((piece,))
+        try:
+            return piece, T, stats, traj, verify_move(prob, traj)
+        except JumpError:
+            log.debug("jump in a cell: the motion without the cell is not certified clear in it")
     found = candidates(scene, prob.qA, prob.qB, prob.q_tops, prob.A, prob.B, prob.z_top, ceiling, vel, acc)
     hinted = [_hinted(scene, prob, h, i) for i, h in enumerate(hints)]
     verdict: Search | None = None
@@ -210,7 +220,8 @@ def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: fl
     iterations = failures = 0
     solved: list[np.ndarray] = []
     for cand in tries:
-        if best is not None and (len(solved) >= SOLVED_WAYS or cand.duration > SECOND_WITHIN * tries[0].duration):
+        if best is not None and (len(solved) >= SOLVED_WAYS or cand.duration > SECOND_WITHIN * tries[0].duration
+                                 or best[3].duration <= free * (1.0 + CONVERGED_TIME)):  # fmt: skip
             break
         if failures >= FAILED_WAYS:
             break
@@ -282,6 +293,8 @@ def _missed(prob: Problem, traj: Trajectory) -> DistanceRow | None:
     return DistanceRow(k, float(np.clip((t - piece.breaks[k]) / h, 0.0, 1.0)), pair)
 
 
+_FREE_CHECK = 400
+"""Samples at which the motion without the cell is first checked against it (then verified, certified)."""
 SOLVED_WAYS = 2
 """Ways (distinct: :func:`_same_way`) solved to the end before the fastest is kept."""
 FAILED_WAYS = 4

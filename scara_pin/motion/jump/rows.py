@@ -151,11 +151,24 @@ class Rows:
         self.rows = self.rows + tuple(fresh)
         return bool(fresh)
 
-    def joints(self, pair: int) -> tuple[int, int]:
-        """(joint of the pair's first shape, joint of its second) in the robot's model (0: the root)."""
+    def swapped(self, pair: int) -> bool:
+        """Whether the pair's plane is fixed to its FIRST shape's joint (and the second shape kept beyond it).
+
+        The plane goes on the shape nearer the root (an obstacle; the ancestor link of a self pair) and the other
+        shape's support is kept beyond it: a plane fixed to a flange that turns on its axis would turn with it and
+        cut the arm it separates (the distance does not change, the row would).
+        """
         gm = self.scene.geometry_model
         pr = self.scene.pairs[pair]
-        return int(gm.geometryObjects[pr.first].parentJoint), int(gm.geometryObjects[pr.second].parentJoint)
+        ja, jb = int(gm.geometryObjects[pr.first].parentJoint), int(gm.geometryObjects[pr.second].parentJoint)
+        return jb != 0 and ja in self.scene.robot.model.supports[jb]
+
+    def joints(self, pair: int) -> tuple[int, int]:
+        """(joint of the shape kept beyond the plane, joint the plane is fixed to) in the model (0: the root)."""
+        gm = self.scene.geometry_model
+        pr = self.scene.pairs[pair]
+        ja, jb = int(gm.geometryObjects[pr.first].parentJoint), int(gm.geometryObjects[pr.second].parentJoint)
+        return (jb, ja) if self.swapped(pair) else (ja, jb)
 
     def function(self, pair: int) -> Any:
         """``s = f(Fa, Fb, n, p, w)``: how far the first shape of ``pair`` is beyond the row's plane [m].
@@ -174,7 +187,8 @@ class Rows:
         import coal
 
         gm = self.scene.geometry_model
-        a = gm.geometryObjects[self.scene.pairs[pair].first]
+        pr = self.scene.pairs[pair]
+        a = gm.geometryObjects[pr.second if self.swapped(pair) else pr.first]
         Fa, Fb = ca.SX.sym("Fa", 12), ca.SX.sym("Fb", 12)
         n_loc, p_loc, w_loc = ca.SX.sym("n", 3), ca.SX.sym("p", 3), ca.SX.sym("w", 3)
         Rb, ob = ca.reshape(Fb[:9], 3, 3), Fb[9:]
@@ -232,9 +246,14 @@ class Rows:
                     if keep_contact and w.distance <= 0.0:
                         left.append(i)
                         continue
-                    out[i, 0:3] = w.oMb.rotation.T @ w.normal
-                    out[i, 3:6] = w.oMb.actInv(w.point_b)
-                    out[i, 6:9] = w.oMa.actInv(w.point_a)
+                    if self.swapped(self.rows[i].pair):  # the plane on the first shape, facing the second
+                        out[i, 0:3] = w.oMa.rotation.T @ -w.normal
+                        out[i, 3:6] = w.oMa.actInv(w.point_a)
+                        out[i, 6:9] = w.oMb.actInv(w.point_b)
+                    else:
+                        out[i, 0:3] = w.oMb.rotation.T @ w.normal
+                        out[i, 3:6] = w.oMb.actInv(w.point_b)
+                        out[i, 6:9] = w.oMa.actInv(w.point_a)
             return left
 
         if rebase:
@@ -308,7 +327,7 @@ class Rows:
             return q, qd
 
         for kk, p in sorted(self._near):
-            m = max(CHECK_POINTS, math.ceil(h[kk] * VERIFY_RATE) + 1)
+            m = max(CHECK_POINTS, math.ceil(h[kk] * VERIFY_RATE / 5.0) + 1)  # the certificate refines where it must
             tt = piece.breaks[kk] + h[kk] * (np.arange(m + 1) / m)
             d = self.scene.distance_array(sample(tt)[0], [p])[:, 0]
             cert = certify(self.scene, sample, tt, d, np.full(len(tt), p), acceleration, floor, pairs=[p])
