@@ -113,7 +113,8 @@ def _foil_cell(margin=0.0):
 def test_a_straight_line_through_a_1um_foil_is_refused(tmp_path, capsys):
     cell = tmp_path / "foil.yaml"
     cell.write_text("margin: 0\nobstacles:\n  - {name: foil, shape: box, size: [0.3, 0.000001, 0.1], "
-                    "xyz: [0.27, 0, -0.15]}\ncarried: {shape: sphere, radius: 0.000001, xyz: [0, 0, 0.05]}\n")  # fmt: skip
+                    "xyz: [0.27, 0, -0.15]}\n"
+                    "carried: {shape: sphere, radius: 0.000001, xyz: [0, 0, 0.05]}\n")  # fmt: skip
     rc = main(["traj", "--linear", "--from-pose", *map(str, FROM), "--to-pose", *map(str, TO), "--cell", str(cell)])
     err = capsys.readouterr().err
     assert rc == 3 and "carried - foil" in err and err.startswith("error: "), err
