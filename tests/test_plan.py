@@ -104,8 +104,8 @@ def test_refusals() -> None:
         MotionRequest(start_q=Q0, start_pose=np.zeros(4), end_q=Q1)
     with pytest.raises(InvalidInputError, match="exactly one end"):
         MotionRequest(start_q=Q0)
-    with pytest.raises(InvalidInputError, match="no via"):
-        MotionRequest(start_pose=np.zeros(4), end_pose=np.ones(4), arch=True, vias=(Q0,))
+    with pytest.raises(InvalidInputError, match="straight-leg arch takes no via"):
+        MotionRequest(start_pose=np.zeros(4), end_pose=np.ones(4), arch=True, vias=(Q0,), path="lines")
     with pytest.raises(ParameterError, match="duration"):
         MotionRequest(start_q=Q0, end_q=Q1, duration=-1.0)
 

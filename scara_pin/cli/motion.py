@@ -61,8 +61,9 @@ def cmd_traj(args: argparse.Namespace) -> int:
         tool_speed = args.tool_speed / units.length
     _arch_options(args)
     if args.arch and not args.linear:
-        if args.via:
-            raise InvalidInputError("--arch takes no --via (one arch between two poses)")
+        if args.via and args.path == "lines":
+            raise InvalidInputError("--arch --path lines takes no --via (one arch between two poses; the jump takes "
+                                    "--via as hints of its way through a cell)")
         if args.duration is not None:
             raise InvalidInputError("--arch is time-optimal: --duration does not apply")
     jerk = jerk_limits(args)
@@ -330,7 +331,8 @@ def register(sub: Any) -> None:
     g.add_argument("--to", dest="to_q", nargs="+", metavar="Q", help="end configuration")
     g.add_argument("--from-pose", nargs="+", metavar="P", help="start pose (IK: the solution nearest mid-range)")
     g.add_argument("--to-pose", nargs="+", metavar="P", help="end pose (IK: the solution nearest the previous point)")
-    g.add_argument("--via", nargs="+", action="append", metavar="Q", help="via configuration (repeatable)")
+    g.add_argument("--via", nargs="+", action="append", metavar="Q",
+                   help="via configuration (repeatable); with --arch, a hint of the jump's way through the cell")
     g = p.add_argument_group("timing")
     g.add_argument("--duration", type=number_type("--duration"), metavar="T",
                    help="quintic time law over T seconds (checked against the limits)")  # fmt: skip

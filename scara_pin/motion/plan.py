@@ -72,7 +72,8 @@ class MotionRequest:
     Attributes:
         start_q, end_q: joint values [rad, m] (URDF order).
         start_pose, end_pose: tool poses (x, y, z, yaw) in the base frame [m, rad].
-        vias: joint waypoints between start and end [rad, m] (not with ``arch``).
+        vias: joint waypoints between start and end [rad, m]; with ``arch`` (the jump), hints of the way through a
+            cell (:func:`~scara_pin.motion.jump.jump_move`'s ``via``).
         duration: a quintic time law over this many seconds; None: time-optimal.
         linear: a straight tool line (SCARA) through the start, the vias' poses and the end.
         arch: an arch (jump) move between the two poses (SCARA; not with ``linear``, vias or a duration).
@@ -132,8 +133,9 @@ class MotionRequest:
                 raise ParameterError(name, value, "must be finite and > 0", "s" if name == "duration" else "m/s")
         if self.rise is not None and not math.isfinite(self.rise):
             raise ParameterError("rise", self.rise, "must be finite", "m")
-        if self.arch and self.vias:
-            raise InvalidInputError("an arch move takes no via (one arch between two poses)")
+        if self.arch and self.vias and self.path != "jump":
+            raise InvalidInputError("a straight-leg arch takes no via (one arch between two poses; the jump takes via "
+                                    "points as hints)")
         if self.arch and self.duration is not None:
             raise InvalidInputError("an arch move is time-optimal: a duration does not apply")
         if self.jerk is not None and self.duration is not None:
@@ -296,7 +298,8 @@ def _jump(robot: RobotModel, request: MotionRequest) -> MotionPlan:
                      clearance_radius=STANDARD_CLEARANCE if request.clearance_radius is None
                      else request.clearance_radius, max_height=request.max_height, payload=request.payload,
                      torque=request.torque, tool_speed=request.tool_speed, start=request.start_q,
-                     end=request.end_q, jerk=request.jerk, limits=request.limits, cell=request.cell)  # fmt: skip
+                     end=request.end_q, jerk=request.jerk, limits=request.limits, cell=request.cell,
+                     via=request.vias)  # fmt: skip
     return MotionPlan(move.trajectory, Method.JUMP, robot, move, move.distance)
 
 

@@ -88,6 +88,7 @@ refused at once, exit 2, instead of running the solver to its iteration limit).
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -101,7 +102,7 @@ from ..trajectory import Trajectory
 from ..verify import VERIFY_RATE, jerk_vector, limits_in_force
 from .bound import lower_bound
 from .cell import solve_in_cell
-from .problem import Problem, default_intervals, endpoints, holds_still, top_configuration
+from .problem import Problem, default_intervals, endpoints, given_via, holds_still, top_configuration
 from .refine import solve
 from .types import (
     BINDING,
@@ -160,6 +161,7 @@ def jump_move(
     branch: str | None = None,
     options: JumpOptions | None = None,
     cell: Cell | None = None,
+    via: Sequence[ArrayLike] = (),
 ) -> JumpMove:
     """The time-optimal jump from rest at ``pose_from`` to rest at ``pose_to`` (module docstring), verified.
 
@@ -183,7 +185,9 @@ def jump_move(
         options: grid and solver options.
         cell: obstacles, the carried part and the margin (:class:`~scara_pin.cell.Cell`): every checked pair
             stays at least the margin apart (:mod:`~scara_pin.motion.jump.rows`), the joint path free to go
-            around or over.
+            around or over (the ways of :mod:`~scara_pin.motion.jump.search`).
+        via: hints of the way through the cell: joint configurations the traverse passes near (the local solve
+            starts from the joint lines through them, and is free to leave them); each inside the joint limits.
 
     Raises:
         ParameterError, InvalidInputError: bad input (exit 2), e.g. poses closer than 2 R horizontally; a start
@@ -213,6 +217,9 @@ def jump_move(
         raise InfeasibleError(f"max_height {ceiling:.6g} m is below the height the clearance needs: z_top = "
                               f"{z_top:.6g} m (rise {rise:.6g} m above the higher pose)")  # fmt: skip
     qA, qB = endpoints(robot, A, B, start, end, branch)
+    hints = tuple(given_via(robot, v, i) for i, v in enumerate(via))
+    if hints and cell is None:
+        raise InvalidInputError("via points are hints of the way through a cell: give the cell too")
     scene = None
     if cell is not None:
         from ...cell import scene as make_scene
@@ -247,7 +254,7 @@ def jump_move(
         traj = Trajectory((piece,))
         check = verify_move(prob, traj)
     else:
-        piece, T, stats, traj, check = solve_in_cell(prob, options, scene, ceiling)
+        piece, T, stats, traj, check = solve_in_cell(prob, options, scene, ceiling, hints)
     legs = legs_of(prob, check, T)
     stats = replace(stats, seconds=time.perf_counter() - t0)
     return JumpMove(trajectory=traj, pose_from=A, pose_to=B, q_from=qA, q_to=qB, rise=rise, clearance_radius=R,

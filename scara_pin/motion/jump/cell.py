@@ -205,7 +205,7 @@ def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: fl
         except JumpError:
             log.debug("jump in a cell: the motion without the cell is not certified clear in it")
     found = candidates(scene, prob.qA, prob.qB, prob.q_tops, prob.A, prob.B, prob.z_top, ceiling, vel, acc)
-    hinted = [_hinted(scene, prob, h, i) for i, h in enumerate(hints)]
+    hinted = [_hinted(scene, prob, np.array(hints))] if hints else []
     verdict: Search | None = None
     if found[0].way == "straight" and found[0].clearance >= 0.0 and not hinted:
         tries = found[:1]
@@ -329,8 +329,8 @@ def _way(scene: Scene, prob: Problem, way: Way, i: int) -> Candidate:
     return Candidate(f"search {i + 1}", waypoints, t, clear)
 
 
-def _hinted(scene: Scene, prob: Problem, via: np.ndarray, i: int) -> Candidate:
-    """A user's via configurations as a warm start."""
-    waypoints = np.vstack([prob.qA, prob.q_tops[0], np.atleast_2d(via), prob.q_tops[1], prob.qB])
+def _hinted(scene: Scene, prob: Problem, vias: np.ndarray) -> Candidate:
+    """The user's via configurations, in order, as a warm start."""
+    waypoints = np.vstack([prob.qA, prob.q_tops[0], vias, prob.q_tops[1], prob.qB])
     t, clear = score(scene, waypoints, prob.velocity, prob.acceleration)
-    return Candidate(f"via {i + 1}", waypoints, t, clear)
+    return Candidate("via", waypoints, t, clear)

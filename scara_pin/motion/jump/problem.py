@@ -107,6 +107,16 @@ def given(robot: RobotModel, q: ArrayLike, pose: np.ndarray, name: str) -> np.nd
     return qq
 
 
+def given_via(robot: RobotModel, q: ArrayLike, i: int) -> np.ndarray:
+    """A via configuration given as a hint, checked: finite, inside the joint limits."""
+    qq = np.array(robot.check_q(q), dtype=float)
+    outside = robot.outside_limits(qq)
+    if outside:
+        raise InvalidInputError(f"via #{i + 1} {np.round(qq, 9).tolist()} is outside the limits of "
+                                f"{', '.join(outside)}")
+    return qq
+
+
 def endpoints(
     robot: RobotModel, A: np.ndarray, B: np.ndarray, start: ArrayLike | None, end: ArrayLike | None, branch: str | None
 ) -> tuple[np.ndarray, np.ndarray]:
