@@ -155,3 +155,24 @@ def test_check_cell_cli(urdf, capsys, tmp_path: Path) -> None:
     assert rc == 2 and len(errors) == 1 and f"{bad} line 2" in errors[0] and "post" in errors[0]
     rc, _, err = run(capsys, ["check", str(urdf), "--points", str(points)])
     assert rc == 2 and "go with --cell" in err
+
+
+def test_a_self_pair_that_touches_in_part_of_its_range_says_which_range_it_costs(robot, tmp_path: Path) -> None:
+    """A third-party description of the default robot whose link2 box reaches the quill's axis (as the project's
+    did): the flange rises into it over the top of the stroke. Closed form: the flange's top is at -0.05 - q3 + 0.01,
+    link2's underside at -0.03, so they are within the 2 mm margin where 0.01 + q3 < 0.002, q3 < -0.008 m."""
+    from scara_pin import robot_from_urdf
+
+    shipped = '<origin rpy="0 0 0" xyz="0.085 0 0"/>\n      <geometry>\n        <box size="0.17 0.06 0.06"/>'
+    old = '<origin rpy="0 0 0" xyz="0.1 0 0"/>\n      <geometry>\n        <box size="0.2 0.06 0.06"/>'
+    urdf = robot.urdf.replace(shipped, old)
+    assert urdf != robot.urdf
+    third = robot_from_urdf(urdf)
+    report = check_cell(scene(third, Cell((sphere("ball", 0.3, 0.0, -0.12, 0.02),), MARGIN)))
+    costs = [f for f in report.findings if f.code == "self-pair-cost"]
+    assert [f.data["pair"] for f in costs] == [["link2", "flange"]]
+    low, high = costs[0].data["ranges"]["joint3"]
+    assert low == pytest.approx(-0.05, abs=1e-12) and high == pytest.approx(-0.008, abs=0.15 / 2000)
+    assert "joint3 in [-50, -8" in costs[0].message and "motions there are refused" in costs[0].message
+    # the shipped robot: its shapes agree with its limits, nothing costs
+    assert not [f for f in check_cell(scene(robot, Cell((), MARGIN))).findings if f.code == "self-pair-cost"]

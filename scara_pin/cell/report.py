@@ -7,6 +7,10 @@ Each rule takes the scene (the robot in its cell) and the configurations to look
 - ``self-pair-checked`` / ``self-pair-disabled`` (info): the robot's self-collision pairs, each disabled one with
   its reason (adjacent links, always in contact at every sampled configuration, allowed by the cell:
   :mod:`scara_pin.cell.geometry`);
+- ``self-pair-cost`` (info): a checked self pair that comes within the margin somewhere in the joint limits, and
+  the range of its joints where it does (a pair that depends on one joint: that joint swept; else the share of
+  configurations drawn in the limits): motions there are refused (a flange rising into its arm over the top of the
+  stroke, a parallelogram's bars meeting);
 - ``obstacle-out-of-reach`` (warning): an obstacle farther than the margin from the robot's REACH ENVELOPE
   (:func:`reach_envelope`) and from its fixed links: no configuration brings any link (or the carried part)
   near it; a misplaced obstacle (millimetres written as metres, another frame), or one that does not matter;
@@ -358,7 +362,49 @@ def _configurations(scene: Scene, configurations: Sequence[tuple[str, np.ndarray
     return out
 
 
-RULES = (_summary, _self_pairs, _out_of_reach, _configurations)
+def _self_pair_costs(scene: Scene, configurations: Sequence[tuple[str, np.ndarray]]) -> list[CellFinding]:
+    """The checked self pairs that come within the margin somewhere in the joint limits, and the range it costs."""
+    from .sweep import pair_joints
+
+    robot = scene.robot
+    lo = np.where(np.array(robot.continuous), -math.pi, np.array(robot.limits.lower, dtype=float))
+    hi = np.where(np.array(robot.continuous), math.pi, np.array(robot.limits.upper, dtype=float))
+    out = []
+    for k, dims in enumerate(pair_joints(scene)):
+        pair = scene.pairs[k]
+        if pair.kind != "self" or not dims:
+            continue
+        if len(dims) == 1:  # a sweep of that joint (the others change nothing)
+            (j,) = dims
+            Q = np.tile(np.clip(robot.default_q, lo, hi), (_COST_SAMPLES, 1))
+            Q[:, j] = np.linspace(lo[j], hi[j], _COST_SAMPLES)
+        else:
+            Q = lo + (hi - lo) * np.random.default_rng(9).random((_COST_SAMPLES, robot.dof))
+        near = scene.distance_array(Q, [k])[:, 0] < scene.margin
+        if not near.any():
+            continue
+        ranges = {robot.joint_names[j]: [float(Q[near, j].min()), float(Q[near, j].max())] for j in sorted(dims)}
+        where = ", ".join(f"{name} in {_shown(robot, name, r)}" for name, r in ranges.items())
+        how = "over" if len(dims) == 1 else f"at {100.0 * near.mean():.2g} % of {_COST_SAMPLES} configurations drawn in"
+        out.append(CellFinding("info", "self-pair-cost", f"{pair.a} - {pair.b}: within the margin {how} the joint "
+                               f"limits, where {where}: motions there are refused",
+                               {"pair": [pair.a, pair.b], "share": float(near.mean()), "ranges": ranges}))  # fmt: skip
+    return out
+
+
+_COST_SAMPLES = 2001
+"""Configurations a self pair is looked at (a sweep of its one joint, or drawn in the limits) for its cost."""
+
+
+def _shown(robot: Any, joint: str, r: list[float]) -> str:
+    """``[-50, -8.04] mm`` or ``[30.2, 85] deg``: a joint's range in human units."""
+    j = robot.joint_names.index(joint)
+    if robot.joint_kinds[j] == "length":
+        return f"[{r[0] * 1e3:.4g}, {r[1] * 1e3:.4g}] mm"
+    return f"[{math.degrees(r[0]):.4g}, {math.degrees(r[1]):.4g}] deg"
+
+
+RULES = (_summary, _self_pairs, _self_pair_costs, _out_of_reach, _configurations)
 """The rules, in the order their findings are listed."""
 
 

@@ -76,6 +76,7 @@ __all__ = [
     "geometry_speeds",
     "joint_motion",
     "joint_placements",
+    "pair_joints",
     "segment_distance",
 ]
 
@@ -351,6 +352,39 @@ def geometry_speeds(scene: Scene, Q: np.ndarray, speeds: np.ndarray) -> tuple[np
         lin[:, k] = np.einsum("ni,ni->n", speeds, np.linalg.norm(col_v, axis=2))
         rot[:, k] = np.einsum("ni,ni->n", speeds, np.linalg.norm(col_w, axis=2))
     return lin, rot
+
+
+def pair_joints(scene: Scene, lower: np.ndarray | None = None, upper: np.ndarray | None = None) -> list[set[int]]:
+    """Per checked pair, the joints of q its distance depends on.
+
+    Those between its two shapes in the kinematic tree (an obstacle's pair: every joint above the robot's shape;
+    link2 and the flange: the quill and the wrist), a mimic counted as the joint it follows, less those found not to
+    change it at six random configurations within [lower, upper] (default: the limits; an unlimited one: one turn)
+    each moved alone to a random value: a round flange turning on its axis, a quill sliding along a tall post.
+    """
+    from ..symbolic import symbolic_model
+
+    robot = scene.robot
+    model = robot.model
+    sources = symbolic_model(robot).sources
+    lo = np.asarray(robot.limits.lower if lower is None else lower, dtype=float)
+    hi = np.asarray(robot.limits.upper if upper is None else upper, dtype=float)
+    lo, hi = np.where(np.isfinite(lo), lo, -np.pi), np.where(np.isfinite(hi), hi, np.pi)
+    rng = np.random.default_rng(5)
+    Q = lo + (hi - lo) * rng.random((6, robot.dof))
+    base = scene.distance_array(Q)
+    moved = {}
+    for j in range(robot.dof):
+        Qj = Q.copy()
+        Qj[:, j] = lo[j] + (hi[j] - lo[j]) * rng.random(len(Q))
+        moved[j] = np.max(np.abs(scene.distance_array(Qj) - base), axis=0) > 1e-9
+    gm = scene.geometry_model
+    out = []
+    for k, pr in enumerate(scene.pairs):
+        ja, jb = int(gm.geometryObjects[pr.first].parentJoint), int(gm.geometryObjects[pr.second].parentJoint)
+        between = {int(sources[j]) for j in set(model.supports[ja]) ^ set(model.supports[jb]) if j > 0}
+        out.append({j for j in between if moved[j][k]})
+    return out
 
 
 # ---------------------------------------------------------------------------------------------- along a path

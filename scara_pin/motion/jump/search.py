@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...cell.sweep import clear_mask, clearance_bound
+from ...cell.sweep import clear_mask, clearance_bound, pair_joints
 
 if TYPE_CHECKING:
     from ...cell import Scene
@@ -137,40 +137,13 @@ class _Lattice:
         self.lo = np.where(np.array(robot.continuous), np.minimum(self.a, self.b) - math.pi, self.lo)
         self.hi = np.where(np.array(robot.continuous), np.maximum(self.a, self.b) + math.pi, self.hi)
         self.length = np.array([k == "length" for k in robot.joint_kinds])
-        self.pair_dims = self._pair_dims()
+        self.pair_dims = pair_joints(scene, self.lo, self.hi)
         self.z_dims = self._tool_dims()
         used = set(self.z_dims).union(*self.pair_dims) if self.pair_dims else set(self.z_dims)
         self.free = np.array([j not in used for j in range(dof)])  # turns from A's to B's along the route
         self.reach = self._reach()
 
     # ------------------------------------------------------------------------------------------ structure
-    def _joint_sources(self, joints: set[int]) -> set[int]:
-        return {int(self.sym.sources[j]) for j in joints if j > 0}
-
-    def _pair_dims(self) -> list[set[int]]:
-        """Per pair, the joints of q its distance depends on.
-
-        Those between its two shapes in the kinematic tree, less those it is found not to change (a round flange
-        turning on its axis) at random configurations.
-        """
-        gm = self.scene.geometry_model
-        model = self.robot.model
-        rng = np.random.default_rng(5)
-        lo, hi = np.where(np.isfinite(self.lo), self.lo, -math.pi), np.where(np.isfinite(self.hi), self.hi, math.pi)
-        Q = lo + (hi - lo) * rng.random((6, self.robot.dof))
-        base = self.scene.distance_array(Q)
-        moved = {}
-        for j in range(self.robot.dof):
-            Qj = Q.copy()
-            Qj[:, j] = lo[j] + (hi[j] - lo[j]) * rng.random(len(Q))
-            moved[j] = np.max(np.abs(self.scene.distance_array(Qj) - base), axis=0) > 1e-9
-        out = []
-        for k, p in enumerate(self.scene.pairs):
-            ja, jb = int(gm.geometryObjects[p.first].parentJoint), int(gm.geometryObjects[p.second].parentJoint)
-            between = self._joint_sources(set(model.supports[ja]) ^ set(model.supports[jb]))
-            out.append({j for j in between if moved[j][k]})
-        return out
-
     def _tool_dims(self) -> list[int]:
         """The joints that move the tool up or down (a SCARA's quill; a palletizer's arms)."""
         rng = np.random.default_rng(3)
