@@ -36,14 +36,13 @@ not approach (a jog that stopped at a post, then moves along it or turns the fla
 its gap over its speed, and the gap stays about zero (a vertical move beside a vertical post keeps it exactly
 constant), so the steps shrink to nothing. A pair that starts less than :data:`SLIDE_BAND` above the margin is
 therefore followed by samples instead: its steps are :data:`SLIDE_STEP` of its shapes' motion (its speed bound
-times the step, the bound taken at the first of up to 64 samples evaluated at once and checked at the last as
-above), its exact distance checked at every one (a sample below the margin is bisected as above), until it is
-:data:`SLIDE_BAND` clear; from then on it is followed conservatively like every other pair. The samples go as far
-as the other pairs' conservative steps allow, so these are still followed without a gap.
-Only such a pair could dip below the margin between two samples and come back unseen: a smooth distance
-(curvature radius r of the shapes' relative motion) dips at most ``SLIDE_STEP**2 / (8 r)`` between samples,
-1.25e-7 m for r = 1 cm; a straight translation of convex shapes (a jog along x, y or z beside a post or a
-wall) cannot dip at all (the distance is then convex along the line).
+times the step, the bound taken at the first of up to 512 samples evaluated at once and checked at the last as
+above, within :data:`BOUND_GROWTH` of it), its exact distance checked at every one (a sample below the margin is
+bisected as above), until it is :data:`SLIDE_BAND` clear; from then on it is followed conservatively like every
+other pair. The samples go as far as the other pairs' conservative steps allow, so these are still followed
+without a gap. Between two samples at or above the margin, a distance that changes at most at its speed bound
+is at least the margin less half the motion between them: ``BOUND_GROWTH * SLIDE_STEP / 2``, under 1e-6 m (the
+verifier's tolerance, :func:`~scara_pin.cell.certify.certify`'s floor): the pair is certified there, not sampled.
 """
 
 from __future__ import annotations
@@ -89,9 +88,10 @@ MAX_STEPS = 200_000
 SLIDE_BAND = 1e-4
 """[m] a pair that starts less than this above the margin is followed by samples until it is this clear (module
 docstring: "Starting at the margin")."""
-SLIDE_STEP = 1e-4
-"""[m] the samples of such a pair: at most this much motion of its shapes between two (by its speed bound)."""
-_BATCH = 64
+SLIDE_STEP = 1.6e-6
+"""[m] the samples of such a pair: at most this much motion of its shapes between two (by its speed bound), so that
+it is certified within 1e-6 m of the margin between them (module docstring)."""
+_BATCH = 512
 """Samples of a pair at the margin taken at once (one path evaluation, one distance query per sample)."""
 _SAFETY = 0.9
 """The fraction of the conservative step taken (rounding, and q' changing within the step)."""

@@ -288,8 +288,8 @@ class _Lattice:
         """Up to :data:`WAYS` ways, each leaving the ones before it (module docstring)."""
         out: list[Way] = []
         penalty = None
-        start, goal = self.node(self.a), self.node(self.b)
-        if not (self.valid[start] and self.valid[goal]):
+        start, goal = self._entry(self.a), self._entry(self.b)
+        if start is None or goal is None:
             return out
         for _ in range(WAYS):
             way = self._way(start, goal, penalty)
@@ -300,6 +300,25 @@ class _Lattice:
             out.append(way)
             penalty = self._penalty(out)
         return sorted(out, key=lambda w: w.cost)
+
+    def _entry(self, q: np.ndarray) -> tuple[int, ...] | None:
+        """The valid lattice node nearest ``q`` (above A or B) whose joint line to it is clear, or None.
+
+        The lattice is anchored above A (its node is exactly there); above B falls between nodes, and the nearest one
+        may be blocked where a way still starts a step away: the nodes within two steps are tried, nearest first.
+        """
+        centre = np.array(self.node(q))
+        offsets = np.array(np.meshgrid(*[np.arange(-2, 3) if n > 1 else [0] for n in self.shape], indexing="ij"))
+        near = centre + offsets.reshape(len(self.shape), -1).T
+        near = near[((near >= 0) & (near < np.array(self.shape))).all(axis=1)]
+        near = near[self.valid[tuple(near.T)]]
+        if not len(near):
+            return None
+        Q = np.array([self.q(n) for n in near])
+        order = np.argsort(np.sum(np.abs(Q - q) / self.velocity, axis=1))
+        ok = self._clear_lines(np.tile(q, (len(order), 1)), Q[order])
+        first = np.flatnonzero(ok)
+        return None if not len(first) else tuple(int(v) for v in near[order[first[0]]])
 
     def _way(self, start: tuple[int, ...], goal: tuple[int, ...], penalty: np.ndarray | None) -> Way | None:
         from scipy.sparse.csgraph import dijkstra
