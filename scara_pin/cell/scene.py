@@ -402,6 +402,27 @@ class Scene:
                 out[i, c] = _sane(pin.computeDistance(gm, gd, k).min_distance)
         return out
 
+    def first_closer(self, Q: ArrayLike, pairs: list[int], candidates: np.ndarray, margin: float) -> np.ndarray:
+        """(n,) per row of ``Q``: the position in ``pairs`` of the first pair closer than ``margin``, -1 if none.
+
+        Only the pairs marked in ``candidates`` ((n, len(pairs)) bool) are asked, in order, each configuration's
+        geometries placed once; rows without a candidate are not placed at all.
+        """
+        import pinocchio as pin
+
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
+        convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
+        out = np.full(len(Q), -1, dtype=int)
+        for i in np.flatnonzero(candidates.any(axis=1)):
+            q = Q[i]
+            pin.updateGeometryPlacements(model, data, gm, gd, convert(q) if convert else q)
+            for c in np.flatnonzero(candidates[i]):
+                if _sane(pin.computeDistance(gm, gd, pairs[c]).min_distance) < margin:
+                    out[i] = c
+                    break
+        return out
+
     def minimum_array(self, Q: ArrayLike) -> np.ndarray:
         """(n,) the smallest distance over every checked pair at each row of ``Q`` [m] (see :meth:`nearest_array`)."""
         return self.nearest_array(Q)[0]

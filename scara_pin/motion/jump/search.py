@@ -15,8 +15,11 @@ part) is one value there, and turns from A's to B's along the route. A joint's r
 the scene at least the margin apart. A pair's distance depends only on the joints between its two shapes in
 the kinematic tree (an obstacle's on every joint above the robot's shape; link2 and the flange on the quill and
 the wrist): each pair is evaluated on the lattice of ITS joints (link1 against a post: one value per J1 step)
-by :func:`~scara_pin.cell.sweep.clear_mask` (bounding spheres, capsules, then coal's exact distance), and
-the results are combined over the whole lattice.
+by :func:`~scara_pin.cell.sweep.pair_masks` (bounding spheres, capsules, boxes grown by the margin, then coal's
+exact distance; the rows whose tool is below z_top are not asked), and the results are combined over the whole
+lattice. Every configuration inside the lattice's box is within half a step of a node in each joint, so within
+``half = sum(reach_j step_j) / 2`` of motion of it: a pair whose capsule bound is at least the margin plus that
+at every node is clear everywhere in the box, and the lines checked below ask only the other pairs.
 
 **Edges** join nodes one step apart along one joint, or along two of the first two joints at once (the arm's
 plane); an edge costs the time its joint move would take at the velocity limits, summed over the joints
@@ -42,7 +45,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...cell.sweep import clear_mask, clearance_bound, pair_joints
+from ...cell.sweep import clear_mask, pair_joints, pair_masks
 
 if TYPE_CHECKING:
     from ...cell import Scene
@@ -211,15 +214,38 @@ class _Lattice:
         # than the margin it is certainly clear (no check needed)
         half = 0.5 * float(np.sum(self.reach * np.array([x[1] - x[0] if len(x) > 1 else 0.0 for x in self.axes])))
         safe = np.ones(self.shape, dtype=bool)
-        for dims, pairs in groups.items():
-            for k in pairs:  # pair by pair: the nodes each closes (for the reason of a refusal)
-                ok = self._on_dims(list(dims), lambda Q, k=k: clear_mask(self.scene, Q, [k]))
+        self.near_pairs: list[int] = []  # the pairs that come within the margin and half an edge somewhere
+        for dims, pairs in groups.items():  # per pair: the nodes it closes first (for the reason of a refusal)
+            both = self._on_dims(list(dims), lambda Q, p=pairs: self._pairs_where_valid(Q, p))
+            for col, k in enumerate(pairs):
+                ok = both[..., col].astype(bool)
                 self.blocked_by[k] = int((~ok & valid).sum())
                 valid &= ok
-            far = self._on_dims(list(dims), lambda Q, p=pairs: clearance_bound(self.scene, Q, p))
-            safe &= far >= self.scene.margin + half
+                far = both[..., len(pairs) + col] >= self.scene.margin + half
+                safe &= far
+                if not far.all():
+                    self.near_pairs.append(k)
         self.valid = valid
         self.safe = (safe & valid).ravel()
+
+    def _pairs_where_valid(self, Q: np.ndarray, pairs: list[int]) -> np.ndarray:
+        """(n, 2k): :func:`~scara_pin.cell.sweep.pair_masks` of ``pairs`` (masks, then bounds) where the tool is valid.
+
+        Only the rows of ``Q`` whose tool is at a valid height are asked; the others (invalid whatever the pairs)
+        are clear, their bounds +inf.
+        """
+        out = np.ones((len(Q), 2 * len(pairs)))
+        out[:, len(pairs):] = np.inf
+        rows = np.arange(len(Q))
+        if self.z_dims and set(self.z_dims) <= {j for j in range(self.robot.dof) if len(np.unique(Q[:, j])) > 1}:
+            z = self._z(Q)
+            keep = z >= self.z_top - 1e-9
+            if self.ceiling is not None:
+                keep &= z <= self.ceiling + 1e-9
+            rows = rows[keep]
+        if len(rows):
+            out[rows] = np.hstack(pair_masks(self.scene, Q[rows], pairs))
+        return out
 
     def _on_dims(self, dims: list[int], f: object) -> np.ndarray:
         """``f`` (rows of q -> values) evaluated on the lattice of ``dims`` only, broadcast to the whole lattice."""
@@ -230,7 +256,8 @@ class _Lattice:
             Q[:, j] = g.ravel()
         values = np.concatenate([np.asarray(f(Q[i : i + _CHUNK])) for i in range(0, len(Q), _CHUNK)])  # type: ignore[operator]
         shape = [len(self.axes[j]) if j in dims else 1 for j in range(len(self.axes))]
-        return np.broadcast_to(values.reshape(shape), self.shape)
+        extra = values.shape[1:]  # a column per value: broadcast with them
+        return np.broadcast_to(values.reshape(shape + list(extra)), self.shape + extra)
 
     def node(self, q: np.ndarray) -> tuple[int, ...]:
         """The lattice index nearest ``q``."""
@@ -316,9 +343,12 @@ class _Lattice:
             return None
         Q = np.array([self.q(n) for n in near])
         order = np.argsort(np.sum(np.abs(Q - q) / self.velocity, axis=1))
-        ok = self._clear_lines(np.tile(q, (len(order), 1)), Q[order])
-        first = np.flatnonzero(ok)
-        return None if not len(first) else tuple(int(v) for v in near[order[first[0]]])
+        for lo in range(0, len(order), 8):  # nearest first, a few lines at a time
+            batch = order[lo : lo + 8]
+            ok = np.flatnonzero(self._clear_lines(np.tile(q, (len(batch), 1)), Q[batch]))
+            if len(ok):
+                return tuple(int(v) for v in near[batch[ok[0]]])
+        return None
 
     def _way(self, start: tuple[int, ...], goal: tuple[int, ...], penalty: np.ndarray | None) -> Way | None:
         from scipy.sparse.csgraph import dijkstra
@@ -373,7 +403,7 @@ class _Lattice:
         owner = np.repeat(np.arange(len(Q0)), n)
         s = np.concatenate([np.linspace(0.0, 1.0, k) for k in n])[:, None]
         Q = Q0[owner] + s * (Q1 - Q0)[owner]
-        ok = clear_mask(self.scene, Q)
+        ok = clear_mask(self.scene, Q, self.near_pairs)
         if self.z_dims:
             z = self._z(Q)
             ok &= z >= self.z_top - 1e-9
