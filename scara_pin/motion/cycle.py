@@ -557,18 +557,6 @@ def _leg_names(path: Any) -> tuple[tuple[str, ...], np.ndarray]:
     return ("lift", "traverse", "descend"), np.array([0.0, 1.0])
 
 
-def _law_time(law: Any, s_target: float) -> float:
-    """The time at which a monotonic law reaches s (bisection)."""
-    lo, hi = 0.0, float(law.duration)
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        if float(law.evaluate(np.array([mid]))[0][0]) < s_target:
-            lo = mid
-        else:
-            hi = mid
-    return hi
-
-
 def _legs(
     robot: RobotModel, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
 ) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
@@ -581,7 +569,7 @@ def _legs(
         names, bounds = _leg_names(path)
         if isinstance(path, ArchPath):
             m = motions[mi]
-            cuts = [0.0] + [_law_time(m.law, float(b)) for b in bounds[1:-1]] + [m.duration]
+            cuts = [0.0, *m.law.times_at(bounds[1:-1], 80).tolist(), m.duration]
             spans += [(names[k], move, t0 + cuts[k], t0 + cuts[k + 1]) for k in range(len(names))]
             t0 += m.duration
             mi += 1
