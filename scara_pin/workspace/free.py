@@ -244,6 +244,7 @@ def plot_free_region(
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
+    from ..files import finish
     from .scara import plot_workspace
 
     fig = plot_workspace(region.workspace, None, units=units, robot_name=robot_name, arm=False)
@@ -275,8 +276,4 @@ def plot_free_region(
                  f"free {region.area * A:.6g} {name}$^2$ of {region.workspace.area * A:.6g}, grid {h * L:.3g} {name}, "
                  f"margin {region.cell.margin * 1e3:g} mm", fontsize=9)  # fmt: skip
     ax.autoscale_view()
-    if path is not None:
-        from ..files import save_figure
-
-        save_figure(fig, path, dpi=dpi, bbox_inches="tight")
-    return fig
+    return finish(fig, path, dpi, bbox_inches="tight")
