@@ -223,33 +223,6 @@ class ArchPath(GeometricPath):
         return out
 
 
-@dataclass(frozen=True, eq=False)
-class _Arch:
-    """The geometry of an arch: corner points, blend sizes, yaw rate."""
-
-    a: np.ndarray
-    b: np.ndarray
-    top: float
-    u: np.ndarray
-    D: float
-    b1: float
-    b2: float
-    yaw_rate: float
-
-
-def _arch_geometry(pose_from: np.ndarray, pose_to: np.ndarray, rise: float, blend: float) -> _Arch:
-    d = pose_to[:2] - pose_from[:2]
-    D = float(np.hypot(*d))
-    if D < 1e-6:
-        raise InvalidInputError(f"the two poses are {D:.3g} m apart horizontally: an arch needs a horizontal move "
-                                "(use a straight line, traj --linear, for a vertical one)")  # fmt: skip
-    top = max(float(pose_from[2]), float(pose_to[2])) + rise
-    u = np.array([d[0] / D, d[1] / D, 0.0])
-    b1 = min(blend, top - float(pose_from[2]), D / 2.0)
-    b2 = min(blend, top - float(pose_to[2]), D / 2.0)
-    return _Arch(pose_from, pose_to, top, u, D, b1, b2, float(pose_to[3] - pose_from[3]) / D)
-
-
 def arch_path(
     robot: RobotModel,
     pose_from: ArrayLike,
@@ -286,23 +259,32 @@ def arch_path(
     A, B = as_vector("pose_from", pose_from), as_vector("pose_to", pose_to)
     rise = _nonneg("rise", rise, strict=True)
     blend = math.inf if blend is None else _nonneg("blend", blend)
-    g = _arch_geometry(A, B, rise, blend)
-    corners = [A, np.array([*A[:2], g.top, A[3]]), np.array([*B[:2], g.top, B[3]]), B]
+    d = B[:2] - A[:2]
+    D = float(np.hypot(*d))
+    if D < 1e-6:
+        raise InvalidInputError(f"the two poses are {D:.3g} m apart horizontally: an arch needs a horizontal move "
+                                "(use a straight line, traj --linear, for a vertical one)")  # fmt: skip
+    top = max(float(A[2]), float(B[2])) + rise  # the corner points, the blend sizes, the yaw per metre
+    u = np.array([d[0] / D, d[1] / D, 0.0])
+    b1 = min(blend, top - float(A[2]), D / 2.0)
+    b2 = min(blend, top - float(B[2]), D / 2.0)
+    yaw_rate = float(B[3] - A[3]) / D
+    corners = [A, np.array([*A[:2], top, A[3]]), np.array([*B[:2], top, B[3]]), B]
     lines = cartesian_path(robot, corners, start=start, end=end, branch=branch)
     if blend == 0.0:
         return lines
     z = np.array([0.0, 0.0, 1.0])
-    c1, c2 = np.array([*A[:2], g.top]), np.array([*B[:2], g.top])
-    y1, y2 = float(A[3]) + g.yaw_rate * g.b1, float(B[3]) - g.yaw_rate * g.b2
+    c1, c2 = np.array([*A[:2], top]), np.array([*B[:2], top])
+    y1, y2 = float(A[3]) + yaw_rate * b1, float(B[3]) - yaw_rate * b2
     pieces: list[tuple[str, Any]] = []
-    if g.top - A[2] - g.b1 > 1e-12:
-        pieces.append(("lift", (A, np.array([*A[:2], g.top - g.b1, A[3]]))))
-    pieces.append(("blend up", (c1, z, g.u, g.b1, float(A[3]))))
-    if g.D - g.b1 - g.b2 > 1e-12:
-        pieces.append(("traverse", (np.array([*(c1 + g.b1 * g.u), y1]), np.array([*(c2 - g.b2 * g.u), y2]))))
-    pieces.append(("blend down", (c2, g.u, -z, g.b2, y2)))
-    if g.top - B[2] - g.b2 > 1e-12:
-        pieces.append(("descend", (np.array([*B[:2], g.top - g.b2, B[3]]), B)))
+    if top - A[2] - b1 > 1e-12:
+        pieces.append(("lift", (A, np.array([*A[:2], top - b1, A[3]]))))
+    pieces.append(("blend up", (c1, z, u, b1, float(A[3]))))
+    if D - b1 - b2 > 1e-12:
+        pieces.append(("traverse", (np.array([*(c1 + b1 * u), y1]), np.array([*(c2 - b2 * u), y2]))))
+    pieces.append(("blend down", (c2, u, -z, b2, y2)))
+    if top - B[2] - b2 > 1e-12:
+        pieces.append(("descend", (np.array([*B[:2], top - b2, B[3]]), B)))
     segments: list[CartesianSegment] = []
     lengths: list[float] = []
     q = lines.q_start
@@ -311,15 +293,15 @@ def arch_path(
             corner, e_in, e_out, b, yaw0 = data
 
             def curve(s: np.ndarray, c: Any = data) -> np.ndarray:
-                return BlendSegment.curve(c[0], c[1], c[2], c[3], g.u, c[4], g.yaw_rate, s)
+                return BlendSegment.curve(c[0], c[1], c[2], c[3], u, c[4], yaw_rate, s)
 
             m = max(1, math.ceil(2.0 * b / _STEP))
             _, q_pts, s_ref, q_ref = follow_curve(robot, lines.branch, curve, q, m, k,
-                                                  extent=(2.0 * b, abs(g.yaw_rate) * b))  # fmt: skip
+                                                  extent=(2.0 * b, abs(yaw_rate) * b))  # fmt: skip
             p0, p1 = curve(np.array([0.0, 1.0]))
             seg: CartesianSegment = BlendSegment(robot, lines.branch, p0, p1, s_ref, q_ref, corner=corner,
-                                                 e_in=e_in, e_out=e_out, b=b, horizontal=g.u,
-                                                 yaw_rate=g.yaw_rate)  # fmt: skip
+                                                 e_in=e_in, e_out=e_out, b=b, horizontal=u,
+                                                 yaw_rate=yaw_rate)  # fmt: skip
             lengths.append(2.0 * b)
         else:
             a, bb = data
