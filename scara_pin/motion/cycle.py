@@ -377,7 +377,7 @@ class CyclePath(enum.Enum):
     LINES = "lines"
 
 
-@dataclass(frozen=True, eq=False, repr=False)
+@dataclass(frozen=True, eq=False, repr=False, kw_only=True)
 class CycleResult(Summarized):
     """The standard cycle: out and back, with its placement (``repr``: ``scara-pin cycle``'s text, in SI).
 
@@ -753,9 +753,10 @@ def standard_cycle(
         pts = [np.array([*(a[:2] + f * (b[:2] - a[:2])), a[2], a[3]]) for f in np.linspace(0.0, 1.0, 41)]
         wmin = min(robot.manipulability(robot.ik_nearest(p, q0)) for p in pts)
     check = verify(robot, move.trajectory, limits=limits, jerk=jerk, torque=torque, payload=payload)
-    return CycleResult(move, a, b, span, rise, used, why, float(wmin), path,
-                       clearance_radius if path is CyclePath.JUMP else None, max_height, bound, robot.name,
-                       check, torque)  # fmt: skip
+    return CycleResult(move=move, start=a, end=b, span=span, rise=rise, blend=used, placement=why,
+                       min_manipulability=float(wmin), path=path, max_height=max_height, lower_bound=bound,
+                       clearance_radius=clearance_radius if path is CyclePath.JUMP else None, robot_name=robot.name,
+                       verification=check, torque=torque)  # fmt: skip
 
 
 def _lines_bound(
