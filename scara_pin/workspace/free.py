@@ -51,7 +51,7 @@ DEFAULT_POINTS = 200
 """Grid points across the workspace's width when no resolution is given."""
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class FreeRegion:
     """Where the tool reaches without collision at one height (module docstring).
 
@@ -177,7 +177,8 @@ def free_region(
             rows = todo[ok]
             if len(rows):
                 free[rows[clear_mask(sc, res.q[ok])]] = True
-    return FreeRegion(ws, cell, z, h, x, y, reachable.reshape(n, n), free.reshape(n, n), yaws, yaw_free)
+    return FreeRegion(workspace=ws, cell=cell, z=z, resolution=h, x=x, y=y, reachable=reachable.reshape(n, n),
+                      free=free.reshape(n, n), yaws=yaws, yaw_free=yaw_free)  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ picture

@@ -237,7 +237,7 @@ def _box(geo: ScaraGeometry) -> ArmBox:
     return ArmBox(geo.a1, geo.arm, t, g, relative=True)
 
 
-@dataclass(frozen=True, repr=False)
+@dataclass(frozen=True, repr=False, kw_only=True)
 class Workspace(Summarized):
     """The exact plan-view region of the wrist axis point (or, with ``yaw``, the tool point at that yaw).
 
@@ -572,7 +572,8 @@ def workspace(
     r_min, r_max = (box.arm.d12, box.arm.l12) if box.second.full else geo.radius_range()
     ip = geo.prismatic
     zs = sorted((geo.z0 + geo.signs[ip] * geo.lower[ip], geo.z0 + geo.signs[ip] * geo.upper[ip]))
-    return Workspace(geo, tuple(arcs), region.loops, region.area, r_min, r_max, (zs[0], zs[1]), offset, yaw, note)
+    return Workspace(geometry=geo, arcs=tuple(arcs), loops=region.loops, area=region.area, r_min=r_min, r_max=r_max,
+                     z_range=(zs[0], zs[1]), offset=offset, yaw=yaw, note=note)  # fmt: skip
 
 
 TOOL_ON_AXIS = 1e-9
