@@ -61,7 +61,7 @@ from .jump import (
     jump_move,
     lower_bound,
 )
-from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
+from .paths import CartesianSegment, GeometricPath, PathError, SegmentedPath, cartesian_path, follow_curve
 from .payload import Payload, PayloadLike, as_payload, with_payload
 from .timing import TimingOptions, limits_in_force, parameterize
 from .trajectory import Motion, Trajectory
@@ -163,7 +163,7 @@ class BlendSegment(CartesianSegment):
 
 
 @dataclass(frozen=True, eq=False)
-class ArchPath(GeometricPath):
+class ArchPath(SegmentedPath, GeometricPath):
     """Tool segments (lines and blends) joined into one path q(s), s in [0, 1]; C2 in s across knots.
 
     Segment k covers ``[bounds[k], bounds[k + 1]]`` with ``bounds`` proportional to the segments' lengths
@@ -186,16 +186,6 @@ class ArchPath(GeometricPath):
     def branch(self) -> str:
         """The elbow branch of every configuration on the path."""
         return self.segments[0].branch
-
-    @property
-    def q_start(self) -> np.ndarray:
-        """The configuration at the start."""
-        return self.segments[0].q_ref[0].copy()
-
-    @property
-    def q_end(self) -> np.ndarray:
-        """The configuration at the end."""
-        return self.segments[-1].q_ref[-1].copy()
 
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
