@@ -28,7 +28,7 @@ import os
 import stat
 import sys
 from collections.abc import Callable, Collection, Iterable, Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, Literal
 
@@ -223,10 +223,8 @@ def atomic_output(path: str | os.PathLike[str], mode: int = 0o666) -> Iterator[P
         _fsync(tmp, os.O_RDONLY)
         check_output_path(path)  # again, just before the rename: it may have changed meanwhile
         os.replace(tmp, path)
-        try:  # the rename itself, on disk
+        with suppress(OSError):  # the rename itself, on disk (some systems cannot fsync a folder)
             _fsync(folder, os.O_RDONLY)
-        except OSError:  # some systems cannot fsync a folder
-            pass
     except BrokenPipeError:  # the reader of stdout went away: the command line handles it
         raise
     except OSError as exc:
