@@ -28,12 +28,15 @@ import os
 import stat
 import sys
 from collections.abc import Callable, Collection, Iterable, Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any, Literal
 
 from .errors import InvalidInputError
 from .signals import raise_pending
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "FIGURE_FORMATS",
@@ -42,6 +45,8 @@ __all__ = [
     "check_output_path",
     "check_outputs",
     "figure_format",
+    "finish",
+    "new_figure",
     "save_figure",
     "write_atomic_with",
     "write_text_atomic",
@@ -218,10 +223,8 @@ def atomic_output(path: str | os.PathLike[str], mode: int = 0o666) -> Iterator[P
         _fsync(tmp, os.O_RDONLY)
         check_output_path(path)  # again, just before the rename: it may have changed meanwhile
         os.replace(tmp, path)
-        try:  # the rename itself, on disk
+        with suppress(OSError):  # the rename itself, on disk (some systems cannot fsync a folder)
             _fsync(folder, os.O_RDONLY)
-        except OSError:  # some systems cannot fsync a folder
-            pass
     except BrokenPipeError:  # the reader of stdout went away: the command line handles it
         raise
     except OSError as exc:
@@ -276,3 +279,26 @@ def save_figure(figure: Any, path: str | os.PathLike[str], **kwargs: Any) -> Pat
     with atomic_output(path) as tmp:
         figure.savefig(tmp, format=fmt, **kwargs)
     return path
+
+
+def new_figure(width: float, height: float, layout: Literal["constrained"] | None = "constrained") -> Figure:
+    """A matplotlib Figure on its own Agg canvas (no pyplot: the caller's backend and figures are untouched).
+
+    Args:
+        width: figure width [inch].
+        height: figure height [inch].
+        layout: matplotlib's layout engine (None: the figure as drawn, trimmed when saved instead).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), layout=layout)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def finish(fig: Figure, path: str | os.PathLike[str] | None, dpi: int = 120, **kwargs: Any) -> Figure:
+    """Write ``fig`` to ``path`` when one is given (atomically; PNG, SVG or PDF by the ending), and return it."""
+    if path is not None:
+        save_figure(fig, path, dpi=dpi, **kwargs)
+    return fig

@@ -1,5 +1,5 @@
 """The package's architecture, checked from its source (issue 38): one-way layers, no import cycle, no private
-name taken from another module.
+name taken from another module; and the README's architecture section and its picture, against the tree.
 
 Every import that runs counts: at the top of a module, inside a function or a method; only the imports under
 ``if TYPE_CHECKING:`` (types, never executed) are left out. Each rule is a function over a folder of source, so
@@ -9,11 +9,16 @@ that each can be shown to fail on a planted violation (the last tests).
 from __future__ import annotations
 
 import ast
+import sys
 from pathlib import Path
+
+import pytest
 
 import scara_pin as sp
 
 ROOT = Path(sp.__file__).parent
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tools"))  # tools/layers.py: the layers' table and picture
 
 # The layers, lowest first. A module may import its own layer and those below, never one above (STYLE.md:
 # description -> model -> kinematics -> cell -> workspace -> motion -> job -> viz -> the facade -> cli).
@@ -282,3 +287,52 @@ def test_the_private_rule_fails_on_a_planted_private_import(tmp_path: Path) -> N
 def test_the_length_rule_fails_on_a_planted_long_module(tmp_path: Path) -> None:
     root = _plant(tmp_path, {"motion/a.py": "x = 1\n" * 1001})
     assert long_modules(root) == ["scara_pin/motion/a.py: 1001 lines"]
+
+
+# ---------------------------------------------------------------------------------------------- the README, the picture
+def _layer_tables() -> tuple[list[tuple[str, list[str]]], list[tuple[str, list[str]]]]:
+    """(the layers of the tree, regenerated from LAYERS and the source; the layers the README's section lists)."""
+    import layers
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    return layers.structure(layers.table(LAYERS, ROOT)), layers.readme_layers(readme)
+
+
+def test_the_readme_lists_the_layers_and_the_modules_of_the_tree() -> None:
+    """README's "Architecture" table: every layer present, lowest first, with exactly its modules and packages."""
+    tree, readme = _layer_tables()
+    assert readme == tree
+    assert len(tree) >= 10 and ("model", ["model.py", "chain.py", "ik_results.py"]) in tree
+
+
+def test_the_layers_picture_is_the_trees(tmp_path: Path) -> None:
+    """docs/layers.png carries the table it was drawn from (its metadata): the same layers and names as the tree.
+
+    The picture is regenerated into tmp_path by the script and both tables compared (the line counts are left
+    out: they change with every edit; `python tools/layers.py` redraws the committed one).
+    """
+    import layers
+
+    rows = layers.table(LAYERS, ROOT)
+    layers.draw(rows, tmp_path / "layers.png")
+    fresh = layers.structure(layers.picture_table(tmp_path / "layers.png"))
+    committed = layers.structure(layers.picture_table(REPO / "docs" / "layers.png"))
+    assert fresh == layers.structure(rows)
+    assert committed == fresh, "docs/layers.png is out of date: run python tools/layers.py"
+
+
+def test_the_readme_check_fails_on_a_new_package_without_its_line(tmp_path: Path) -> None:
+    """A package added to a layer (and to the tree) but not to the README is a difference; one in no layer, refused."""
+    import layers
+
+    tree, readme = _layer_tables()
+    files = {f"{name}/__init__.py" if name.endswith("/") else name: "" for _, names in tree for name in names}
+    root = _plant(tmp_path, {**files, "newpkg/a.py": "X = 1\n"})
+    plus = tuple((*layer, "newpkg") if layer[0] == "viz" else layer for layer in LAYERS)
+    grown = layers.structure(layers.table(plus, root))
+    listed = {name for _, names in readme for name in names}
+    assert grown != readme and [name for _, names in grown for name in names if name not in listed] == ["newpkg/"]
+    with pytest.raises(ValueError, match="newpkg"):
+        layers.table(LAYERS, root)
+    section = "# x\n\n## Architecture\n\n| layer | names | what |\n|---|---|---|\n| 1 a | `m.py`, `p/` | the `w` |\n"
+    assert layers.readme_layers(section) == [("a", ["m.py", "p/"])]

@@ -194,11 +194,12 @@ def test_the_cli_plot_honours_units_and_shows_torque(monkeypatch: pytest.MonkeyP
     """``traj --arch --torque --payload 1 --deg --mm --plot``: the figure has the torque column, axes in deg and
     mm, the law in the title; ``traj --plot`` of a joint move too (the issue: --deg was ignored, torque shown
     nowhere)."""
+    import scara_pin.files as files
     import scara_pin.viz.plots as plots
     from scara_pin.cli import main
 
     figures, written = [], []
-    monkeypatch.setattr(plots, "save_figure", lambda fig, path, **kw: written.append((fig, path)))
+    monkeypatch.setattr(files, "save_figure", lambda fig, path, **kw: written.append((fig, path)))
     real = plots.plot_trajectory
 
     def spy(*args, **kwargs):  # type: ignore[no-untyped-def]

@@ -120,7 +120,7 @@ class ErrorParameter:
         return _UNITS[self.kind]
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class Origin:
     """A URDF joint whose ``<origin>`` carries errors: a moving joint of the chain, or the tool's fixed joint.
 
@@ -149,6 +149,13 @@ class Origin:
     basis: np.ndarray
     axis: np.ndarray
     prismatic: bool
+
+    @classmethod
+    def read(cls, el: ET.Element, placement: pin.SE3, **fields: object) -> Origin:
+        """The origin of the URDF joint ``el`` whose Pinocchio placement is ``placement``; ``fields``: the others."""
+        xyz, rpy = read_triple(el.find("origin"), "xyz"), read_triple(el.find("origin"), "rpy")
+        R0 = pin.rpy.rpyToMatrix(*rpy)
+        return cls(xyz=xyz, rpy=rpy, R0=R0, pre=placement * pin.SE3(R0, xyz).inverse(), **fields)  # type: ignore[arg-type]
 
     def placement(self, dp: np.ndarray, w: np.ndarray) -> pin.SE3:
         """The origin with errors: ``(R0 exp(B w), xyz + dp)``."""
@@ -212,7 +219,7 @@ def _skew_rows(v: np.ndarray) -> np.ndarray:
     return out
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class ChainModel:
     """The candidate errors of a robot's chain, its predictions and their analytic Jacobian.
 
@@ -280,24 +287,20 @@ class ChainModel:
         origins: list[Origin] = []
         for j in chain:
             el = urdf_joints[model.names[j]]
-            xyz, rpy = read_triple(el.find("origin"), "xyz"), read_triple(el.find("origin"), "rpy")
-            R0 = pin.rpy.rpyToMatrix(*rpy)
             axis_el = el.find("axis")
             axis = read_triple(axis_el, "xyz") if axis_el is not None else np.array([1.0, 0.0, 0.0])
             axis = axis / np.linalg.norm(axis)
             prismatic = el.get("type") == "prismatic"
-            basis = np.eye(3) if prismatic else rotation_basis(axis)[0]
-            pre = model.jointPlacements[j] * pin.SE3(R0, xyz).inverse()
-            origins.append(Origin(model.names[j], model.names[j], j, -1, pre, xyz, R0, rpy, basis, axis, prismatic))
+            origins.append(Origin.read(el, model.jointPlacements[j], name=model.names[j], label=model.names[j], joint=j,
+                                       frame=-1, basis=np.eye(3) if prismatic else rotation_basis(axis)[0], axis=axis,
+                                       prismatic=prismatic))  # fmt: skip
         notes: list[str] = []
         children = {(c.get("link") if (c := el.find("child")) is not None else None): el for el in urdf_joints.values()}
         tool_el = children.get(robot.tool_frame)
         if tool_el is not None and tool_el.get("type") == "fixed":
-            xyz, rpy = read_triple(tool_el.find("origin"), "xyz"), read_triple(tool_el.find("origin"), "rpy")
-            R0 = pin.rpy.rpyToMatrix(*rpy)
-            pre = model.frames[robot.tool_id].placement * pin.SE3(R0, xyz).inverse()
-            origins.append(Origin(tool_el.get("name", ""), robot.tool_frame, tool_joint, int(robot.tool_id), pre, xyz,
-                                  R0, rpy, np.eye(3), np.zeros(3), False))  # fmt: skip
+            origins.append(Origin.read(tool_el, model.frames[robot.tool_id].placement, name=tool_el.get("name", ""),
+                                       label=robot.tool_frame, joint=tool_joint, frame=int(robot.tool_id),
+                                       basis=np.eye(3), axis=np.zeros(3), prismatic=False))  # fmt: skip
         elif Group.TOOL in groups:
             notes.append(f"the tool frame {robot.tool_frame!r} is the child of a moving joint, with no fixed joint to "
                          "carry a tool offset: the tool group is left out (the target is that joint's frame origin)")
@@ -306,7 +309,8 @@ class ChainModel:
         scaled = tuple((k, int(model.joints[o.joint].idx_q)) for k, o in enumerate(origins) if o.prismatic)
         pin.framesForwardKinematics(model, robot.data, pin.neutral(model))
         bMo = robot.data.oMf[robot.base_id].inverse()
-        return cls(robot, frame, yaw, groups, tuple(origins), params, tuple(notes), slots, bMo, scaled)
+        return cls(robot=robot, frame=frame, yaw=yaw, groups=groups, origins=tuple(origins), parameters=params,
+                   notes=tuple(notes), _slots=slots, _bMo=bMo, _scaled=scaled)
 
     # ------------------------------------------------------------------------------ parameters
     @property

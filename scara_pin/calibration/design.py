@@ -179,23 +179,20 @@ def plan_experiment(
         improved = False
         for slot, c in enumerate(chosen):
             rest = M - A[c].T @ A[c]
-            if criterion is Criterion.DET:
+            if criterion is Criterion.DET:  # the best candidate in c's place, if it does better than c
                 gain = np.where(free, _scores(rest, A), -np.inf)
                 best = int(np.argmax(gain))
-                if gain[best] > _scores(rest, A[c : c + 1])[0] + 1e-12:
-                    chosen[slot], free[best], free[c] = best, False, True
-                    M = rest + A[best].T @ A[best]
-                    improved = True
+                better = gain[best] > _scores(rest, A[c : c + 1])[0] + 1e-12
             else:
                 current = _min_sv(M)
                 trials = rng.choice(np.flatnonzero(free), size=min(EXCHANGE_TRIALS, int(free.sum())), replace=False)
                 values = [_min_sv(rest + A[t].T @ A[t]) for t in trials]
-                best_i = int(np.argmax(values))
-                if values[best_i] > current * (1 + 1e-12):
-                    best = int(trials[best_i])
-                    chosen[slot], free[best], free[c] = best, False, True
-                    M = rest + A[best].T @ A[best]
-                    improved = True
+                best = int(trials[int(np.argmax(values))])
+                better = max(values) > current * (1 + 1e-12)
+            if better:
+                chosen[slot], free[best], free[c] = best, False, True
+                M = rest + A[best].T @ A[best]
+                improved = True
         if not improved:
             break
     q = pool[chosen]

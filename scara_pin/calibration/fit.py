@@ -38,6 +38,7 @@ The steps of :func:`calibrate`:
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, field
 
@@ -393,10 +394,8 @@ def _standardised(problem: _Problem, used: np.ndarray, theta: np.ndarray, kept: 
     sign = np.where(used, -1.0, 1.0)[:, None, None]
     M = np.eye(k)[None] + sign * H
     for i in range(n):
-        try:
+        with contextlib.suppress(np.linalg.LinAlgError):  # a row the fit meets exactly whatever its value: NaN
             out[i] = math.sqrt(max(float(w[i] @ np.linalg.solve(M[i], w[i])), 0.0)) / sigma
-        except np.linalg.LinAlgError:  # a row the fit meets exactly whatever its value (no redundancy)
-            pass
     return out
 
 

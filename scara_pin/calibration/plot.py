@@ -32,17 +32,13 @@ def plot_residuals(
     Returns:
         the matplotlib Figure (on its own Agg canvas: no pyplot, the caller's figures are untouched).
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    from ..files import save_figure
+    from ..files import new_figure, save_figure
 
     k, Ln = units.scale("length"), units.name("length")
     before = np.linalg.norm(result.residuals_before[:, :3], axis=1) * k
     after = np.linalg.norm(result.residuals_after[:, :3], axis=1) * k
     rows = np.array(result.measurements.lines, dtype=float)  # as messages name the rows: line (or row) numbers
-    fig = Figure(figsize=(9, 4.5), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(9, 4.5)
     ax = fig.add_subplot()
     ax.bar(rows - 0.2, before, width=0.4, color="0.6", label=f"nominal (rms {result.before.rms * k:.3g} {Ln})")
     ax.bar(rows + 0.2, after, width=0.4, color="tab:blue", label=f"calibrated (rms {result.after.rms * k:.3g} {Ln})")

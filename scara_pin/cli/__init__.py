@@ -93,9 +93,6 @@ class _Ignored:
     def add_argument_group(self, *args: Any, **kwargs: Any) -> _Ignored:  # noqa: D102
         return self
 
-    def add_mutually_exclusive_group(self, *args: Any, **kwargs: Any) -> _Ignored:  # noqa: D102
-        return self
-
     def set_defaults(self, **kwargs: Any) -> None:  # noqa: D102
         return None
 

@@ -65,7 +65,6 @@ def _cell_report(args: argparse.Namespace) -> Any:
     robot = load_urdf(args.file, tool=args.tool, base=args.base, package_path=args.package_path or (),
                       lock=parse_locks(args.lock))  # fmt: skip
     cell = cell_from_args(args)
-    configurations: list[tuple[str, Any]] = []
     taught: list[tuple[str, Any]] = []
     home = ("home (q = 0)", np.zeros(robot.dof))
     if args.points is not None:
@@ -76,5 +75,4 @@ def _cell_report(args: argparse.Namespace) -> Any:
                 home = ("home (point home of the points file)", point.q)
             else:
                 taught.append((point.name, point.q))
-    configurations = [home, *taught]
-    return check_cell(scene(robot, cell), configurations, source=args.cell)
+    return check_cell(scene(robot, cell), [home, *taught], source=args.cell)

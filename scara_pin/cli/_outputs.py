@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 from collections.abc import Sequence
 
@@ -24,10 +25,8 @@ def input_files(args: argparse.Namespace) -> dict[str, list[str]]:
              if isinstance(value := getattr(args, name, None), str) and value not in ("", "-")}  # fmt: skip
     robot = getattr(args, "robot", None)
     if "--urdf" not in found and "--dh" not in found and (robot is None or len(robot) <= MAX_NAME):
-        try:
+        with contextlib.suppress(UnknownRobotError, ValueError, OSError):  # refused when the robot is loaded
             found["--robot"] = [str(f) for f in config_files(robot or "default")]
-        except (UnknownRobotError, ValueError, OSError):  # refused when the robot is loaded
-            pass
     return found
 
 

@@ -239,9 +239,7 @@ def _clear_solutions(robot: Robot, cell: Any, qs: list[Any], branches: list[str]
     from ..cell import describe, scene
 
     sc = scene(robot, cell)
-    keep_q: list[Any] = []
-    keep_b: list[str] = []
-    keep_t: list[Any] = []
+    keep: list[int] = []
     refused: list[dict[str, Any]] = []
     for i, (q, b) in enumerate(zip(qs, branches)):
         closest = sc.distances(q).closest
@@ -249,12 +247,9 @@ def _clear_solutions(robot: Robot, cell: Any, qs: list[Any], branches: list[str]
             refused.append({"q": np.asarray(q, dtype=float).tolist(), "branch": b, "status": "COLLISION",
                             "pair": [closest.pair.a, closest.pair.b], "distance": closest.distance,
                             "reason": describe(closest, sc.margin)})  # fmt: skip
-            continue
-        keep_q.append(q)
-        keep_b.append(b)
-        if turns:
-            keep_t.append(turns[i])
-    return keep_q, keep_b, keep_t, refused
+        else:
+            keep.append(i)
+    return [qs[i] for i in keep], [branches[i] for i in keep], [turns[i] for i in keep] if turns else [], refused
 
 
 def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:

@@ -98,19 +98,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
         if args.strict:
             raise InfeasibleError(message)
         log.warning(message)
-    outputs: dict[str, str] = {}
-    if args.out:
-        traj.save(args.out, rate=args.rate)
-        outputs["trajectory"] = str(args.out)
-    if args.setpoints:
-        _write_setpoints(args, planned, traj, units)
-        outputs["setpoints"] = args.setpoints
-    if args.plot:
-        from ..viz.plots import plot_trajectory
-
-        plot_trajectory(traj, args.plot, robot=planned, units=units.display, law=method, torque=args.torque,
-                        tool_speed=tool_speed)  # fmt: skip
-        outputs["plot"] = args.plot
+    outputs = _write_outputs(args, planned, traj, units, method, tool_speed)
     summary = {
         "robot": planned.name,
         "method": method,
@@ -193,13 +181,9 @@ def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Uni
     write_text_atomic(Path(args.setpoints), sp.csv_text())
 
 
-def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any,
-                tool_speed: float | None, cell: Any = None) -> int:
-    """``traj --arch``: write and print the arch move (the jump, or the straight-leg arch with ``--path lines``)."""
-    from ..motion.plan import Method
-
-    traj = move.trajectory
-    jump = method is Method.JUMP
+def _write_outputs(args: argparse.Namespace, robot: Any, traj: Any, units: Units, law: str,
+                   tool_speed: float | None) -> dict[str, str]:  # fmt: skip
+    """``--out``, ``--setpoints``, ``--plot`` (the planned ``robot`` carries the payload): what was written, by kind."""
     outputs: dict[str, str] = {}
     if args.out:
         traj.save(args.out, rate=args.rate)
@@ -207,13 +191,24 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
     if args.setpoints:
         _write_setpoints(args, robot, traj, units)
         outputs["setpoints"] = args.setpoints
-    if args.plot:  # the robot carries the payload: the torques are the loaded arm's
+    if args.plot:
         from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=method.value, torque=args.torque,
+        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=law, torque=args.torque,
                         tool_speed=tool_speed)  # fmt: skip
         outputs["plot"] = args.plot
-    faster = None if jump else _jump_time(robot, move, args, units)
+    return outputs
+
+
+def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, method: Any,
+                tool_speed: float | None, cell: Any = None) -> int:
+    """``traj --arch``: write and print the arch move (the jump, or the straight-leg arch with ``--path lines``)."""
+    from ..motion.plan import Method
+
+    traj = move.trajectory
+    jump = method is Method.JUMP
+    outputs = _write_outputs(args, robot, traj, units, method.value, tool_speed)
+    faster = None if jump else _jump_time(robot, move, args, units, tool_speed)
     if args.json:
         summary = {"robot": robot.name, "method": method.value, "path": "jump" if jump else "lines",
                    "duration": traj.duration, "q_from": traj.q_start.tolist(), "q_to": traj.q_end.tolist(),
@@ -255,7 +250,8 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
     return 0
 
 
-def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) -> float | None:
+def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units, tool_speed: float | None
+               ) -> float | None:  # fmt: skip
     """The jump's duration between the same configurations and limits, or None if it cannot be planned."""
     from ..errors import ScaraError
     from ..motion.jump import STANDARD_RISE, jump_move
@@ -263,7 +259,6 @@ def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units) ->
     q0, q1 = move.trajectory.q_start, move.trajectory.q_end
     rise = STANDARD_RISE if args.rise is None else number("--rise", args.rise) / units.length
     ceiling = None if args.max_height is None else number("--max-height", args.max_height) / units.length
-    tool_speed = None if args.tool_speed is None else args.tool_speed / units.length
     try:
         return jump_move(robot, robot.tool_pose(q0), robot.tool_pose(q1), rise=rise, max_height=ceiling,
                          payload=move.payload, torque=args.torque, tool_speed=tool_speed, start=q0, end=q1,

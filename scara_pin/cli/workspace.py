@@ -57,16 +57,10 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     if args.plot:
         ray = None if hit is None else (start[:2], direction[:2])
         plot_workspace(ws, args.plot, ray=ray, units=units.display, robot_name=robot.name)
+    if args.json and hit is not None:
+        return _print_json(args, robot, ray={"start": start, "direction": direction, **hit.to_dict()})
     if args.json:
-        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}}
-        if hit is not None:
-            out["ray"] = {"start": start, "direction": direction, **hit.to_dict()}
-        else:
-            out["workspace"] = ws.to_dict()
-        if args.plot:
-            out["plot"] = args.plot
-        print(json.dumps(out))
-        return 0
+        return _print_json(args, robot, workspace=ws.to_dict())
     n = units.length_name
     if hit is not None:
         print(f"robot     {robot.name}: ray from {units.fmt(start, 'length')} [{n}] along "
@@ -102,6 +96,15 @@ def cmd_workspace(args: argparse.Namespace) -> int:
     return 0
 
 
+def _print_json(args: argparse.Namespace, robot: Robot, **fields: Any) -> int:
+    """``--json``: one object, the robot, the units (SI), ``fields`` and the picture written (``--plot``)."""
+    out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}, **fields}
+    if args.plot:
+        out["plot"] = args.plot
+    print(json.dumps(out))
+    return 0
+
+
 def _free_workspace(args: argparse.Namespace, robot: Robot, units: Units, cell: Any) -> int:
     """``workspace --cell FILE --height Z``: the plan-view region reachable without collision at that height."""
     from ..workspace.free import free_region, plot_free_region
@@ -118,11 +121,7 @@ def _free_workspace(args: argparse.Namespace, robot: Robot, units: Units, cell: 
     if args.plot:
         plot_free_region(region, args.plot, units=units.display, robot_name=robot.name)
     if args.json:
-        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"}, **region.to_dict()}
-        if args.plot:
-            out["plot"] = args.plot
-        print(json.dumps(out))
-        return 0
+        return _print_json(args, robot, **region.to_dict())
     n = units.length_name
     h = region.resolution
     print(f"robot     {robot.name}: reachable without collision at z = {units.num(z, 'length')} {n} in {cell.origin}")
@@ -148,12 +147,7 @@ def _palletizer_workspace(args: argparse.Namespace, robot: Robot, units: Units) 
     if args.plot:
         plot_envelope(env, args.plot, units=units.display, robot_name=robot.name, tool_frame=robot.tool_frame)
     if args.json:
-        out: dict[str, Any] = {"robot": robot.name, "units": {"length": "m", "angle": "rad"},
-                               "envelope": env.to_dict()}  # fmt: skip
-        if args.plot:
-            out["plot"] = args.plot
-        print(json.dumps(out))
-        return 0
+        return _print_json(args, robot, envelope=env.to_dict())
     name = units.length_name
     print(f"robot     {robot.name}: reach envelope of {robot.tool_frame} in the arm plane (r from the waist axis, z)")
     print(f"area      {units.num(env.area, 'area')} {name}^2")

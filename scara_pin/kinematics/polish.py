@@ -286,17 +286,12 @@ def polish_batch(
     branch sign).
     """
     for i in range(len(batch.status)):
-        if batch.status[i] != 0:
-            q, status, sign = solve_row(i)
-            batch.q[i] = np.nan if q is None else q
-            batch.status[i], batch.branch[i] = status, sign
-            continue
-        label = "right" if batch.branch[i] > 0 else "left"
-        seed = IKSolution(batch.q[i].copy(), label, False, ())
-        out = _polish_one(robot, geo, seed, tasks[i])
-        if isinstance(out, IKSolution):
-            batch.q[i] = out.q
-            continue
+        if batch.status[i] == 0:
+            seed = IKSolution(batch.q[i].copy(), "right" if batch.branch[i] > 0 else "left", False, ())
+            out = _polish_one(robot, geo, seed, tasks[i])
+            if isinstance(out, IKSolution):
+                batch.q[i] = out.q
+                continue
         q, status, sign = solve_row(i)
         batch.q[i] = np.nan if q is None else q
         batch.status[i], batch.branch[i] = status, sign

@@ -189,12 +189,12 @@ def _joints(
     """
     ra, rb, rc, _, s_a, s_b, s_c, _, _, _, _, _, _, _, _, _, b1, db = geo._k
     lo, hi, turn = geo.lower, geo.upper, geo._turn
+    s, arm, b2 = geo.signs, geo.arm, geo.beta2
+    wob = arm.wobble(gamma)
     # elbow
     vb = s_b * (gamma - db)
     tb = turn[rb](vb, ref[rb])
     if tb is None:
-        s, arm, b2 = geo.signs, geo.arm, geo.beta2
-        wob = arm.wobble(gamma)
         edge = turn_edge(vb, lo[rb], hi[rb], wob)
         if edge is not None:
             theta1, miss = arm.with_elbow(wx, wy, geo.elbow_angle(edge))
@@ -205,8 +205,6 @@ def _joints(
     va = s_a * (theta1 - b1)
     ta = turn[ra](va, ref[ra])
     if ta is None:
-        s, arm, b2 = geo.signs, geo.arm, geo.beta2
-        wob = arm.wobble(gamma)
         edge = turn_edge(va, lo[ra], hi[ra], wob)
         if edge is not None:
             g, miss = arm.with_link1(wx, wy, s[ra] * edge + b1)
@@ -218,8 +216,6 @@ def _joints(
     vc = s_c * (alpha - s_a * ta[0] - s_b * tb[0])
     tc = turn[rc](vc, ref[rc])
     if tc is None:
-        s, arm, b2 = geo.signs, geo.arm, geo.beta2
-        wob = arm.wobble(gamma)
         edge = turn_edge(vc, lo[rc], hi[rc], 2.0 * wob)
         if edge is not None:  # the wrist on its limit fixes link 2's heading
             sigma = alpha - s[rc] * edge + b2

@@ -31,7 +31,7 @@ Q_TOL = 1e-9
 """[rad, m] largest joint difference for two configurations to count as the same."""
 
 
-@dataclass
+@dataclass(kw_only=True)
 class ValidationReport:
     """Counts, worst errors and timings of :func:`validate_ik`.
 
@@ -104,7 +104,7 @@ def validate_ik(
     kin = robot.kinematics
     rng = np.random.default_rng(seed)
     lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
-    report = ValidationReport(robot.name, samples, seed)
+    report = ValidationReport(robot=robot.name, samples=samples, seed=seed)
     t_closed = t_numeric = 0.0
 
     def fail(text: str) -> None:

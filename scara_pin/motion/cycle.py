@@ -61,7 +61,7 @@ from .jump import (
     jump_move,
     lower_bound,
 )
-from .paths import CartesianSegment, GeometricPath, PathError, cartesian_path, follow_curve
+from .paths import CartesianSegment, GeometricPath, PathError, SegmentedPath, cartesian_path, follow_curve
 from .payload import Payload, PayloadLike, as_payload, with_payload
 from .timing import TimingOptions, limits_in_force, parameterize
 from .trajectory import Motion, Trajectory
@@ -163,7 +163,7 @@ class BlendSegment(CartesianSegment):
 
 
 @dataclass(frozen=True, eq=False)
-class ArchPath(GeometricPath):
+class ArchPath(SegmentedPath, GeometricPath):
     """Tool segments (lines and blends) joined into one path q(s), s in [0, 1]; C2 in s across knots.
 
     Segment k covers ``[bounds[k], bounds[k + 1]]`` with ``bounds`` proportional to the segments' lengths
@@ -186,16 +186,6 @@ class ArchPath(GeometricPath):
     def branch(self) -> str:
         """The elbow branch of every configuration on the path."""
         return self.segments[0].branch
-
-    @property
-    def q_start(self) -> np.ndarray:
-        """The configuration at the start."""
-        return self.segments[0].q_ref[0].copy()
-
-    @property
-    def q_end(self) -> np.ndarray:
-        """The configuration at the end."""
-        return self.segments[-1].q_ref[-1].copy()
 
     def evaluate(self, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:  # noqa: D102
         s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
@@ -221,33 +211,6 @@ class ArchPath(GeometricPath):
             if sel.any():
                 out[sel] = seg.poses((s[sel] - self.bounds[k]) / (self.bounds[k + 1] - self.bounds[k]))
         return out
-
-
-@dataclass(frozen=True, eq=False)
-class _Arch:
-    """The geometry of an arch: corner points, blend sizes, yaw rate."""
-
-    a: np.ndarray
-    b: np.ndarray
-    top: float
-    u: np.ndarray
-    D: float
-    b1: float
-    b2: float
-    yaw_rate: float
-
-
-def _arch_geometry(pose_from: np.ndarray, pose_to: np.ndarray, rise: float, blend: float) -> _Arch:
-    d = pose_to[:2] - pose_from[:2]
-    D = float(np.hypot(*d))
-    if D < 1e-6:
-        raise InvalidInputError(f"the two poses are {D:.3g} m apart horizontally: an arch needs a horizontal move "
-                                "(use a straight line, traj --linear, for a vertical one)")  # fmt: skip
-    top = max(float(pose_from[2]), float(pose_to[2])) + rise
-    u = np.array([d[0] / D, d[1] / D, 0.0])
-    b1 = min(blend, top - float(pose_from[2]), D / 2.0)
-    b2 = min(blend, top - float(pose_to[2]), D / 2.0)
-    return _Arch(pose_from, pose_to, top, u, D, b1, b2, float(pose_to[3] - pose_from[3]) / D)
 
 
 def arch_path(
@@ -286,23 +249,32 @@ def arch_path(
     A, B = as_vector("pose_from", pose_from), as_vector("pose_to", pose_to)
     rise = _nonneg("rise", rise, strict=True)
     blend = math.inf if blend is None else _nonneg("blend", blend)
-    g = _arch_geometry(A, B, rise, blend)
-    corners = [A, np.array([*A[:2], g.top, A[3]]), np.array([*B[:2], g.top, B[3]]), B]
+    d = B[:2] - A[:2]
+    D = float(np.hypot(*d))
+    if D < 1e-6:
+        raise InvalidInputError(f"the two poses are {D:.3g} m apart horizontally: an arch needs a horizontal move "
+                                "(use a straight line, traj --linear, for a vertical one)")  # fmt: skip
+    top = max(float(A[2]), float(B[2])) + rise  # the corner points, the blend sizes, the yaw per metre
+    u = np.array([d[0] / D, d[1] / D, 0.0])
+    b1 = min(blend, top - float(A[2]), D / 2.0)
+    b2 = min(blend, top - float(B[2]), D / 2.0)
+    yaw_rate = float(B[3] - A[3]) / D
+    corners = [A, np.array([*A[:2], top, A[3]]), np.array([*B[:2], top, B[3]]), B]
     lines = cartesian_path(robot, corners, start=start, end=end, branch=branch)
     if blend == 0.0:
         return lines
     z = np.array([0.0, 0.0, 1.0])
-    c1, c2 = np.array([*A[:2], g.top]), np.array([*B[:2], g.top])
-    y1, y2 = float(A[3]) + g.yaw_rate * g.b1, float(B[3]) - g.yaw_rate * g.b2
+    c1, c2 = np.array([*A[:2], top]), np.array([*B[:2], top])
+    y1, y2 = float(A[3]) + yaw_rate * b1, float(B[3]) - yaw_rate * b2
     pieces: list[tuple[str, Any]] = []
-    if g.top - A[2] - g.b1 > 1e-12:
-        pieces.append(("lift", (A, np.array([*A[:2], g.top - g.b1, A[3]]))))
-    pieces.append(("blend up", (c1, z, g.u, g.b1, float(A[3]))))
-    if g.D - g.b1 - g.b2 > 1e-12:
-        pieces.append(("traverse", (np.array([*(c1 + g.b1 * g.u), y1]), np.array([*(c2 - g.b2 * g.u), y2]))))
-    pieces.append(("blend down", (c2, g.u, -z, g.b2, y2)))
-    if g.top - B[2] - g.b2 > 1e-12:
-        pieces.append(("descend", (np.array([*B[:2], g.top - g.b2, B[3]]), B)))
+    if top - A[2] - b1 > 1e-12:
+        pieces.append(("lift", (A, np.array([*A[:2], top - b1, A[3]]))))
+    pieces.append(("blend up", (c1, z, u, b1, float(A[3]))))
+    if D - b1 - b2 > 1e-12:
+        pieces.append(("traverse", (np.array([*(c1 + b1 * u), y1]), np.array([*(c2 - b2 * u), y2]))))
+    pieces.append(("blend down", (c2, u, -z, b2, y2)))
+    if top - B[2] - b2 > 1e-12:
+        pieces.append(("descend", (np.array([*B[:2], top - b2, B[3]]), B)))
     segments: list[CartesianSegment] = []
     lengths: list[float] = []
     q = lines.q_start
@@ -311,15 +283,15 @@ def arch_path(
             corner, e_in, e_out, b, yaw0 = data
 
             def curve(s: np.ndarray, c: Any = data) -> np.ndarray:
-                return BlendSegment.curve(c[0], c[1], c[2], c[3], g.u, c[4], g.yaw_rate, s)
+                return BlendSegment.curve(c[0], c[1], c[2], c[3], u, c[4], yaw_rate, s)
 
             m = max(1, math.ceil(2.0 * b / _STEP))
             _, q_pts, s_ref, q_ref = follow_curve(robot, lines.branch, curve, q, m, k,
-                                                  extent=(2.0 * b, abs(g.yaw_rate) * b))  # fmt: skip
+                                                  extent=(2.0 * b, abs(yaw_rate) * b))  # fmt: skip
             p0, p1 = curve(np.array([0.0, 1.0]))
             seg: CartesianSegment = BlendSegment(robot, lines.branch, p0, p1, s_ref, q_ref, corner=corner,
-                                                 e_in=e_in, e_out=e_out, b=b, horizontal=g.u,
-                                                 yaw_rate=g.yaw_rate)  # fmt: skip
+                                                 e_in=e_in, e_out=e_out, b=b, horizontal=u,
+                                                 yaw_rate=yaw_rate)  # fmt: skip
             lengths.append(2.0 * b)
         else:
             a, bb = data
@@ -395,7 +367,7 @@ class CyclePath(enum.Enum):
     LINES = "lines"
 
 
-@dataclass(frozen=True, eq=False, repr=False)
+@dataclass(frozen=True, eq=False, repr=False, kw_only=True)
 class CycleResult(Summarized):
     """The standard cycle: out and back, with its placement (``repr``: ``scara-pin cycle``'s text, in SI).
 
@@ -557,18 +529,6 @@ def _leg_names(path: Any) -> tuple[tuple[str, ...], np.ndarray]:
     return ("lift", "traverse", "descend"), np.array([0.0, 1.0])
 
 
-def _law_time(law: Any, s_target: float) -> float:
-    """The time at which a monotonic law reaches s (bisection)."""
-    lo, hi = 0.0, float(law.duration)
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        if float(law.evaluate(np.array([mid]))[0][0]) < s_target:
-            lo = mid
-        else:
-            hi = mid
-    return hi
-
-
 def _legs(
     robot: RobotModel, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
 ) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
@@ -581,7 +541,7 @@ def _legs(
         names, bounds = _leg_names(path)
         if isinstance(path, ArchPath):
             m = motions[mi]
-            cuts = [0.0] + [_law_time(m.law, float(b)) for b in bounds[1:-1]] + [m.duration]
+            cuts = [0.0, *m.law.times_at(bounds[1:-1], 80).tolist(), m.duration]
             spans += [(names[k], move, t0 + cuts[k], t0 + cuts[k + 1]) for k in range(len(names))]
             t0 += m.duration
             mi += 1
@@ -783,9 +743,10 @@ def standard_cycle(
         pts = [np.array([*(a[:2] + f * (b[:2] - a[:2])), a[2], a[3]]) for f in np.linspace(0.0, 1.0, 41)]
         wmin = min(robot.manipulability(robot.ik_nearest(p, q0)) for p in pts)
     check = verify(robot, move.trajectory, limits=limits, jerk=jerk, torque=torque, payload=payload)
-    return CycleResult(move, a, b, span, rise, used, why, float(wmin), path,
-                       clearance_radius if path is CyclePath.JUMP else None, max_height, bound, robot.name,
-                       check, torque)  # fmt: skip
+    return CycleResult(move=move, start=a, end=b, span=span, rise=rise, blend=used, placement=why,
+                       min_manipulability=float(wmin), path=path, max_height=max_height, lower_bound=bound,
+                       clearance_radius=clearance_radius if path is CyclePath.JUMP else None, robot_name=robot.name,
+                       verification=check, torque=torque)  # fmt: skip
 
 
 def _lines_bound(

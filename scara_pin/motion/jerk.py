@@ -409,7 +409,7 @@ class _Grid:
         if len(nodes) and nodes[-1] > n - 1:
             raise TimingError("JerkNLP", f"the path has {len(knots)} knots: too many for {n} intervals (more "
                               "intervals needed)", segment=segment)  # fmt: skip
-        t[nodes] = _law_times(law, knots)
+        t[nodes] = law.times_at(knots)
         s[nodes] = knots
         if not (np.diff(t) > 0).all():
             raise TimingError("JerkNLP", f"the path's knots are too close in time for {n} intervals (more "
@@ -421,16 +421,6 @@ class _Grid:
             raise TimingError("JerkNLP", "the initial law does not advance along the path", segment=segment)
         x0 = np.concatenate([np.diff(t) / (Tr / n), sd * Tr, sdd * Tr**2, c * Tr**3, np.full(n, 0.5)])
         return cls(s, m, nodes, x0)
-
-
-def _law_times(law: TimeLaw, s_target: np.ndarray) -> np.ndarray:
-    """The times a monotonic law reaches ``s_target`` (bisection, all at once)."""
-    lo, hi = np.zeros(len(s_target)), np.full(len(s_target), float(law.duration))
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        below = law.evaluate(mid)[0] < s_target
-        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
-    return hi
 
 
 class _Solver:

@@ -46,7 +46,7 @@ SINGULAR_EDGE_GAP = 1e-6
 """[m] in a cell, the contact is looked for up to this short of a singular edge (the line cannot end on it)."""
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class JogResult:
     """A planned jog.
 
@@ -179,7 +179,8 @@ def jog_to_edge(
     if contact is not None:  # the pair at the end, as the end configuration has it
         assert sc is not None  # noqa: S101
         contact = sc.distances(traj.q_end).of(contact.pair)
-    return JogResult(traj, hit, pose0, end, travel, ratio, contact, 0.0 if sc is None else sc.margin)
+    return JogResult(trajectory=traj, hit=hit, start_pose=pose0, end_pose=end, distance=travel, ratio=ratio,
+                     contact=contact, margin=0.0 if sc is None else sc.margin)  # fmt: skip
 
 
 def _contact(robot: RobotModel, sc: Any, q0: np.ndarray, pose0: np.ndarray, u: np.ndarray, reach: float

@@ -238,14 +238,15 @@ class PoseAnswer:
     message: str = ""
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class JogMove:
     """The result of one jog step.
 
     Attributes:
         q: the joint values after it [rad, m] (the start when it did not move).
         outcome: how it ended.
-        status: ``"OK"``, ``"STOPPED"``, ``"AT_EDGE"``, or the code of the refusal (an IK status name).
+        status: ``"OK"``, ``"STOPPED"``, ``"AT_EDGE"`` (the outcome's value: the default), or the code of the
+            refusal (an IK status name).
         reason: what stopped or refused it (None for a whole step).
         travelled: how far it moved along the motion [m or rad] (>= 0).
         requested: the step asked for [m or rad] (> 0).
@@ -255,12 +256,16 @@ class JogMove:
 
     q: np.ndarray
     outcome: JogOutcome
-    status: str
-    reason: StopReason | None
+    status: str = ""
+    reason: StopReason | None = None
     travelled: float
     requested: float
-    solver: Solver
+    solver: Solver = Solver.NONE
     contact: PairDistance | None = None
+
+    def __post_init__(self) -> None:
+        if not self.status:
+            object.__setattr__(self, "status", self.outcome.value)
 
     @property
     def moved(self) -> bool:
@@ -360,11 +365,11 @@ def _before_contact(robot: RobotModel, scene: Scene, q0: np.ndarray, motion: Jog
     if not travelled > CONTACT_ROOM:
         reason = StopReason(StopKind.OBSTACLE, f"at the margin: {c.distance:.6g} m from {pair}, and this way "
                             "comes closer", c.pair.b)  # fmt: skip
-        return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, reason, 0.0, move.requested, Solver.NONE,
-                       scene.distances(q0).of(c.pair))  # fmt: skip
+        return JogMove(q=q0, outcome=JogOutcome.AT_EDGE, reason=reason, travelled=0.0, requested=move.requested,
+                       contact=scene.distances(q0).of(c.pair))  # fmt: skip
     reason = StopReason(StopKind.OBSTACLE, f"stopped {c.distance:.6g} m from {pair}", c.pair.b)
-    return JogMove(found.q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, travelled, move.requested,
-                   move.solver, c)  # fmt: skip
+    return JogMove(q=found.q, outcome=JogOutcome.STOPPED, reason=reason, travelled=travelled, requested=move.requested,
+                   solver=move.solver, contact=c)  # fmt: skip
 
 
 def _move_paths(robot: RobotModel, q0: np.ndarray, motion: JogMotion, move: JogMove) -> list[tuple[JointPath, float]]:
@@ -458,20 +463,18 @@ def _joint_step(robot: RobotModel, q0: np.ndarray, j: int, sign: int, length: fl
         raise InvalidInputError(f"joint index {j} must be in [0, {robot.dof - 1}] (J1..J{robot.dof})")
     q = q0.copy()
     q[j] = q0[j] + sign * length
-    if robot.continuous[j]:
-        return JogMove(q, JogOutcome.OK, "OK", None, length, length, Solver.NONE)
     name = robot.joint_names[j]
     side, bound = ("upper", robot.limits.upper[j]) if sign > 0 else ("lower", robot.limits.lower[j])
-    if (q[j] <= bound) if sign > 0 else (q[j] >= bound):
-        return JogMove(q, JogOutcome.OK, "OK", None, length, length, Solver.NONE)
+    if robot.continuous[j] or ((q[j] <= bound) if sign > 0 else (q[j] >= bound)):
+        return JogMove(q=q, outcome=JogOutcome.OK, travelled=length, requested=length)
     unit = "rad" if robot.joint_kinds[j] == "angle" else "m"
     room = (bound - q0[j]) * sign
     if not room > 0:
         reason = StopReason(StopKind.JOINT_LIMIT, f"{name} is at its {side} limit {bound:.9g} {unit}", f"{name}_{side}")
-        return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, reason, 0.0, length, Solver.NONE)
+        return JogMove(q=q0, outcome=JogOutcome.AT_EDGE, reason=reason, travelled=0.0, requested=length)
     q[j] = bound
     reason = StopReason(StopKind.JOINT_LIMIT, f"stopped at {name}'s {side} limit {bound:.9g} {unit}", f"{name}_{side}")
-    return JogMove(q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, float(room), length, Solver.NONE)
+    return JogMove(q=q, outcome=JogOutcome.STOPPED, reason=reason, travelled=float(room), requested=length)
 
 
 def direction(robot: RobotModel, q: np.ndarray, motion: JogMotion) -> np.ndarray:
@@ -509,7 +512,7 @@ def _cartesian_step(robot: RobotModel, q0: np.ndarray, motion: JogMotion, length
         if hit is not None and hit.distance < length:
             if hit.distance <= _EDGE:
                 reason = StopReason(StopKind.WORKSPACE, f"on the edge: {hit.description}", hit.limit.value)
-                return JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, reason, 0.0, length, Solver.NONE)
+                return JogMove(q=q0, outcome=JogOutcome.AT_EDGE, reason=reason, travelled=0.0, requested=length)
             end = hit.distance
         else:
             hit = None
@@ -530,11 +533,12 @@ def _cartesian_step(robot: RobotModel, q0: np.ndarray, motion: JogMotion, length
         last_s, last_q, solver = s, answer.q, answer.solver
     else:
         if hit is None:
-            return JogMove(last_q, JogOutcome.OK, "OK", None, length, length, solver)
+            return JogMove(q=last_q, outcome=JogOutcome.OK, travelled=length, requested=length, solver=solver)
         here = _at_limits(robot, last_q)  # which joints the robot has at a limit there (the edge may have two names)
         message = f"stopped on the edge: {hit.description}" + (f" (here {', '.join(here)})" if here else "")
         reason = StopReason(StopKind.WORKSPACE, message, hit.limit.value)
-        return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, end, length, solver)
+        return JogMove(q=last_q, outcome=JogOutcome.STOPPED, reason=reason, travelled=end, requested=length,
+                       solver=solver)  # fmt: skip
     # the first refused sample: bisect between the last reachable one and it
     lo, hi, refusal = last_s, s, answer
     while hi - lo > BISECT_TOL:
@@ -546,11 +550,12 @@ def _cartesian_step(robot: RobotModel, q0: np.ndarray, motion: JogMotion, length
             lo, last_q, solver = mid, answer.q, answer.solver
     if lo == 0.0:
         reason = StopReason(StopKind.IK, refusal.message, refusal.status)
-        return JogMove(q0, JogOutcome.AT_EDGE, refusal.status, reason, 0.0, length, refusal.solver)
+        return JogMove(q=q0, outcome=JogOutcome.AT_EDGE, status=refusal.status, reason=reason, travelled=0.0,
+                       requested=length, solver=refusal.solver)  # fmt: skip
     words = refusal.status.lower().replace("_", " ")  # OUT_OF_REACH: out of reach (the code stays in limit)
     reason = StopReason(StopKind.IK, f"stopped where the IK stops; just beyond: {words}: {refusal.message}",
                         refusal.status)  # fmt: skip
-    return JogMove(last_q, JogOutcome.STOPPED, JogOutcome.STOPPED.value, reason, lo, length, solver)
+    return JogMove(q=last_q, outcome=JogOutcome.STOPPED, reason=reason, travelled=lo, requested=length, solver=solver)
 
 
 def _at_limits(robot: RobotModel, q: np.ndarray) -> list[str]:
@@ -656,7 +661,7 @@ def hold_advance(
         return best
     lo, hi = 0.0, move.travelled / ratio
     singular = StopReason(StopKind.SINGULAR, "too close to a singularity to move at the jog's speed", "singular")
-    good = JogMove(q0, JogOutcome.AT_EDGE, JogOutcome.AT_EDGE.value, singular, 0.0, length, Solver.NONE)
+    good = JogMove(q=q0, outcome=JogOutcome.AT_EDGE, reason=singular, travelled=0.0, requested=length)
     for _ in range(20):  # to a millionth of the step
         mid = 0.5 * (lo + hi)
         trial = jog_step(robot, q0, motion, mid, ws=ws)

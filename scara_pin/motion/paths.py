@@ -44,6 +44,7 @@ __all__ = [
     "JointLine",
     "JointSpline",
     "PathError",
+    "SegmentedPath",
     "cartesian_path",
     "joint_path",
     "joint_pose",
@@ -494,8 +495,24 @@ class CartesianSegment(GeometricPath):
         return (q, dq, ddq)
 
 
+class SegmentedPath:
+    """A path made of ``segments`` (each a :class:`CartesianSegment`): its configurations at both ends."""
+
+    segments: tuple[CartesianSegment, ...]
+
+    @property
+    def q_start(self) -> np.ndarray:
+        """The configuration at the start."""
+        return self.segments[0].q_ref[0].copy()
+
+    @property
+    def q_end(self) -> np.ndarray:
+        """The configuration at the end."""
+        return self.segments[-1].q_ref[-1].copy()
+
+
 @dataclass(frozen=True, eq=False)
-class CartesianPath:
+class CartesianPath(SegmentedPath):
     """Straight tool lines through poses (via points), one :class:`CartesianSegment` per pair, one branch.
 
     Attributes:
@@ -511,16 +528,6 @@ class CartesianPath:
     branch: str
     segments: tuple[CartesianSegment, ...]
     checkpoints: tuple[tuple[np.ndarray, np.ndarray], ...]
-
-    @property
-    def q_start(self) -> np.ndarray:
-        """The configuration at the start."""
-        return self.segments[0].q_ref[0].copy()
-
-    @property
-    def q_end(self) -> np.ndarray:
-        """The configuration at the end."""
-        return self.segments[-1].q_ref[-1].copy()
 
 
 def joint_pose(robot: RobotModel, q: ArrayLike) -> np.ndarray:

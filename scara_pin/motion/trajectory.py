@@ -125,6 +125,16 @@ class TimeLaw(abc.ABC):
         """
         return None
 
+    def times_at(self, s_target: ArrayLike, iterations: int = 60) -> np.ndarray:
+        """The times the law reaches the path parameters ``s_target`` (it is monotonic): bisection, all at once."""
+        s_target = np.asarray(s_target, dtype=float)
+        lo, hi = np.zeros(len(s_target)), np.full(len(s_target), float(self.duration))
+        for _ in range(iterations):
+            mid = 0.5 * (lo + hi)
+            below = self.evaluate(mid)[0] < s_target
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+        return hi
+
 
 @dataclass(frozen=True)
 class _ScaledLaw(TimeLaw):

@@ -5,7 +5,8 @@ joint torque when asked), each with its own unit and its own limits, beside the 
 view) and the tool speed. The shared helpers give every figure the same conventions:
 
 - :func:`new_figure`: object-oriented matplotlib (a Figure on the Agg canvas: no pyplot, no global state,
-  the caller's backend left alone), so a notebook shows the returned Figure and a script saves it;
+  the caller's backend left alone), so a notebook shows the returned Figure and a script saves it (it and
+  :func:`finish` live in :mod:`scara_pin.files`, below the workspace's and the calibration's pictures);
 - :func:`quantity_label`: a quantity and its unit, ``"joint1 velocity [deg/s]"``, in the units chosen
   (:class:`scara_pin.units.DisplayUnits`, the ``--deg``/``--mm`` of the command line);
 - :func:`draw_limits`: a joint's limits as dashed lines tagged ``gid="limit"``, or a note when a limit lies
@@ -28,7 +29,7 @@ import numpy as np
 
 from ..description import JointLimits
 from ..errors import ParameterError
-from ..files import save_figure
+from ..files import finish, new_figure
 from ..motion.trajectory import Trajectory
 from ..units import SI, DisplayUnits, decimals_for, format_number
 
@@ -61,28 +62,6 @@ _SHOW_LIMIT = 2.5
 """A limit is drawn inside a panel when within this factor of the largest plotted magnitude; else noted."""
 _DEFAULT_KINDS = ("angle", "angle", "length", "angle")
 _QUANTITIES = ("position", "velocity", "acceleration")
-
-
-def new_figure(width: float, height: float) -> Figure:
-    """A matplotlib Figure on its own Agg canvas (no pyplot: the caller's backend and figures are untouched).
-
-    Args:
-        width: figure width [inch].
-        height: figure height [inch].
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(width, height), layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def finish(fig: Figure, path: str | os.PathLike[str] | None, dpi: int = 120, **kwargs: Any) -> Figure:
-    """Write ``fig`` to ``path`` when one is given (atomically; PNG, SVG or PDF by the ending), and return it."""
-    if path is not None:
-        save_figure(fig, path, dpi=dpi, **kwargs)
-    return fig
 
 
 def rate_unit(unit: str, order: int) -> str:

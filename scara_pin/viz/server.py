@@ -8,6 +8,7 @@ watches its stdin (a pipe from the parent, at end of file once the parent is gon
 from __future__ import annotations
 
 import collections
+import contextlib
 import logging
 import os
 import queue
@@ -120,10 +121,8 @@ class MeshcatServer:
         proc = self.proc
         if proc.poll() is None:
             if proc.stdin is not None:
-                try:
+                with contextlib.suppress(OSError):
                     proc.stdin.close()
-                except OSError:
-                    pass
             try:
                 proc.wait(timeout=2.0)
             except subprocess.TimeoutExpired:

@@ -113,7 +113,7 @@ _AXES = {"x": JogAxis.X, "y": JogAxis.Y, "z": JogAxis.Z, "yaw": JogAxis.YAW}
 _FRAMES = {f.value: f for f in JogFrame}
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class TeachReply:
     """The answer to one request: the session's q after it, and whether it moved.
 
@@ -290,8 +290,9 @@ class TeachSession:
                      "angle": motion is not None and motion.is_angle(self.robot), "contact": move.contact}
         elif self._hold is not None:  # a running hold: how far so far
             extra = {"travelled": self._hold.travelled, "angle": self._hold.angle}
-        return TeachReply(q, self.robot.tool_pose(q), branch_of(self.robot, q), moved, status, message, solver,
-                          holding=self.holding, points=self._points if points else None, **extra)  # fmt: skip
+        return TeachReply(q=q, pose=self.robot.tool_pose(q), branch=branch_of(self.robot, q), moved=moved,
+                          status=status, message=message, solver=solver, holding=self.holding,
+                          points=self._points if points else None, **extra)  # fmt: skip
 
     def state(self) -> TeachReply:
         """The current state and the points (moved is False); after a hold ended, how it ended."""

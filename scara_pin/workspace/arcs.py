@@ -220,7 +220,7 @@ class Role(enum.Enum):
     FOLDED = "folded"  # gamma = pi
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Candidate(Generic[L]):
     """An arc that may carry boundary: center + radius e(a) for a from ``start`` by ``sweep`` (<= 2 pi).
 
@@ -297,7 +297,8 @@ def candidates(box: ArmBox, labels: Mapping[Role, tuple[L, int]]) -> list[Candid
             start = second.start if second.full or not box.relative else t + second.lo
             if second.sweep > 0.0:
                 c = (ox + l1 * math.cos(t), oy + l1 * math.sin(t))
-                out.append(Candidate(c, l2, start, second.sweep, Family.LINK1, t, *labels[role]))
+                out.append(Candidate(center=c, radius=l2, start=start, sweep=second.sweep, family=Family.LINK1,
+                                     value=t, label=labels[role][0], rank=labels[role][1]))  # fmt: skip
     if not second.full and first.sweep > 0.0:  # the second joint at a limit, theta1 sweeping
         for v, role in ((second.lo, Role.SECOND_LO), (second.hi, Role.SECOND_HI)):
             if box.relative:  # radius r(gamma) about the shoulder
@@ -306,10 +307,12 @@ def candidates(box: ArmBox, labels: Mapping[Role, tuple[L, int]]) -> list[Candid
                     continue
                 start = first.start + (0.0 if first.full else arm.lean(v))
                 g = abs(math.remainder(v, _TWO_PI))
-                out.append(Candidate(box.origin, R, start, first.sweep, Family.ELBOW, g, *labels[role]))
+                out.append(Candidate(center=box.origin, radius=R, start=start, sweep=first.sweep, family=Family.ELBOW,
+                                     value=g, label=labels[role][0], rank=labels[role][1]))  # fmt: skip
             else:  # radius l1 about the end of link 2 laid from the shoulder
                 c = (ox + l2 * math.cos(v), oy + l2 * math.sin(v))
-                out.append(Candidate(c, l1, first.start, first.sweep, Family.LINK2, v, *labels[role]))
+                out.append(Candidate(center=c, radius=l1, start=first.start, sweep=first.sweep, family=Family.LINK2,
+                                     value=v, label=labels[role][0], rank=labels[role][1]))  # fmt: skip
     # the singular circles, at angle theta1 + lean(g): lean = 0 stretched, 0 or pi folded
     for g, R, lean, role in ((0.0, arm.l12, 0.0, Role.STRETCHED),
                              (math.pi, arm.d12, 0.0 if l1 > l2 else math.pi, Role.FOLDED)):  # fmt: skip
@@ -317,7 +320,8 @@ def candidates(box: ArmBox, labels: Mapping[Role, tuple[L, int]]) -> list[Candid
             continue
         for a, b in box.theta1_where(g):
             if b > a:
-                out.append(Candidate(box.origin, R, a + lean, b - a, Family.ELBOW, g, *labels[role]))
+                out.append(Candidate(center=box.origin, radius=R, start=a + lean, sweep=b - a, family=Family.ELBOW,
+                                     value=g, label=labels[role][0], rank=labels[role][1]))  # fmt: skip
     return out
 
 

@@ -51,7 +51,7 @@ DEFAULT_POINTS = 200
 """Grid points across the workspace's width when no resolution is given."""
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, kw_only=True)
 class FreeRegion:
     """Where the tool reaches without collision at one height (module docstring).
 
@@ -177,7 +177,8 @@ def free_region(
             rows = todo[ok]
             if len(rows):
                 free[rows[clear_mask(sc, res.q[ok])]] = True
-    return FreeRegion(ws, cell, z, h, x, y, reachable.reshape(n, n), free.reshape(n, n), yaws, yaw_free)
+    return FreeRegion(workspace=ws, cell=cell, z=z, resolution=h, x=x, y=y, reachable=reachable.reshape(n, n),
+                      free=free.reshape(n, n), yaws=yaws, yaw_free=yaw_free)  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ picture
@@ -244,6 +245,7 @@ def plot_free_region(
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
+    from ..files import finish
     from .scara import plot_workspace
 
     fig = plot_workspace(region.workspace, None, units=units, robot_name=robot_name, arm=False)
@@ -275,8 +277,4 @@ def plot_free_region(
                  f"free {region.area * A:.6g} {name}$^2$ of {region.workspace.area * A:.6g}, grid {h * L:.3g} {name}, "
                  f"margin {region.cell.margin * 1e3:g} mm", fontsize=9)  # fmt: skip
     ax.autoscale_view()
-    if path is not None:
-        from ..files import save_figure
-
-        save_figure(fig, path, dpi=dpi, bbox_inches="tight")
-    return fig
+    return finish(fig, path, dpi, bbox_inches="tight")

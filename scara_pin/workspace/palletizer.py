@@ -206,13 +206,12 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str | os.PathLike[str] | None = N
     Returns:
         the matplotlib Figure.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
     from matplotlib.ticker import FuncFormatter
 
+    from ..files import finish, new_figure  # object-oriented: no pyplot; written atomically
+
     geo = env.geometry
-    fig = Figure(figsize=(7, 7))  # object-oriented: no pyplot, no global backend or figure state
-    FigureCanvasAgg(fig)
+    fig = new_figure(7, 7, layout=None)
     ax = fig.add_subplot()
     seen: set[str] = set()
     for a in env.arcs:
@@ -242,8 +241,4 @@ def plot_envelope(env: ArmPlaneEnvelope, path: str | os.PathLike[str] | None = N
     ax.set_title(f"{robot_name or 'palletizer'}: {tool_frame} in the arm plane, area {area} {n}$^2$")
     ax.legend(loc="best", fontsize=8)
     ax.grid(True, alpha=0.3)
-    if path is not None:
-        from ..files import save_figure  # written atomically: never through a symlink, never a device
-
-        save_figure(fig, path, dpi=dpi, bbox_inches="tight")
-    return fig
+    return finish(fig, path, dpi, bbox_inches="tight")

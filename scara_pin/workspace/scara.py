@@ -237,7 +237,7 @@ def _box(geo: ScaraGeometry) -> ArmBox:
     return ArmBox(geo.a1, geo.arm, t, g, relative=True)
 
 
-@dataclass(frozen=True, repr=False)
+@dataclass(frozen=True, repr=False, kw_only=True)
 class Workspace(Summarized):
     """The exact plan-view region of the wrist axis point (or, with ``yaw``, the tool point at that yaw).
 
@@ -572,7 +572,8 @@ def workspace(
     r_min, r_max = (box.arm.d12, box.arm.l12) if box.second.full else geo.radius_range()
     ip = geo.prismatic
     zs = sorted((geo.z0 + geo.signs[ip] * geo.lower[ip], geo.z0 + geo.signs[ip] * geo.upper[ip]))
-    return Workspace(geo, tuple(arcs), region.loops, region.area, r_min, r_max, (zs[0], zs[1]), offset, yaw, note)
+    return Workspace(geometry=geo, arcs=tuple(arcs), loops=region.loops, area=region.area, r_min=r_min, r_max=r_max,
+                     z_range=(zs[0], zs[1]), offset=offset, yaw=yaw, note=note)  # fmt: skip
 
 
 TOOL_ON_AXIS = 1e-9
@@ -655,16 +656,15 @@ def plot_workspace(
     Returns:
         the matplotlib Figure.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path as MPath
     from matplotlib.ticker import FuncFormatter
 
+    from ..files import finish, new_figure  # object-oriented: no pyplot; written atomically
+
     colours = {Limit.OUTER: "tab:blue", Limit.FOLDED: "tab:purple", Limit.J1_LOWER: "tab:red",
                Limit.J1_UPPER: "tab:orange", Limit.J2_LOWER: "tab:green", Limit.J2_UPPER: "tab:olive"}  # fmt: skip
-    fig = Figure(figsize=(7, 7))  # object-oriented: no pyplot, no global backend or figure state
-    FigureCanvasAgg(fig)
+    fig = new_figure(7, 7, layout=None)
     ax = fig.add_subplot()
     L, n = units.scale("length"), units.name("length")
     verts: list[np.ndarray] = []
@@ -722,8 +722,4 @@ def plot_workspace(
     radii = ", ".join(format_number(r * L, decimals_for(L, 1e-6)) for r in (ws.r_min, ws.r_max))
     ax.set_title(f"{head}reachable region of the wrist axis\narea {area} {n}$^2$, r in [{radii}] {n}")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=7, framealpha=0.8)
-    if path is not None:
-        from ..files import save_figure  # written atomically: never through a symlink, never a device
-
-        save_figure(fig, path, dpi=dpi, bbox_inches="tight")
-    return fig
+    return finish(fig, path, dpi, bbox_inches="tight")
