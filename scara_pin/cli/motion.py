@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..files import write_text_atomic
+from ..files import outputs_together, write_text_atomic
 from ..units import format_number, format_vector
 from ._joints import joint_arg, needs_wrist, read_pose
 from ._numbers import jerk_limits, number, number_type
@@ -98,18 +98,19 @@ def cmd_traj(args: argparse.Namespace) -> int:
             raise InfeasibleError(message)
         log.warning(message)
     outputs: dict[str, str] = {}
-    if args.out:
-        traj.save(args.out, rate=args.rate)
-        outputs["trajectory"] = str(args.out)
-    if args.setpoints:
-        _write_setpoints(args, planned, traj, units)
-        outputs["setpoints"] = args.setpoints
-    if args.plot:
-        from ..viz.plots import plot_trajectory
+    with outputs_together():  # all of them, or none
+        if args.out:
+            traj.save(args.out, rate=args.rate)
+            outputs["trajectory"] = str(args.out)
+        if args.setpoints:
+            _write_setpoints(args, planned, traj, units)
+            outputs["setpoints"] = args.setpoints
+        if args.plot:
+            from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=planned, units=units.display, law=method, torque=args.torque,
-                        tool_speed=tool_speed)  # fmt: skip
-        outputs["plot"] = args.plot
+            plot_trajectory(traj, args.plot, robot=planned, units=units.display, law=method, torque=args.torque,
+                            tool_speed=tool_speed)  # fmt: skip
+            outputs["plot"] = args.plot
     summary = {
         "robot": planned.name,
         "method": method,
@@ -200,18 +201,19 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
     traj = move.trajectory
     jump = method is Method.JUMP
     outputs: dict[str, str] = {}
-    if args.out:
-        traj.save(args.out, rate=args.rate)
-        outputs["trajectory"] = str(args.out)
-    if args.setpoints:
-        _write_setpoints(args, robot, traj, units)
-        outputs["setpoints"] = args.setpoints
-    if args.plot:  # the robot carries the payload: the torques are the loaded arm's
-        from ..viz.plots import plot_trajectory
+    with outputs_together():  # all of them, or none
+        if args.out:
+            traj.save(args.out, rate=args.rate)
+            outputs["trajectory"] = str(args.out)
+        if args.setpoints:
+            _write_setpoints(args, robot, traj, units)
+            outputs["setpoints"] = args.setpoints
+        if args.plot:  # the robot carries the payload: the torques are the loaded arm's
+            from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=method.value, torque=args.torque,
-                        tool_speed=tool_speed)  # fmt: skip
-        outputs["plot"] = args.plot
+            plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=method.value, torque=args.torque,
+                            tool_speed=tool_speed)  # fmt: skip
+            outputs["plot"] = args.plot
     faster = None if jump else _jump_time(robot, move, args, units)
     if args.json:
         summary = {"robot": robot.name, "method": method.value, "path": "jump" if jump else "lines",
