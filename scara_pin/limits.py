@@ -64,6 +64,8 @@ __all__ = [
     "MAX_WALK_ENTRIES",
     "MAX_WORKSPACE_GRID",
     "MAX_XACRO_FILES",
+    "MAX_XACRO_MEMORY",
+    "MAX_XACRO_SECONDS",
     "MAX_YAML_DEPTH",
     "MAX_YAML_NODES",
     "OutputIsInputError",
@@ -162,6 +164,12 @@ MAX_WALK_ENTRIES = 200_000
 MAX_XACRO_FILES = 1_000
 """Files (includes, yaml) read by the expansion of one xacro file; their bytes together are at most
 :data:`MAX_DOCUMENT_BYTES`."""
+MAX_XACRO_SECONDS = 10
+"""Seconds (wall clock) of one xacro expansion, robot or cell: it runs in a child process, killed at the cap (a
+macro calling itself twice 30 deep, ``${(9**9**9) % 7}``; a real description expands in well under a second)."""
+MAX_XACRO_MEMORY = 1024 * 1024 * 1024
+"""Bytes of memory one xacro expansion may take beyond what the process held (its child's address space is capped
+there: an allocation beyond fails)."""
 
 
 def check_count(what: str, n: float, cap: int, hint: str = "") -> int:
@@ -215,7 +223,10 @@ class OutputIsInputError(InvalidInputError):
     def __init__(self, option: str, output: str, what: str, read: str) -> None:
         super().__init__(f"{option} {output} is the {what} {read} that this command reads: it would be replaced; "
                          "write the output elsewhere")  # fmt: skip
-        self.option, self.output, self.read = option, output, read
+        self.option, self.output, self.what, self.read = option, output, what, read
+
+    def __reduce__(self) -> tuple[type, tuple[str, str, str, str]]:
+        return (type(self), (self.option, self.output, self.what, self.read))  # pickled from a child process
 
 
 @dataclass
