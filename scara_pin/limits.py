@@ -43,6 +43,7 @@ __all__ = [
     "MAX_CELL_TRIANGLES",
     "MAX_CHECK_ELEMENTS",
     "MAX_DOCUMENT_BYTES",
+    "MAX_DWELL",
     "MAX_FRAMES",
     "MAX_JOB_BYTES",
     "MAX_JOB_DEPTH",
@@ -115,6 +116,9 @@ MAX_JOB_BYTES = 2 * 1024 * 1024
 """Bytes of one job file (``scara-pin job``): a job is a page of steps; its pallets and loops make it long."""
 MAX_JOB_DEPTH = 4
 """``for`` loops nested in one another in a job (a pallet's layers, rows and columns are one loop)."""
+MAX_DWELL = 3_600
+"""Seconds of one dwell, pick or place of a job (an hour at rest; with :data:`MAX_JOB_STEPS` a job's total stays
+finite: ``dwell: 1e308`` twice made it infinite, and ``--json`` printed ``Infinity``)."""
 MAX_JOB_STEPS = 10_000
 """Moves and dwells one job expands to, its loops unrolled (counted before any is built; each new jump is a
 solve of about 0.1-0.5 s)."""

@@ -301,6 +301,34 @@ def test_a_mesh_cannot_leave_the_cell_files_folder(name: str, tmp_path: Path) ->
     assert load_cell(folder / "cell.yaml").obstacles[0].shape.triangles == 12  # inside it, even absolute: read
 
 
+@pytest.mark.parametrize(("step", "value"), [("dwell", "1e308"), ("dwell", "1e12"), ("pick", "1e308"),
+                                           ("dwell", "3600.5")])  # fmt: skip
+def test_a_dwell_beyond_an_hour_is_refused_with_its_line(step: str, value: str, tmp_path: Path) -> None:
+    """Class 4: ``dwell: 1e308`` twice made the total infinite (``--json``: ``Infinity``); ``dwell: 1e12`` was taken."""
+    from scara_pin.errors import JobFileError
+    from scara_pin.job import Job
+
+    extra = "carry: {shape: box, size: [0.02, 0.02, 0.02]}\n" if step == "pick" else ""
+    job = tray_job(tmp_path, cell=None)
+    text = job.read_text().replace("      - dwell: 0.05\n      - jump: feeder", f"      - {step}: {value}\n"
+                                   f"      - {'place' if step == 'pick' else 'dwell'}: 0.05\n      - jump: feeder", 1)
+    job.write_text(extra + text)
+    with pytest.raises(JobFileError, match=r"job.yaml line 1[34]: (dwell|pick) is [0-9.e+]+ s; it must be "
+                       r">= 0 and at most 3,600 \(seconds at rest"):  # fmt: skip
+        Job.load(job)
+
+
+def test_a_job_at_the_dwell_cap_prints_finite_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``dwell: 3600`` in a loop of two: the total is a number, the JSON strict (no ``Infinity``), no warning."""
+    job = tray_job(tmp_path, cell=None)
+    job.write_text(job.read_text().replace("dwell: 0.05", "dwell: 3600"))
+    assert main(["job", str(job), "--json"]) == 0
+    out = capsys.readouterr()
+    data = json.loads(out.out, parse_constant=lambda name: pytest.fail(f"non-finite {name} in the JSON"))
+    assert 4 * 3600 < data["total"] < 4 * 3600 + 5 and data["parts_per_hour"] > 0
+    assert "warning" not in out.err.lower()
+
+
 # --------------------------------------------------------------------------------------------- 5: all outputs or none
 def test_ctrl_c_while_the_outputs_are_written_leaves_none_of_them(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
