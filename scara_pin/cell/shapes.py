@@ -8,8 +8,8 @@ axis, centred, a sphere ``(radius,)``. A mesh holds its triangles (vertices alre
 Every number is checked here, where the shape is made: finite, sizes > 0 and at most :data:`MAX_SIZE`,
 positions within :data:`MAX_POSITION`, at most :data:`~scara_pin.limits.MAX_CELL_TRIANGLES` triangles.
 Distances are coal's (``coal.Box``, ``coal.Cylinder``, ``coal.Sphere``; a closed convex mesh is its hull, a
-``coal.Convex``, a solid; any other mesh a ``BVHModelOBBRSS`` of its triangles, a surface: see
-:mod:`scara_pin.cell.scene`).
+``coal.Convex``, a solid, whatever its winding or scale sign; an open mesh a ``BVHModelOBBRSS`` of its triangles,
+a surface: see :mod:`scara_pin.cell.scene`, which refuses a closed mesh that is not convex).
 """
 
 from __future__ import annotations
@@ -36,6 +36,9 @@ MIN_SIZE = 1e-6
 MAX_POSITION = 1000.0
 """[m] the largest coordinate of a shape's centre in the robot's base frame."""
 _SIZE_NAMES = {"box": ("x", "y", "z"), "cylinder": ("radius", "length"), "sphere": ("radius",)}
+_CONVEX_TOL = 1e-6
+"""A closed mesh whose volume is within this fraction of its convex hull's is convex (its hull is then the solid
+checked: it holds the mesh, so a distance to it is never larger than to the mesh)."""
 
 
 def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
@@ -154,17 +157,43 @@ class Shape:
 
     @property
     def convex(self) -> bool:
-        """A mesh that is closed and convex (trimesh's test): its distances are taken on its hull, a solid."""
+        """A mesh that is closed and convex: its distances are taken on its hull, a solid (:meth:`closure`)."""
+        return self.kind != "mesh" or self.closure() == (True, True)
+
+    @property
+    def closed(self) -> bool:
+        """A mesh whose triangles enclose a volume (each edge shared by exactly two), or any primitive."""
+        return self.kind != "mesh" or self.closure()[0]
+
+    def closure(self) -> tuple[bool, bool]:
+        """(closed, convex) of a mesh, whatever the order of its triangles' vertices (its winding) and its scale's sign.
+
+        Closed: watertight once shared vertices are merged (trimesh). Convex: closed, and its volume is its convex
+        hull's (the winding made consistent first, so an inverted or mirrored mesh, ``scale: -1``, is the same
+        solid: it was taken for a hollow surface, and a robot inside a closed crate for clear). A primitive is both.
+        """
         if self.kind != "mesh":
-            return True
-        found = self.__dict__.get("_convex")
+            return (True, True)
+        found = self.__dict__.get("_closure")
         if found is None:
+            import warnings
+
             import trimesh
 
-            mesh = trimesh.Trimesh(self.vertices, self.faces, process=True)
-            found = bool(mesh.is_watertight and mesh.is_convex)
-            object.__setattr__(self, "_convex", found)
-        return bool(found)
+            with warnings.catch_warnings(), np.errstate(all="ignore"):  # trimesh divides by a zero volume
+                warnings.simplefilter("ignore")
+                mesh = trimesh.Trimesh(self.vertices, self.faces, process=True)
+                closed = bool(mesh.is_watertight)
+                convex = False
+                if closed:
+                    if not mesh.is_winding_consistent:
+                        trimesh.repair.fix_winding(mesh)
+                    volume = abs(float(mesh.volume))
+                    hull = float(mesh.convex_hull.volume)
+                    convex = bool(volume > 0.0 and volume >= hull * (1.0 - _CONVEX_TOL))
+            found = (closed, convex)
+            object.__setattr__(self, "_closure", found)
+        return found
 
     def corners(self) -> np.ndarray:
         """(k, 3) points whose convex hull holds the shape, in its frame (the box around it; a mesh's vertices)."""
