@@ -263,6 +263,124 @@ def test_triangles_are_counted_from_the_text_before_parsing(kind: str, tmp_path:
     assert file.triangles == len(mesh.faces) == len(parse_mesh(file).faces) == 320
 
 
+# --------------------------------------------------------------------------------------------- 3: unbounded work
+def sleeve_cell(tmp: Path) -> Path:
+    """An open tube (no caps: a surface), 0.1 m in radius and 0.3 m tall, around the default robot's base column
+    (radius 0.08 m, its top at z = 0): ``workspace --cell`` with it ran past 400 s (1.4 s with a post)."""
+    import trimesh
+
+    tube = trimesh.creation.cylinder(radius=0.1, height=0.3, sections=64)
+    tube.update_faces(np.abs(tube.face_normals[:, 2]) < 0.5)
+    tube.remove_unreferenced_vertices()
+    tube.export(tmp / "sleeve.stl")
+    (tmp / "cell.yaml").write_text("obstacles:\n  - {name: sleeve, shape: mesh, file: sleeve.stl, xyz: [0, 0, -0.2]}\n")
+    return tmp / "cell.yaml"
+
+
+def test_the_free_region_in_a_sleeve_asks_coal_little_and_is_what_every_distance_says(tmp_path: Path) -> None:
+    """Class 3: the base - sleeve pair (both fixed) is asked once, and the bounding boxes spare coal's distance to the
+    tube where they are apart; the free points are those of every pair's exact distance (the independent route:
+    each reachable configuration's distances, all of them, from the scene). The whole default grid: benchmarked
+    by the command in the issue's report (it answers in seconds)."""
+    from scara_pin.cell import load_cell, scene
+    from scara_pin.cell.sweep import clear_mask
+    from scara_pin.workspace.free import free_region
+
+    robot = sp_robot()
+    cell = load_cell(sleeve_cell(tmp_path))
+    sc = scene(robot, cell)
+    asked: dict[str, int] = {}
+    exact = sc.distance_array
+
+    def counted(Q: np.ndarray, pairs: object = None) -> np.ndarray:
+        for k in ([] if pairs is None else list(pairs)):  # type: ignore[call-overload]
+            asked[sc.pairs[k].label] = asked.get(sc.pairs[k].label, 0) + len(np.atleast_2d(Q))
+        return exact(Q, pairs)  # type: ignore[arg-type]
+
+    sc.distance_array = counted  # type: ignore[method-assign]
+    region = free_region(robot, cell, -0.1, resolution=0.04)
+    rows = int(region.reachable.sum())
+    assert asked.get("base_link - sleeve", 0) <= 2  # once per clear_mask call (one per branch), not per row
+    assert asked.get("link1 - sleeve", 0) == 0  # link1 is above the sleeve: its box never comes within the margin
+    sc.distance_array = exact  # type: ignore[method-assign]
+    for branch in ("right", "left"):
+        targets = np.column_stack([np.stack(np.meshgrid(region.x, region.y), -1).reshape(-1, 2),
+                                   np.full(region.x.size * region.y.size, -0.1), np.zeros(region.x.size ** 2)])
+        res = robot.ik_batch(targets, branch=branch)
+        Q = res.q[res.ok]
+        brute = exact(Q).min(axis=1) >= cell.margin
+        np.testing.assert_array_equal(clear_mask(sc, Q), brute)
+    assert 0 < region.free.sum() < rows
+
+
+def sp_robot() -> object:
+    import scara_pin as sp
+
+    return sp.load_robot("default")
+
+
+def test_a_carried_part_of_199000_triangles_is_checked_as_its_hull_at_microseconds_a_query(tmp_path: Path) -> None:
+    """Class 3: the issue's 199,000-triangle STL carried: coal's distance to its tree of triangles cost 0.68 s a
+    query near link2 (``traj --linear`` killed at 120 s in the 10 kHz check). The part held is a solid: its hull,
+    which holds it (so no collision is missed), at microseconds a query; the distance to the hull is checked here
+    against the distance to the triangles (never larger, and close for this compact part)."""
+    import coal
+
+    from scara_pin.cell import load_cell, scene
+
+    (tmp_path / "big.stl").write_bytes(big_stl())
+    (tmp_path / "cell.yaml").write_text("carried: {shape: mesh, file: big.stl, xyz: [0, 0, 0.02]}\n")
+    robot = sp_robot()
+    cell = load_cell(tmp_path / "cell.yaml")
+    sc = scene(robot, cell)  # type: ignore[arg-type]
+    carried = next(o for o in sc.geometry_model.geometryObjects if o.name == "carried")
+    assert isinstance(carried.geometry, coal.ConvexBase)
+    q = robot.ik_nearest([0.26, -0.15, -0.0875, 0.0], np.zeros(4))  # type: ignore[attr-defined]
+    Q = np.tile(q, (50, 1)) + np.linspace(0.0, 0.2, 50)[:, None] * np.array([1.0, 0.0, 0.0, 0.0])
+    t0 = time.perf_counter()
+    D = sc.distance_array(Q)
+    per_query = (time.perf_counter() - t0) / len(Q)
+    assert per_query < 0.01, per_query  # every pair of a row: it was 0.68 s for the carried part's pair alone
+    k = next(i for i, p in enumerate(sc.pairs) if p.label == "carried - link2 (self)")
+    tree = cell.carried.geometry()  # the triangles themselves
+    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    import pinocchio as pin
+
+    model, data, gm = robot.model, robot.model.createData(), sc.geometry_model  # type: ignore[attr-defined]
+    gd = gm.createData()
+    pin.updateGeometryPlacements(model, data, gm, gd, robot.to_pinocchio_q(Q[0]))  # type: ignore[attr-defined]
+    link2 = gm.geometryObjects[sc.pairs[k].second]
+    true = coal.distance(tree, gd.oMg[sc.pairs[k].first], link2.geometry, gd.oMg[sc.pairs[k].second], request, result)
+    assert D[0, k] <= true + 1e-9 and true - D[0, k] < 0.002
+
+
+def test_a_hull_too_fine_for_coal_is_snapped_and_inflated_and_still_holds_every_point() -> None:
+    """coal keeps 255 neighbours per hull vertex: a ball of 300 x 300 facets (its poles have 300) could not be a
+    hull (an internal error). Snapped to a grid and inflated by the snap: every vertex inside, the distance from
+    outside within the inflation of the ball's."""
+    import coal
+    import trimesh
+
+    from scara_pin.cell.shapes import hull
+
+    ball = trimesh.creation.uv_sphere(radius=0.02, count=[300, 300])
+    convex = hull(np.asarray(ball.vertices))
+    inflation = convex.getSweptSphereRadius()
+    assert 0 < inflation < 0.02 / 50
+    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    probe = coal.Sphere(1e-6)
+    rng = np.random.default_rng(35)
+    for v in np.asarray(ball.vertices)[rng.choice(len(ball.vertices), 50, replace=False)]:
+        result.clear()
+        assert coal.distance(convex, coal.Transform3s(), probe, coal.Transform3s(np.eye(3), v), request, result) <= 0
+    result.clear()
+    far = coal.distance(convex, coal.Transform3s(), probe, coal.Transform3s(np.eye(3), np.array([0.05, 0, 0])),
+                        request, result)  # fmt: skip
+    assert 0.05 - 0.02 - 1e-6 - inflation - 1e-6 <= far <= 0.05 - 0.02 - 1e-6 + 1e-6
+    flat = hull(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]))  # qhull refuses it
+    assert flat.num_points == 8
+
+
 # --------------------------------------------------------------------------------------------- 4: garbage
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
 def test_a_non_finite_vertex_refuses_the_mesh_instead_of_dropping_its_triangles(value: str, tmp_path: Path) -> None:

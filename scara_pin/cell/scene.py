@@ -262,9 +262,8 @@ class Scene:
                 raise InvalidInputError(f"{cell.origin}{f' line {o.line}' if o.line else ''}: obstacle {o.name!r} has "
                                         f"the name of a link of robot {robot.name} ({o.name}): rename the obstacle "
                                         "(in allow: and in messages a name stands for one thing)")  # fmt: skip
-        for what, shape, line in [("the carried part", cell.carried, 0)] + [(f"obstacle {o.name}", o.shape, o.line)
-                                                                            for o in cell.obstacles]:  # fmt: skip
-            if shape is not None and shape.closed and not shape.convex:
+        for what, shape, line in [(f"obstacle {o.name}", o.shape, o.line) for o in cell.obstacles]:
+            if shape.closed and not shape.convex:
                 raise InvalidInputError(f"{cell.origin}{f' line {line}' if line else ''}: {what}: mesh {shape.source} "
                                         "is closed but not convex: a closed mesh is checked as a solid only when it is "
                                         "convex (its hull), an open one as a surface; give it as convex parts, one "
@@ -276,7 +275,7 @@ class Scene:
             frame = robot.model.frames[robot.tool_id]
             carried = gm.addGeometryObject(pin.GeometryObject(CARRIED, int(frame.parentJoint), int(robot.tool_id),
                                                               frame.placement * cell.carried.placement(),
-                                                              cell.carried.geometry()))  # fmt: skip
+                                                              cell.carried.geometry(solid=True)))  # fmt: skip
             names.append(CARRIED)
         for o in cell.obstacles:
             gm.addGeometryObject(pin.GeometryObject(f"obstacle:{o.name}", 0, 0, base * o.shape.placement(),
