@@ -19,20 +19,31 @@ Rules:
 Before any work, a command checks all its outputs together with :func:`check_outputs`: each name as above
 (and a plot's ending), at most one of them on standard output, and no output the same file as one of the
 command's inputs or as another output (after resolving links: a measurements file named as ``--out`` would
-be replaced by the URDF; ``--out X --overlay X`` would keep one of two outputs).
+be replaced by the URDF; ``--out X --overlay X`` would keep one of two outputs). The outputs are then declared
+(:func:`scara_pin.limits.declare_outputs`): a file the command reads later (a mesh of its cell, a xacro
+include) that is one of them is refused when it is opened, and just before the rename each declared output is
+checked once more against every file the command read.
+
+**All outputs or none.** Inside :func:`outputs_together` the renames wait: each output is written to its
+temporary file, and when the block ends they are all moved into place together, with SIGINT and SIGTERM held
+for the few renames (a signal that arrives then is raised after them). An error, Ctrl-C or SIGTERM before the
+end leaves none of them (``--out t.csv --plot t.png --html t.html``: all three, or none).
 """
 
 from __future__ import annotations
 
 import os
+import signal
 import stat
 import sys
 from collections.abc import Callable, Collection, Iterable, Iterator, Mapping
 from contextlib import contextmanager, suppress
+from contextvars import ContextVar
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, Literal
 
 from .errors import InvalidInputError
+from .limits import check_not_read, declared_option
 from .signals import raise_pending
 
 if TYPE_CHECKING:
@@ -47,6 +58,7 @@ __all__ = [
     "figure_format",
     "finish",
     "new_figure",
+    "outputs_together",
     "save_figure",
     "write_atomic_with",
     "write_text_atomic",
@@ -183,17 +195,23 @@ def _fsync(path: Path, flags: int) -> None:
         os.close(fd)
 
 
+_BATCH: ContextVar[list[tuple[Path, Path]] | None] = ContextVar("scara_pin_outputs", default=None)
+"""The outputs of :func:`outputs_together` waiting for their rename: (temporary file, destination)."""
+
+
 @contextmanager
 def atomic_output(path: str | os.PathLike[str], mode: int = 0o666) -> Iterator[Path]:
     """Yield a temporary file's path; on success move it onto ``path`` (``-``: copy it to stdout), else delete it.
 
     Write to the yielded path (``open(tmp, "w")``, ``figure.savefig(tmp, format="png")``...). An error,
     Ctrl-C or SIGTERM (under the command line) leaves the old file or none, never a partial one. The new
-    file's mode is ``mode`` & ~umask (``0o600``: for its owner only).
+    file's mode is ``mode`` & ~umask (``0o600``: for its owner only). Inside :func:`outputs_together` the move
+    waits for the block's end (all the block's outputs together).
 
     Raises:
         InvalidInputError: the folder does not exist or cannot be written, ``path`` is not a regular file
             (see the module docstring), the disk is full...
+        OutputIsInputError: ``path`` is an output of the running command and a file it read.
     """
     path = check_output_path(path)
     to_stdout = str(path) == STDOUT
@@ -204,27 +222,18 @@ def atomic_output(path: str | os.PathLike[str], mode: int = 0o666) -> Iterator[P
     else:
         folder = path.parent if str(path.parent) else Path(".")
     created: list[Path] = []
+    batch = _BATCH.get()
     try:
         tmp = _new_temp(folder, "stdout" if to_stdout else path.name, created, mode)
         yield tmp
         raise_pending()  # a Ctrl-C or SIGTERM that a library swallowed meanwhile: nothing is written
-        if to_stdout:
-            sys.stdout.flush()
-            with tmp.open("rb") as src:
-                out = getattr(sys.stdout, "buffer", None)
-                if out is None:  # a text stream (tests): text outputs only
-                    sys.stdout.write(src.read().decode("utf-8"))
-                else:
-                    import shutil
-
-                    shutil.copyfileobj(src, out)
-            sys.stdout.flush()
+        if not to_stdout:
+            _fsync(tmp, os.O_RDONLY)
+        if batch is not None:  # moved into place with the block's other outputs
+            batch.append((tmp, path))
+            created.remove(tmp)
             return
-        _fsync(tmp, os.O_RDONLY)
-        check_output_path(path)  # again, just before the rename: it may have changed meanwhile
-        os.replace(tmp, path)
-        with suppress(OSError):  # the rename itself, on disk (some systems cannot fsync a folder)
-            _fsync(folder, os.O_RDONLY)
+        _move(tmp, path)
     except BrokenPipeError:  # the reader of stdout went away: the command line handles it
         raise
     except OSError as exc:
@@ -232,6 +241,84 @@ def atomic_output(path: str | os.PathLike[str], mode: int = 0o666) -> Iterator[P
     finally:
         for name in created:  # after the rename: nothing there
             name.unlink(missing_ok=True)
+
+
+def _check_destination(path: Path) -> None:
+    """Just before a rename: still a place for a regular file, and not a file the command read (if an output)."""
+    if str(path) == STDOUT:
+        return
+    check_output_path(path)  # again: it may have changed meanwhile
+    option = declared_option(path)
+    if option is not None:
+        check_not_read(option, path)
+
+
+def _move(tmp: Path, path: Path) -> None:
+    """The temporary file ``tmp`` (written, flushed) onto ``path``, or copied to standard output for ``-``."""
+    _check_destination(path)
+    if str(path) == STDOUT:
+        sys.stdout.flush()
+        with tmp.open("rb") as src:
+            out = getattr(sys.stdout, "buffer", None)
+            if out is None:  # a text stream (tests): text outputs only
+                sys.stdout.write(src.read().decode("utf-8"))
+            else:
+                import shutil
+
+                shutil.copyfileobj(src, out)
+        sys.stdout.flush()
+        tmp.unlink(missing_ok=True)
+        return
+    os.replace(tmp, path)
+    folder = path.parent if str(path.parent) else Path(".")
+    with suppress(OSError):  # the rename itself, on disk (some systems cannot fsync a folder)
+        _fsync(folder, os.O_RDONLY)
+
+
+_HELD = {signal.SIGINT, signal.SIGTERM}
+
+
+@contextmanager
+def outputs_together() -> Iterator[None]:
+    """The outputs written inside the block (by :func:`atomic_output` and its users) appear together at its end.
+
+    Each is written to its temporary file as usual; at the end, after a last look for a signal a library
+    swallowed, every destination is checked again and the files are renamed into place one after the other
+    with SIGINT and SIGTERM held (a signal that arrives meanwhile is raised right after the last rename). An
+    error, Ctrl-C or SIGTERM inside the block (or in the checks) deletes the temporary files: none is written.
+
+    Raises:
+        InvalidInputError: a destination that can no longer be written, or an output that is a file read.
+    """
+    pending: list[tuple[Path, Path]] = []
+    token = _BATCH.set(pending)
+    active = True
+    done = False
+    try:
+        yield
+        _BATCH.reset(token)  # the renames below are this block's own
+        active = False
+        raise_pending()
+        for _, path in pending:
+            _check_destination(path)
+        held = hasattr(signal, "pthread_sigmask")
+        if held:
+            signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+        try:
+            for tmp, path in pending:
+                _move(tmp, path)
+            done = True
+        finally:
+            if held:
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)
+    except OSError as exc:
+        raise InvalidInputError(f"cannot write the outputs: {exc.strerror or exc}") from None
+    finally:
+        if active:
+            _BATCH.reset(token)
+        if not done:
+            for tmp, _ in pending:
+                tmp.unlink(missing_ok=True)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str, mode: int = 0o666) -> Path:

@@ -10,7 +10,12 @@ One place for the caps and the checks, used by the command line and the library 
 - :func:`read_bytes` and :func:`read_text` read a whole file (URDF, yaml, JSON, a mesh, a package's
   ``package.xml``, a xacro include) through :func:`open_regular`, with a byte cap: nothing larger is read;
 - :func:`text_lines` streams a text file line by line, each line at most :data:`MAX_LINE_CHARS`
-  characters, bad UTF-8 and NUL bytes refused with the line number.
+  characters, bad UTF-8 and NUL bytes refused with the line number;
+- while a command runs (:func:`files_recorded`), every file :func:`open_regular` opens is recorded by its
+  identity (device, inode: whatever the route to it, a symbolic link, a hard link, ``..``), and the command's
+  outputs, once declared (:func:`declare_outputs`), are never read: a mesh, an include or a points file that is
+  one of them is refused the moment it is opened (:class:`OutputIsInputError`), and the atomic writer
+  (:mod:`scara_pin.files`) checks them against every file read before it replaces any.
 
 The caps are module constants (documented in docs/cli.md, "Resource limits"); they are generous for a robot cell
 and small enough that one command never needs more than a few GB of memory.
@@ -21,7 +26,10 @@ from __future__ import annotations
 import math
 import os
 import stat
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
@@ -30,10 +38,12 @@ from .errors import InvalidInputError
 __all__ = [
     "MAX_CALIBRATION_ROWS",
     "MAX_CELL_BYTES",
+    "MAX_CELL_MESH_BYTES",
     "MAX_CELL_OBSTACLES",
     "MAX_CELL_TRIANGLES",
     "MAX_CHECK_ELEMENTS",
     "MAX_DOCUMENT_BYTES",
+    "MAX_DWELL",
     "MAX_FRAMES",
     "MAX_JOB_BYTES",
     "MAX_JOB_DEPTH",
@@ -55,12 +65,21 @@ __all__ = [
     "MAX_WALK_ENTRIES",
     "MAX_WORKSPACE_GRID",
     "MAX_XACRO_FILES",
+    "MAX_XACRO_MEMORY",
+    "MAX_XACRO_SECONDS",
     "MAX_YAML_DEPTH",
     "MAX_YAML_NODES",
+    "OutputIsInputError",
     "UnreadableFileError",
     "check_count",
     "check_input_file",
+    "check_not_read",
+    "declare_outputs",
+    "declared_option",
+    "files_read",
+    "files_recorded",
     "open_regular",
+    "record_read",
     "read_bytes",
     "read_text",
     "text_lines",
@@ -97,6 +116,9 @@ MAX_JOB_BYTES = 2 * 1024 * 1024
 """Bytes of one job file (``scara-pin job``): a job is a page of steps; its pallets and loops make it long."""
 MAX_JOB_DEPTH = 4
 """``for`` loops nested in one another in a job (a pallet's layers, rows and columns are one loop)."""
+MAX_DWELL = 3_600
+"""Seconds of one dwell, pick or place of a job (an hour at rest; with :data:`MAX_JOB_STEPS` a job's total stays
+finite: ``dwell: 1e308`` twice made it infinite, and ``--json`` printed ``Infinity``)."""
 MAX_JOB_STEPS = 10_000
 """Moves and dwells one job expands to, its loops unrolled (counted before any is built; each new jump is a
 solve of about 0.1-0.5 s)."""
@@ -115,8 +137,12 @@ MAX_CELL_OBSTACLES = 500
 """Obstacles of one cell, placed boxes of a job included (every one is checked against every link at each of
 the 10 kHz samples of a motion: 500 obstacles and 6 links take about 3 ms a sample)."""
 MAX_CELL_TRIANGLES = 200_000
-"""Mesh triangles of one cell, all its meshes together (coal's bounding-volume tree keeps a distance query
-near a few microseconds up to there)."""
+"""Mesh triangles of one cell, all its meshes together, a file counted once per shape naming it, from its header
+or text BEFORE it is parsed (coal's bounding-volume tree keeps a distance query near a few microseconds up to
+there)."""
+MAX_CELL_MESH_BYTES = 256 * 1024 * 1024
+"""Bytes of the mesh files of one cell, each file once, from their sizes before any is read, then as read
+(decompressed); one file is at most :data:`MAX_MESH_BYTES`."""
 MAX_WORKSPACE_GRID = 250_000
 """Grid points of one collision-free region (``workspace --cell --height``: 500 x 500; each reachable point
 costs up to two IK solutions and their distance checks, about 10 s at the cap)."""
@@ -142,6 +168,12 @@ MAX_WALK_ENTRIES = 200_000
 MAX_XACRO_FILES = 1_000
 """Files (includes, yaml) read by the expansion of one xacro file; their bytes together are at most
 :data:`MAX_DOCUMENT_BYTES`."""
+MAX_XACRO_SECONDS = 10
+"""Seconds (wall clock) of one xacro expansion, robot or cell: it runs in a child process, killed at the cap (a
+macro calling itself twice 30 deep, ``${(9**9**9) % 7}``; a real description expands in well under a second)."""
+MAX_XACRO_MEMORY = 1024 * 1024 * 1024
+"""Bytes of memory one xacro expansion may take beyond what the process held (its child's address space is capped
+there: an allocation beyond fails)."""
 
 
 def check_count(what: str, n: float, cap: int, hint: str = "") -> int:
@@ -180,6 +212,119 @@ class UnreadableFileError(InvalidInputError):
         self.errno = errno
 
 
+# ----------------------------------------------------------------------- what a command reads and writes
+Identity = tuple[int, int]
+"""A file's (device, inode): the same file whatever the name it is reached by."""
+
+
+class OutputIsInputError(InvalidInputError):
+    """An output of the command is a file the command reads (exit code 2): it would be replaced.
+
+    Attributes:
+        option: the output's option (``--out``), output: its name as given, read: the input's name as read.
+    """
+
+    def __init__(self, option: str, output: str, what: str, read: str) -> None:
+        super().__init__(f"{option} {output} is the {what} {read} that this command reads: it would be replaced; "
+                         "write the output elsewhere")  # fmt: skip
+        self.option, self.output, self.what, self.read = option, output, what, read
+
+    def __reduce__(self) -> tuple[type, tuple[str, str, str, str]]:
+        return (type(self), (self.option, self.output, self.what, self.read))  # pickled from a child process
+
+
+@dataclass
+class _Record:
+    """The files one command has read (identity -> (what, name)) and the outputs it declared (identity -> option)."""
+
+    reads: dict[Identity, tuple[str, str]] = field(default_factory=dict)
+    outputs: dict[Identity, tuple[str, str]] = field(default_factory=dict)
+    declared: dict[str, str] = field(default_factory=dict)  # resolved name -> option
+
+
+_RECORD: ContextVar[_Record | None] = ContextVar("scara_pin_files", default=None)
+
+
+@contextmanager
+def files_recorded() -> Iterator[None]:
+    """While a command runs (the command line's ``main``): the files it reads are recorded (module docstring).
+
+    Outside it (a library user's program) nothing is recorded and nothing is refused for it.
+    """
+    token = _RECORD.set(_Record())
+    try:
+        yield
+    finally:
+        _RECORD.reset(token)
+
+
+def _identity(path: str | os.PathLike[str]) -> Identity | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino)
+
+
+def record_read(identity: Identity, name: str, what: str = "file") -> None:
+    """Record that the command read the file ``identity`` (called by :func:`open_regular`; and for reads elsewhere).
+
+    Raises:
+        OutputIsInputError: the file is one of the command's declared outputs.
+    """
+    record = _RECORD.get()
+    if record is None:
+        return
+    record.reads.setdefault(identity, (what, name))
+    if identity in record.outputs:
+        option, output = record.outputs[identity]
+        raise OutputIsInputError(option, output, what, name)
+
+
+def files_read() -> dict[Identity, tuple[str, str]]:
+    """The files the running command has read so far: identity -> (what, name); empty outside a command."""
+    record = _RECORD.get()
+    return {} if record is None else dict(record.reads)
+
+
+def check_not_read(option: str, path: str | os.PathLike[str]) -> None:
+    """Refuse an output ``path`` that names a file the running command has read (any route to it).
+
+    Raises:
+        OutputIsInputError: it does.
+    """
+    record = _RECORD.get()
+    key = None if record is None else _identity(path)
+    if record is not None and key is not None and key in record.reads:
+        what, name = record.reads[key]
+        raise OutputIsInputError(option, str(path), what, name)
+
+
+def declare_outputs(outputs: Mapping[str, str | os.PathLike[str] | None]) -> None:
+    """The running command's outputs (option -> file; None or ``-``: none): a file among them is never read after.
+
+    Raises:
+        OutputIsInputError: one of them is a file the command has read already.
+    """
+    record = _RECORD.get()
+    if record is None:
+        return
+    for option, path in outputs.items():
+        if path is None or str(path) in ("", "-"):
+            continue
+        check_not_read(option, path)
+        record.declared[str(Path(path).resolve())] = option
+        key = _identity(path)
+        if key is not None:
+            record.outputs[key] = (option, str(path))
+
+
+def declared_option(path: str | os.PathLike[str]) -> str | None:
+    """The option under which the running command declared ``path`` as an output (:func:`declare_outputs`), or None."""
+    record = _RECORD.get()
+    return None if record is None else record.declared.get(str(Path(path).resolve()))
+
+
 def open_regular(path: str | os.PathLike[str], what: str = "file") -> IO[bytes]:
     """Open ``path`` for reading (binary) if it is a regular file; never blocks on a FIFO.
 
@@ -188,9 +333,12 @@ def open_regular(path: str | os.PathLike[str], what: str = "file") -> IO[bytes]:
     blocking it, and is refused. The flag is cleared before the handle is returned (reads of a regular
     file never block anyway).
 
+    While a command runs, the file is recorded as read (:func:`record_read`).
+
     Raises:
         UnreadableFileError: missing, unreadable, or not a regular file (a device such as ``/dev/zero``,
             a FIFO, a socket, a folder).
+        OutputIsInputError: the file is one of the running command's outputs.
     """
     path = Path(path)
     try:  # a device is not even opened (opening some has effects: a tape rewinds)
@@ -205,8 +353,10 @@ def open_regular(path: str | os.PathLike[str], what: str = "file") -> IO[bytes]:
     except OSError as exc:
         raise UnreadableFileError(what, path, exc.strerror or str(exc), exc.errno) from None
     try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
             raise UnreadableFileError(what, path, _NOT_REGULAR)
+        record_read((st.st_dev, st.st_ino), str(path), what)
         os.set_blocking(fd, True)
         return os.fdopen(fd, "rb")
     except BaseException:
@@ -232,7 +382,8 @@ def check_input_file(path: str | os.PathLike[str], what: str = "file", limit: in
 def read_bytes(path: str | os.PathLike[str], what: str = "file", limit: int = MAX_DOCUMENT_BYTES) -> bytes:
     """The bytes of a regular file (:func:`open_regular`) of at most ``limit`` bytes; larger files are refused.
 
-    At most ``limit + 1`` bytes are read, whatever the file's size says (it may grow meanwhile).
+    At most ``limit + 1`` bytes are read, whatever the file's size says (it may grow meanwhile); the buffer is the
+    file's size, not the cap's.
 
     Raises:
         InvalidInputError: missing, unreadable, not a regular file, or over ``limit`` bytes.
@@ -242,7 +393,9 @@ def read_bytes(path: str | os.PathLike[str], what: str = "file", limit: int = MA
             size = os.fstat(handle.fileno()).st_size
             if size > limit:
                 raise InvalidInputError(f"{what} {path} is {size:,} bytes, above the cap of {limit:,}; refused")
-            data = handle.read(limit + 1)
+            data = handle.read(size + 1)  # what the file says it holds: no buffer of the cap's size
+            if len(data) > size:  # it grew meanwhile: the rest, up to the cap
+                data += handle.read(limit + 1 - len(data))
         except OSError as exc:
             raise InvalidInputError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
     if len(data) > limit:

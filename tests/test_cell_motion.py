@@ -190,7 +190,8 @@ def test_a_fixed_path_through_an_obstacle_is_refused(tmp_path, capsys):
     code = main(["traj", "--linear", "--cell", str(tmp_path / "cell.yaml"), "--from-pose", *map(str, FROM),
                  "--to-pose", *map(str, TO)])  # fmt: skip
     err = capsys.readouterr().err
-    assert code == 3 and "closer than the margin" in err and "post" in err and "at t = " in err and " mm in base" in err
+    assert code == 3 and "closer than the margin" in err and "post" in err and " mm in base" in err
+    assert "% of the path" in err and "found before any timing" in err  # the path checked before TOPP-RA (issue 37)
 
 
 def test_around_one_obstacle_and_over_a_lower_one(robot):

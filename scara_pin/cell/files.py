@@ -35,7 +35,8 @@ no margin, carried part or allowed pairs: :func:`load_cell` takes them as argume
 
 Every file is sized before it is read (:data:`~scara_pin.limits.MAX_CELL_BYTES`); obstacles and
 triangles are capped (:data:`~scara_pin.limits.MAX_CELL_OBSTACLES`, :data:`~scara_pin.limits.MAX_CELL_TRIANGLES`)
-before any geometry is built; meshes are read by :func:`scara_pin.cell.meshes.load_mesh` (its caps).
+before any geometry is built; meshes are read by :func:`scara_pin.cell.meshes.load_meshes` (each file once, its
+bytes and triangles sized before it is parsed; a mesh cannot leave the cell file's folder).
 """
 
 from __future__ import annotations
@@ -61,6 +62,8 @@ FORMAT = "scara-pin cell 1"
 _TOP_KEYS = ("format", "margin", "obstacles", "carried", "allow")
 _SHAPE_KEYS = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",), "mesh": ("file",)}
 _OPTIONAL = {"box": (), "cylinder": (), "sphere": (), "mesh": ("scale",)}
+_Meshes = dict[Path, Any]
+"""The cell's mesh files, read and parsed once each: resolved path -> :class:`~scara_pin.cell.meshes.MeshGeometry`."""
 
 
 def load_cell(
@@ -109,6 +112,7 @@ class _Reader:
 
     def __init__(self, origin: str) -> None:
         self.origin = origin
+        self.paths: dict[tuple[Path | None, str], Path] = {}  # the mesh files resolved (one lookup per name)
 
     def error(self, line: int | None, message: str) -> InvalidInputError:
         return InvalidInputError(f"{self.origin}{'' if line is None else f' line {line}'}: {message}")
@@ -148,16 +152,18 @@ def parse_cell(text: str, origin: str = "cell", folder: Path | None = None) -> C
         if not isinstance(raw, list):
             raise reader.error(yaml_line(top, "obstacles"), "obstacles must be a list")
         check_count(f"{origin}: obstacles", len(raw), MAX_CELL_OBSTACLES)
+    meshes = _meshes(reader, top, folder)  # every mesh file read once, sized before any is parsed
+    if raw is not None:
         seen: set[str] = set()
         for i in range(len(raw)):
-            o = _obstacle(reader, raw, i, folder)
+            o = _obstacle(reader, raw, i, folder, meshes)
             if o.name in seen:
                 raise reader.error(o.line, f"obstacle name {o.name!r} is used twice")
             seen.add(o.name)
             obstacles.append(o)
     carried = None
     if top.get("carried") is not None:
-        carried = _shape(reader, top, "carried", "the carried part", folder, named=False)
+        carried = _shape(reader, top, "carried", "the carried part", folder, meshes, named=False)
     allow: list[tuple[str, str]] = []
     if top.get("allow") is not None:
         pairs = top["allow"]
@@ -199,7 +205,7 @@ def _name(reader: _Reader, data: Any, key: Any, what: str) -> str:
         raise reader.error(yaml_line(data, key), str(exc)) from None
 
 
-def _obstacle(reader: _Reader, items: list[Any], i: int, folder: Path | None) -> Obstacle:
+def _obstacle(reader: _Reader, items: list[Any], i: int, folder: Path | None, meshes: _Meshes) -> Obstacle:
     from ..description.yaml_units import yaml_line
 
     item = items[i]
@@ -209,10 +215,11 @@ def _obstacle(reader: _Reader, items: list[Any], i: int, folder: Path | None) ->
     if "name" not in item:
         raise reader.error(line, "an obstacle needs a name")
     name = _name(reader, item, "name", "obstacle name")
-    return Obstacle(name, _shape(reader, items, i, f"obstacle {name}", folder, named=True), line or 0)
+    return Obstacle(name, _shape(reader, items, i, f"obstacle {name}", folder, meshes, named=True), line or 0)
 
 
-def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | None, *, named: bool) -> Shape:
+def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | None, meshes: _Meshes, *,
+           named: bool) -> Shape:  # fmt: skip
     from ..description.yaml_units import yaml_line
 
     d = parent[key]
@@ -239,7 +246,7 @@ def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | Non
             size = tuple(_numbers(reader, d, "size", f"{what}: size", 3))
             return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
         if kind == "mesh":
-            return _mesh_shape(reader, d, what, folder, xyz, rpy)
+            return _mesh_shape(reader, d, what, folder, xyz, rpy, meshes)
         size = tuple(_number(reader, d, k, f"{what}: {k}") for k in _SHAPE_KEYS[kind])
         return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
     except InvalidInputError as exc:
@@ -249,30 +256,75 @@ def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | Non
         raise reader.error(line, message) from None
 
 
-def _mesh_shape(reader: _Reader, d: dict[str, Any], what: str, folder: Path | None, xyz: list[float],
-                rpy: list[float]) -> Shape:  # fmt: skip
-    from ..description.mesh_paths import MeshProblem
+def _mesh_path(reader: _Reader, d: dict[str, Any], what: str, folder: Path | None) -> Path:
+    """The file a mesh shape names, resolved (links followed), inside the cell file's folder; else an error.
+
+    A mesh cannot leave the cell's folder: ``../outside.stl``, an absolute path elsewhere, or a link pointing out
+    are refused (as a URDF cell refuses them), naming the line.
+    """
     from ..description.yaml_units import yaml_line
-    from .meshes import load_mesh
 
     file = d["file"]
-    if not isinstance(file, str) or not file or len(file) > 4096:
+    if not isinstance(file, str) or not file or len(file) > 4096 or "\0" in file:
         raise reader.error(yaml_line(d, "file"), f"{what}: file must be a file name")
+    found = reader.paths.get((folder, file))
+    if found is not None:
+        return found
+    root = (folder or Path.cwd()).resolve()
+    path = (root / file).resolve()
+    if path != root and root not in path.parents:
+        raise reader.error(yaml_line(d, "file"), f"{what}: mesh {file!r} is outside the cell file's folder {root}: "
+                           "not read (a mesh cannot leave the cell's folder)")  # fmt: skip
+    reader.paths[(folder, file)] = path
+    return path
+
+
+def _meshes(reader: _Reader, top: dict[Any, Any], folder: Path | None) -> _Meshes:
+    """Every mesh file the obstacles and the carried part name, read once each and sized before any is parsed.
+
+    :func:`~scara_pin.cell.meshes.load_meshes`: the files' bytes, then their triangles counted from their headers
+    times the shapes naming them, against the cell's caps; then each file parsed once. A shape that is not a
+    well-formed mesh is left to the reading of its shape (its own message).
+    """
+    from ..description.yaml_units import yaml_line
+    from .meshes import MeshUse, MeshUseError, load_meshes
+
+    items: list[tuple[Any, Any, str]] = []
+    if isinstance(top.get("obstacles"), list):
+        for i, item in enumerate(top["obstacles"]):
+            name = item.get("name") if isinstance(item, dict) else None
+            items.append((top["obstacles"], i, f"obstacle {name}" if isinstance(name, str) else f"obstacle #{i + 1}"))
+    if top.get("carried") is not None:
+        items.append((top, "carried", "the carried part"))
+    uses: list[MeshUse] = []
+    lines: dict[int, int | None] = {}
+    for parent, key, what in items:
+        d = parent[key]
+        if isinstance(d, dict) and d.get("shape") == "mesh" and "file" in d:
+            uses.append(MeshUse(_mesh_path(reader, d, what, folder), d["file"], what))
+            lines[id(uses[-1])] = yaml_line(d, "file")
+    if not uses:
+        return {}
+    try:
+        return load_meshes(uses, reader.origin)
+    except MeshUseError as exc:
+        raise reader.error(lines[id(exc.use)], f"{exc.use.what}: {exc.problem}") from None
+
+
+def _mesh_shape(reader: _Reader, d: dict[str, Any], what: str, folder: Path | None, xyz: list[float],
+                rpy: list[float], meshes: _Meshes) -> Shape:  # fmt: skip
+    from ..description.yaml_units import yaml_line
+    from .meshes import scaled
+
+    file = d["file"]
     scale = [1.0, 1.0, 1.0]
     if "scale" in d:
         scale = _numbers(reader, d, "scale", f"{what}: scale", 3) if isinstance(d["scale"], list) \
             else [_number(reader, d, "scale", f"{what}: scale")] * 3  # fmt: skip
         if not all(v != 0.0 and abs(v) <= 1e6 for v in scale):
             raise reader.error(yaml_line(d, "scale"), f"{what}: scale must be finite, nonzero numbers")
-    path = Path(file)
-    if not path.is_absolute():
-        path = (folder or Path.cwd()) / path
-    try:
-        geometry = load_mesh(path, file)
-    except MeshProblem as exc:
-        raise reader.error(yaml_line(d, "file"), f"{what}: {exc}") from None
-    return Shape("mesh", (), np.array(xyz), np.array(rpy), geometry.vertices * np.array(scale), geometry.faces,
-                 file, what)  # fmt: skip
+    vertices, faces = scaled(meshes[_mesh_path(reader, d, what, folder)], scale)
+    return Shape("mesh", (), np.array(xyz), np.array(rpy), vertices, faces, file, what)
 
 
 # ---------------------------------------------------------------------------------------------- URDF, xacro
@@ -286,7 +338,7 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     from ..description.packages import PackagePath, read_robot_file
     from ..description.placeholders import placeholder_urdf
     from ..limits import check_input_file
-    from .meshes import load_mesh, mesh_scale
+    from .meshes import MeshUse, MeshUseError, load_meshes, mesh_scale, scaled
 
     check_input_file(path, "cell file", MAX_CELL_BYTES)
     packages: PackagePath = PackagePath(tuple(Path(d) for d in package_dirs), path.parent)
@@ -307,7 +359,7 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     collisions = [(link.get("name", ""), i, c) for link in root.findall("link")
                   for i, c in enumerate(link.findall("collision"))]  # fmt: skip
     check_count(f"{origin}: obstacles (<collision> elements)", len(collisions), MAX_CELL_OBSTACLES)
-    meshes: dict[str, Shape] = {}
+    uses: dict[str, tuple[MeshUse, tuple[float, float, float]]] = {}
     for link, i, c in collisions:
         mesh = c.find("geometry/mesh")
         if mesh is None:
@@ -316,11 +368,17 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
         filename = mesh.get("filename", "")
         try:
             scale = mesh_scale(mesh.get("scale"), filename)
-            geometry = load_mesh(mesh_file(filename, packages), filename)
+            uses[f"{link}_{i}"] = (MeshUse(mesh_file(filename, packages), filename, what), scale)
         except MeshProblem as exc:
             raise InvalidInputError(f"{origin}: {what}: {exc}") from None
-        meshes[f"{link}_{i}"] = Shape("mesh", (), np.zeros(3), np.zeros(3), geometry.vertices * np.array(scale),
-                                      geometry.faces, filename, what)  # fmt: skip
+    try:  # every file read once, sized (bytes, triangles from its header) before any is parsed
+        read = load_meshes([use for use, _ in uses.values()], origin)
+    except MeshUseError as exc:
+        raise InvalidInputError(f"{origin}: {exc.use.what}: {exc.problem}") from None
+    meshes: dict[str, Shape] = {}
+    for key, (use, scale) in uses.items():
+        vertices, faces = scaled(read[use.path], scale)
+        meshes[key] = Shape("mesh", (), np.zeros(3), np.zeros(3), vertices, faces, use.filename, use.what)
     try:
         model = pin.buildModelFromXML(placeholder_urdf(text))
         geom = pin.buildGeomFromUrdfString(model, placeholder_urdf(text), pin.GeometryType.COLLISION)

@@ -46,6 +46,7 @@ import gzip
 import io
 import logging
 import math
+import re
 import xml.etree.ElementTree as ET
 import zipfile
 import zlib
@@ -64,6 +65,7 @@ from ..limits import (
     MAX_PAGE_MESH_BYTES,
     MAX_PAGE_MESH_READ,
     MAX_VISUALS,
+    OutputIsInputError,
     UnreadableFileError,
     check_count,
     read_bytes,
@@ -79,11 +81,18 @@ __all__ = [
     "MAX_MESH_COORDINATE",
     "MeshProblem",
     "SMALL_RATIO",
+    "MeshFile",
     "MeshGeometry",
+    "MeshUse",
+    "MeshUseError",
     "VisualMesh",
     "check_visual_count",
     "collision_meshes",
     "load_mesh",
+    "load_meshes",
+    "parse_mesh",
+    "read_mesh_file",
+    "scaled",
     "resolve_mesh",
     "robot_size",
     "visual_meshes",
@@ -261,8 +270,57 @@ def _no_files() -> Any:
     return NoFiles()
 
 
-def _load(path: Path, filename: str) -> MeshGeometry:
-    """The triangles of a mesh file (rules in the module docstring), or :class:`MeshProblem`."""
+@dataclass(frozen=True, eq=False)
+class MeshFile:
+    """The bytes of one mesh file, read (once) and decompressed, not yet parsed.
+
+    Attributes:
+        path: the file read.
+        filename: how to name it in messages (as the user wrote it).
+        kind: ``"stl"``, ``"dae"`` or ``"obj"``.
+        data: its bytes (a zipped or gzipped COLLADA file: decompressed).
+        unit: [m] the length of one unit of the file (a COLLADA ``<unit>``; 1 otherwise).
+    """
+
+    path: Path
+    filename: str
+    kind: str
+    data: bytes
+    unit: float = 1.0
+
+    @property
+    def triangles(self) -> int:
+        """Triangles the file holds at least, counted from its header or its text WITHOUT parsing it.
+
+        Exact for a binary STL (its header's count, which the file's size confirms) and an ASCII one (its
+        ``endfacet`` lines); for an OBJ its face lines (a polygon is at least one triangle); for a COLLADA file the
+        ``count`` of its ``<triangles>``, ``<polylist>``, ``<polygons>``, ``<tristrips>`` and ``<trifans>``.
+        """
+        data = self.data
+        if self.kind == "stl":
+            if len(data) >= 84:
+                n = int.from_bytes(data[80:84], "little")
+                if len(data) == 84 + 50 * n:
+                    return n
+            return data.count(b"endfacet") + data.count(b"ENDFACET")
+        if self.kind == "obj":
+            return sum(data.count(prefix) for prefix in (b"\nf ", b"\nf\t")) + data.startswith((b"f ", b"f\t"))
+        return sum(int(n) for n in _COLLADA_COUNTS.findall(data))
+
+
+_COLLADA_COUNTS = re.compile(
+    rb"<(?:\w+:)?(?:triangles|polylist|polygons|tristrips|trifans)\b[^>]*?\scount\s*=\s*[\"'](\d{1,12})[\"']"
+)
+"""A COLLADA primitive's ``count`` attribute (its number of triangles, polygons or strips)."""
+
+
+def read_mesh_file(path: Path, filename: str) -> MeshFile:
+    """The bytes of a mesh file under this module's rules (regular file, bounded after decompression), not parsed.
+
+    Raises:
+        MeshProblem: an unknown ending, a missing, unreadable or oversized file, a broken archive.
+        OutputIsInputError: the file is an output of the running command.
+    """
     kind = _FORMATS.get(path.suffix.lower())
     if kind is None:
         raise MeshProblem(f"mesh {filename!r}: {path.suffix or 'no'} extension: only STL, DAE (ZAE) and OBJ are read")
@@ -272,18 +330,33 @@ def _load(path: Path, filename: str) -> MeshGeometry:
         if exc.errno == errno.ENOENT:
             raise MeshProblem(f"mesh {filename!r}: {path} does not exist") from None
         raise MeshProblem(f"mesh {filename!r}: {path} cannot be read ({exc.reason})") from None
+    except OutputIsInputError:
+        raise
     except InvalidInputError:
         raise MeshProblem(f"mesh {filename!r}: {path} is over the {MAX_MESH_BYTES / 2**20:.0f} MiB read") from None
     unit = 1.0
     if kind == "dae":
         data = _decompressed(data, path, filename)
         unit = _collada_unit(data, filename)
+    return MeshFile(path, filename, kind, data, unit)
+
+
+def parse_mesh(file: MeshFile) -> MeshGeometry:
+    """The triangles of a mesh file read by :func:`read_mesh_file` (trimesh; no material or texture is read).
+
+    A vertex that is not finite (NaN, inf, or beyond float32) refuses the file: it is never dropped with its
+    triangles (a closed cube would become an open surface).
+
+    Raises:
+        MeshProblem: not a mesh of its kind, no triangles, a non-finite vertex.
+    """
     import trimesh
 
+    path, filename, kind = file.path, file.filename, file.kind
     try:
-        log.debug("reading mesh %s (%d bytes)", path, len(data))
-        mesh: Any = trimesh.load(io.BytesIO(data), file_type=kind, force="mesh", resolver=_no_files(),
-                                 skip_materials=True)  # fmt: skip
+        log.debug("reading mesh %s (%d bytes)", path, len(file.data))
+        mesh: Any = trimesh.load(io.BytesIO(file.data), file_type=kind, force="mesh", resolver=_no_files(),
+                                 skip_materials=True, process=False)  # fmt: skip
         vertices = np.asarray(mesh.vertices, dtype=float)
         faces = np.asarray(mesh.faces, dtype=np.int64)
     except Exception as exc:  # trimesh and its readers raise many kinds of errors on a bad file
@@ -294,10 +367,20 @@ def _load(path: Path, filename: str) -> MeshGeometry:
     if vertices.ndim != 2 or vertices.shape[1:] != (3,) or faces.ndim != 2 or faces.shape[1:] != (3,) \
             or len(faces) == 0 or len(vertices) == 0:  # fmt: skip
         raise MeshProblem(f"mesh {filename!r}: {path} holds no triangles")
-    vertices = vertices * unit
+    vertices = vertices * file.unit
     if not np.isfinite(vertices.astype(np.float32)).all():
-        raise MeshProblem(f"mesh {filename!r}: {path} holds non-finite vertices (or beyond float32, 3.4e38)")
-    return MeshGeometry(path, vertices, faces, unit, len(data))
+        raise MeshProblem(f"mesh {filename!r}: {path} holds non-finite vertices (NaN, inf, or beyond float32, "
+                          "3.4e38)")  # fmt: skip
+    if faces.min() < 0 or faces.max() >= len(vertices):
+        raise MeshProblem(f"mesh {filename!r}: {path}: a triangle names a vertex that does not exist")
+    merged = trimesh.Trimesh(vertices, faces, process=True)  # shared vertices merged, as trimesh.load would
+    return MeshGeometry(path, np.asarray(merged.vertices, dtype=float), np.asarray(merged.faces, dtype=np.int64),
+                        file.unit, len(file.data))  # fmt: skip
+
+
+def _load(path: Path, filename: str) -> MeshGeometry:
+    """The triangles of a mesh file (rules in the module docstring), or :class:`MeshProblem`."""
+    return parse_mesh(read_mesh_file(path, filename))
 
 
 def robot_size(robot: RobotModel) -> float:
@@ -460,6 +543,17 @@ def _robot_meshes(robot: RobotModel, element: str) -> tuple[tuple[VisualMesh, ..
     return tuple(out), problems
 
 
+def scaled(geometry: MeshGeometry, scale: Any) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, faces) of ``geometry`` scaled by ``scale`` (one number or three, nonzero) [m].
+
+    A scale that mirrors (an odd number of negative factors: ``scale: -1``) reverses each triangle's vertex order, so
+    that a closed surface keeps its faces' normals outward: it stays the same solid, mirrored.
+    """
+    s = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
+    faces = geometry.faces if float(np.prod(np.sign(s))) > 0 else geometry.faces[:, ::-1].copy()
+    return geometry.vertices * s, faces
+
+
 def load_mesh(path: Path, filename: str) -> MeshGeometry:
     """The triangles of one mesh file, read under this module's rules (one file's caps; no package lookup).
 
@@ -471,3 +565,85 @@ def load_mesh(path: Path, filename: str) -> MeshGeometry:
         MeshProblem: refused, missing or unreadable (the message says which and why).
     """
     return _load(path, filename)
+
+
+@dataclass(frozen=True)
+class MeshUse:
+    """One shape that names a mesh file (an obstacle, the carried part).
+
+    Attributes:
+        path: the file (resolved: two names of one file are one file).
+        filename: the name as written.
+        what: the shape, for messages (``obstacle fixture``).
+    """
+
+    path: Path
+    filename: str
+    what: str
+
+
+class MeshUseError(Exception):
+    """A mesh file that one of its uses cannot read: the use (the first that names it) and the problem."""
+
+    def __init__(self, use: MeshUse, problem: MeshProblem) -> None:
+        super().__init__(str(problem))
+        self.use = use
+        self.problem = problem
+
+
+def load_meshes(uses: list[MeshUse], origin: str) -> dict[Path, MeshGeometry]:
+    """The triangles of every mesh file the shapes of one cell name: each file read and parsed ONCE, sized first.
+
+    Before any file is parsed: the files' sizes on disk together (``stat``) are at most
+    :data:`~scara_pin.limits.MAX_CELL_MESH_BYTES`, and so are their bytes once read (decompressed); then each
+    file's triangles are counted from its header or text (:attr:`MeshFile.triangles`, no parsing), times the
+    shapes that name it, against :data:`~scara_pin.limits.MAX_CELL_TRIANGLES`. Only then is each file parsed,
+    once, whatever the number of shapes naming it (500 obstacles naming one 10 MB STL of 199,000 triangles: the
+    file read once, its header's count times 500 refused, nothing parsed).
+
+    Args:
+        uses: the shapes naming a mesh, in the cell's order.
+        origin: the cell, for messages.
+
+    Raises:
+        MeshUseError: a file that cannot be read or parsed, with the first shape naming it.
+        InvalidInputError: the bytes or the triangles of the cell's meshes above their caps (counted before parsing).
+    """
+    import os
+
+    from ..limits import MAX_CELL_MESH_BYTES, MAX_CELL_TRIANGLES
+
+    first: dict[Path, MeshUse] = {}
+    count: dict[Path, int] = {}
+    for use in uses:
+        first.setdefault(use.path, use)
+        count[use.path] = count.get(use.path, 0) + 1
+    size = 0
+    for path in first:
+        try:
+            size += os.stat(path).st_size
+        except OSError:
+            pass  # read_mesh_file says what is wrong with it
+    check_count(f"bytes of the mesh files of {origin} ({len(first)} file(s), on disk)", size, MAX_CELL_MESH_BYTES)
+    files: dict[Path, MeshFile] = {}
+    read = 0
+    triangles = 0
+    for path, use in first.items():
+        try:
+            files[path] = found = read_mesh_file(path, use.filename)
+        except MeshProblem as exc:
+            raise MeshUseError(use, exc) from None
+        read += len(found.data)
+        check_count(f"bytes of the mesh files of {origin} (read, decompressed)", read, MAX_CELL_MESH_BYTES)
+        triangles += found.triangles * count[path]
+        if triangles > MAX_CELL_TRIANGLES:
+            names = f"{count[path]:,} shape(s) naming {use.filename} of {found.triangles:,} triangles"
+            check_count(f"mesh triangles of {origin} (counted before parsing; {names})", triangles,
+                        MAX_CELL_TRIANGLES)  # fmt: skip
+    out: dict[Path, MeshGeometry] = {}
+    for path, found in files.items():
+        try:
+            out[path] = parse_mesh(found)
+        except MeshProblem as exc:
+            raise MeshUseError(first[path], exc) from None
+    return out

@@ -6,8 +6,10 @@ The scene is one Pinocchio ``GeometryModel`` on the robot's model: the robot's c
 
 - every robot geometry and the carried part against every obstacle;
 - the robot's self-collision pairs (:class:`~scara_pin.cell.geometry.SelfPairs`), and the carried part
-  against the links that are not adjacent to the tool's link and not in contact with it at every sample;
-- minus the cell's ``allow`` pairs (by name: links, obstacles, ``carried``).
+  against the links that are not adjacent to the tool's link (a carried part in contact with the arm at every
+  sample is refused: a sign slip, not the design);
+- minus the cell's ``allow`` pairs (by name: links, obstacles, ``carried``: one namespace, an obstacle named like
+  a link is refused).
 
 Distances are coal's signed distances between the exact shapes (negative: penetration depth), with
 GJK/EPA tolerances of :data:`GJK_TOLERANCE` (coal's default, 1e-6, would leave errors of about 4e-7 m).
@@ -19,9 +21,9 @@ relative velocity of the two witness points: ``dd/dq = n . (J_b(p_b) - J_a(p_a))
 Jacobian of the point p fixed to shape x's joint (zero for an obstacle). It holds where the witness points
 are unique (two strictly convex shapes, or a face against a vertex), and is a subgradient elsewhere.
 
-A closed convex mesh is its hull (``coal.Convex``): a solid, with signed distances. Any other mesh is a coal
-bounding-volume tree of its triangles, a SURFACE: a robot geometry entirely inside a closed mesh is not in
-contact with it; motions are checked densely, so crossing the surface is always seen. coal's distance to a
+A closed convex mesh is its hull (``coal.Convex``): a solid, with signed distances, whatever its winding or scale
+sign; a closed mesh that is not convex is refused. An open mesh is a coal bounding-volume tree of its triangles, a
+SURFACE; motions are checked densely, so crossing it is always seen. coal's distance to a
 bounding-volume tree costs about 2 ms per pair when the tree is far away (10 us near it), so such a pair is
 first bounded below by the two shapes' bounding spheres: beyond :data:`FAR` the bound stands for the
 distance in :meth:`Scene.distance_array` (the planner and the verifier only compare distances with the
@@ -58,6 +60,9 @@ FAR = 0.05
 distance in :meth:`Scene.distance_array` (not coal's exact one, which costs about 2 ms there)."""
 EPA_ITERATIONS = 1000
 """coal's EPA iterations (its default, 64, leaves penetration depths of parallel cylinders wrong)."""
+_OVERLAP = 1e-6
+"""[m] a carried part deeper than this in a link of the arm at every sampled configuration (the links it is held by
+included) is refused: its top face on the flange's face is a contact (0 m), a sign slip in its z is not."""
 
 
 class InCollisionError(InvalidInputError):
@@ -251,6 +256,18 @@ class Scene:
         geo = robot_geometry(robot)
         gm = pin.GeometryModel(geo.model)
         names = list(geo.links)
+        links = {f.name for f in robot.model.frames if f.type == pin.FrameType.BODY} | set(names)
+        for o in cell.obstacles:  # one namespace: a name in allow: or in a message stands for one thing
+            if o.name in links:
+                raise InvalidInputError(f"{cell.origin}{f' line {o.line}' if o.line else ''}: obstacle {o.name!r} has "
+                                        f"the name of a link of robot {robot.name} ({o.name}): rename the obstacle "
+                                        "(in allow: and in messages a name stands for one thing)")  # fmt: skip
+        for what, shape, line in [(f"obstacle {o.name}", o.shape, o.line) for o in cell.obstacles]:
+            if shape.closed and not shape.convex:
+                raise InvalidInputError(f"{cell.origin}{f' line {line}' if line else ''}: {what}: mesh {shape.source} "
+                                        "is closed but not convex: a closed mesh is checked as a solid only when it is "
+                                        "convex (its hull), an open one as a surface; give it as convex parts, one "
+                                        "obstacle each")  # fmt: skip
         base = robot.data.oMf[robot.base_id]  # fixed to the root (the model keeps it from its neutral FK)
         self._oMbase = pin.SE3(base)
         carried = None
@@ -258,7 +275,7 @@ class Scene:
             frame = robot.model.frames[robot.tool_id]
             carried = gm.addGeometryObject(pin.GeometryObject(CARRIED, int(frame.parentJoint), int(robot.tool_id),
                                                               frame.placement * cell.carried.placement(),
-                                                              cell.carried.geometry()))  # fmt: skip
+                                                              cell.carried.geometry(solid=True)))  # fmt: skip
             names.append(CARRIED)
         for o in cell.obstacles:
             gm.addGeometryObject(pin.GeometryObject(f"obstacle:{o.name}", 0, 0, base * o.shape.placement(),
@@ -301,8 +318,34 @@ class Scene:
             else:
                 to_sample.append((a, b))
         always = self._always_in_contact(gm, to_sample)
+        if carried is not None:  # the part held is never "in contact by design" with the arm: a sign slip is an error
+            inside = self._always_in_contact(gm, [(j, carried) for j in range(n_robot)], depth=_OVERLAP)
+            stuck = sorted(inside | {ab for ab in always if carried in ab})
+            if stuck:
+                self._carried_overlap(gm, [names[a] for a, _ in stuck], stuck[0][0], carried)
         disabled += [(names[a], names[b], "always in contact") for a, b in to_sample if (a, b) in always]
         return [ab for ab in to_sample if ab not in always], disabled
+
+    def _carried_overlap(self, gm: pin.GeometryModel, links: list[str], link: int, carried: int) -> None:
+        """Refuse a carried part in contact with the arm at every sampled configuration (``links``), naming the overlap.
+
+        Its placement is the cell's (tool frame); the depth shown is at q = 0.
+        """
+        import pinocchio as pin
+
+        probe = pin.GeometryModel(gm)
+        probe.removeAllCollisionPairs()
+        probe.addCollisionPair(pin.CollisionPair(link, carried))
+        pd = probe.createData()
+        q0 = sample_configurations(self.robot, 0)[0]
+        pin.computeDistances(self.robot.model, self.robot.model.createData(), probe, pd, self.robot.to_pinocchio_q(q0))
+        d = float(pd.distanceResults[0].min_distance)
+        depth = f"{-d * 1e3:.3g} mm deep in {links[0]}" if d < 0 else f"touching {links[0]}"
+        xyz = ", ".join(f"{v:.6g}" for v in self.cell.carried.xyz) if self.cell.carried is not None else ""
+        raise InvalidInputError(f"{self.cell.origin}: the carried part overlaps the arm at every configuration "
+                                f"({', '.join(links)}; at q = 0 {depth}): it would never be checked against it. The "
+                                f"part is placed in the tool frame, whose z axis points out of the flange (down): a "
+                                f"part hanging below the flange has a positive z (its xyz is [{xyz}])")  # fmt: skip
 
     def _configure(self, gm: pin.GeometryModel) -> None:
         """The geometry data and its distance requests (:data:`GJK_TOLERANCE`, :data:`EPA_ITERATIONS`, fresh guesses).
@@ -330,8 +373,9 @@ class Scene:
             self._spheres[i] = (np.asarray(geometry.aabb_center, dtype=float).copy(), float(geometry.aabb_radius))
 
     # ------------------------------------------------------------------ building
-    def _always_in_contact(self, gm: pin.GeometryModel, candidates: list[tuple[int, int]]) -> set[tuple[int, int]]:
-        """The candidate pairs in contact (distance <= 0) at every sampled configuration."""
+    def _always_in_contact(self, gm: pin.GeometryModel, candidates: list[tuple[int, int]],
+                           depth: float = 0.0) -> set[tuple[int, int]]:  # fmt: skip
+        """The candidate pairs in contact (distance <= -``depth``) at every sampled configuration."""
         import pinocchio as pin
 
         if not candidates:
@@ -345,7 +389,7 @@ class Scene:
         alive = set(range(len(candidates)))
         for q in sample_configurations(self.robot):
             pin.computeDistances(self.robot.model, data, probe, pd, self.robot.to_pinocchio_q(q))
-            alive = {k for k in alive if pd.distanceResults[k].min_distance <= 0.0}
+            alive = {k for k in alive if pd.distanceResults[k].min_distance <= -depth}
             if not alive:
                 break
         return {candidates[k] for k in alive}

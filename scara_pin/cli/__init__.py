@@ -28,6 +28,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..errors import ScaraError
+from ..limits import files_recorded
 from ..signals import Terminated, kept, raise_pending
 from ._options import Parser, UsageError
 from ._outputs import log
@@ -136,7 +137,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if func is None:
             print("error: no command given (see scara-pin --help)", file=sys.stderr)
             return 2
-        with kept():  # SIGINT / SIGTERM raise, and one swallowed by a library is raised again
+        with kept(), files_recorded():  # SIGINT / SIGTERM raise (one a library swallowed again); the files read
             try:
                 code = func(args)
             except Exception:

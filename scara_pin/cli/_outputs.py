@@ -35,9 +35,13 @@ def check_command_outputs(args: argparse.Namespace, outputs: dict[str, str | Non
     """The command's outputs, checked BEFORE any work by :func:`scara_pin.files.check_outputs`.
 
     Each name (no device, folder or missing folder; a plot's ending), at most one on standard output (with
-    ``--json``), none the same file as an input of the command (:func:`input_files`) or as another output.
+    ``--json``), none the same file as an input of the command (:func:`input_files`), as a file it has read so far,
+    or as another output. They are then declared (:func:`scara_pin.limits.declare_outputs`): a file the command
+    reads afterwards (a mesh or an include of its cell, its robot's meshes) that is one of them is refused then.
     """
     from ..files import check_outputs
+    from ..limits import declare_outputs
 
     stdout = "--json" if getattr(args, "json", False) else None
     check_outputs(outputs, input_files(args), figures=figures, stdout=stdout)
+    declare_outputs(outputs)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidInputError
-from ..files import write_text_atomic
+from ..files import outputs_together, write_text_atomic
 from ._numbers import integer_type, number_type
 from ._options import add_robot_options, add_units
 from ._outputs import check_command_outputs, log
@@ -74,24 +74,25 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     for warning in result.warnings:
         log.warning("%s", warning)
     written: dict[str, str] = {}
-    if args.out is not None:
-        if args.out == "-":
-            sys.stdout.write(result.urdf)
-            return 0
-        write_text_atomic(Path(args.out), result.urdf)
-        written["urdf"] = args.out
+    if args.out == "-":
+        sys.stdout.write(result.urdf)
+        return 0
     overlay = None
-    if args.overlay is not None:
-        from ..calibration.overlay import yaml_overlay
+    with outputs_together():  # all of them, or none
+        if args.out is not None:
+            write_text_atomic(Path(args.out), result.urdf)
+            written["urdf"] = args.out
+        if args.overlay is not None:
+            from ..calibration.overlay import yaml_overlay
 
-        overlay = yaml_overlay(result)
-        write_text_atomic(Path(args.overlay), overlay.to_yaml())
-        written["overlay"] = args.overlay
-    if args.plot is not None:
-        from ..calibration.plot import plot_residuals
+            overlay = yaml_overlay(result)
+            write_text_atomic(Path(args.overlay), overlay.to_yaml())
+            written["overlay"] = args.overlay
+        if args.plot is not None:
+            from ..calibration.plot import plot_residuals
 
-        plot_residuals(result, args.plot)
-        written["plot"] = args.plot
+            plot_residuals(result, args.plot)
+            written["plot"] = args.plot
     if args.json:
         doc = result.to_dict()
         doc["written"] = written

@@ -8,6 +8,7 @@ import logging
 from typing import Any
 
 from ..errors import InvalidInputError, ParameterError
+from ..files import outputs_together
 from ._joints import needs_wrist, read_pose
 from ._numbers import jerk_limits, number, number_type
 from ._options import add_acceleration, add_cell_options, add_robot_options, add_units
@@ -64,16 +65,17 @@ def cmd_cycle(args: argparse.Namespace) -> int:
         result = standard_cycle(robot, path=path, blend=blend, **common)  # type: ignore[arg-type]
     move = result.move
     outputs: dict[str, str] = {}
-    if args.out:
-        move.trajectory.save(args.out, rate=args.rate)
-        outputs["trajectory"] = str(args.out)
-    if args.plot:
-        from ..viz.cycle import plot_cycle
+    with outputs_together():  # all of them, or none
+        if args.out:
+            move.trajectory.save(args.out, rate=args.rate)
+            outputs["trajectory"] = str(args.out)
+        if args.plot:
+            from ..viz.cycle import plot_cycle
 
-        plot_cycle(result, args.plot, robot=robot, units=units.display, limits=limits,
-                   title=f"{robot.name}: standard cycle ({path.value}) {result.cycle_time:.4g} s, payload "
-                   f"{move.payload.mass:g} kg")  # fmt: skip
-        outputs["plot"] = args.plot
+            plot_cycle(result, args.plot, robot=robot, units=units.display, limits=limits,
+                       title=f"{robot.name}: standard cycle ({path.value}) {result.cycle_time:.4g} s, payload "
+                       f"{move.payload.mass:g} kg")  # fmt: skip
+            outputs["plot"] = args.plot
     compare = _jump_for_comparison(robot, result, common, radius) if path is CyclePath.LINES else None
     bound = result.lower_bound
     if args.json:

@@ -8,7 +8,7 @@ import sys
 from typing import Any
 
 from ..errors import ParameterError
-from ..files import check_outputs
+from ..files import check_outputs, outputs_together
 from ..limits import MAX_SAMPLES, check_count
 from ._joints import needs_wrist
 from ._numbers import number_type
@@ -42,17 +42,18 @@ def cmd_job(args: argparse.Namespace) -> int:
     robot = with_acceleration(args, robot, units)
     result = _plan(job, robot)
     written: dict[str, str] = {}
-    if args.out:
-        result.trajectory.save(args.out, rate=args.rate)
-        written["trajectory"] = args.out
-    if args.plot:
-        from ..viz.job import plot_job
+    with outputs_together():  # all of them, or none
+        if args.out:
+            result.trajectory.save(args.out, rate=args.rate)
+            written["trajectory"] = args.out
+        if args.plot:
+            from ..viz.job import plot_job
 
-        plot_job(result, args.plot, robot=robot)
-        written["plot"] = args.plot
-    if args.html:
-        _page(result, robot, args.html)
-        written["page"] = args.html
+            plot_job(result, args.plot, robot=robot)
+            written["plot"] = args.plot
+        if args.html:
+            _page(result, robot, args.html)
+            written["page"] = args.html
     if args.json:
         print(json.dumps({**result.to_dict(), "outputs": written}))
         return 0

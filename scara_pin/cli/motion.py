@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..files import write_text_atomic
+from ..files import outputs_together, write_text_atomic
 from ..units import format_number, format_vector
 from ._joints import joint_arg, needs_wrist, read_pose
 from ._numbers import jerk_limits, number, number_type
@@ -185,18 +185,19 @@ def _write_outputs(args: argparse.Namespace, robot: Any, traj: Any, units: Units
                    tool_speed: float | None) -> dict[str, str]:  # fmt: skip
     """``--out``, ``--setpoints``, ``--plot`` (the planned ``robot`` carries the payload): what was written, by kind."""
     outputs: dict[str, str] = {}
-    if args.out:
-        traj.save(args.out, rate=args.rate)
-        outputs["trajectory"] = str(args.out)
-    if args.setpoints:
-        _write_setpoints(args, robot, traj, units)
-        outputs["setpoints"] = args.setpoints
-    if args.plot:
-        from ..viz.plots import plot_trajectory
+    with outputs_together():  # all of them, or none
+        if args.out:
+            traj.save(args.out, rate=args.rate)
+            outputs["trajectory"] = str(args.out)
+        if args.setpoints:
+            _write_setpoints(args, robot, traj, units)
+            outputs["setpoints"] = args.setpoints
+        if args.plot:
+            from ..viz.plots import plot_trajectory
 
-        plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=law, torque=args.torque,
-                        tool_speed=tool_speed)  # fmt: skip
-        outputs["plot"] = args.plot
+            plot_trajectory(traj, args.plot, robot=robot, units=units.display, law=law, torque=args.torque,
+                            tool_speed=tool_speed)  # fmt: skip
+            outputs["plot"] = args.plot
     return outputs
 
 

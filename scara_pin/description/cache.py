@@ -43,6 +43,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..limits import read_bytes
+
 __all__ = ["FORMAT", "MAX_ENTRY_BYTES", "DescriptionCache"]
 
 log = logging.getLogger(__name__)
@@ -97,7 +99,7 @@ class DescriptionCache:
         add("overrides", repr(sorted((k, float(v)) for k, v in overrides.items())).encode())
         templates = (p for p in description.rglob("*.xacro") if "config" not in p.relative_to(description).parts)
         for template in sorted(templates):
-            add(f"template {template.relative_to(description)}", template.read_bytes())
+            add(f"template {template.relative_to(description)}", read_bytes(template, "robot template"))
         spec = importlib.util.find_spec("xacro")
         origin = None if spec is None else spec.origin
         add("xacro", b"" if origin is None else Path(origin).read_bytes())

@@ -28,7 +28,9 @@ resolved against the folder of the file that includes it (as ROS's xacro does), 
 folder.
 
 Security: expanding a xacro file runs the expressions written in it (``${...}``, ``$(eval ...)``): only
-the user's own files are expanded, never text from the command line (no ``--set`` into a user's xacro).
+the user's own files are expanded, never text from the command line (no ``--set`` into a user's xacro). The
+expansion runs in a child process, bounded in time and memory (:mod:`~scara_pin.description.expansion`:
+``${(9**9**9) % 7}`` or a macro calling itself twice 30 deep end with a message, not a hang).
 """
 
 from __future__ import annotations
@@ -39,7 +41,6 @@ import os
 import re
 import stat
 import sys
-import threading
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -54,11 +55,14 @@ from ..limits import (
     MAX_WALK_DEPTH,
     MAX_WALK_ENTRIES,
     MAX_XACRO_FILES,
+    MAX_XACRO_MEMORY,
+    OutputIsInputError,
     UnreadableFileError,
     open_regular,
     read_bytes,
     read_text,
 )
+from .expansion import bounded, xacro_lock
 
 __all__ = ["PackagePath", "read_robot_file", "xacro_lock"]
 
@@ -67,9 +71,6 @@ _PACKAGE_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*\Z")
 _SHOWN_NOTES = 3
 """Notes (skipped package.xml files, caps reached) named in a 'package not found' message."""
 
-xacro_lock = threading.Lock()
-"""Held while xacro runs: xacro keeps its state in module globals (file stack, arguments), and the
-expansion of a user's file replaces its ``open`` and ``$(find)`` for a while."""
 
 
 # ----------------------------------------------------------------------------------------- the search
@@ -276,16 +277,21 @@ class PackagePath:
         """The URDF text of a xacro file, ``$(find pkg)`` resolved (``package://`` names are kept).
 
         Relative includes are resolved against the including file's folder; every file read follows the
-        module's rules (regular files, bounded).
+        module's rules (regular files, bounded). The expansion runs under the time and memory bounds of
+        :func:`~scara_pin.description.expansion.bounded`.
 
         Raises:
-            UrdfError: a missing package, an include that is not a regular file or over the caps, or
-                xacro's own error (one line).
+            UrdfError: a missing package, an include that is not a regular file or over the caps, xacro's own
+                error (one line; an error in an included file names it), or a bound of the expansion reached.
         """
+        path = Path(path)
+        return bounded(str(path), lambda: self._expanded(path))
+
+    def _expanded(self, path: Path) -> str:
+        """:meth:`expand_xacro`'s work (in the child process)."""
         from xacro import XacroException
         from xacrodoc import XacroDoc, packages
 
-        path = Path(path)
         text = _read_robot_text(path)
         missing: list[UrdfError] = []
 
@@ -296,13 +302,22 @@ class PackagePath:
                 missing.append(exc)
                 raise packages.PackageNotFoundError(package) from None
 
+        session = None
         try:
-            with _xacro_session(path, find):
+            with _xacro_session(path, find) as session:
                 doc = XacroDoc.from_string(text, resolve_packages=False, rootdir=path.parent)
         except Exception as exc:  # xacro raises plain Python errors for bad expressions, XML errors...
+            where = f"{path}" if session is None or session.failed_in is None \
+                else f"{path}: in the included file {session.failed_in}"  # fmt: skip
             refused = _in_chain(exc, _Refused)
             if refused is not None:
                 raise UrdfError(f"{path}: xacro: {refused}") from None
+            if _in_chain(exc, MemoryError) is not None:
+                raise UrdfError(f"{where}: xacro: the expansion needed more than {MAX_XACRO_MEMORY / 2**20:,.0f} MiB "
+                                "of memory, the cap (MAX_XACRO_MEMORY); not expanded") from None
+            clash = _in_chain(exc, OutputIsInputError)
+            if clash is not None:
+                raise clash from None
             if missing:
                 raise missing[-1] from None
             # a missing package wrapped by xacro (xacrodoc 2.0.0 raises its own copy of XacroException)
@@ -310,8 +325,8 @@ class PackagePath:
             if not_found is not None:
                 raise self._not_found(not_found.args[0] if not_found.args else "?", []) from None
             if isinstance(exc, XacroException):
-                raise UrdfError(f"{path}: xacro: {' '.join(str(exc).split())}") from None
-            raise UrdfError(f"{path}: xacro: {type(exc).__name__}: {' '.join(str(exc).split())}") from None
+                raise UrdfError(f"{where}: xacro: {' '.join(str(exc).split())}") from None
+            raise UrdfError(f"{where}: xacro: {type(exc).__name__}: {' '.join(str(exc).split())}") from None
         return str(doc.dom.toprettyxml(indent="  "))
 
 
@@ -336,11 +351,15 @@ def _in_chain(exc: BaseException, kind: type[BaseException]) -> Any:
 
 
 class _XacroFiles:
-    """xacro's ``open`` while one file is expanded: regular files only, bounded in number and bytes."""
+    """xacro's ``open`` while one file is expanded: regular files only, bounded in number and bytes.
+
+    ``failed_in``: the file xacro was reading when the expansion failed (an include's), or None (the top file).
+    """
 
     def __init__(self) -> None:
         self.files = 0
         self.bytes = 0
+        self.failed_in: str | None = None
 
     def open(self, file: Any, mode: str = "r", *args: Any, **kwargs: Any) -> IO[Any]:
         if mode not in ("r", "rt", "rb"):  # xacro writes only its command line's output file
@@ -404,6 +423,11 @@ def _xacro_session(path: Path, find: Callable[[str], str]) -> Iterator[_XacroFil
         substitution_args._eval_find = find
         try:
             yield files
+        except BaseException:
+            stack = [f for f in (xacro.filestack or []) if f]
+            if stack and os.path.abspath(stack[-1]) != os.path.abspath(path):
+                files.failed_in = stack[-1]  # the included file being read (its line is the error's)
+            raise
         finally:
             if saved[0] is None:
                 del xacro.open  # type: ignore[attr-defined]

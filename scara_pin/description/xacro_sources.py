@@ -84,6 +84,9 @@ class XacroSourceError(UrdfError):
         self.file = file
         self.line = line
 
+    def __reduce__(self) -> tuple[type, tuple[str, Path | None, int | None]]:
+        return (type(self), (self.reason, self.file, self.line))  # pickled from the expansion's child process
+
 
 @contextmanager
 def _tagging_parser(top: Path, table: list[tuple[Path, int]], failed: list[int]) -> Iterator[None]:
@@ -139,13 +142,22 @@ def _tagging_parser(top: Path, table: list[tuple[Path, int]], failed: list[int])
 def expand_with_sources(path: str | Path, packages: PackagePath) -> tuple[str, SourceMap]:
     """The URDF text of a xacro file (the loader's), and where each of its elements was written.
 
+    Under the loader's bounds (:func:`~scara_pin.description.expansion.bounded`: time, memory, size).
+
     Raises:
         XacroSourceError: as the loader's expansion (a missing package, xacro's own error), with where the
             element xacro was evaluating was written (file and line, when known).
+        UrdfError: a bound of the expansion reached.
     """
+    from .expansion import bounded
+
+    return bounded(str(path), lambda: _expand_with_sources(Path(path), packages))
+
+
+def _expand_with_sources(path: Path, packages: PackagePath) -> tuple[str, SourceMap]:
+    """:func:`expand_with_sources`'s work (in the child process of the bounded expansion)."""
     import xacro
 
-    path = Path(path)
     table: list[tuple[Path, int]] = []
     failed: list[int] = []
     try:

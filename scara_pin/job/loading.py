@@ -50,7 +50,15 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from ..errors import InvalidInputError, JobFileError
-from ..limits import MAX_DOCUMENT_BYTES, MAX_JOB_BYTES, MAX_JOB_DEPTH, MAX_JOB_STEPS, check_input_file, read_text
+from ..limits import (
+    MAX_DOCUMENT_BYTES,
+    MAX_DWELL,
+    MAX_JOB_BYTES,
+    MAX_JOB_DEPTH,
+    MAX_JOB_STEPS,
+    check_input_file,
+    read_text,
+)
 from ..motion.payload import Payload
 from ..motion.points import PointSet, check_point_name, read_points
 from .pallets import Order, Pallet
@@ -386,14 +394,15 @@ def _step(at: _At, points: PointSet, pallets: Mapping[str, Pallet], scope: Mappi
         return MotionStep(kind, target, line, **_shape(entries))
     if "dwell" in keys:
         entries = at.mapping(("dwell",))
-        return Dwell(entries["dwell"].number(lambda v: v >= 0, ">= 0 (seconds at rest)", "s"), line)
+        return Dwell(entries["dwell"].number(lambda v: 0 <= v <= MAX_DWELL, f">= 0 and at most {MAX_DWELL:,} (seconds "
+                                             "at rest; MAX_DWELL)", "s"), line)  # fmt: skip
     grips = [g for g in GripKind if g.value in keys]
     if grips:
         if len(grips) > 1:
             at.fail("one grip per step: pick and place in one step")
         entries = at.mapping((grips[0].value,))
-        seconds = entries[grips[0].value].number(lambda v: v >= 0, ">= 0 (seconds at rest while the gripper acts)",
-                                                 "s")  # fmt: skip
+        rule = f">= 0 and at most {MAX_DWELL:,} (seconds at rest while the gripper acts; MAX_DWELL)"
+        seconds = entries[grips[0].value].number(lambda v: 0 <= v <= MAX_DWELL, rule, "s")
         return Grip(grips[0], seconds, line)
     if keys & {"speed", "accel"}:
         entries = at.mapping(("speed", "accel"))

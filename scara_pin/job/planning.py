@@ -339,6 +339,7 @@ def plan_job(job: JobSpec, robot: RobotModel, *, progress: Callable[[int, int], 
             raise located(job.path, job.lines.get("carry"), exc) from None
     carry = job.carry.part() if job.carry is not None else None
     planner = Planner(robot, torque=job.torque, payload=job.payload, cell=cell, carry=carry)
+    _check_goals(robot, planner, job, program)  # every goal and fixed path in its cell, before any move is planned
     q, at, t = program.start_q, program.start, 0.0
     pose = robot.tool_pose(q)
     placed: tuple[Obstacle, ...] = ()  # the boxes placed so far: the cell's obstacles for the moves after them
@@ -387,6 +388,56 @@ def plan_job(job: JobSpec, robot: RobotModel, *, progress: Callable[[int, int], 
         raise JobFileError(job.path, job.lines.get("steps"), "the job never moves nor dwells: nothing to time")
     return JobResult(job.path, robot.name, tuple(rows), Trajectory(tuple(pieces)), len(program.places), planner.stats,
                      tuple(boxes), cell, carry)  # fmt: skip
+
+
+def _check_goals(robot: RobotModel, planner: Planner, job: JobSpec, program: Any) -> None:
+    """Every goal of the job, and every fixed path (``move``, ``go``), clear of its step's cell BEFORE any planning.
+
+    The program is walked as :func:`plan_job` walks it (the part held from a pick to a place, each box placed an
+    obstacle after it): the start, where each part is picked, the robot after each place, each move's target, and
+    the geometric path of each ``move`` and ``go`` (:func:`~scara_pin.motion.plan.check_fixed_path`). A job whose
+    10th place is in collision planned 9 jumps first; now it is refused at once, naming the step's line.
+
+    Raises:
+        JobFileError: a goal in collision (exit 2), at its line.
+        JobStepError: a fixed path through an obstacle (exit 3), at its line.
+    """
+    from ..cell import scene
+    from ..motion.plan import MotionRequest, check_fixed_path
+
+    first = planner.cell_for((), False)
+    if first is None:
+        return
+    q = np.asarray(program.start_q, dtype=float)
+    at = program.start
+    placed: tuple[Obstacle, ...] = ()
+    holding = False
+    try:
+        scene(robot, first).check(q, f"the start of the job ({at})")
+    except ScaraError as exc:
+        raise located(job.path, job.lines.get("start"), exc) from None
+    for k, action in enumerate(program.actions):
+        if isinstance(action, Grip):
+            holding = action.kind is GripKind.PICK
+            if holding:
+                _clear(robot, planner.cell_for(placed, True), q, job, action, f"the part picked at {at}")
+            else:
+                placed = (*placed, _place(robot, planner, job, action, k + 1, q, placed, 0.0).obstacle)
+            continue
+        if not isinstance(action, Move):
+            continue
+        cell = planner.cell_for(placed, holding) or first
+        target = np.asarray(action.q, dtype=float)
+        what = f"{action.kind.value} {at} -> {action.target}"
+        try:
+            if float(np.max(np.abs(target - q))) > STILL:
+                scene(robot, cell).check(target, f"the goal ({action.target})")
+                if action.kind is not MoveKind.JUMP:
+                    check_fixed_path(robot, MotionRequest(start_q=q, end_q=target, linear=action.kind is MoveKind.MOVE,
+                                                          cell=cell))  # fmt: skip
+        except ScaraError as exc:
+            raise located(job.path, action.line, exc, what) from None
+        q, at = target, action.target
 
 
 def _job_cell(job: JobSpec) -> Cell | None:
