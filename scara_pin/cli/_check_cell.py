@@ -62,8 +62,15 @@ def _cell_report(args: argparse.Namespace) -> Any:
     from ..robots import load_urdf
     from ._numbers import parse_locks
 
-    robot = load_urdf(args.file, tool=args.tool, base=args.base, package_path=args.package_path or (),
-                      lock=parse_locks(args.lock))  # fmt: skip
+    if getattr(args, "robot", None) is not None:
+        from ..robots import load_robot
+        from ._numbers import parse_sets
+
+        robot = load_robot(args.robot, parse_sets(args.set), tool=args.tool, base=args.base,
+                           lock=parse_locks(args.lock))  # fmt: skip
+    else:
+        robot = load_urdf(args.file, tool=args.tool, base=args.base, package_path=args.package_path or (),
+                          lock=parse_locks(args.lock))  # fmt: skip
     cell = cell_from_args(args)
     configurations: list[tuple[str, Any]] = []
     taught: list[tuple[str, Any]] = []
