@@ -78,10 +78,11 @@ def _cell_report(args: argparse.Namespace) -> Any:
     if args.points is not None:
         from ..motion.points import read_points
 
-        for point in read_points(args.points, robot).points:
-            if point.name == "home":
-                home = ("home (point home of the points file)", point.q)
+        points = read_points(args.points, robot).resolved(robot, origin=f"points file {args.points}")
+        for name in points.names:
+            if name == "home":
+                home = ("home (point home of the points file)", points.q_of(name))
             else:
-                taught.append((point.name, point.q))
+                taught.append((name, points.q_of(name)))
     configurations = [home, *taught]
     return check_cell(scene(robot, cell), configurations, source=args.cell)
