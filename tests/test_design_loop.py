@@ -258,3 +258,58 @@ def test_results_are_short_and_say_what_they_are(planned: tuple[Job, object]) ->
     assert repr(step).startswith("StepResult 1 (line ") and len(repr(step)) < 300
     assert step.kind is StepKind.JUMP and step.kind == "jump" and json.dumps(step.to_dict())
     assert repr(result.stats).startswith("2 moves planned")  # type: ignore[attr-defined]
+
+
+def test_a_jerk_limit_is_planned_as_the_cycle_plans_it(robot_default: Robot, tmp_path: Path) -> None:
+    """``jerk: 2000`` (the job's units: rad/s^3, m/s^3): the jump is ``jump_move(..., jerk=2000)`` alone."""
+    from scara_pin.motion.jump import jump_move
+
+    job = Job.load(write_job(tmp_path, "start: feeder\njerk: 2000\nsteps:\n  - jump: T11\n  - go: feeder\n",
+                             robot_default))  # fmt: skip
+    result = job.plan(robot_default)
+    q0, q1 = (job.points.q_of(n) for n in ("feeder", "T11"))
+    alone = jump_move(robot_default, robot_default.tool_pose(q0), robot_default.tool_pose(q1), start=q0, end=q1,
+                      jerk=2000.0)  # fmt: skip
+    step, go = result.steps
+    assert abs(step.duration - alone.duration) <= 1e-9
+    assert go.method == "joint path, jerk-limited time-optimal"  # verified at 10 kHz with the jerk limit
+    assert any(b.quantity == "jerk" for b in step.binding)  # the jerk binds, and the table says it
+    free = Job.load(write_job(tmp_path, "start: feeder\nsteps:\n  - jump: T11\n", robot_default)).plan(robot_default)
+    assert step.duration > free.total + 1e-3  # the limit costs time
+
+
+def test_the_job_picture_is_in_the_units_asked_and_its_labels_never_overlap(robot_default: Robot,
+                                                                            tmp_path: Path) -> None:  # fmt: skip
+    """A 3-row tray of 12 parts left as boxes (as a palletizing job's result): seen from the side, the rows stand in
+    one line of sight; every label of both views keeps clear of every other, in mm as in m."""
+    from scara_pin.cell import Cell, Obstacle, Shape
+    from scara_pin.job.results import JobResult, PlacedBox, PlanningStats, StepResult
+    from scara_pin.motion.polynomial import PolynomialPiece
+    from scara_pin.motion.trajectory import Trajectory
+    from scara_pin.units import HUMAN
+    from scara_pin.viz.job import plot_job
+
+    q = robot_default.ik_nearest(np.array([0.25, 0.0, -0.08, 0.0]), np.zeros(4))
+    hold = Trajectory((PolynomialPiece(np.array([0.0, 1.0]), q[None, None, :]),))
+    boxes = tuple(PlacedBox(f"box{k + 1}", 1, "tray", 1.0, Obstacle(f"box{k + 1}", Shape(
+        "box", (0.02, 0.02, 0.01), np.array([0.22 + 0.03 * (k // 4), -0.05 + 0.03 * (k % 4), -0.12]), np.zeros(3))))
+        for k in range(12))  # fmt: skip
+    step = StepResult(1, 1, StepKind.DWELL, "tray", "tray", 0.0, 1.0, q=tuple(q))
+    cell = Cell((Obstacle("post", Shape("cylinder", (0.01, 0.2), np.array([0.3, -0.2, -0.1]), np.zeros(3))),))
+    result = JobResult(tmp_path / "job.yaml", "default", (step,), hold, 12, PlanningStats(), boxes, cell)
+    files = {}
+    for units in (None, HUMAN):
+        path = tmp_path / f"job_{'si' if units is None else 'mm'}.png"
+        fig = plot_job(result, path, robot=robot_default, **({} if units is None else {"units": units}))
+        plan, side = fig.subfigs[0].axes
+        renderer = fig.canvas.get_renderer()
+        for ax in (plan, side):
+            boxes_drawn = [t.get_window_extent(renderer) for t in ax.texts if t.get_text()]
+            assert len(boxes_drawn) >= 2
+            for i, a in enumerate(boxes_drawn):
+                for b in boxes_drawn[i + 1 :]:
+                    assert not a.overlaps(b), (ax.get_title(), [t.get_text() for t in ax.texts])
+        assert plan.get_xlabel() == ("x [mm]" if units else "x [m]")
+        files[units] = path.read_bytes()
+        assert any(t.get_text().count(",") >= 2 for t in side.texts)  # the three rows' numbers in one label
+    assert files[None] != files[HUMAN]

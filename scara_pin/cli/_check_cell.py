@@ -29,15 +29,16 @@ def report_with_cell(args: argparse.Namespace, report: CheckReport) -> int:
     """
     from ..errors import InvalidInputError
 
-    if getattr(args, "cell", None) is None:
+    if getattr(args, "cell", None) is None and getattr(args, "carry", None) is None:
         if getattr(args, "points", None) is not None or getattr(args, "margin", None) is not None:
-            raise InvalidInputError("--points and --margin of check go with --cell")
+            raise InvalidInputError("--points and --margin of check go with --cell (or --carry)")
         print(report.to_json() if args.json else report.format_text())
         return int(report.exit_code)
     cell_doc: dict[str, Any]
+    source = args.cell if args.cell is not None else args.carry
     if report.exit_code == 2:
-        cell_doc = {"source": args.cell, "status": "unchecked", "reason": "the URDF is unusable"}
-        text = f"{args.cell}: unchecked (the URDF is unusable)"
+        cell_doc = {"source": source, "status": "unchecked", "reason": "the URDF is unusable"}
+        text = f"{source}: unchecked (the URDF is unusable)"
         code = 2
     else:
         cell_report = _cell_report(args)
@@ -85,4 +86,4 @@ def _cell_report(args: argparse.Namespace) -> Any:
             else:
                 taught.append((name, points.q_of(name)))
     configurations = [home, *taught]
-    return check_cell(scene(robot, cell), configurations, source=args.cell)
+    return check_cell(scene(robot, cell), configurations, source=args.cell if args.cell is not None else args.carry)

@@ -85,6 +85,8 @@ def add_cell_options(p: argparse.ArgumentParser, *, margin: bool = True) -> None
         g.add_argument("--margin", type=number_type("--margin"), metavar="M",
                        help="the smallest distance kept to any obstacle [m, or mm with --mm], instead of the "
                        "cell file's")  # fmt: skip
+    g.add_argument("--carry", metavar="FILE", help="the part the tool carries: a job file's carry: (or a file holding "
+                   "{shape: box, size, xyz}); it collides as the job's part does (docs/job.md)")  # fmt: skip
 
 
 def add_acceleration(p: Any) -> None:

@@ -176,7 +176,7 @@ def cell_digest(cell: Cell | None) -> str:
     _add(digest, "allow", repr(tuple(cell.allow)).encode())
     _add(digest, "carried", _shape_bytes(cell.carried))
     for o in cell.obstacles:
-        _add(digest, f"obstacle {o.name}", _shape_bytes(o.shape))
+        _add(digest, f"obstacle {o.name} {o.margin!r}", _shape_bytes(o.shape))
     return digest.hexdigest()
 
 

@@ -90,7 +90,7 @@ from .steps import (
     tally,
 )
 
-__all__ = ["FORMAT", "KEYS", "read_job"]
+__all__ = ["FORMAT", "KEYS", "read_carry", "read_job"]
 
 FORMAT = "scara-pin job 1"
 """The ``format:`` value of a job file."""
@@ -275,6 +275,38 @@ def read_job(path: str | Path, overrides: Iterable[Override] = (), *, text: str 
                    start=start, jump=shape, torque=torque, payload=payload, cell=cell, carry=carry, actions=count,
                    dwell=dwell, lines=lines, frames=frames, speed=speed, accel=accel, jerk=jerk, units=top.units,
                    text=text, overrides=overrides)  # fmt: skip
+
+
+def read_carry(path: str | Path) -> Carry:
+    """The part a job carries, for the pendant and ``check --cell`` (``--carry FILE``).
+
+    A job file's ``carry:`` (in its ``units:``), or a file that is that mapping itself (``{shape: box, size:
+    [...], xyz: [...]}``).
+
+    Raises:
+        JobFileError: no carry, or one the job would refuse (the file and the line).
+        InvalidInputError: the file cannot be read.
+    """
+    from ..description.yaml_units import load_yaml, yaml_line
+    from ..errors import YamlError
+
+    path = Path(path)
+    text = read_text(check_input_file(path, "carry file", MAX_JOB_BYTES), "carry file", MAX_JOB_BYTES)
+    try:
+        data = load_yaml(text, str(path))
+    except YamlError as exc:
+        raise JobFileError(path, exc.line, exc.problem if exc.refused else f"not valid YAML ({exc.problem})") from None
+    top = _At(data, path, "the file", yaml_line(data))
+    if not isinstance(data, dict):
+        top.fail("a carry file is a job file with carry:, or the carry itself: {shape: box, size: [x, y, z], xyz: "
+                 "[...]}")  # fmt: skip
+    if "units" in data:
+        top.units = _units(top.child("units"))
+    if "shape" in data:
+        return _carry(top)
+    if "carry" not in data:
+        top.fail("no carry: in this file (a job's part: carry: {shape: box, size: [x, y, z], xyz: [...]})")
+    return _carry(top.child("carry"))
 
 
 def _units(at: _At) -> DisplayUnits:

@@ -563,7 +563,7 @@ def _job_cell(job: JobSpec) -> Cell | None:
         from ..cell import Obstacle
 
         bMw = job.frames.base_M_world()
-        moved = tuple(Obstacle(o.name, o.shape.moved(bMw), o.line) for o in cell.obstacles)
+        moved = tuple(Obstacle(o.name, o.shape.moved(bMw), o.line, o.margin) for o in cell.obstacles)
         cell = replace(cell, obstacles=moved)
     if job.carry is not None and cell.carried is not None:
         raise JobFileError(job.path, job.lines.get("carry"), f"the cell file {job.cell} gives a carried part too: in "

@@ -18,6 +18,7 @@ and each box from the moment it is placed (the page's player shows a node only o
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -34,7 +35,8 @@ if TYPE_CHECKING:
     from ..job.results import JobResult
     from ..model import RobotModel
 
-__all__ = ["BOX_COLOR", "CARRYING_COLOR", "EMPTY_COLOR", "KIND_COLORS", "OBSTACLE_COLOR", "job_page", "plot_job"]
+__all__ = ["BOX_COLOR", "CARRYING_COLOR", "EMPTY_COLOR", "KIND_COLORS", "OBSTACLE_COLOR", "job_page", "plot_job",
+           "untangle"]
 
 KIND_COLORS = {"jump": "#9ec5e8", "move": "#f5c48a", "go": "#b9dfa8"}
 """The band colour of each kind of move."""
@@ -121,6 +123,8 @@ def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, r
     else:
         rate_text = f", {result.places} places, {rate:,.0f} parts per hour" if rate is not None else ""
     fig.suptitle(title or f"{result.path.name} on {result.robot}: {T:.4f} s{rate_text}")
+    if views:
+        untangle(fig, (plan, side))
     return finish(fig, path)
 
 
@@ -179,10 +183,10 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel, un
         else:  # an obstacle's name inside its top edge, clear of the boxes on it
             plan.annotate(name, (float(xyz[0]), float(pts[:, 1].max())), fontsize=7, ha="center", va="top",
                           xytext=(0, -2), textcoords="offset points", zorder=4)  # fmt: skip
-    for (x, y), found in labels.items():
-        plan.annotate(_listed(found), (x, y), fontsize=7, ha="center", va="center", zorder=4)
-    for (x, z), found in side_labels.items():
-        side.annotate(_listed(found), (x, z), fontsize=7, ha="center", va="center", zorder=4)
+    for ax, found_at in ((plan, labels), (side, side_labels)):
+        for (x, y), found in found_at.items():
+            ax.annotate(_listed(found), (x, y), fontsize=7, ha="center", va="center", zorder=4, xytext=(0, 0),
+                        textcoords="offset points")  # fmt: skip
     for ax, (i, j) in ((plan, (0, 1)), (side, (along, 2))):
         for state, color, label, style in ((False, EMPTY_COLOR, "tool, empty", "--"),
                                            (True, CARRYING_COLOR, "tool, holding the part", "-")):  # fmt: skip
@@ -207,6 +211,33 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel, un
     side.set(xlabel=f"{names[along]} [{L}]", ylabel=f"z [{L}]",
              title=f"side view of {what} (seen along {names[across]})")  # fmt: skip
     plan.legend(fontsize=7, loc="best")
+
+
+def untangle(fig: Figure, axes: Sequence[Axes], rounds: int = 3) -> None:
+    """Move the labels of ``axes`` that would be written over each other apart, up or down by whole line heights.
+
+    The figure is drawn to measure them (their sizes on the page); a label moved keeps its place along the other
+    axis. Drawn again until none overlaps (the layout may change as they move), at most ``rounds`` times.
+    """
+    for _ in range(rounds):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+        moved = False
+        for ax in axes:
+            placed: list[Any] = []
+            for text in ax.texts:
+                box = text.get_window_extent(renderer)
+                x0, y0 = getattr(text, "xyann", (0.0, 0.0))
+                k = 0
+                while any(box.overlaps(p) for p in placed) and k < 40 and hasattr(text, "xyann"):
+                    k += 1
+                    lines = (k + 1) // 2 * (1 if k % 2 else -1)  # +1, -1, +2, -2, ... line heights
+                    text.xyann = (x0, y0 + lines * 1.15 * box.height * 72.0 / fig.dpi)
+                    box = text.get_window_extent(renderer)
+                    moved = True
+                placed.append(box)
+        if not moved:
+            return
 
 
 def _listed(names: list[str]) -> str:
