@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import json
 import logging
 import math
 from collections.abc import Callable, Iterable
@@ -55,12 +56,12 @@ if TYPE_CHECKING:
     from ..model import RobotModel
     from ..motion.trajectory import Trajectory
 
-__all__ = ["FORMAT", "MAX_PLAN_BYTES", "PlanStore", "StoredPiece", "cell_digest", "decode_trajectory",
+__all__ = ["FORMAT", "MAX_PLAN_BYTES", "PlanStore", "StoredPiece", "built", "cell_digest", "decode_trajectory",
            "encode_trajectory", "move_key", "planner_digest", "robot_digest"]  # fmt: skip
 
 log = logging.getLogger(__name__)
 
-FORMAT = 1
+FORMAT = 2
 """The layout of a plan entry (part of every key)."""
 MAX_PLAN_BYTES = 16 * 1024 * 1024
 """[bytes] a plan entry larger than this is not read (a jump is a few KB, a straight move about 100 KB)."""
@@ -207,7 +208,11 @@ def _array(value: Any, ndim: int) -> np.ndarray:
 
 
 def encode_trajectory(traj: Trajectory) -> dict[str, Any] | None:
-    """A trajectory's pieces as plain data (exact: floats round-trip through JSON), or None if one is unknown."""
+    """A trajectory's pieces as plain data (exact: floats round-trip through JSON), or None if one is unknown.
+
+    Each piece: its duration and its states at both ends, and the rest (``data``) as JSON text: read only when the
+    piece is sampled inside (parsing thousands of numbers costs more than the table needs).
+    """
     pieces = []
     for piece in traj.pieces:
         data = _encode_piece(piece)
@@ -223,9 +228,12 @@ def _encode_piece(piece: Piece) -> dict[str, Any] | None:
     from ..motion.trajectory import Motion, ProfileLaw, TrapezoidLaw
 
     if isinstance(piece, StoredPiece):
-        return piece.data
+        return {"duration": piece.duration, "ends": [e.tolist() for e in piece.ends], "data": piece.data}
+    ends = [e.tolist() for e in piece.evaluate(np.array([0.0, piece.duration]))]
     if isinstance(piece, PolynomialPiece):
-        return {"type": "polynomial", "breaks": piece.breaks.tolist(), "coefficients": piece.coefficients.tolist()}
+        data: dict[str, Any] = {"type": "polynomial", "breaks": piece.breaks.tolist(),
+                                "coefficients": piece.coefficients.tolist()}  # fmt: skip
+        return {"duration": piece.duration, "ends": ends, "data": json.dumps(data)}
     if not isinstance(piece, Motion):
         return None
     path, law = piece.path, piece.law
@@ -246,9 +254,7 @@ def _encode_piece(piece: Piece) -> dict[str, Any] | None:
         if not isinstance(law, JerkLaw):
             return None
         w = {"type": "jerk", "t": law.t.tolist(), "c": law.c.tolist(), "knots": list(law.knots)}
-    ends = piece.evaluate(np.array([0.0, piece.duration]))
-    return {"type": "motion", "path": p, "law": w, "duration": piece.duration,
-            "ends": [e.tolist() for e in ends]}  # fmt: skip
+    return {"duration": piece.duration, "ends": ends, "data": json.dumps({"type": "motion", "path": p, "law": w})}
 
 
 def decode_trajectory(robot: RobotModel, data: dict[str, Any]) -> Trajectory:
@@ -261,24 +267,25 @@ def decode_trajectory(robot: RobotModel, data: dict[str, Any]) -> Trajectory:
     return Trajectory(tuple(_decode_piece(robot, item) for item in items))
 
 
-def _decode_piece(robot: RobotModel, data: Any) -> Piece:
+def _decode_piece(robot: RobotModel, item: Any) -> Piece:
+    if not isinstance(item, dict) or not isinstance(item.get("data"), str):
+        raise ValueError("a piece is its duration, its ends and its data")
+    duration = float(item["duration"])
+    ends = [_array(e, 2) for e in item["ends"]]
+    if not (math.isfinite(duration) and duration > 0.0) or len(ends) != 3:
+        raise ValueError("a piece's duration and end states")
+    return StoredPiece(duration, tuple(ends), item["data"], robot)  # type: ignore[arg-type]
+
+
+def _build(robot: RobotModel, text: str) -> Piece:
+    """The piece of an entry made again from its data: a jump's polynomials, or a motion's path and time law."""
     from ..motion.polynomial import PolynomialPiece
 
-    if not isinstance(data, dict):
-        raise ValueError("a piece is a mapping")
-    if data.get("type") == "polynomial":
+    data = json.loads(text)
+    if not isinstance(data, dict) or data.get("type") not in ("polynomial", "motion"):
+        raise ValueError("not a piece's data")
+    if data["type"] == "polynomial":
         return PolynomialPiece(_array(data["breaks"], 1), _array(data["coefficients"], 3))
-    if data.get("type") != "motion":
-        raise ValueError(f"unknown piece {str(data.get('type'))[:40]!r}")
-    duration = float(data["duration"])
-    ends = [_array(e, 2) for e in data["ends"]]
-    if not (math.isfinite(duration) and duration > 0.0) or len(ends) != 3:
-        raise ValueError("a motion's duration and end states")
-    return StoredPiece(duration, tuple(ends), data, robot)  # type: ignore[arg-type]
-
-
-def _build(robot: RobotModel, data: dict[str, Any]) -> Piece:
-    """The motion of an entry (its path and time law made again from their data)."""
     from ..motion.jerk import JerkLaw
     from ..motion.paths import CartesianSegment, JointLine
     from ..motion.trajectory import Motion, ProfileLaw, TrapezoidLaw
@@ -306,21 +313,22 @@ def _build(robot: RobotModel, data: dict[str, Any]) -> Piece:
 
 @dataclass(frozen=True, eq=False)
 class StoredPiece(Piece):
-    """A motion read from the plan cache, rebuilt when it is first sampled inside (module docstring).
+    """A piece read from the plan cache, rebuilt when it is first sampled inside (module docstring).
 
     Its states at both ends are stored: sampling only its ends (a trajectory's continuity check, a table) builds
-    nothing.
+    nothing; a jump's polynomials are checked again when they are built
+    (:class:`~scara_pin.motion.polynomial.PolynomialPiece`'s continuity).
 
     Attributes:
         duration: [s].
         ends: (q, qd, qdd) at its start and end, each (2, dof).
-        data: the entry's data of the piece.
+        data: the entry's data of the piece (JSON text).
         robot: the robot it moves.
     """
 
     duration: float
     ends: tuple[np.ndarray, np.ndarray, np.ndarray]
-    data: dict[str, Any] = field(repr=False)
+    data: str = field(repr=False)
     robot: Any = field(repr=False)
     _built: list[Piece] = field(default_factory=list, init=False, repr=False)
 
@@ -346,6 +354,11 @@ class StoredPiece(Piece):
 
     def breakpoints(self) -> np.ndarray | None:  # noqa: D102
         return self.piece.breakpoints()
+
+
+def built(piece: Piece) -> Piece:
+    """``piece`` itself, or the piece a :class:`StoredPiece` stands for (built now)."""
+    return piece.piece if isinstance(piece, StoredPiece) else piece
 
 
 def stored_or_none(read: Callable[[], Any]) -> Any:

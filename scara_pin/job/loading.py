@@ -49,9 +49,9 @@ Everything that can be checked without a robot is checked here, each refusal a
 steps and points, pallets without enough corners, percentages outside (0, 100], an index past a pallet's
 end (a loop variable's whole range checked against it), loops nested deeper than
 :data:`~scara_pin.limits.MAX_JOB_DEPTH`, and more moves and dwells than
-:data:`~scara_pin.limits.MAX_JOB_STEPS` (counted, never unrolled). With the robot, :meth:`Job.program`
-then checks the points (the pendant's poses against the robot's FK), the pallets' corners (collinear,
-coincident, folded) and every place's reach.
+:data:`~scara_pin.limits.MAX_JOB_STEPS` (counted, never unrolled). With the robot,
+:meth:`~scara_pin.job.spec.JobSpec.program` then checks the points (the pendant's poses against the robot's FK;
+pose points solved), the pallets' corners (collinear, coincident, folded) and every place's reach.
 """
 
 from __future__ import annotations

@@ -48,10 +48,10 @@ import numpy as np
 from ..errors import InvalidInputError, JobFileError, ScaraError
 from ..motion.payload import Payload, PayloadLike, as_payload, with_payload
 from ..motion.polynomial import PolynomialPiece
-from ..motion.trajectory import Trajectory
+from ..motion.trajectory import Piece, Trajectory
 from ..signals import raise_pending
 from .cache import FORMAT as CACHE_FORMAT
-from .cache import PlanStore, cell_digest, decode_trajectory, encode_trajectory, move_key, robot_digest
+from .cache import PlanStore, built, cell_digest, decode_trajectory, encode_trajectory, move_key, robot_digest
 from .results import JobResult, LimitShare, PlacedBox, PlanningStats, StepResult
 from .steps import Dwell, Grip, GripKind, Move, MoveKind, StepKind, located
 
@@ -290,7 +290,8 @@ def _jerks(traj: Trajectory, t: np.ndarray) -> np.ndarray:
     from ..motion.verify import motion_states
 
     out = np.zeros((len(t), traj.dof))
-    for start, end, piece in zip(traj.starts[:-1].tolist(), traj.starts[1:].tolist(), traj.pieces):
+    for start, end, stored in zip(traj.starts[:-1].tolist(), traj.starts[1:].tolist(), traj.pieces):
+        piece = built(stored)
         inside = (t >= start) & (t <= end)
         if not inside.any():
             continue
@@ -427,7 +428,7 @@ class Planner:
             if counted:
                 self.stats = replace(self.stats, cached=self.stats.cached + 1)
         elif back is not None and back.trajectory is not None and back.source is not Source.STILL:
-            piece = back.trajectory.pieces[0]
+            piece = built(back.trajectory.pieces[0])  # a move read from the cache: its polynomial now
             if not isinstance(piece, PolynomialPiece):  # pragma: no cover - jumps are polynomial pieces
                 raise InvalidInputError("a reversed jump needs a polynomial piece")
             limits = scaled_limits(self.robot, move.speed, move.accel)
@@ -456,9 +457,33 @@ def _floats(values: np.ndarray) -> tuple[float, ...]:
     return tuple(float(v) for v in values)
 
 
-def _hold(q: np.ndarray, seconds: float) -> PolynomialPiece:
-    """At rest at ``q`` for ``seconds``: a polynomial piece of degree 0."""
-    return PolynomialPiece(np.array([0.0, seconds]), np.asarray(q, dtype=float)[None, None, :])
+def _hold(q: np.ndarray, seconds: float) -> Rest:
+    """At rest at ``q`` for ``seconds`` (a dwell, a pick, a place)."""
+    return Rest(seconds, np.asarray(q, dtype=float))
+
+
+@dataclass(frozen=True, eq=False)
+class Rest(Piece):
+    """At rest at ``q`` for ``duration`` [s]: a piece of a job's trajectory (a dwell, a pick, a place).
+
+    What a polynomial of degree 0 is, without its checks (a job of thousands of dwells builds thousands).
+
+    Attributes:
+        duration: [s] > 0.
+        q: the joint values held [rad, m].
+    """
+
+    duration: float
+    q: np.ndarray
+
+    def evaluate(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, 0, 0) at every local time."""
+        n = np.asarray(tau).size
+        return np.tile(self.q, (n, 1)), np.zeros((n, self.q.size)), np.zeros((n, self.q.size))
+
+    def jerk(self, tau: np.ndarray) -> np.ndarray:
+        """Zero: at rest."""
+        return np.zeros((np.asarray(tau).size, self.q.size))
 
 
 def plan_job(job: JobSpec, robot: RobotModel, *, progress: Callable[[int, int], None] | None = None,
