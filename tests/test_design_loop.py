@@ -313,3 +313,44 @@ def test_the_job_picture_is_in_the_units_asked_and_its_labels_never_overlap(robo
         files[units] = path.read_bytes()
         assert any(t.get_text().count(",") >= 2 for t in side.texts)  # the three rows' numbers in one label
     assert files[None] != files[HUMAN]
+
+
+def test_moving_the_frame_is_one_option_and_the_page_opens_in_the_units_asked(
+    robot_default: Robot, tmp_path: Path, planned: tuple[Job, object]
+) -> None:  # fmt: skip
+    from scara_pin.job import parse_override
+
+    job, _ = planned
+    x, y, z = (v * 1e3 for v in FRAME)
+    option = Job.load(job.path, [parse_override(f"frames.tray.xyz=[{x + 80.0!r}, {y!r}, {z!r}]")])
+    call = job.with_frame("tray", xyz=[x + 80.0, y, z])
+    assert [getattr(a, "q", None) is not None and np.array_equal(a.q, b.q)  # type: ignore[union-attr]
+            for a, b in zip(option.program(robot_default).actions, call.program(robot_default).actions)
+            if hasattr(a, "q")] == [True] * 4  # fmt: skip
+    for flags, opened in (([], "m"), (["--mm", "--deg"], "mm")):  # every move from the cache: no planning
+        page = tmp_path / f"job{len(flags)}.html"
+        assert main(["job", str(job.path), "--html", str(page), *flags]) == 0
+        html = page.read_text()
+        start = html.index(">", html.index('id="scara-data"')) + 1
+        data = json.loads(html[start : html.index("</script>", start)])
+        assert data["units"] == opened
+        assert {item["text"] for item in data["labels"]} == {"tray[1]", "tray[2]", "feeder"}  # the poses reached
+
+
+def test_the_pendant_records_either_form(robot_default: Robot, tmp_path: Path) -> None:
+    from scara_pin.motion.points import PosePoint, read_points
+    from scara_pin.viz.teach import TeachSession
+
+    q = robot_default.ik_nearest(np.array([0.25, 0.1, -0.08, 7.0]), np.array([0.0, 0.0, 0.0, 6.0]))  # a wrist turn
+    session = TeachSession(robot_default, q, points_file=tmp_path / "points.yaml")
+    session.record("J")
+    session.record("P", form="pose")
+    session.save_points()
+    points = read_points(tmp_path / "points.yaml", robot_default)
+    pose = points["P"]
+    assert isinstance(pose, PosePoint) and pose.hand == robot_default.branch_of(q) and pose.turns == 1
+    assert np.allclose(pose.pose, robot_default.tool_pose(q), atol=1e-12)
+    assert np.allclose(pose.solve(robot_default), q, atol=1e-12)  # its IK: the configuration recorded
+    assert np.array_equal(points.q_of("J"), q)
+    with pytest.raises(Exception, match="CSV points file holds joint points only"):
+        session.save_points(tmp_path / "points.csv")

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import JobFileError, ScaraError
 from ..motion.payload import Payload
+from ..summary import Summarized
 from ..units import SI, DisplayUnits
 from .frames import FrameTree
 from .steps import JumpShape, Program, Step, Target, expand, located
@@ -66,8 +67,8 @@ class Carry:
         return {"shape": self.shape, "size": list(self.size), "xyz": list(self.xyz or ()), "rpy": list(self.rpy)}
 
 
-@dataclass(frozen=True, eq=False, kw_only=True)
-class JobSpec:
+@dataclass(frozen=True, eq=False, kw_only=True, repr=False)
+class JobSpec(Summarized):
     """A job's data: taught points, pallets and steps, checked (:mod:`~scara_pin.job.loading` reads one).
 
     Attributes:
@@ -116,6 +117,25 @@ class JobSpec:
     units: DisplayUnits = SI
     text: str = ""
     overrides: tuple[Override, ...] = ()
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """A few lines: the file, its robot, points, frames, pallets, steps and options (``repr``)."""
+        poses = sum(1 for p in self.points if not hasattr(p, "q"))
+        places = sum(p.places for p in self.pallets.values())
+        lines = [f"Job {self.path}: robot {self.robot or '(any)'}, {len(self.points)} point(s) ({poses} pose "
+                 f"point(s)), {len(self.pallets)} pallet(s) of {places} place(s), {self.actions} moves and dwells"]
+        if self.frames.frames or self.frames.moved:
+            lines.append(f"  frames {', '.join(self.frames.frames) or 'none'}; base "
+                         f"{'placed' if self.frames.moved else 'at the world origin'}")  # fmt: skip
+        options = [f"speed {100 * self.speed:g} %" if self.speed != 1.0 else "",
+                   f"accel {100 * self.accel:g} %" if self.accel != 1.0 else "",
+                   f"jerk {', '.join(f'{v:g}' for v in self.jerk)}" if self.jerk else "",
+                   f"cell {self.cell.name}" if self.cell is not None else "", "carry" if self.carry else "",
+                   f"{len(self.overrides)} override(s): {', '.join(o.key for o in self.overrides)}"
+                   if self.overrides else ""]  # fmt: skip
+        if any(options):
+            lines.append("  " + "; ".join(o for o in options if o))
+        return "\n".join(lines)
 
     def jerk_limits(self, robot: RobotModel) -> tuple[float, ...] | None:
         """The joint jerk limits of the job on ``robot`` [rad/s^3, m/s^3] (one per joint), or None."""
