@@ -634,7 +634,7 @@
   labelLayer.id = "labels";
   labelLayer.style.cssText = "position:absolute;inset:0;pointer-events:none;overflow:hidden;";
   $("scene").appendChild(labelLayer);
-  var labels = [];
+  var labels = [], placing = false;
   function setLabels(group, items) {
     labels = labels.filter(function (l) {
       if (l.group !== group) return true;
@@ -650,25 +650,27 @@
       labelLayer.appendChild(el);
       labels.push({ group: group, xyz: item.xyz, el: el });
     });
+    if (labels.length && !placing) {  // follow the camera on every frame while there are labels, only then
+      placing = true;
+      window.requestAnimationFrame(placeLabels);
+    }
   }
   function placeLabels() {
-    if (labels.length) {
-      var base = node(data.base).object, rect = labelLayer.getBoundingClientRect();
-      base.updateMatrixWorld(true);
-      labels.forEach(function (l) {
-        var v = base.localToWorld(new THREE.Vector3(l.xyz[0], l.xyz[1], l.xyz[2])).project(viewer.camera);
-        var inside = v.z > -1 && v.z < 1 && Math.abs(v.x) <= 1.05 && Math.abs(v.y) <= 1.05;
-        l.el.style.display = inside ? "" : "none";
-        l.el.style.left = ((v.x + 1) / 2 * rect.width) + "px";
-        l.el.style.top = ((1 - v.y) / 2 * rect.height) + "px";
-      });
-    }
+    if (!labels.length) { placing = false; return; }
+    var base = node(data.base).object, rect = labelLayer.getBoundingClientRect();
+    base.updateMatrixWorld(true);
+    labels.forEach(function (l) {
+      var v = base.localToWorld(new THREE.Vector3(l.xyz[0], l.xyz[1], l.xyz[2])).project(viewer.camera);
+      var inside = v.z > -1 && v.z < 1 && Math.abs(v.x) <= 1.05 && Math.abs(v.y) <= 1.05;
+      l.el.style.display = inside ? "" : "none";
+      l.el.style.left = ((v.x + 1) / 2 * rect.width) + "px";
+      l.el.style.top = ((1 - v.y) / 2 * rect.height) + "px";
+    });
     window.requestAnimationFrame(placeLabels);
   }
   var groups = {};
   (data.labels || []).forEach(function (l) { (groups[l.group] = groups[l.group] || []).push(l); });
   Object.keys(groups).forEach(function (g) { setLabels(g, groups[g]); });
-  window.requestAnimationFrame(placeLabels);
 
   if (units !== "mm") {  // open in the units asked for: the switch and every label follow
     var opened = document.querySelector("input[name=units][value=" + units + "]");
