@@ -2,8 +2,8 @@
 """Benchmark: the issue's 4 x 6 tray job (docs/examples/tray) and the palletizer's job (docs/examples/palletizer)
 against their moves planned alone, and the clock.
 
-Run with the project's interpreter (``.venv/bin/python benchmarks/bench_job.py [tray] [palletizer]
-[--variants]``, both jobs by default); reported, not enforced (the suite's tests/test_job_plan.py checks the
+Run with the project's interpreter (``.venv/bin/python benchmarks/bench_job.py [tray] [palletizer] [cache]
+[--variants]``, the two jobs by default); reported, not enforced (the suite's tests/test_job_plan.py checks the
 tray's promises on a 2 x 2 tray, tests/test_job_palletizer.py the palletizer's on the whole job).
 
 The tray:
@@ -30,6 +30,13 @@ The palletizer (2 layers of 3 boxes from a conveyor, issue 28 item 3):
    ``independent_clearance``: coal on Pinocchio's collision model, the boxes from the JSON).
 8. ``--variants``: the same job filled near-first (the boxes carried over the boxes already placed) and with
    10 mm between the boxes instead of 20: whether they plan, and how long that takes.
+
+The design loop (``cache``, issue 34), in a plan cache of its own:
+
+9. the tray job planned once, then run again unchanged ``ROUNDS`` times, each round beside ``python -c "import
+   scara_pin"``, interleaved: the medians of their wall times and their ratio (the promise: at most 1.5);
+10. ``docs/examples/tray/frames.yaml`` (pose points, the tray in a frame), then the tray moved 80 mm with ``--set
+    frames.tray.xyz=[...]``: the moves each run planned and read from the cache, and its wall time.
 """
 
 from __future__ import annotations
@@ -37,6 +44,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import os
 import resource
 import shutil
 import subprocess
@@ -218,8 +226,45 @@ def palletizer(variants: bool) -> None:
                       f"{done.stderr.strip().split(': ', 2)[-1]}")  # fmt: skip
 
 
+ROUNDS = 7
+"""Interleaved rounds of the cached job and of the bare import (their medians are compared)."""
+
+
+def cache() -> None:
+    """The design loop: an unchanged job run again, against Python's start with scara-pin; a moved tray."""
+    import statistics
+
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, SCARA_PIN_CACHE_DIR=tmp)
+        cmd = [sys.executable, "-c", "import sys; from scara_pin.cli import main; sys.exit(main())", "job"]
+
+        def timed(argv: list[str]) -> tuple[float, str]:
+            t0 = time.perf_counter()
+            done = subprocess.run(argv, capture_output=True, text=True, check=True, env=env, cwd=ROOT)
+            return time.perf_counter() - t0, done.stdout
+
+        first, text = timed([*cmd, str(EXAMPLE)])
+        print(f"first      {EXAMPLE.name}: {first:.2f} s wall; {text.strip().splitlines()[-1]}")
+        runs, imports = [], []
+        for _ in range(ROUNDS):
+            imports.append(timed([sys.executable, "-c", "import scara_pin"])[0])
+            wall, text = timed([*cmd, str(EXAMPLE)])
+            runs.append(wall)
+        run, imp = statistics.median(runs), statistics.median(imports)
+        print(f"again      {text.strip().splitlines()[-1]}")
+        print(f"rerun      median of {ROUNDS}: {run:.3f} s wall; `python -c \"import scara_pin\"` {imp:.3f} s: "
+              f"{run / imp:.2f}x")  # fmt: skip
+        frames = EXAMPLE.parent / "frames.yaml"
+        for what, extra in (("frames", []), ("frames again", []),
+                            ("tray moved", ["--set", "frames.tray.xyz=[300,-60,-100]"])):  # fmt: skip
+            wall, text = timed([*cmd, str(frames), *extra])
+            print(f"{what:<10} {wall:.2f} s wall; {text.strip().splitlines()[-1]}")
+
+
 if __name__ == "__main__":
     chosen = [a for a in sys.argv[1:] if not a.startswith("--")] or ["tray", "palletizer"]
+    if "cache" in chosen:
+        cache()
     if "tray" in chosen:
         main_()
     if "palletizer" in chosen:

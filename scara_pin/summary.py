@@ -9,7 +9,6 @@ notebook (Jupyter shows ``_repr_html_``: the same lines, preformatted). Its data
 
 from __future__ import annotations
 
-from html import escape
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -36,4 +35,6 @@ class Summarized:
         return text
 
     def _repr_html_(self) -> str:
+        from html import escape  # here: a command that prints a result does not pay for the html package
+
         return f'<pre class="scara-pin-summary">{escape(repr(self))}</pre>'

@@ -8,7 +8,9 @@ standard :mod:`csv` module (quoting). The rules, the same for every file:
 
 - blank lines and lines starting with ``#`` are skipped;
 - the first other line is the header; the wanted columns are found by name (case and surrounding blanks
-  ignored), other columns are ignored; with ``exact=True`` the header must be exactly the wanted names;
+  ignored), other columns are ignored; with ``exact=True`` the header must be exactly the wanted names; a
+  name may carry its unit in brackets (``q1 [rad]``, as a job's trajectory writes it): with ``units``, it
+  must be one of those the column takes (a file in other units is refused, never read as SI);
 - every data row has as many cells as the header, and the wanted cells are plain numbers
   (no ``nan``, ``inf``, ``1_000``) of magnitude at most
   :data:`scara_pin.limits.MAX_NUMBER`.
@@ -21,7 +23,8 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Callable, Iterator, Sequence
+import re
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
@@ -33,6 +36,9 @@ from .errors import InvalidInputError
 from .limits import MAX_NUMBER, MAX_ROWS, UnreadableFileError, open_regular, text_lines
 
 __all__ = ["csv_rows", "open_csv", "read_csv"]
+
+_UNIT = re.compile(r"^(.*?)\s*\[([^\[\]]*)\]\s*$")
+"""A column name with its unit in brackets: ``q1 [rad]``."""
 
 
 @contextmanager
@@ -60,6 +66,7 @@ def csv_rows(
     max_rows: int = MAX_ROWS,
     progress: Callable[[int], object] | None = None,
     optional: Sequence[str] = (),
+    units: Mapping[str, Collection[str]] | None = None,
 ) -> Iterator[tuple[int, list[float]]]:
     """Stream ``(line number, values of the wanted columns)`` from a CSV file, in bounded memory.
 
@@ -74,6 +81,7 @@ def csv_rows(
         progress: called with the bytes of each line read (for a progress bar).
         optional: column names read when the header has them, their values after the wanted ones; NaN for
             a column the header lacks (a cell is never NaN: ``nan`` is refused).
+        units: for a wanted column, the units its name may carry in brackets (``{"t": ("s",)}``); None: any.
 
     Raises:
         InvalidInputError: unreadable text (see :func:`~scara_pin.limits.text_lines`), not CSV, a header
@@ -96,7 +104,12 @@ def csv_rows(
         header = next(reader, None)
         if header is None:
             raise InvalidInputError(f"{origin}: empty file; the first line must be the header {','.join(columns)}")
-        names = [h.strip().lower() for h in header]
+        names: list[str] = []
+        marked: list[str | None] = []
+        for h in header:
+            m = _UNIT.match(h.strip())
+            names.append((m.group(1) if m else h).strip().lower())
+            marked.append(m.group(2).strip() if m else None)
         if exact and names != wanted:
             raise InvalidInputError(f"{origin}: the first line must be the header {','.join(columns)}")
         missing = [c for c in wanted if c not in names]
@@ -104,6 +117,11 @@ def csv_rows(
             raise InvalidInputError(f"{origin}: the header has no column {', '.join(missing)}; it must name "
                                     f"{','.join(columns)} (header: {','.join(header)[:200]})")  # fmt: skip
         index = [names.index(c) for c in wanted]
+        for c, i in zip(columns, index):
+            allowed, unit = None if units is None else units.get(c), marked[i]
+            if allowed is not None and unit is not None and unit not in allowed:
+                raise InvalidInputError(f"{origin}: column {header[i].strip()[:60]} is in {unit[:20]}; it must be "
+                                        f"in {' or '.join(allowed)} (SI)")  # fmt: skip
         extra = [names.index(c) if c in names else -1 for c in (o.strip().lower() for o in optional)]
         for row in reader:
             if len(row) != len(header):
@@ -122,6 +140,7 @@ def read_csv(
     exact: bool = False,
     max_rows: int = MAX_ROWS,
     optional: Sequence[str] = (),
+    units: Mapping[str, Collection[str]] | None = None,
 ) -> np.ndarray:
     """The wanted columns of a CSV file as an (n, len(columns)) float array, n >= 1 (see :func:`csv_rows`).
 
@@ -132,7 +151,7 @@ def read_csv(
     """
     with open_csv(path) as handle:
         rows = [values for _, values in csv_rows(handle, str(path), columns, exact=exact, max_rows=max_rows,
-                                                 optional=optional)]  # fmt: skip
+                                                 optional=optional, units=units)]  # fmt: skip
     if not rows:
         raise InvalidInputError(f"{path}: no data row after the header")
     return np.array(rows, dtype=float)

@@ -37,6 +37,16 @@ def pytest_unconfigure(config: pytest.Config) -> None:
             os.environ[k] = v
 
 
+@pytest.fixture(autouse=True)
+def _own_plan_cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each test's jobs in a plan cache of their own (scara_pin.job.cache): what one test planned never makes
+    another's moves come from the cache. The description cache stays the session's (robots made once)."""
+    from scara_pin.job.cache import PlanStore
+
+    folder = tmp_path_factory.mktemp("plans")
+    monkeypatch.setattr(PlanStore, "default", classmethod(lambda cls: cls(folder)))
+
+
 @pytest.fixture(scope="session")
 def robot_default() -> Robot:
     """The ``default`` robot (source S4: l1 = l2 = 0.200 m, tool 50 mm below the reference plane)."""

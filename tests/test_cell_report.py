@@ -75,7 +75,10 @@ def test_obstacles_out_of_reach_are_found_and_never_reached(robot) -> None:
     sc = scene(robot, Cell((far, near, high), MARGIN))
     report = check_cell(sc, [("home (q = 0)", np.zeros(4))])
     out = report.find("obstacle-out-of-reach")
-    assert [f.data["obstacle"] for f in out] == ["far", "high"]
+    assert [f.data["obstacle"] for f in out] == ["far"]
+    above = report.find("obstacle-beyond-stroke")  # above the quill's top, inside the footprint: not misplaced
+    assert [(f.severity, f.data["obstacle"]) for f in above] == [("info", "high")]
+    assert "high is above the robot's reach" in above[0].message and "millimetres" not in above[0].message
     assert out[0].data["distance"] == pytest.approx(MARGIN + 1e-3, abs=1e-9)
     assert "reach envelope (a cylinder about the first joint's axis" in out[0].message
     assert report.status == "warnings" and report.exit_code == 4

@@ -53,3 +53,18 @@ def test_the_role_check_catches_a_role(tmp_path: Path) -> None:
     (tmp_path / "cli").mkdir()
     assert len(surviving_roles(tmp_path)) == 1
     assert broken_links(tmp_path) == ["a.html: cli/"]  # a folder: a directory listing from file://
+
+
+def test_the_site_needs_no_internet(tmp_path: Path) -> None:
+    """The site's search opened from disk (issue 34): the offline plugin's worker shim is the site's own copy (it
+    loads it from unpkg.com unless mkdocs.yml names one), and the build refuses any asset from another site."""
+    import yaml
+    from mkdocs_hooks import remote_assets
+
+    (tmp_path / "a.html").write_text('<script src="https://unpkg.com/iframe-worker/shim"></script>'
+                                     '<a href="https://example.org/">read more</a><script src="assets/x.js"></script>')
+    found = remote_assets(tmp_path)  # one: the script; a link to read elsewhere is fine, a local script too
+    assert len(found) == 1 and found[0].startswith('a.html: <script src="https://unpkg.com/iframe-worker/shim">')
+    config = yaml.load((ROOT / "mkdocs.yml").read_text(), Loader=yaml.BaseLoader)  # its python tags left as text
+    shims = [p for p in config["extra"]["polyfills"] if "iframe-worker" in p]
+    assert shims and all((DOCS / p).is_file() and not p.startswith(("http:", "https:", "//")) for p in shims)

@@ -21,6 +21,7 @@ from scara_pin.errors import InvalidInputError, JobFileError
 from scara_pin.job import Job, Order, Pallet, Source
 from scara_pin.job import planning as planning_module
 from scara_pin.limits import MAX_JOB_DEPTH, MAX_JOB_STEPS
+from scara_pin.motion import jump as jump_module
 from scara_pin.motion.points import PointSet, TaughtPoint, write_points
 from scara_pin.viz.teach import TeachSession
 
@@ -65,7 +66,7 @@ def no_planning(monkeypatch: pytest.MonkeyPatch) -> None:
         pytest.fail("a move was planned before the refusal")
 
     monkeypatch.setattr(planning_module, "plan_move", planned)
-    monkeypatch.setattr(planning_module, "jump_move", planned)
+    monkeypatch.setattr(jump_module, "jump_move", planned)
 
 
 # ---------------------------------------------------------------------------------------------- pallets

@@ -10,6 +10,7 @@ Independent routes for every expected value:
   a post planted on the straight line; the carried box, hanging 20 mm below the flange, through a block whose top
   is 5 mm below the flange's path), found by the test's own closed-form FK;
 - the cache: moves counted by the planner's statistics under states the test chooses;
+- what the cell costs: the same jump planned alone without the cell (``jump_move`` without ``cell=``);
 - the part left on the flange: its top face on the flange face (the default carry) is 0 mm from the tool's links.
 
 The palletizer's job (the issue's Must-hold) is tests/test_job_palletizer.py.
@@ -82,6 +83,11 @@ def test_a_jump_in_a_cell_is_the_jump_planned_alone_in_it_and_a_line_through_it_
     assert there["clearance"]["distance"] >= MARGIN - 1e-6  # every checked pair, the robot's own too
     assert back["planned"] == "an earlier jump reversed" and abs(back["duration"] - there["duration"]) <= 1e-12
     assert back["clearance"] is not None and back["clearance"]["distance"] >= MARGIN - 1e-6  # verified in the cell
+    # what the cell costs (issue 34): each move's free-space time is the same jump planned alone without the cell
+    for step in (there, back):
+        assert abs(step["free"] - free.duration) <= 1e-6
+        assert abs(step["cell_cost"] - (alone.duration - free.duration)) <= 1e-6
+    assert abs(out["cell_cost"] - 2.0 * (alone.duration - free.duration)) <= 2e-6
     assert out["cell"]["margin"] == MARGIN and [o["name"] for o in out["cell"]["obstacles"]] == ["post", "stake"]
     # a straight line is a fixed path: through the post, refused (exit 3), naming the pair, at the move's line
     job.write_text(job.read_text().replace("  - jump: feeder\n", "  - move: feeder\n"))

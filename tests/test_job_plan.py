@@ -207,8 +207,9 @@ def test_ctrl_c_during_a_long_job_is_130_and_no_file(robot_default: Robot, tmp_p
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     env.pop("SCARA_PIN_DEBUG", None)
     proc = subprocess.Popen([sys.executable, "-c", "import sys; from scara_pin.cli import main; sys.exit(main())",
-                             "-v", "job", str(job), "--out", "out.csv"], cwd=tmp_path, stderr=subprocess.PIPE,
-                            stdout=subprocess.DEVNULL, text=True, preexec_fn=default_sigint, env=env)  # fmt: skip
+                             "-v", "job", str(job), "--out", "out.csv", "--no-cache"], cwd=tmp_path,
+                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, preexec_fn=default_sigint,
+                            env=env)  # fmt: skip
     assert proc.stderr is not None
     deadline = time.monotonic() + 60
     for text in proc.stderr:  # the first move planned: the job is under way

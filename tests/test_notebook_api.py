@@ -172,3 +172,8 @@ def test_the_tour_notebook_runs_in_a_jupyter_kernel() -> None:
     assert sum("image/png" in o.get("data", {}) for o in outputs) >= 2  # the trajectory and workspace figures
     text = "".join(o.get("text", "") + json.dumps(o.get("data", {}).get("text/plain", "")) for o in outputs)
     assert re.search(r"array\(\[", text)  # FK and IK answers printed
+    # the cell and the job (issue 34): the 3-D view names the post and the points; the job's table, short; a
+    # variant with the tray moved plans only the moves to and from the places that moved
+    assert sum(h.startswith("<iframe srcdoc=") for h in html) >= 2 and any("post" in h and "T11" in h for h in html)
+    assert re.search(r"total     2\.\d+ s: 2 places, [\d,.]+ parts per hour", text)
+    assert "2 moves planned, 2 jumps reversed, 0 repeated, 1 from the cache" in text  # the way home from the cache

@@ -6,7 +6,9 @@
   literal text). Every HTML page and the search index are read; a role (``:func:`solve``` in Markdown,
   ``:func:<code>solve</code>`` once rendered) anywhere is an error naming the page and the role;
 - the site works opened from disk: every local link and asset of every page (``href``, ``src``) names a
-  FILE of the site (a folder would show a directory listing from ``file://``), anchors aside.
+  FILE of the site (a folder would show a directory listing from ``file://``), anchors aside;
+- and without the internet: no page loads a script, a style sheet or an image from another site (issue 34: the
+  search's worker shim came from unpkg.com; it is the site's own copy now, ``docs/assets/javascripts``).
 """
 
 from __future__ import annotations
@@ -57,6 +59,20 @@ def broken_links(site: Path) -> list[str]:
     return broken
 
 
+REMOTE = re.compile(r"""<(?:script|img|iframe)\b[^>]*\bsrc=["'](?:https?:)?//|<link\b[^>]*\bhref=["'](?:https?:)?//""")
+"""A script, image or frame (``src``), or a style sheet or icon (``link href``), loaded from another site."""
+
+
+def remote_assets(site: Path) -> list[str]:
+    """``page: tag`` for each asset a page of the site loads from another site (a link to read elsewhere is fine)."""
+    found = []
+    for page in sorted(site.rglob("*.html")):
+        text = page.read_text(encoding="utf-8", errors="replace")
+        for m in REMOTE.finditer(text):
+            found.append(f"{page.relative_to(site)}: {text[m.start() : m.start() + 100].splitlines()[0]}")
+    return found
+
+
 def on_post_build(config: Any, **kwargs: Any) -> None:
     """Fail the build if a reST role survived into ``site/``, or a local link does not open from disk."""
     site = Path(config["site_dir"])
@@ -67,3 +83,7 @@ def on_post_build(config: Any, **kwargs: Any) -> None:
     broken = broken_links(site)
     if broken:
         raise SiteError("links that do not open from disk (file://) in the built site:\n" + "\n".join(broken[:50]))
+    remote = remote_assets(site)
+    if remote:
+        raise SiteError("assets loaded from another site (the site must work without the internet):\n"
+                        + "\n".join(remote[:50]))  # fmt: skip

@@ -42,15 +42,34 @@ class Obstacle:
         name: its name (unique in the cell).
         shape: its shape, placed in the robot's base frame.
         line: the line of the cell file where it is described (0 when made in Python).
+        margin: [m] the distance kept from this obstacle when it is larger than the cell's margin, or None (the
+            cell's): the obstacle is then checked grown by the difference (:meth:`keep_out`).
     """
 
     name: str
     shape: Shape
     line: int = 0
+    margin: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.margin is not None:
+            m = float(self.margin)
+            if not (math.isfinite(m) and 0.0 <= m <= MAX_MARGIN):
+                raise InvalidInputError(f"obstacle {self.name}: margin {m:.6g} m must be finite, in [0, "
+                                        f"{MAX_MARGIN:g}] m")  # fmt: skip
+            if self.shape.kind == "mesh":
+                self.shape.grown(m)  # refused: a mesh takes the cell's margin
+            object.__setattr__(self, "margin", m)
+
+    def keep_out(self, margin: float) -> Shape:
+        """The shape checked against the cell's ``margin`` [m]: grown by ``self.margin - margin`` when larger."""
+        if self.margin is None or self.margin <= margin:
+            return self.shape
+        return self.shape.grown(self.margin - margin)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {"name": self.name, **self.shape.to_dict()}
+        """JSON-ready (``margin``: its own, when it has one)."""
+        return {"name": self.name, **self.shape.to_dict(), **({} if self.margin is None else {"margin": self.margin})}
 
 
 @dataclass(frozen=True, eq=False)

@@ -11,6 +11,7 @@
         length: 0.20
         xyz: [0.306, -0.052, -0.10]   # the shape's centre (a mesh's origin)
         rpy: [0, 0, 0]                # its orientation, as URDF's (optional)
+        margin: 0.02           # optional: keep 20 mm from this one (more than the cell's margin; not a mesh)
       - name: fixture
         shape: mesh
         file: fixture.stl      # relative to the cell file; STL, DAE or OBJ (read as the viewer reads meshes)
@@ -215,7 +216,12 @@ def _obstacle(reader: _Reader, items: list[Any], i: int, folder: Path | None, me
     if "name" not in item:
         raise reader.error(line, "an obstacle needs a name")
     name = _name(reader, item, "name", "obstacle name")
-    return Obstacle(name, _shape(reader, items, i, f"obstacle {name}", folder, meshes, named=True), line or 0)
+    shape = _shape(reader, items, i, f"obstacle {name}", folder, meshes, named=True)
+    margin = _number(reader, item, "margin", f"obstacle {name}: margin") if "margin" in item else None
+    try:
+        return Obstacle(name, shape, line or 0, margin)
+    except InvalidInputError as exc:
+        raise reader.error(yaml_line(item, "margin"), str(exc)) from None
 
 
 def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | None, meshes: _Meshes, *,
@@ -231,7 +237,7 @@ def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | Non
     kind = d["shape"]
     if kind not in KINDS:
         raise reader.error(yaml_line(d, "shape"), f"{what}: shape {str(kind)[:40]!r} must be one of {', '.join(KINDS)}")
-    allowed = ("name",) * named + ("shape", "xyz", "rpy") + _SHAPE_KEYS[kind] + _OPTIONAL[kind]
+    allowed = ("name", "margin") * named + ("shape", "xyz", "rpy") + _SHAPE_KEYS[kind] + _OPTIONAL[kind]
     for k in d:
         if k not in allowed:
             raise reader.error(yaml_line(d, k), f"{what}: unknown key {str(k)[:40]!r} for a {kind} (keys: "

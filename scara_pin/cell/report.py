@@ -12,8 +12,13 @@ Each rule takes the scene (the robot in its cell) and the configurations to look
   configurations drawn in the limits): motions there are refused (a flange rising into its arm over the top of the
   stroke, a parallelogram's bars meeting);
 - ``obstacle-out-of-reach`` (warning): an obstacle farther than the margin from the robot's REACH ENVELOPE
-  (:func:`reach_envelope`) and from its fixed links: no configuration brings any link (or the carried part)
-  near it; a misplaced obstacle (millimetres written as metres, another frame), or one that does not matter;
+  (:func:`reach_envelope`) and from its fixed links, and outside the envelope's footprint too (beside the robot,
+  not above or below it): no configuration brings any link (or the carried part) near it; a misplaced obstacle
+  (another frame; millimetres written as metres when it is farther from the reach than the reach is wide), or
+  one that does not matter;
+- ``obstacle-beyond-stroke`` (info): an obstacle out of reach but inside the envelope's footprint, above or
+  below it: a table or a tray under the lowest the tool goes, a ceiling; never touched (the part the tool
+  carries, ``--carry``, goes lower than the bare flange);
 - ``home-in-collision`` (warning): the robot at its home (q = 0, or a points file's point ``home``) closer than
   the margin, naming the pair and the distance: every motion from there is refused;
 - ``point-in-collision`` (warning): a taught point closer than the margin (name, pair, distance).
@@ -36,7 +41,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -311,9 +316,11 @@ def _out_of_reach(scene: Scene, configurations: Sequence[tuple[str, np.ndarray]]
     import coal
 
     env = reach_envelope(scene)
-    cylinder, placement = env.geometry(scene.robot.data.oMf[scene.robot.base_id])
+    base = scene.robot.data.oMf[scene.robot.base_id]
+    cylinder, placement = env.geometry(base)
     gm = scene.geometry_model
     fixed = [i for i, g in enumerate(gm.geometryObjects) if g.parentJoint == 0 and not g.name.startswith("obstacle:")]
+    column, column_at = replace(env, low=-MAX_STROKE, high=MAX_STROKE).geometry(base)  # the envelope's footprint
     out = []
     for o in scene.cell.obstacles:
         index = gm.getGeometryId(f"obstacle:{o.name}")
@@ -323,12 +330,24 @@ def _out_of_reach(scene: Scene, configurations: Sequence[tuple[str, np.ndarray]]
         near_fixed = [gm.geometryObjects[i].name for i in fixed
                       if _distance(gm.geometryObjects[i].geometry, _transform(gm.geometryObjects[i]), obj.geometry, M)
                       <= scene.margin]  # fmt: skip
-        if d > scene.margin and not near_fixed:
-            out.append(CellFinding("warning", "obstacle-out-of-reach",
-                                   f"obstacle {o.name} is out of reach: {d:.6g} m from the robot's reach envelope "
-                                   f"({env.describe()}), more than the margin {scene.margin * 1e3:g} mm: no "
-                                   "configuration brings it near the robot (misplaced? millimetres as metres?)",
-                                   {"obstacle": o.name, "distance": d}))  # fmt: skip
+        if d <= scene.margin or near_fixed:
+            continue
+        data = {"obstacle": o.name, "distance": d}
+        if _distance(column, column_at, obj.geometry, M) <= scene.margin:  # above or below the reach: not misplaced
+            heights = (o.shape.corners() - env.point) @ env.axis  # along the first joint's axis
+            where = "below" if float(heights.max()) < env.low else "above"
+            lower = (" (a part the tool carries reaches lower than the bare flange: --carry, or the cell's "
+                     "carried:)") if where == "below" and scene.cell.carried is None else ""  # fmt: skip
+            out.append(CellFinding("info", "obstacle-beyond-stroke",
+                                   f"obstacle {o.name} is {where} the robot's reach: {d:.6g} m from its reach "
+                                   f"envelope, inside its footprint; no link ever comes within the margin "
+                                   f"{scene.margin * 1e3:g} mm of it{lower}", data))  # fmt: skip
+            continue
+        units = " millimetres as metres?" if d > env.radius else ""
+        out.append(CellFinding("warning", "obstacle-out-of-reach",
+                               f"obstacle {o.name} is out of reach: {d:.6g} m from the robot's reach envelope "
+                               f"({env.describe()}), more than the margin {scene.margin * 1e3:g} mm: no "
+                               f"configuration brings it near the robot (misplaced?{units})", data))  # fmt: skip
     return out
 
 

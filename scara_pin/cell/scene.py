@@ -278,8 +278,9 @@ class Scene:
                                                               cell.carried.geometry(solid=True)))  # fmt: skip
             names.append(CARRIED)
         for o in cell.obstacles:
-            gm.addGeometryObject(pin.GeometryObject(f"obstacle:{o.name}", 0, 0, base * o.shape.placement(),
-                                                    o.shape.geometry()))  # fmt: skip
+            shape = o.keep_out(cell.margin)  # an obstacle asking for more than the margin: checked grown by the rest
+            gm.addGeometryObject(pin.GeometryObject(f"obstacle:{o.name}", 0, 0, base * shape.placement(),
+                                                    shape.geometry()))  # fmt: skip
             names.append(o.name)
         return gm, names, len(geo.links), carried
 

@@ -127,6 +127,30 @@ class Shape:
 
         return pin.SE3(self.rotation, self.xyz)
 
+    def grown(self, by: float) -> Shape:
+        """The shape made ``by`` [m] larger all round, holding every point within ``by`` of it.
+
+        A box's edges + 2 by, a cylinder's radius + by and length + 2 by, a sphere's radius + by: exact on the
+        faces, a little more at a box's and a cylinder's edges and corners (sound, never short).
+
+        Raises:
+            InvalidInputError: a mesh (no sound growth of any triangle soup), or ``by`` < 0.
+        """
+        if not (math.isfinite(by) and by >= 0.0):
+            raise InvalidInputError(f"{self.what}: a growth of {by!r} m must be finite and >= 0")
+        if by == 0.0:
+            return self
+        if self.kind == "mesh":
+            raise InvalidInputError(f"{self.what}: a mesh takes the cell's margin (a margin of its own needs a box, a "
+                                    "cylinder or a sphere)")  # fmt: skip
+        if self.kind == "box":
+            size: tuple[float, ...] = tuple(v + 2.0 * by for v in self.size)
+        elif self.kind == "cylinder":
+            size = (self.size[0] + by, self.size[1] + 2.0 * by)
+        else:
+            size = (self.size[0] + by,)
+        return Shape(self.kind, size, self.xyz, self.rpy, what=self.what)
+
     def moved(self, frameMshape: pin.SE3, what: str | None = None) -> Shape:
         """The same shape placed at ``frameMshape * self.placement()`` (e.g. a carried box put down)."""
         import pinocchio as pin

@@ -70,7 +70,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"scara-pin {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
+    sub = _Commands(parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser))
     target: Any = sub if command is None else _OneCommand(sub, command)
     names = list(dict.fromkeys(COMMANDS.values())) if command not in COMMANDS else [COMMANDS[command]]
     for name in names:
@@ -96,6 +96,19 @@ class _Ignored:
 
     def set_defaults(self, **kwargs: Any) -> None:  # noqa: D102
         return None
+
+
+class _Commands:
+    """The subparsers; every command takes ``-v`` after its name too (``scara-pin job J.yaml -v``, as docs write)."""
+
+    def __init__(self, sub: Any) -> None:
+        self._sub = sub
+
+    def add_parser(self, name: str, **kwargs: Any) -> Any:  # noqa: D102
+        p = self._sub.add_parser(name, **kwargs)
+        # SUPPRESS: given before the command, the top level's value stands (a default here would overwrite it)
+        p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="log details to stderr")
+        return p
 
 
 class _OneCommand:

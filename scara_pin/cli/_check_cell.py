@@ -29,15 +29,16 @@ def report_with_cell(args: argparse.Namespace, report: CheckReport) -> int:
     """
     from ..errors import InvalidInputError
 
-    if getattr(args, "cell", None) is None:
+    if getattr(args, "cell", None) is None and getattr(args, "carry", None) is None:
         if getattr(args, "points", None) is not None or getattr(args, "margin", None) is not None:
-            raise InvalidInputError("--points and --margin of check go with --cell")
+            raise InvalidInputError("--points and --margin of check go with --cell (or --carry)")
         print(report.to_json() if args.json else report.format_text())
         return int(report.exit_code)
     cell_doc: dict[str, Any]
+    source = args.cell if args.cell is not None else args.carry
     if report.exit_code == 2:
-        cell_doc = {"source": args.cell, "status": "unchecked", "reason": "the URDF is unusable"}
-        text = f"{args.cell}: unchecked (the URDF is unusable)"
+        cell_doc = {"source": source, "status": "unchecked", "reason": "the URDF is unusable"}
+        text = f"{source}: unchecked (the URDF is unusable)"
         code = 2
     else:
         cell_report = _cell_report(args)
@@ -62,17 +63,25 @@ def _cell_report(args: argparse.Namespace) -> Any:
     from ..robots import load_urdf
     from ._numbers import parse_locks
 
-    robot = load_urdf(args.file, tool=args.tool, base=args.base, package_path=args.package_path or (),
-                      lock=parse_locks(args.lock))  # fmt: skip
+    if getattr(args, "robot", None) is not None:
+        from ..robots import load_robot
+        from ._numbers import parse_sets
+
+        robot = load_robot(args.robot, parse_sets(args.set), tool=args.tool, base=args.base,
+                           lock=parse_locks(args.lock))  # fmt: skip
+    else:
+        robot = load_urdf(args.file, tool=args.tool, base=args.base, package_path=args.package_path or (),
+                          lock=parse_locks(args.lock))  # fmt: skip
     cell = cell_from_args(args)
     taught: list[tuple[str, Any]] = []
     home = ("home (q = 0)", np.zeros(robot.dof))
     if args.points is not None:
         from ..motion.points import read_points
 
-        for point in read_points(args.points, robot).points:
-            if point.name == "home":
-                home = ("home (point home of the points file)", point.q)
+        points = read_points(args.points, robot).resolved(robot, origin=f"points file {args.points}")
+        for name in points.names:
+            if name == "home":
+                home = ("home (point home of the points file)", points.q_of(name))
             else:
-                taught.append((point.name, point.q))
-    return check_cell(scene(robot, cell), [home, *taught], source=args.cell)
+                taught.append((name, points.q_of(name)))
+    return check_cell(scene(robot, cell), [home, *taught], source=args.cell if args.cell is not None else args.carry)

@@ -44,14 +44,17 @@ def add_units(
         p.add_argument("--json", action="store_true", help=json_help)
 
 
-def add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True) -> None:
-    """The group ``robot``: ``--robot``, ``--set`` and, with ``urdf_file``, ``--urdf`` and the frame options."""
+def add_robot_options(p: argparse.ArgumentParser, urdf_file: bool = True, set_help: str | None = None) -> None:
+    """The group ``robot``: ``--robot``, ``--set`` and, with ``urdf_file``, ``--urdf`` and the frame options.
+
+    ``set_help``: what ``--set`` says it does, for a command whose ``--set`` takes more than the robot's parameters.
+    """
     g = p.add_argument_group("robot")
     g.add_argument("--robot", default=None, metavar="NAME|CONFIG_DIR",
                    help="shipped robot name (see `scara-pin robots`) or a folder of yaml files "
                    "(default: default)")  # fmt: skip
     g.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a parameter, SI units (e.g. --set l1=0.25); repeatable")  # fmt: skip
+                   help=set_help or "override a parameter, SI units (e.g. --set l1=0.25); repeatable")  # fmt: skip
     if urdf_file:
         g.add_argument("--urdf", metavar="FILE", help="load this URDF file (or .xacro file, expanded: it runs "
                        "the expressions written in it) instead of a configured robot")  # fmt: skip
@@ -82,6 +85,8 @@ def add_cell_options(p: argparse.ArgumentParser, *, margin: bool = True) -> None
         g.add_argument("--margin", type=number_type("--margin"), metavar="M",
                        help="the smallest distance kept to any obstacle [m, or mm with --mm], instead of the "
                        "cell file's")  # fmt: skip
+    g.add_argument("--carry", metavar="FILE", help="the part the tool carries: a job file's carry: (or a file holding "
+                   "{shape: box, size, xyz}); it collides as the job's part does (docs/job.md)")  # fmt: skip
 
 
 def add_acceleration(p: Any) -> None:

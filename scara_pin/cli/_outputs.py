@@ -12,7 +12,7 @@ from ._robot import MAX_NAME
 log = logging.getLogger("scara_pin")
 """The logger of the command line's warnings (``warning: ...`` on stderr; :func:`scara_pin.cli.main`)."""
 
-INPUT_OPTIONS = ("urdf", "dh", "points", "measurements", "input", "traj", "simulate", "cell", "file")
+INPUT_OPTIONS = ("urdf", "dh", "points", "measurements", "input", "traj", "simulate", "cell", "carry", "file")
 """The options that name a file a command reads (those it has)."""
 
 

@@ -59,9 +59,9 @@ def _load(args: argparse.Namespace, robot: Robot, names: list[str]) -> PointSet:
     """
     from ..motion.points import read_points
 
-    points = read_points(args.points, robot)
+    points = read_points(args.points, robot).resolved(robot, origin=f"points file {args.points}")  # poses: their IK
     for name in names:
-        outside = robot.outside_limits(points[name].q, tol=1e-12)  # an unknown name: exit 2 naming the known ones
+        outside = robot.outside_limits(points.q_of(name), tol=1e-12)  # an unknown name: exit 2 naming the known ones
         if outside:
             raise InfeasibleError(f"points file {args.points}: point {name} is outside the joint limits: "
                                   + "; ".join(outside))  # fmt: skip
@@ -96,7 +96,7 @@ def use_points(args: argparse.Namespace, robot: Robot, units: Units, command: st
             raise InvalidInputError(f"--points --through replaces {', '.join(taken)}: give one or the other")
         points = _load(args, robot, names)
         scale = units.scale(units.q)
-        qs = [[_text(v, s) for v, s in zip(points[n].q, scale, strict=True)] for n in names]
+        qs = [[_text(v, s) for v, s in zip(points.q_of(n), scale, strict=True)] for n in names]
         args.from_q, args.to_q, args.via = qs[0], qs[-1], qs[1:-1] or None
         return
     names = [n for n in (args.from_point, args.to_point) if n is not None]
@@ -112,7 +112,7 @@ def use_points(args: argparse.Namespace, robot: Robot, units: Units, command: st
     if taken:
         raise InvalidInputError(f"--from-point/--to-point replace {', '.join(taken)}: give one or the other")
     points = _load(args, robot, names)
-    a, b = (robot.tool_pose(robot.check_q(points[n].q)) for n in names)
+    a, b = (robot.tool_pose(robot.check_q(points.q_of(n))) for n in names)
     dz, dyaw = float(b[2] - a[2]), math.remainder(float(b[3] - a[3]), 2 * math.pi)
     if abs(dz) > _SAME or abs(dyaw) > _SAME:
         raise InvalidInputError(f"the standard cycle's two ends share one height and yaw; {names[1]} differs from "

@@ -80,19 +80,34 @@ def with_acceleration(args: argparse.Namespace, robot: Robot, units: Units) -> R
 
 
 def cell_from_args(args: argparse.Namespace, units: Units | None = None) -> Any:
-    """The cell named by ``--cell`` (with ``--margin``), or None; the margin in the typed length unit."""
+    """The cell named by ``--cell`` (with ``--margin``), with the part of ``--carry`` on the tool, or None.
+
+    The margin is in the typed length unit; ``--carry`` alone is a cell of no obstacle holding that part (the
+    default margin).
+    """
     path = getattr(args, "cell", None)
     margin = getattr(args, "margin", None)
-    if path is None:
+    carry = getattr(args, "carry", None)
+    if path is None and carry is None:
         if margin is not None:
             raise UsageError("--margin needs --cell")
         return None
-    from ..cell import load_cell
+    from ..cell import Cell, load_cell
 
     if margin is not None and units is not None:
         margin = margin / units.length
     packages = tuple(getattr(args, "package_path", None) or ())
-    return load_cell(path, margin=margin, package_dirs=packages)
+    cell = load_cell(path, margin=margin, package_dirs=packages) if path is not None else None
+    if carry is None:
+        return cell
+    from ..job.loading import read_carry
+
+    part = read_carry(carry).part()
+    if cell is None:
+        return Cell(margin=Cell().margin if margin is None else margin, carried=part, origin=f"the part of {carry}")
+    if cell.carried is not None:
+        raise InvalidInputError(f"--carry {carry} and the cell file {path}'s carried: name two parts: give one")
+    return cell.with_carried(part)
 
 
 def payload_from_args(args: argparse.Namespace, units: Units) -> Any:

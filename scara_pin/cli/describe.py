@@ -96,10 +96,22 @@ def cmd_check(args: argparse.Namespace) -> int:
         else:
             print(rules_text())
         return 0
-    if args.file is None:
-        raise InvalidInputError("check needs a FILE.urdf (or --list-rules)")
-    from ..lint import check_urdf_file
     from ._check_cell import report_with_cell
+
+    if args.robot is not None:  # a configured robot: its generated URDF (what every command loads)
+        from ..description import generate_urdf
+        from ..lint import check_urdf
+
+        if args.file is not None:
+            raise InvalidInputError("give either FILE.urdf or --robot NAME to check, not both")
+        text = generate_urdf(args.robot, parse_sets(args.set))
+        return report_with_cell(args, check_urdf(text, origin=f"robot {args.robot}", tool=args.tool, base=args.base,
+                                                 lock=parse_locks(args.lock)))  # fmt: skip
+    if args.set:
+        raise InvalidInputError("--set overrides a configured robot's parameters: it goes with --robot")
+    if args.file is None:
+        raise InvalidInputError("check needs a FILE.urdf, --robot NAME (or --list-rules)")
+    from ..lint import check_urdf_file
 
     report = check_urdf_file(args.file, tool=args.tool, base=args.base, package_dirs=args.package_path or (),
                              lock=parse_locks(args.lock))
@@ -122,7 +134,12 @@ def register(sub: Any) -> None:
     p.add_argument("file", metavar="FILE.urdf", nargs="?", help="the URDF (or .xacro, expanded) to check")
     p.add_argument("--list-rules", action="store_true", help="print the rules of check, one line each, and exit")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    add_frame_options(p.add_argument_group("robot"))
+    g = p.add_argument_group("robot")
+    g.add_argument("--robot", default=None, metavar="NAME|CONFIG_DIR", help="check a configured robot (its generated "
+                   "URDF; see `scara-pin robots`) instead of a FILE")  # fmt: skip
+    g.add_argument("--set", action="append", metavar="KEY=VALUE", help="with --robot: override a parameter, SI units "
+                   "(e.g. --set l1=0.25); repeatable")  # fmt: skip
+    add_frame_options(g)
     from ._check_cell import add_check_cell_options
 
     add_check_cell_options(p)

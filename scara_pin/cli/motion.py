@@ -6,11 +6,10 @@ import argparse
 import json
 import logging
 import sys
-from pathlib import Path
 from typing import Any
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
-from ..files import outputs_together, write_text_atomic
+from ..files import outputs_together
 from ..units import format_number, format_vector
 from ._joints import joint_arg, needs_wrist, read_pose
 from ._numbers import jerk_limits, number, number_type
@@ -18,6 +17,7 @@ from ._options import add_acceleration, add_cell_options, add_robot_options, add
 from ._outputs import check_command_outputs, log
 from ._points import add_points_options, use_points
 from ._robot import cell_from_args, payload_from_args, robot_from_args, with_acceleration
+from ._setpoints import add_setpoint_options, check_setpoint_options, write_setpoints
 from ._units import POSE_KINDS, Units
 from .cycle import cell_summary, cell_text
 
@@ -133,7 +133,6 @@ def cmd_traj(args: argparse.Namespace) -> int:
 
 
 _ARCH_ONLY = ("rise", "blend", "clearance_radius", "max_height", "path")
-_SETPOINTS_ONLY = ("setpoint_rate", "delays", "gear", "steps_per_rev", "screw_lead")
 
 
 def _flag(name: str) -> str:
@@ -142,9 +141,7 @@ def _flag(name: str) -> str:
 
 def _arch_options(args: argparse.Namespace) -> None:
     """Refuse (exit 2) an option given with a motion kind it does not act on, naming the combination."""
-    for name in _SETPOINTS_ONLY:
-        if getattr(args, name) is not None and not args.setpoints:
-            raise InvalidInputError(f"{_flag(name)} shapes the controller setpoints: it needs --setpoints")
+    check_setpoint_options(args)
     if not args.arch:
         for name in _ARCH_ONLY:
             if getattr(args, name) is not None:
@@ -161,26 +158,6 @@ def _arch_options(args: argparse.Namespace) -> None:
         raise InvalidInputError("--payload changes only the torques: give --torque too")
 
 
-def _write_setpoints(args: argparse.Namespace, robot: Any, traj: Any, units: Units) -> None:
-    """``--setpoints``: the controller setpoints of ``traj`` (motor steps, latency compensation), atomically."""
-    from ..motion import trajectory as tr
-
-    motor = None
-    if args.gear or args.steps_per_rev or args.screw_lead is not None:
-        if not (args.gear and args.steps_per_rev and args.screw_lead is not None):
-            raise InvalidInputError("motor steps need --gear G1..G4, --steps-per-rev S1..S4 and --screw-lead L")
-        motor = tr.MotorUnits.from_drive(
-            [number("--gear", g) for g in args.gear],
-            [number("--steps-per-rev", v) for v in args.steps_per_rev],
-            units.value("--screw-lead", args.screw_lead, "length"),
-            prismatic=robot.joint_kinds.index("length"),
-        )
-    delays = [number("--delays", d) for d in args.delays] if args.delays else None
-    rate = args.setpoint_rate if args.setpoint_rate is not None else args.rate
-    sp = traj.setpoints(rate, delays=delays, motor=motor)
-    write_text_atomic(Path(args.setpoints), sp.csv_text())
-
-
 def _write_outputs(args: argparse.Namespace, robot: Any, traj: Any, units: Units, law: str,
                    tool_speed: float | None) -> dict[str, str]:  # fmt: skip
     """``--out``, ``--setpoints``, ``--plot`` (the planned ``robot`` carries the payload): what was written, by kind."""
@@ -190,7 +167,7 @@ def _write_outputs(args: argparse.Namespace, robot: Any, traj: Any, units: Units
             traj.save(args.out, rate=args.rate)
             outputs["trajectory"] = str(args.out)
         if args.setpoints:
-            _write_setpoints(args, robot, traj, units)
+            write_setpoints(args, robot, traj, units)
             outputs["setpoints"] = args.setpoints
         if args.plot:
             from ..viz.plots import plot_trajectory
@@ -361,13 +338,7 @@ def register(sub: Any) -> None:
     g.add_argument("--out", metavar="FILE", help="samples t, q, qd, qdd as CSV (or JSON for *.json), atomically")
     g.add_argument("--plot", metavar="PNG", help="each joint's q, qd, qdd (and torque with --torque) against "
                    "time with its limits, in the units of --mm/--deg; the tool path and speed (.png, .svg, .pdf)")
-    g.add_argument("--setpoints", metavar="CSV", help="controller setpoints (S4) at --setpoint-rate")
-    g.add_argument("--setpoint-rate", type=number_type("--setpoint-rate"), metavar="HZ",
-                   help="setpoint rate (default: --rate)")  # fmt: skip
-    g.add_argument("--delays", nargs="+", metavar="S", help="per-axis command latency [s], compensated")
-    g.add_argument("--gear", nargs=4, metavar="G", help="gear ratios (motor turns per joint/screw turn)")
-    g.add_argument("--steps-per-rev", nargs=4, metavar="N", help="motor steps per motor turn")
-    g.add_argument("--screw-lead", metavar="L", help="quill screw travel per turn [m, or mm with --mm]")
+    add_setpoint_options(g)
     add_units(p, inputs=True, json_help="print one JSON object (with the samples unless --out)")
     add_robot_options(p)
     add_cell_options(p)

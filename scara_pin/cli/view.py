@@ -42,9 +42,14 @@ def cmd_view(args: argparse.Namespace) -> int:
         from ..viz.inline import workspace_polylines
 
         polylines = workspace_polylines(robot)
+    targets, names = None, None
+    if args.points:  # taught points: small frames at their poses, named on the page
+        from ..viz.inline import point_poses
+
+        targets, names = point_poses(robot, args.points)
     if args.html:
-        viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines,
-                        title=f"scara-pin: {robot.name}", cell=cell)  # fmt: skip
+        viz.export_html(robot, args.html, q=q, times=times, qs=qs, polylines=polylines, targets=targets,
+                        title=f"scara-pin: {robot.name}", cell=cell, target_names=names)  # fmt: skip
         print(f"wrote {args.html} (self-contained; open it from disk, no network needed)")
         return 0
     with viz.Viewer(robot, open=args.open) as viewer:
@@ -52,6 +57,8 @@ def cmd_view(args: argparse.Namespace) -> int:
             viewer.draw_polylines(polylines)
         if cell is not None:
             viewer.draw_cell(cell)
+        if targets is not None:
+            viewer.draw_targets(targets)
         if times is not None and qs is not None:
             viewer.draw_tool_path(qs)
             viewer.animate(times, qs, loop=True)
@@ -77,6 +84,8 @@ def register(sub: Any) -> None:
     p.add_argument("--workspace", action="store_true",
                    help="draw the workspace boundary (SCARA: on the floor; palletizer: its envelope in 3-D)")
     p.add_argument("--html", metavar="FILE", help="write one self-contained HTML page (works offline) and exit")
+    p.add_argument("--points", metavar="FILE", help="a points file (of `teach`): each point drawn at its pose as a "
+                   "small frame, named on the --html page")  # fmt: skip
     p.add_argument("--open", action="store_true", help="open the page in the web browser")
     add_units(p, json_help=None)
     add_robot_options(p)

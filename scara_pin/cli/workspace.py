@@ -116,7 +116,7 @@ def _free_workspace(args: argparse.Namespace, robot: Robot, units: Units, cell: 
         raise InvalidInputError("--ray/--z/--dz do not go with --cell (the ray meets the joint limits' edge only)")
     z = units.value("--height", args.height, "length")
     h = None if args.resolution is None else units.value("--resolution", args.resolution, "length")
-    yaw = None if args.yaw is None else number("--yaw", args.yaw)
+    yaw = None if args.yaw is None else units.value("--yaw", args.yaw, "angle")
     region = free_region(robot, cell, z, resolution=h, yaw=yaw)
     if args.plot:
         plot_free_region(region, args.plot, units=units.display, robot_name=robot.name)
@@ -174,9 +174,9 @@ def register(sub: Any) -> None:
                    "region reachable there with every link clear of the cell by its margin (a raster)")  # fmt: skip
     g.add_argument("--resolution", metavar="H", help="the raster's spacing [m, or mm with --mm] (default: the "
                    "workspace's width / 200)")  # fmt: skip
-    g.add_argument("--yaw", metavar="A", help="one tool yaw for every point [rad] (default: free with a carried "
-                   "part, the first of 12 that clears; else 0)")  # fmt: skip
-    add_units(p, deg=False)
+    g.add_argument("--yaw", metavar="A", help="one tool yaw for every point [rad, or deg with --deg] (default: free "
+                   "with a carried part, the first of 12 that clears; else 0)")  # fmt: skip
+    add_units(p)
     add_robot_options(p)
     add_cell_options(p)
     p.set_defaults(func=cmd_workspace)

@@ -45,12 +45,22 @@ from ..errors import YamlError
 from ..limits import MAX_YAML_DEPTH, MAX_YAML_NODES
 from ..units import NUMBER_TEXT, number_text
 
-__all__ = ["load_yaml", "unit_tags", "yaml_line"]
+__all__ = ["Tagged", "load_yaml", "unit_tags", "yaml_line"]
 
 _INT_DIGITS = 18
 """Longest integer (digits) read as an int; a longer one is read as a float (``int()`` of thousands of digits
 is slow, and past 4,300 refused by Python)."""
 _INTEGER = re.compile(r"[+-]?[0-9]+", re.ASCII)
+
+
+class Tagged(float):
+    """A number written with a unit tag (``!millimeters 150``): a float, already in SI units.
+
+    A reader whose file names its own units (a job's ``units: mm,deg``) scales the plain numbers and leaves
+    these as they are.
+    """
+
+    __slots__ = ()
 
 
 class _YamlMap(dict):  # type: ignore[type-arg]
@@ -215,7 +225,7 @@ def _loader() -> type:
             text = loader.construct_scalar(node)
             value = number_text(text)
             # left as text: the caller refuses it, naming the parameter and file
-            return f"{node.tag} {text}" if math.isnan(value) else value * scale
+            return f"{node.tag} {text}" if math.isnan(value) else Tagged(value * scale)
 
         Loader.add_constructor(tag, construct_unit)
     return Loader

@@ -4,7 +4,16 @@ The format (docs/job.md has it beside its SPEL+ and RAPID equivalents)::
 
     format: scara-pin job 1          # optional; checked when present
     robot: default                   # optional; the robot the job is for (checked against the one planning it)
-    points: points.yaml              # the taught points (the pendant's file), relative to this file
+    units: mm,deg                    # optional: the lengths and angles of this file (default m, rad)
+    points: points.yaml              # the taught points (the pendant's file: joint or pose points, SI)
+    frames:                          # optional: frames in the cell (SPEL+'s Local), in their parent (default world)
+      tray: {xyz: [220, -60, -100], yaw: 0, parent: world}
+    base: {xyz: [0, 0, 0], yaw: 0}   # optional: the robot's base in the cell's world frame
+    poses:                           # optional: pose points written here, in a frame (default world)
+      T11: {xyz: [0, 0, 0], yaw: 28.6, hand: right, turns: 0, frame: tray}
+    speed: 100                       # optional: every move's velocity limits times this % too (the override)
+    accel: 100                       # optional: every move's acceleration limits times this % too
+    jerk: 2000                       # optional: joint jerk limits, one or one per joint [rad/s^3, m/s^3]
     start: feeder                    # optional: where the robot is when the job begins (default: the first target)
     jump: {rise: 0.025, clearance_radius: 0.005, max_height: 0.0}   # optional: every jump's clearance
     torque: false                    # optional: also respect the effort limits (with payload: the load)
@@ -25,9 +34,13 @@ opening during S seconds at rest); each place leaves a box that every later move
 "Palletizing"). A pick while holding, a place while empty, grips without ``carry`` and ``carry`` without grips
 are refused here (:func:`~scara_pin.job.steps.check_grips`).
 
-Values may carry xacro's unit tags (``!millimeters 150``, ``!degrees 90``); lengths are metres, times
-seconds. The file is read through the package's one yaml loader
-(:func:`~scara_pin.description.yaml_units.load_yaml`, its caps included) and sized first
+Lengths are metres and angles radians unless ``units:`` names others (``mm,deg``: then every length and angle
+of the file, poses, frames, the base, clearances, the carry, and the jerk limits per joint kind, is in those);
+values may carry xacro's unit tags (``!millimeters 150``, ``!degrees 90``), read as written whatever ``units:``
+says; times are seconds, ``speed`` and ``accel`` percentages. ``read_job(path, overrides)`` replaces values at
+dotted keys before the checks (:mod:`~scara_pin.job.overrides`: ``--set frames.tray.xyz=[...]``). The file is
+read through the package's one yaml loader (:func:`~scara_pin.description.yaml_units.load_yaml`, its caps
+included) and sized first
 (:data:`~scara_pin.limits.MAX_JOB_BYTES`); its node tree (composed a second time, never constructed) gives
 the line of each value for the messages.
 
@@ -36,20 +49,22 @@ Everything that can be checked without a robot is checked here, each refusal a
 steps and points, pallets without enough corners, percentages outside (0, 100], an index past a pallet's
 end (a loop variable's whole range checked against it), loops nested deeper than
 :data:`~scara_pin.limits.MAX_JOB_DEPTH`, and more moves and dwells than
-:data:`~scara_pin.limits.MAX_JOB_STEPS` (counted, never unrolled). With the robot, :meth:`Job.program`
-then checks the points (the pendant's poses against the robot's FK), the pallets' corners (collinear,
-coincident, folded) and every place's reach.
+:data:`~scara_pin.limits.MAX_JOB_STEPS` (counted, never unrolled). With the robot,
+:meth:`~scara_pin.job.spec.JobSpec.program` then checks the points (the pendant's poses against the robot's FK;
+pose points solved), the pallets' corners (collinear, coincident, folded) and every place's reach.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, NoReturn
 
-from ..errors import InvalidInputError, JobFileError
+import numpy as np
+
+from ..errors import InvalidInputError, JobFileError, ParameterError
 from ..limits import (
     MAX_DOCUMENT_BYTES,
     MAX_DWELL,
@@ -60,7 +75,10 @@ from ..limits import (
     read_text,
 )
 from ..motion.payload import Payload
-from ..motion.points import PointSet, check_point_name, read_points
+from ..motion.points import PointSet, PosePoint, check_point_name, read_points
+from ..units import SI, DisplayUnits
+from .frames import BASE, WORLD, Frame, FrameTree
+from .overrides import Override, apply_overrides
 from .pallets import Order, Pallet
 from .spec import Carry, JobSpec
 from .steps import (
@@ -80,24 +98,36 @@ from .steps import (
     tally,
 )
 
-__all__ = ["FORMAT", "read_job"]
+__all__ = ["FORMAT", "KEYS", "read_carry", "read_job"]
 
 FORMAT = "scara-pin job 1"
 """The ``format:`` value of a job file."""
 
-_KEYS = ("format", "robot", "points", "start", "jump", "torque", "payload", "cell", "carry", "pallets", "steps")
+KEYS = ("format", "robot", "units", "points", "frames", "base", "poses", "speed", "accel", "jerk", "start", "jump",
+        "torque", "payload", "cell", "carry", "pallets", "steps")
+"""The top-level keys of a job file (an override's first name is one of them)."""
+_POSE_KEYS = ("xyz", "yaw", "hand", "turns", "frame")
 _PALLET_KEYS = ("corners", "rows", "columns", "layers", "layer_height")
 _JUMP_KEYS = ("rise", "clearance_radius", "max_height")
 _STEP_KINDS = "speed, accel, jump, move, go, dwell, pick, place, for"
 
 
 class _At:
-    """A value of the job file and the line where it is written; :meth:`fail` refuses it, naming the line."""
+    """A value of the job file and the line where it is written; :meth:`fail` refuses it, naming the line.
 
-    def __init__(self, value: Any, path: Path, name: str, line: int | None) -> None:
+    A value an override put there (:mod:`~scara_pin.job.overrides`), or inside one, has no line: its messages name
+    the override (``origin``). ``units`` are the file's (its ``units:``): :meth:`length` and :meth:`angle` read in
+    them.
+    """
+
+    def __init__(self, value: Any, path: Path, name: str, line: int | None, units: DisplayUnits = SI,
+                 placed: dict[int, dict[Any, str]] | None = None, origin: str | None = None) -> None:  # fmt: skip
         self.value, self.path, self.name, self.line = value, path, name, line
+        self.units, self.placed, self.origin = units, placed or {}, origin
 
     def fail(self, reason: str) -> NoReturn:
+        if self.origin is not None:
+            raise JobFileError(self.path, None, f"{self.origin}: {reason}")
         raise JobFileError(self.path, self.line, reason)
 
     def child(self, key: str | int, name: str | None = None) -> _At:
@@ -105,8 +135,26 @@ class _At:
         from ..description.yaml_units import yaml_line
 
         label = name if name is not None else (f"{self.name}[{key}]" if isinstance(key, int) else str(key))
+        origin = self.origin or self.placed.get(id(self.value), {}).get(key)
         line = yaml_line(self.value, key)
-        return _At(self.value[key], self.path, label, self.line if line is None else line)
+        return _At(self.value[key], self.path, label, self.line if line is None else line, self.units, self.placed,
+                   origin)  # fmt: skip
+
+    def length(self, rule: Callable[[float], bool], what: str) -> float:
+        """A length in the file's units [m] (a unit-tagged value as tagged): checked by ``rule`` as written."""
+        return self._scaled("length", rule, what)
+
+    def angle(self, rule: Callable[[float], bool], what: str) -> float:
+        """An angle in the file's units [rad] (a unit-tagged value as tagged)."""
+        return self._scaled("angle", rule, what)
+
+    def _scaled(self, kind: str, rule: Callable[[float], bool], what: str) -> float:
+        from ..description.yaml_units import Tagged
+
+        scale = self.units.scale(kind)
+        if isinstance(self.value, Tagged) or scale == 1.0:
+            return self.number(rule, what, "m" if kind == "length" else "rad")
+        return self.number(rule, what, self.units.name(kind)) / scale
 
     def mapping(self, keys: tuple[str, ...], required: tuple[str, ...] = ()) -> dict[str, _At]:
         """The entries of a mapping with only ``keys`` (and every ``required`` one)."""
@@ -156,31 +204,50 @@ def _shown(value: object) -> str:
     return text if len(text) <= 40 else text[:40] + "..."
 
 
-def read_job(path: str | Path) -> JobSpec:
+def read_job(path: str | Path, overrides: Iterable[Override] = (), *, text: str | None = None) -> JobSpec:
     """Read a job file and check it (module docstring); the points file is read too.
 
     :func:`~scara_pin.job.job.load_job` gives it as the :class:`~scara_pin.job.job.Job` users hold.
 
+    Args:
+        path: the job file (names the job in messages; its folder is where its points and cell files are).
+        overrides: values replaced at their dotted keys before the checks (:mod:`~scara_pin.job.overrides`).
+        text: the job file's text, read before (a variant of a job read once); None: read ``path``.
+
     Raises:
-        JobFileError: the file, the line and the reason of the first problem (exit 2).
+        JobFileError: the file, the line (or the override) and the reason of the first problem (exit 2).
         InvalidInputError: the file cannot be read (missing, not a regular file, over its cap, not UTF-8).
     """
     from ..description.yaml_units import load_yaml, yaml_line
     from ..errors import YamlError
 
     path = Path(path)
-    text = read_text(check_input_file(path, "job file", MAX_JOB_BYTES), "job file", MAX_JOB_BYTES)
+    if text is None:
+        text = read_text(check_input_file(path, "job file", MAX_JOB_BYTES), "job file", MAX_JOB_BYTES)
     try:
         data = load_yaml(text, str(path))  # the one bounded loader: every value knows its line
     except YamlError as exc:
         raise JobFileError(path, exc.line, exc.problem if exc.refused else f"not valid YAML ({exc.problem})") from None
-    top = _At(data, path, "the job", yaml_line(data))
-    entries = top.mapping(_KEYS, required=("points", "steps"))
+    overrides = tuple(overrides)
+    try:
+        data, placed = apply_overrides(data, overrides)
+    except InvalidInputError as exc:
+        raise JobFileError(path, None, str(exc)) from None
+    top = _At(data, path, "the job", yaml_line(data), placed=placed)
+    if isinstance(data, dict) and "units" in data:
+        top.units = _units(top.child("units"))
+    entries = top.mapping(KEYS, required=("steps",))
+    if "points" not in entries and "poses" not in entries:
+        top.fail("the job needs points: (the pendant's points file) or poses: (pose points written here), or both")
     lines = {k: at.line for k, at in entries.items()}
     if "format" in entries and entries["format"].value != FORMAT:
         entries["format"].fail(f"format {_shown(entries['format'].value)} is not {FORMAT!r}")
     robot = entries["robot"].text() if "robot" in entries else None
-    points_file, points = _points(entries["points"], path)
+    points_file, points = _points(entries["points"], path) if "points" in entries else (None, PointSet())
+    frames = _frames(entries)
+    if "poses" in entries:
+        points = _poses(entries["poses"], points)
+    _pose_frames(points, frames, entries)
     pallets = {}
     if "pallets" in entries:
         items = entries["pallets"]
@@ -197,6 +264,9 @@ def read_job(path: str | Path) -> JobSpec:
         entries["payload"].fail("a payload changes only the torques: set torque: true too")
     cell = _cell(entries["cell"], path) if "cell" in entries else None
     carry = _carry(entries["carry"]) if "carry" in entries else None
+    speed = _percent(entries["speed"]) / 100.0 if "speed" in entries else 1.0
+    accel = _percent(entries["accel"]) / 100.0 if "accel" in entries else 1.0
+    jerk = _jerk(entries["jerk"]) if "jerk" in entries else None
     start = None
     if "start" in entries:
         start = _target(entries["start"], points, pallets, {})
@@ -209,8 +279,128 @@ def read_job(path: str | Path) -> JobSpec:
     if count > MAX_JOB_STEPS:
         steps_at.fail(f"the steps expand to {count:,} moves and dwells, above the cap of {MAX_JOB_STEPS:,} "
                       "(MAX_JOB_STEPS): split the job")  # fmt: skip
-    return JobSpec(path, points_file, points, pallets, steps, robot, start, shape, torque, payload, cell, carry, count,
-                   dwell, lines)  # fmt: skip
+    return JobSpec(path=path, points_file=points_file, points=points, pallets=pallets, steps=steps, robot=robot,
+                   start=start, jump=shape, torque=torque, payload=payload, cell=cell, carry=carry, actions=count,
+                   dwell=dwell, lines=lines, frames=frames, speed=speed, accel=accel, jerk=jerk, units=top.units,
+                   text=text, overrides=overrides)  # fmt: skip
+
+
+def read_carry(path: str | Path) -> Carry:
+    """The part a job carries, for the pendant and ``check --cell`` (``--carry FILE``).
+
+    A job file's ``carry:`` (in its ``units:``), or a file that is that mapping itself (``{shape: box, size:
+    [...], xyz: [...]}``).
+
+    Raises:
+        JobFileError: no carry, or one the job would refuse (the file and the line).
+        InvalidInputError: the file cannot be read.
+    """
+    from ..description.yaml_units import load_yaml, yaml_line
+    from ..errors import YamlError
+
+    path = Path(path)
+    text = read_text(check_input_file(path, "carry file", MAX_JOB_BYTES), "carry file", MAX_JOB_BYTES)
+    try:
+        data = load_yaml(text, str(path))
+    except YamlError as exc:
+        raise JobFileError(path, exc.line, exc.problem if exc.refused else f"not valid YAML ({exc.problem})") from None
+    top = _At(data, path, "the file", yaml_line(data))
+    if not isinstance(data, dict):
+        top.fail("a carry file is a job file with carry:, or the carry itself: {shape: box, size: [x, y, z], xyz: "
+                 "[...]}")  # fmt: skip
+    if "units" in data:
+        top.units = _units(top.child("units"))
+    if "shape" in data:
+        return _carry(top)
+    if "carry" not in data:
+        top.fail("no carry: in this file (a job's part: carry: {shape: box, size: [x, y, z], xyz: [...]})")
+    return _carry(top.child("carry"))
+
+
+def _units(at: _At) -> DisplayUnits:
+    """``units: mm,deg`` (a text, or a list ``[mm, deg]``): the file's lengths and angles."""
+    value = at.value
+    if isinstance(value, list) and all(isinstance(v, str) for v in value):
+        value = ",".join(value)
+    if not isinstance(value, str):
+        at.fail("units must name a length unit and an angle unit, e.g. units: mm,deg (m or mm; rad or deg)")
+    try:
+        return DisplayUnits.parse(value)
+    except ParameterError:
+        at.fail(f"units {_shown(value)} must name units among m, mm (lengths) and rad, deg (angles), e.g. mm,deg")
+
+
+def _placement(at: _At, keys: tuple[str, ...]) -> dict[str, Any]:
+    """``{xyz, yaw[, parent]}`` of a frame or of the base, in the file's units, SI out."""
+    entries = at.mapping(keys)
+    out: dict[str, Any] = {}
+    if "xyz" in entries:
+        out["xyz"] = _three(entries["xyz"], "xyz is 3 lengths [{unit}] (x, y, z in the parent frame)", kind="length")
+    if "yaw" in entries:
+        out["yaw"] = entries["yaw"].angle(math.isfinite, "a number (the turn about the parent's z axis)")
+    if "parent" in entries:
+        out["parent"] = entries["parent"].text(32)
+    return out
+
+
+def _frames(entries: Mapping[str, _At]) -> FrameTree:
+    """The job's ``frames:`` and ``base:`` (module docstring of :mod:`~scara_pin.job.frames`)."""
+    frames: dict[str, Frame] = {}
+    if "frames" in entries:
+        items = entries["frames"]
+        if not isinstance(items.value, dict):
+            items.fail("frames must be a mapping of names to {xyz, yaw, parent}")
+        for name in items.value:
+            at = items.child(name, f"frame {name}")
+            if not isinstance(name, str) or not VARIABLE.fullmatch(name) or name in (WORLD, BASE):
+                at.fail(f"frame name {_shown(name)} must be a letter or _ then letters, digits or _ (not world, base)")
+            frames[name] = Frame(**_placement(at, ("xyz", "yaw", "parent")))
+    base = Frame(**_placement(entries["base"], ("xyz", "yaw"))) if "base" in entries else Frame()
+    try:
+        return FrameTree(frames, base)
+    except InvalidInputError as exc:
+        entries["frames"].fail(str(exc))
+
+
+def _poses(at: _At, points: PointSet) -> PointSet:
+    """``poses:``: pose points written in the job, in its units, each name new to the points file."""
+    if not isinstance(at.value, dict) or not at.value:
+        at.fail("poses must be a mapping of names to {xyz, yaw, hand[, turns, frame]}")
+    for name in at.value:
+        item = at.child(name, f"pose {name}")
+        try:
+            check_point_name(name)
+        except InvalidInputError:
+            item.fail(f"pose name {_shown(name)} must be a letter then up to 31 letters, digits, _, - or .")
+        if name in points:
+            item.fail(f"pose {name} has the name of a point of the points file: name it otherwise")
+        keys = item.mapping(_POSE_KEYS, required=("xyz", "yaw", "hand"))
+        xyz = _three(keys["xyz"], "xyz is 3 lengths [{unit}] (the tool's position in its frame)", kind="length")
+        yaw = keys["yaw"].angle(math.isfinite, "a number (the tool's yaw in its frame)")
+        turns = keys["turns"].whole(-1000, 1000) if "turns" in keys else 0
+        frame = keys["frame"].text(32) if "frame" in keys else ""
+        try:
+            points = points.added(PosePoint(name, np.array(xyz), yaw, keys["hand"].text(16), turns, frame))
+        except InvalidInputError as exc:
+            item.fail(str(exc))
+    return points
+
+
+def _pose_frames(points: PointSet, frames: FrameTree, entries: Mapping[str, _At]) -> None:
+    """Every pose point's frame is one of the job's (or world, base)."""
+    for p in points:
+        if isinstance(p, PosePoint) and p.frame and p.frame not in (WORLD, BASE) and p.frame not in frames.frames:
+            where = entries["poses"] if "poses" in entries and p.name in entries["poses"].value else entries["points"]
+            where.fail(f"point {p.name} is in frame {p.frame}, which the job does not have (frames: "
+                       f"{', '.join([WORLD, BASE, *frames.frames])})")  # fmt: skip
+
+
+def _jerk(at: _At) -> tuple[float, ...]:
+    """``jerk: J`` or ``[J1, J2, J3, J4]``: > 0, in the file's units per joint kind (scaled with the robot)."""
+    values = at.elements() if isinstance(at.value, list) else [at]
+    if len(values) not in (1, 4):
+        at.fail("jerk is one number or one per joint (4)")
+    return tuple(v.number(lambda x: x > 0, "> 0 (a joint jerk limit)", "per s^3") for v in values)
 
 
 def _points(at: _At, job: Path) -> tuple[Path, PointSet]:
@@ -233,9 +423,11 @@ def _carry(at: _At) -> Carry:
     keys = at.mapping(("shape", "size", "xyz", "rpy"), required=("shape", "size"))
     if keys["shape"].value != "box":
         keys["shape"].fail(f"carry shape {_shown(keys['shape'].value)} is not one scara-pin knows (box)")
-    size = _three(keys["size"], "a box's size is 3 lengths [m] (x, y, z in the tool frame)", lambda v: v > 0, "> 0")
-    xyz = _three(keys["xyz"], "xyz is 3 lengths [m] (the part's centre in the tool frame)") if "xyz" in keys else None
-    rpy = (_three(keys["rpy"], "rpy is 3 angles [rad] (roll, pitch, yaw in the tool frame)", unit="rad")
+    size = _three(keys["size"], "a box's size is 3 lengths [{unit}] (x, y, z in the tool frame)", lambda v: v > 0,
+                  "> 0", kind="length")  # fmt: skip
+    xyz = (_three(keys["xyz"], "xyz is 3 lengths [{unit}] (the part's centre in the tool frame)", kind="length")
+           if "xyz" in keys else None)  # fmt: skip
+    rpy = (_three(keys["rpy"], "rpy is 3 angles [{unit}] (roll, pitch, yaw in the tool frame)", kind="angle")
            if "rpy" in keys else None)  # fmt: skip
     carry = Carry("box", size, xyz, rpy or (0.0, 0.0, 0.0))
     try:
@@ -246,11 +438,13 @@ def _carry(at: _At) -> Carry:
 
 
 def _three(at: _At, what: str, rule: Callable[[float], bool] = math.isfinite, rule_text: str = "a number",
-           unit: str = "m") -> tuple[float, float, float]:  # fmt: skip
+           kind: str = "length") -> tuple[float, float, float]:  # fmt: skip
+    """Three lengths (or angles) in the file's units, SI out."""
     values = at.elements()
     if len(values) != 3:
-        at.fail(what)
-    a, b, c = (v.number(rule, rule_text, unit) for v in values)
+        at.fail(what.format(unit=at.units.name(kind)))
+    read = _At.length if kind == "length" else _At.angle
+    a, b, c = (read(v, rule, rule_text) for v in values)
     return a, b, c
 
 
@@ -279,10 +473,8 @@ def _payload(at: _At) -> Payload:
     mass = keys["mass"].number(lambda v: v >= 0, ">= 0", "kg")
     com = (0.0, 0.0, 0.0)
     if "com" in keys:
-        values = keys["com"].elements()
-        if len(values) != 3:
-            keys["com"].fail("com is 3 lengths [m] (x, y, z in the tool frame)")
-        com = tuple(v.number(lambda _: True, "a number", "m") for v in values)  # type: ignore[assignment]
+        com = _three(keys["com"], "com is 3 lengths [{unit}] (x, y, z in the tool frame)", lambda _: True,
+                     kind="length")  # fmt: skip
     return Payload(mass, com)
 
 
@@ -292,8 +484,8 @@ def _shape(keys: Mapping[str, _At]) -> dict[str, float]:
     for name in _JUMP_KEYS:
         if name in keys:
             positive = name != "max_height"
-            out[name] = keys[name].number((lambda v: v > 0) if positive else (lambda _: True),
-                                          "> 0" if positive else "a number", "m")  # fmt: skip
+            out[name] = keys[name].length((lambda v: v > 0) if positive else (lambda _: True),
+                                          "> 0" if positive else "a number")  # fmt: skip
     return out
 
 
@@ -314,7 +506,7 @@ def _pallet(at: _At, name: str, points: PointSet) -> Pallet:
     rows = keys["rows"].whole(1, MAX_JOB_STEPS)
     columns = keys["columns"].whole(1, MAX_JOB_STEPS)
     layers = keys["layers"].whole(1, MAX_JOB_STEPS) if "layers" in keys else 1
-    height = keys["layer_height"].number(lambda v: v > 0, "> 0", "m") if "layer_height" in keys else 0.0
+    height = keys["layer_height"].length(lambda v: v > 0, "> 0") if "layer_height" in keys else 0.0
     try:
         return Pallet(name, tuple(corners), rows, columns, layers, height)
     except InvalidInputError as exc:

@@ -6,6 +6,15 @@ step's time they are there, largest first; a move on which none reaches it names
 parts per hour count every arrival at a pallet's place (a part picked from or put into it) over the total.
 A palletizing job (``carry`` with ``pick`` and ``place`` steps) also gives the boxes it placed, where and when
 (:class:`PlacedBox`), the boxes per hour, and in a cell each move's closest pair.
+
+**What the cell costs.** In a cell (the job's obstacles, or the boxes it places) each move is also planned
+without the cell (:meth:`~scara_pin.job.planning.Planner.free`): its time in free space is the table's ``free
+[s]`` column, and the difference, summed, the cell's cost of the whole job (:attr:`JobResult.cell_cost`).
+
+**Steady state.** The total counts the way in and the way out (a move home after the last part); a cell making
+parts runs the loop again and again. One period of the loop (:attr:`JobResult.period`) is the span of the
+job's top-level steps that reach the pallet places, from the first to the last of them: the steady-state rate is
+3600 x places / period parts per hour (:attr:`JobResult.steady_parts_per_hour`).
 """
 
 from __future__ import annotations
@@ -14,19 +23,50 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..summary import Summarized
 from ..units import format_number
+from .steps import StepKind
 
 if TYPE_CHECKING:
     from ..cell import Cell, Obstacle, Shape
-    from ..motion.jump import Binding
     from ..motion.trajectory import Trajectory
     from ..motion.verify import Clearance
+    from ..units import DisplayUnits
 
-__all__ = ["JobResult", "PlacedBox", "PlanningStats", "StepResult"]
+__all__ = ["JobResult", "LimitShare", "PlacedBox", "PlanningStats", "StepResult"]
+
+_ROWS_SHOWN = 6
+"""Rows of the table a result's summary shows at each end (its ``repr``; :meth:`JobResult.table` has them all)."""
 
 
-@dataclass(frozen=True, eq=False)
-class PlacedBox:
+@dataclass(frozen=True)
+class LimitShare:
+    """A limit on a step of a job: its largest |value| / limit there and the share of the step's time at >= 99.9 %.
+
+    Attributes:
+        quantity: "velocity", "acceleration", "jerk", "torque" or "tool speed".
+        joint: the joint ("tool" for the tool speed).
+        ratio: its largest |value| / limit on the step.
+        share: the fraction of the step's time it is at >= :data:`~scara_pin.motion.jump.BINDING` of the limit.
+    """
+
+    quantity: str
+    joint: str
+    ratio: float
+    share: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"quantity": self.quantity, "joint": self.joint, "ratio": self.ratio, "share": self.share}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> LimitShare:
+        """From :meth:`to_dict`'s (``KeyError``, ``ValueError``: not one)."""
+        return cls(str(data["quantity"]), str(data["joint"]), float(data["ratio"]), float(data["share"]))
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class PlacedBox(Summarized):
     """A box a job's ``place`` left: an obstacle of the cell for every move after it.
 
     Attributes:
@@ -48,40 +88,59 @@ class PlacedBox:
         """The box's shape, in the base frame."""
         return self.obstacle.shape
 
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """One line: the box, where and when it was left."""
+        from ..units import SI
+
+        u = units or SI
+        return (f"PlacedBox {self.name} at {self.at} (step {self.step}, t = {self.time:.6f} s): centre "
+                f"{u.format_vector(self.shape.xyz, 'length')} [{u.length}] in base")  # fmt: skip
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (SI): name, step, at, time and the shape (``shape``, sizes, ``xyz``, ``rpy`` in base)."""
         return {"name": self.name, "step": self.step, "at": self.at, "time": self.time, **self.shape.to_dict()}
 
 
-@dataclass(frozen=True)
-class PlanningStats:
+@dataclass(frozen=True, repr=False)
+class PlanningStats(Summarized):
     """How the moves of a job were obtained.
 
     Attributes:
         planned: moves planned (solved) by the planners.
         same: moves that were a move planned before (same ends, limits, clearance, obstacles).
         reversed: jumps that were a jump planned before, played backwards.
+        cached: moves read from the plan cache (:mod:`~scara_pin.job.cache`), planned by an earlier run.
+        free: moves planned without the cell for the cost column (not counted above).
         seconds: [s] the wall time of the planning and verification.
     """
 
     planned: int = 0
     same: int = 0
     reversed: int = 0
+    cached: int = 0
+    free: int = 0
     seconds: float = 0.0
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """One line, as the table's last."""
+        free = f" (and {self.free} in free space for the cell's cost)" if self.free else ""
+        return (f"{self.planned} moves planned, {self.reversed} jumps reversed, {self.same} repeated, {self.cached} "
+                f"from the cache{free}; {self.seconds:.3g} s")  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
-        return {"planned": self.planned, "same": self.same, "reversed": self.reversed, "seconds": self.seconds}
+        return {"planned": self.planned, "same": self.same, "reversed": self.reversed, "cached": self.cached,
+                "free": self.free, "seconds": self.seconds}  # fmt: skip
 
 
-@dataclass(frozen=True, eq=False)
-class StepResult:
-    """One row of a job's table: a move or a dwell.
+@dataclass(frozen=True, eq=False, repr=False)
+class StepResult(Summarized):
+    """One row of a job's table: a move, a dwell, a pick or a place.
 
     Attributes:
         index: its number in the program, from 1.
         line: the line of its step in the job file.
-        kind: "jump", "move", "go" or "dwell".
+        kind: jump, move, go, dwell, pick or place (:class:`~scara_pin.job.steps.StepKind`, a str enum).
         origin: where it starts (a point's name or a place, ``tray[5]``).
         target: where it ends.
         t_start, t_end: [s] in the job.
@@ -98,18 +157,20 @@ class StepResult:
         clearance: in a cell, the move's smallest distance of a checked pair, which and when (from the move's
             start), from the 10 kHz verification; None for a dwell or without a cell.
         box: the box a place step leaves, else None.
+        free: [s] in a cell, the same move planned without the cell (the cost column); None otherwise.
+        top: the index (from 0) of the job's top-level step this row comes from (loops unrolled).
     """
 
     index: int
     line: int | None
-    kind: str
+    kind: StepKind
     origin: str
     target: str
     t_start: float
     t_end: float
     place: tuple[str, int] | None = None
-    binding: tuple[Binding, ...] = ()
-    worst: Binding | None = None
+    binding: tuple[LimitShare, ...] = ()
+    worst: LimitShare | None = None
     speed: float | None = None
     accel: float | None = None
     planned: str = ""
@@ -121,11 +182,27 @@ class StepResult:
     boxes: int = 0
     clearance: Clearance | None = None
     box: PlacedBox | None = None
+    free: float | None = None
+    top: int = 0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kind", StepKind(self.kind))
 
     @property
     def duration(self) -> float:
         """[s]."""
         return self.t_end - self.t_start
+
+    @property
+    def cell_cost(self) -> float | None:
+        """[s] the time the cell adds to this move (its time in the cell minus in free space), or None."""
+        return None if self.free is None else self.duration - self.free
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """One line: the row of the table."""
+        cost = "" if self.cell_cost is None else f" (+{self.cell_cost:.6f} s for the cell)"
+        return (f"StepResult {self.index} (line {self.line}): {self.kind} {self.origin} -> {self.target}, "
+                f"{self.duration:.6f} s{cost}: {self.binding_text()}")  # fmt: skip
 
     def binding_text(self) -> str:
         """What binds, as the table says it."""
@@ -156,6 +233,7 @@ class StepResult:
             "clearance": None if self.clearance is None else {**self.clearance.to_dict(),
                                                               "t": self.t_start + self.clearance.time},
             "box": None if self.box is None else self.box.to_dict(),
+            "free": self.free, "cell_cost": self.cell_cost,
         }  # fmt: skip
 
 def _percent(share: float) -> str:
@@ -163,9 +241,9 @@ def _percent(share: float) -> str:
     return "<1 %" if 100.0 * share < 0.5 else f"{100.0 * share:.0f} %"
 
 
-@dataclass(frozen=True, eq=False)
-class JobResult:
-    """A job planned: its steps, time, throughput and trajectory.
+@dataclass(frozen=True, eq=False, repr=False)
+class JobResult(Summarized):
+    """A job planned: its steps, time, throughput and trajectory (``repr``: the table's ends and totals).
 
     Attributes:
         path: the job file.
@@ -205,42 +283,112 @@ class JobResult:
         return 3600.0 * len(self.boxes) / self.total if self.boxes else None
 
     @property
+    def loop(self) -> tuple[StepResult, StepResult] | None:
+        """The first and last rows of one period of the loop (module docstring), or None when no place is reached."""
+        tops = {s.top for s in self.steps if s.place is not None}
+        if not tops:
+            return None
+        rows = [s for s in self.steps if min(tops) <= s.top <= max(tops)]
+        return rows[0], rows[-1]
+
+    @property
+    def period(self) -> float | None:
+        """[s] one period of the loop: the time of the top-level steps that reach the places (module docstring)."""
+        loop = self.loop
+        return None if loop is None else loop[1].t_end - loop[0].t_start
+
+    @property
+    def steady_parts_per_hour(self) -> float | None:
+        """3600 x places / :attr:`period`: the rate of the loop run again and again, or None without places."""
+        period = self.period
+        return None if period is None or not period > 0 else 3600.0 * self.places / period
+
+    @property
+    def cell_cost(self) -> float | None:
+        """[s] what the cell adds to the job: the moves' time in the cell minus in free space; None without a cell."""
+        costs = [s.cell_cost for s in self.steps if s.cell_cost is not None]
+        return sum(costs) if costs else None
+
+    @property
     def closest(self) -> StepResult | None:
         """In a cell, the move whose clearance is the smallest of the job (None without a cell)."""
         moves = [s for s in self.steps if s.clearance is not None]
         return min(moves, key=lambda s: s.clearance.distance) if moves else None  # type: ignore[union-attr]
 
-    def table(self) -> str:
-        """The text table: one row per step, then the total and the parts per hour (module docstring)."""
+    def table(self, units: DisplayUnits | None = None) -> str:
+        """The text table: one row per step, then the total and the parts per hour (module docstring).
+
+        Args:
+            units: the lengths of the cell line (default: millimetres); times are seconds.
+        """
+        return "\n".join([*self._rows(self.steps), self._totals(units)])
+
+    def _rows(self, steps: tuple[StepResult, ...]) -> list[str]:
+        """The title, the header and the rows of ``steps`` (columns as wide as the whole table's)."""
         wide = max([4, *(len(s.origin) for s in self.steps), *(len(s.target) for s in self.steps)])
-        head = (f"{'step':>5} {'line':>5}  {'kind':<5}  {'from':<{wide}}  {'to':<{wide}}  {'time [s]':>9}  "
+        costed = any(s.free is not None for s in self.steps)
+        free_head = f"{'free [s]':>9}  " if costed else ""
+        head = (f"{'step':>5} {'line':>5}  {'kind':<5}  {'from':<{wide}}  {'to':<{wide}}  {'time [s]':>9}  {free_head}"
                 "binds (share of the step's time at >= 99.9 % of the limit)")  # fmt: skip
         lines = [f"job       {self.path} on robot {self.robot}", head]
-        for s in self.steps:
+        for s in steps:
             line = "" if s.line is None else str(s.line)
+            free = "" if not costed else (f"{s.free:9.6f}  " if s.free is not None else " " * 11)
             lines.append(f"{s.index:>5} {line:>5}  {s.kind:<5}  {s.origin:<{wide}}  {s.target:<{wide}}  "
-                         f"{s.duration:9.6f}  {s.binding_text()}")  # fmt: skip
+                         f"{s.duration:9.6f}  {free}{s.binding_text()}")  # fmt: skip
+        return lines
+
+    def _totals(self, units: DisplayUnits | None) -> str:
+        """The lines after the rows: total and rates, the steady state, the boxes, the cell, the planning."""
+
+        def length(value: float, fmt: str = ".4g") -> str:
+            if units is None:
+                return f"{value * 1e3:{fmt}} mm"
+            return f"{units.format(value, 'length')} {units.length}"
+
         rate = self.parts_per_hour
-        lines.append(f"total     {format_number(self.total, 6)} s"
-                     + (f": {self.places} places, {rate:,.1f} parts per hour" if rate is not None else ""))  # fmt: skip
+        lines = [f"total     {format_number(self.total, 6)} s"
+                 + (f": {self.places} places, {rate:,.1f} parts per hour" if rate is not None else "")]  # fmt: skip
+        loop, steady = self.loop, self.steady_parts_per_hour
+        if loop is not None and steady is not None:
+            lines.append(f"steady    {format_number(self.period or 0.0, 6)} s per period of the loop (steps "
+                         f"{loop[0].index}-{loop[1].index}, {self.places} places): {steady:,.1f} parts per hour")
         if self.boxes:
             lines.append(f"boxes     {len(self.boxes)} placed, {self.boxes_per_hour:,.1f} boxes per hour")
-        closest = self.closest
-        if closest is not None and closest.clearance is not None and self.cell is not None:
-            c = closest.clearance
-            lines.append(f"cell      {self.cell.origin}: {len(self.cell.obstacles)} obstacle(s), margin "
-                         f"{self.cell.margin * 1e3:g} mm; closest {c.pair} {c.distance * 1e3:.4g} mm (step "
-                         f"{closest.index}, t = {closest.t_start + c.time:.4f} s)")  # fmt: skip
-        st = self.stats
-        lines.append(f"planning  {st.planned} moves planned, {st.reversed} jumps reversed, {st.same} repeated; "
-                     f"{st.seconds:.3g} s")  # fmt: skip
+        closest, cost = self.closest, self.cell_cost
+        if self.cell is not None or cost is not None:
+            words = [f"cell      {self.cell.origin if self.cell is not None else 'the boxes'}"]
+            if self.cell is not None:
+                words.append(f": {len(self.cell.obstacles)} obstacle(s), margin {length(self.cell.margin, 'g')}")
+            if cost is not None:
+                words.append(f"; costs {cost:.6f} s over the same moves in free space ({100 * cost / self.total:.2f} % "
+                             "of the total)")
+            if closest is not None and closest.clearance is not None:
+                c = closest.clearance
+                words.append(f"; closest {c.pair} {length(c.distance)} (step {closest.index}, t = "
+                             f"{closest.t_start + c.time:.4f} s)")  # fmt: skip
+            lines.append("".join(words))
+        lines.append(f"planning  {self.stats.summary()}")
         return "\n".join(lines)
+
+    def summary(self, units: DisplayUnits | None = None) -> str:
+        """The table's first and last rows and its totals (:meth:`table` has every row): one screen."""
+        n = _ROWS_SHOWN
+        if len(self.steps) <= 2 * n:
+            return self.table(units)
+        rows = [*self._rows(self.steps[:n]), f"  ... ({len(self.steps) - 2 * n} more rows: .table() lists them all)",
+                *self._rows(self.steps[-n:])[2:]]  # fmt: skip
+        return "\n".join([*rows, self._totals(units)])
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (SI units)."""
-        closest = self.closest
+        closest, loop = self.closest, self.loop
+        steady = None if loop is None else {"period": self.period, "first_step": loop[0].index,
+                                            "last_step": loop[1].index, "places": self.places,
+                                            "parts_per_hour": self.steady_parts_per_hour}  # fmt: skip
         return {"job": str(self.path), "robot": self.robot, "total": self.total, "places": self.places,
-                "parts_per_hour": self.parts_per_hour, "steps": [s.to_dict() for s in self.steps],
+                "parts_per_hour": self.parts_per_hour, "steady_state": steady, "cell_cost": self.cell_cost,
+                "steps": [s.to_dict() for s in self.steps],
                 "boxes": [b.to_dict() for b in self.boxes], "boxes_per_hour": self.boxes_per_hour,
                 "carry": None if self.carry is None else self.carry.to_dict(),
                 "cell": None if self.cell is None else self.cell.to_dict(),

@@ -37,7 +37,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import InfeasibleError, InvalidInputError, JobFileError, JobStepError, NoSolutionError, ScaraError
-from ..motion.jump import STANDARD_CLEARANCE, STANDARD_RISE
 from .pallets import Order, Pallet
 
 if TYPE_CHECKING:
@@ -56,6 +55,7 @@ __all__ = [
     "Program",
     "Setting",
     "Step",
+    "StepKind",
     "Target",
     "check_grips",
     "expand",
@@ -70,8 +70,8 @@ VARIABLE = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,31}", re.ASCII)
 _TARGET = re.compile(rf"({_NAME})(?:\[\s*([0-9]{{1,9}}|[A-Za-z_][A-Za-z0-9_]{{0,31}})\s*\])?", re.ASCII)
 
 
-class MoveKind(enum.Enum):
-    """A move's kind; the value is its key in a job file."""
+class MoveKind(enum.StrEnum):
+    """A move's kind; the value is its key in a job file (a str: ``MoveKind.JUMP == "jump"``)."""
 
     JUMP = "jump"
     MOVE = "move"
@@ -128,14 +128,23 @@ class JumpShape:
     """The clearance of a jump (:func:`~scara_pin.motion.jump.jump_move`), SI.
 
     Attributes:
-        rise: [m] how high above the higher pose the tool must be away from both.
-        clearance_radius: [m] within this of a pose (horizontally) the tool may be lower.
+        rise: [m] how high above the higher pose the tool must be away from both; None: the standard
+            (:data:`~scara_pin.motion.jump.STANDARD_RISE`).
+        clearance_radius: [m] within this of a pose (horizontally) the tool may be lower; None: the standard
+            (:data:`~scara_pin.motion.jump.STANDARD_CLEARANCE`).
         max_height: [m] a ceiling for the tool's z, or None.
     """
 
-    rise: float = STANDARD_RISE
-    clearance_radius: float = STANDARD_CLEARANCE
+    rise: float | None = None
+    clearance_radius: float | None = None
     max_height: float | None = None
+
+    def resolved(self) -> tuple[float, float, float | None]:
+        """(rise, clearance_radius, max_height) with the standard values for those not given [m]."""
+        from ..motion.jump import STANDARD_CLEARANCE, STANDARD_RISE  # the planner's: imported when a jump is planned
+
+        return (STANDARD_RISE if self.rise is None else self.rise,
+                STANDARD_CLEARANCE if self.clearance_radius is None else self.clearance_radius, self.max_height)
 
 
 @dataclass(frozen=True)
@@ -174,11 +183,31 @@ class Dwell:
     at: str = ""
 
 
-class GripKind(enum.Enum):
-    """What the gripper does; the value is the step's key in a job file."""
+class GripKind(enum.StrEnum):
+    """What the gripper does; the value is the step's key in a job file (a str: ``GripKind.PICK == "pick"``)."""
 
     PICK = "pick"
     PLACE = "place"
+
+
+class StepKind(enum.StrEnum):
+    """The kind of a row of a job's table (:class:`~scara_pin.job.results.StepResult`): a move's, a grip's or a dwell.
+
+    Its values are the job file's keys, the same as :class:`MoveKind`'s and :class:`GripKind`'s
+    (``StepKind.JUMP == MoveKind.JUMP == "jump"``).
+    """
+
+    JUMP = "jump"
+    MOVE = "move"
+    GO = "go"
+    DWELL = "dwell"
+    PICK = "pick"
+    PLACE = "place"
+
+    @classmethod
+    def of(cls, action: Action) -> StepKind:
+        """The kind of an action of a program."""
+        return cls.DWELL if isinstance(action, Dwell) else cls(action.kind.value)
 
 
 @dataclass(frozen=True)
@@ -303,12 +332,14 @@ class Program:
         start: the start's name; start_q: its joint values.
         actions: the moves and dwells.
         places: the (pallet, place number) the moves reach, in order (each arrival counts).
+        tops: for each action, the index (from 0) of the job's top-level step it comes from (loops unrolled).
     """
 
     start: str
     start_q: np.ndarray
     actions: tuple[Action, ...]
     places: tuple[tuple[str, int], ...] = field(default=())
+    tops: tuple[int, ...] = field(default=())
 
 
 @dataclass
@@ -317,6 +348,7 @@ class _State:
     at: str
     speed: float = 1.0
     accel: float = 1.0
+    override: tuple[float, float] = (1.0, 1.0)  # the job's speed and accel, times every move's
 
 
 class _Resolver:
@@ -332,7 +364,7 @@ class _Resolver:
         """The corner poses of pallet ``name``, checked once (a refusal names the pallet's line)."""
         if name not in self._corners:
             pallet = self.pallets[name]
-            poses = np.array([self.robot.tool_pose(self.points[c].q) for c in pallet.corners])
+            poses = np.array([self.robot.tool_pose(self.points.q_of(c)) for c in pallet.corners])
             try:
                 self._corners[name] = pallet.corner_poses(poses)
             except InvalidInputError as exc:
@@ -343,12 +375,12 @@ class _Resolver:
                 ) -> tuple[str, tuple[str, int] | None, np.ndarray, np.ndarray]:  # fmt: skip
         """(text, place or None, q, pose) of ``target`` with the loop variables ``env``, IK nearest ``near``."""
         if target.index is None:
-            q = self.points[target.name].q
+            q = self.points.q_of(target.name)
             return target.name, None, q, self.robot.tool_pose(q)
         index = env[target.index] if isinstance(target.index, str) else target.index
         pallet = self.pallets[target.name]
         pose = pallet.pose(self.corners(target.name), index)  # the index checked again (the loader did)
-        first = self.points[pallet.corners[0]].q
+        first = self.points.q_of(pallet.corners[0])
         text = f"{target.name}[{index}]"
         branch = self.robot.branch_of(first)
         try:
@@ -371,6 +403,8 @@ def expand(
     path: Path,
     start_line: int | None = None,
     pallet_lines: Mapping[str, int | None] | None = None,
+    speed: float = 1.0,
+    accel: float = 1.0,
 ) -> Program:
     """The program of ``steps``: loops unrolled, targets resolved (module docstring).
 
@@ -384,6 +418,8 @@ def expand(
         path: the job file (for the messages).
         start_line: the line of ``start`` in the job file.
         pallet_lines: the line of each pallet in the job file.
+        speed: the job's override of the velocity limits: every move's fraction times it, in (0, 1].
+        accel: the same for the acceleration limits.
 
     Raises:
         JobFileError: collinear or coincident corners (exit 2, at the pallet's line).
@@ -392,7 +428,7 @@ def expand(
     resolver = _Resolver(robot, points, pallets, pallet_lines or {}, path)
     for name in pallets:  # every pallet's corners checked, used or not
         resolver.corners(name)
-    state = _State(None, "")
+    state = _State(None, "", override=(speed, accel))
     if start is not None:
         try:
             state.at, _, state.q, _ = resolver.resolve(start, {}, None)
@@ -401,16 +437,19 @@ def expand(
     begin = (state.at, state.q)
     actions: list[Action] = []
     places: list[tuple[str, int]] = []
-    for action in _unroll(steps, {}, state, resolver, shape, path):
-        if isinstance(action, Move):
-            if begin[1] is None:  # no start given: the robot starts at the first move's target
-                begin = (action.target, action.q)
-            if action.place is not None:
-                places.append(action.place)
-        actions.append(action)
+    tops: list[int] = []
+    for top, step in enumerate(steps):
+        for action in _unroll((step,), {}, state, resolver, shape, path):
+            if isinstance(action, Move):
+                if begin[1] is None:  # no start given: the robot starts at the first move's target
+                    begin = (action.target, action.q)
+                if action.place is not None:
+                    places.append(action.place)
+            actions.append(action)
+            tops.append(top)
     if begin[1] is None:
         raise JobFileError(path, None, "the job has no move: nothing to time")
-    return Program(begin[0], np.array(begin[1], dtype=float), tuple(actions), tuple(places))
+    return Program(begin[0], np.array(begin[1], dtype=float), tuple(actions), tuple(places), tuple(tops))
 
 
 def _unroll(steps: tuple[Step, ...], env: dict[str, int], state: _State, resolver: _Resolver, shape: JumpShape,
@@ -433,7 +472,8 @@ def _unroll(steps: tuple[Step, ...], env: dict[str, int], state: _State, resolve
                 jump = JumpShape(shape.rise if step.rise is None else step.rise,
                                  shape.clearance_radius if step.clearance_radius is None else step.clearance_radius,
                                  shape.max_height if step.max_height is None else step.max_height)  # fmt: skip
-            yield Move(step.kind, text, place, q, pose, state.speed, state.accel, jump, step.line)
+            speed, accel = state.speed * state.override[0], state.accel * state.override[1]
+            yield Move(step.kind, text, place, q, pose, speed, accel, jump, step.line)
             state.q, state.at = q, text
         else:
             if isinstance(step.over, int):

@@ -6,6 +6,15 @@ tool frame in the base frame, Pinocchio's FK at ``q``) is written beside it for 
 reading when present: a file taught on another robot (other lengths, other zero offsets) is refused
 instead of silently moving elsewhere.
 
+A POSE POINT (:class:`PosePoint`, Epson SPEL+'s ``XY(x, y, z, u) /R``) is a NAME and a tool pose: ``xyz`` and
+``yaw``, the elbow branch ``hand`` (``right`` or ``left``; a palletizer's ``up`` or ``down``) and ``turns``, the
+J4 turn (the wrist's angle within pi of 2 pi turns; 0 by default), optionally in a named ``frame`` (a job's
+frames: SPEL+'s ``Local``; without one, the cell's world frame, which is the robot's base unless a job places
+the robot). Its joint values are the closed-form IK of the pose on that branch at that turn
+(:meth:`PosePoint.solve`): the same configuration on every robot of the same geometry, and the point moves with
+its frame. A pose point of a frame is only a job's (:mod:`scara_pin.job`): elsewhere (``traj --through``, the
+pendant, ``check --cell``) a points file's pose points are in the base frame.
+
 The points file comes in two formats, chosen by the file's extension (``.yaml``/``.yml`` or ``.csv``);
 both are SI (m, rad), written at full precision (``repr``, so a point reads back bit for bit):
 
@@ -30,6 +39,13 @@ CSV (``#`` lines are comments; the header names the columns; the pose columns ar
     name,q1,q2,q3,q4,x,y,z,yaw
     P1,0.3,0.9,0.02,-0.5,0.0964...,0.1556...,0.08,0.7
 
+    - name: T11                    # a pose point (YAML files only)
+      xyz: [0.22, -0.06, -0.1]
+      yaw: 0.5
+      hand: right
+      turns: 0                     # optional (0: the wrist within pi of 0)
+      frame: tray                  # optional: a frame of the job that uses the file
+
 Names: a letter, then up to 31 letters, digits, ``_``, ``-`` or ``.`` (``P1``, ``pick_2``, ``home``);
 case-sensitive, unique in a file. At most :data:`scara_pin.limits.MAX_POINTS` points, and the file at most
 :data:`scara_pin.limits.MAX_POINTS_BYTES` bytes.
@@ -41,7 +57,7 @@ import csv
 import io
 import math
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -57,8 +73,11 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FORMAT",
+    "HANDS",
     "POSE_TOL",
+    "Point",
     "PointSet",
+    "PosePoint",
     "TaughtPoint",
     "check_point_name",
     "parse_points",
@@ -113,9 +132,106 @@ class TaughtPoint:
         return cls(name, values, np.asarray(robot.tool_pose(values), dtype=float))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: name, q, pose (None when unknown) in SI."""
-        return {"name": self.name, "q": [float(v) for v in self.q],
+        """JSON-ready: name, form ``joint``, q, pose (None when unknown) in SI."""
+        return {"name": self.name, "form": "joint", "q": [float(v) for v in self.q],
                 "pose": None if self.pose is None else [float(v) for v in self.pose]}  # fmt: skip
+
+
+HANDS = ("right", "left", "up", "down")
+"""The elbow branches a pose point may name: a SCARA's ``right``/``left``, a palletizer's ``up``/``down``."""
+TURN_TOL = 1e-9
+"""[rad] how far past pi from 2 pi turns a pose point's wrist angle may be (the boundary between two turns)."""
+
+
+@dataclass(frozen=True, eq=False)
+class PosePoint:
+    """A pose point: a tool pose with its elbow branch and wrist turn (module docstring).
+
+    Attributes:
+        name: its name.
+        xyz: (3,) the tool frame's origin in ``frame`` [m].
+        yaw: the tool's yaw in ``frame`` [rad].
+        hand: the elbow branch (:data:`HANDS`; the robot's own branches are checked against it).
+        turns: the wrist's turn: q4 within pi of 2 pi ``turns``.
+        frame: the frame the pose is in ("" : the world frame, the robot's base unless a job places the robot).
+    """
+
+    name: str
+    xyz: np.ndarray
+    yaw: float
+    hand: str
+    turns: int = 0
+    frame: str = ""
+
+    def __post_init__(self) -> None:
+        check_point_name(self.name)
+        object.__setattr__(self, "xyz", _finite(f"point {self.name}: xyz", self.xyz, 3))
+        yaw = self.yaw
+        if isinstance(yaw, bool) or not isinstance(yaw, (int, float)) or not math.isfinite(yaw):
+            raise InvalidInputError(f"point {self.name}: yaw {brief(yaw, 40)} must be a finite number [rad]")
+        object.__setattr__(self, "yaw", float(yaw))
+        if self.hand not in HANDS:
+            raise InvalidInputError(f"point {self.name}: hand {brief(self.hand, 40)} must be one of {', '.join(HANDS)} "
+                                    "(the elbow branch: SPEL+'s /R, /L)")  # fmt: skip
+        turns = self.turns
+        if isinstance(turns, bool) or not isinstance(turns, int) or abs(turns) > 1000:
+            raise InvalidInputError(f"point {self.name}: turns {brief(turns, 40)} must be a whole number (the wrist's "
+                                    "turn) within +/-1000")  # fmt: skip
+        if self.frame and not _NAME.fullmatch(self.frame):
+            raise InvalidInputError(f"point {self.name}: frame {brief(self.frame, 40)} must be a name")
+
+    @property
+    def pose(self) -> np.ndarray:
+        """(x, y, z, yaw) in :attr:`frame` [m, rad]."""
+        return np.array([*self.xyz, self.yaw])
+
+    @classmethod
+    def at(cls, robot: RobotModel, name: str, q: object) -> PosePoint:
+        """The pose point of ``robot`` at joint values ``q``: its FK pose, branch and wrist turn (base frame)."""
+        values = robot.check_q(q)
+        pose = robot.tool_pose(values)
+        return cls(name, pose[:3], float(pose[3]), robot.branch_of(values), round(float(values[-1]) / (2 * math.pi)))
+
+    def solve(self, robot: RobotModel, pose: np.ndarray | None = None) -> np.ndarray:
+        """The joint values of the point: the closed-form IK on :attr:`hand`, the wrist at :attr:`turns`.
+
+        ``pose``: the pose in the robot's base frame (default: :attr:`pose`); the other joints at the turn nearest 0.
+
+        Raises:
+            InvalidInputError: a hand that is not one of the robot's branches.
+            InfeasibleError: the pose out of reach on that branch, or no wrist angle of that turn within the limits.
+        """
+        from ..errors import InfeasibleError
+
+        branches = tuple(robot.kinematics.branches)
+        if self.hand not in branches:
+            raise InvalidInputError(f"point {self.name}: hand {self.hand} is not a branch of robot {robot.name!r} "
+                                    f"({', '.join(branches)})")  # fmt: skip
+        target = self.pose if pose is None else np.asarray(pose, dtype=float)
+        reference = np.zeros(robot.dof)
+        reference[-1] = 2.0 * math.pi * self.turns
+        result = robot.ik(target, branch=self.hand, reference=reference)
+        best = result.nearest(reference, branch=self.hand) if result.success else None
+        shown = ", ".join(f"{v:.6g}" for v in target)
+        if best is None:
+            raise InfeasibleError(f"point {self.name} at (x, y, z, yaw) = ({shown}) [m, rad] is out of reach on the "
+                                  f"{self.hand} branch: {result.message}")  # fmt: skip
+        q = np.array(best.q, dtype=float)
+        if abs(q[-1] - reference[-1]) > math.pi + TURN_TOL:
+            raise InfeasibleError(f"point {self.name}: turns {self.turns} puts the wrist within pi of "
+                                  f"{reference[-1]:.6g} rad, outside its limits (the nearest is q4 = {q[-1]:.6g} rad, "
+                                  f"turns {round(q[-1] / (2 * math.pi))})")  # fmt: skip
+        return q
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: name, form ``pose``, xyz, yaw, pose (x, y, z, yaw), hand, turns, frame (SI)."""
+        return {"name": self.name, "form": "pose", "xyz": [float(v) for v in self.xyz], "yaw": self.yaw,
+                "pose": [float(v) for v in self.pose], "hand": self.hand, "turns": self.turns,
+                "frame": self.frame}  # fmt: skip
+
+
+Point = TaughtPoint | PosePoint
+"""A point of a points file: joint values, or a pose with its branch and turn."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,7 +245,7 @@ class PointSet:
         tool: the tool frame of the poses ("" when unknown).
     """
 
-    points: tuple[TaughtPoint, ...] = ()
+    points: tuple[Point, ...] = ()
     robot: str = ""
     base: str = ""
     tool: str = ""
@@ -148,7 +264,7 @@ class PointSet:
     def __len__(self) -> int:
         return len(self.points)
 
-    def __iter__(self) -> Iterator[TaughtPoint]:
+    def __iter__(self) -> Iterator[Point]:
         return iter(self.points)
 
     def __contains__(self, name: object) -> bool:
@@ -159,7 +275,7 @@ class PointSet:
         """The names, in order."""
         return tuple(p.name for p in self.points)
 
-    def __getitem__(self, name: str) -> TaughtPoint:
+    def __getitem__(self, name: str) -> Point:
         """The point named ``name`` (an :class:`InvalidInputError` listing the names when there is none)."""
         try:
             return self.points[self._index[name]]
@@ -172,7 +288,7 @@ class PointSet:
         taken = set(self._index)
         return next(f"{prefix}{i}" for i in range(1, len(self.points) + 2) if f"{prefix}{i}" not in taken)
 
-    def added(self, point: TaughtPoint) -> PointSet:
+    def added(self, point: Point) -> PointSet:
         """A copy with ``point`` appended (its name must be new)."""
         if point.name in self:
             raise InvalidInputError(f"a point named {point.name!r} exists already; rename or delete it first")
@@ -184,7 +300,7 @@ class PointSet:
         check_point_name(new)
         if new != old and new in self:
             raise InvalidInputError(f"a point named {new!r} exists already")
-        moved = TaughtPoint(new, point.q, point.pose)
+        moved = replace(point, name=new)
         return replace(self, points=tuple(moved if p.name == old else p for p in self.points))
 
     def removed(self, name: str) -> PointSet:
@@ -197,15 +313,22 @@ class PointSet:
 
         Another joint count, a joint value the robot cannot take (beyond +/-1e6 rad or m:
         :meth:`~scara_pin.model.RobotModel.check_q`), or a written pose that is not the FK of its q on this robot
-        (beyond :data:`POSE_TOL`; the yaw compared modulo 2 pi). The joint limits are not checked here: a
-        pendant shows such a point; a command that moves to it refuses it.
+        (beyond :data:`POSE_TOL`; the yaw compared modulo 2 pi); a pose point whose hand is not a branch of the
+        robot. The joint limits are not checked here: a pendant shows such a point; a command that moves to it
+        refuses it (a pose point's reach is :meth:`resolved`'s).
 
         Raises:
             InvalidInputError: naming the point and what differs.
         """
         from ..errors import ParameterError
 
+        branches = tuple(robot.kinematics.branches)
         for p in self.points:
+            if isinstance(p, PosePoint):
+                if p.hand not in branches:
+                    raise InvalidInputError(f"{origin}: point {p.name}: hand {p.hand} is not a branch of robot "
+                                            f"{robot.name!r} ({', '.join(branches)})")  # fmt: skip
+                continue
             if p.q.shape != (robot.dof,):
                 raise InvalidInputError(f"{origin}: point {p.name} has {p.q.size} joint values; robot "
                                         f"{robot.name!r} has {robot.dof}")  # fmt: skip
@@ -226,6 +349,48 @@ class PointSet:
                     f"robot {robot.name!r} ({fk[k]:.9g}, off by {error[k]:.3g}){taught}"
                 )
 
+    def q_of(self, name: str) -> np.ndarray:
+        """The joint values of joint point ``name`` (a pose point's are :meth:`resolved`'s: refused here).
+
+        Raises:
+            InvalidInputError: no point of that name, or a pose point.
+        """
+        point = self[name]
+        if isinstance(point, PosePoint):
+            raise InvalidInputError(f"point {name} is a pose point: its joint values are the robot's IK of it "
+                                    "(PointSet.resolved)")  # fmt: skip
+        return point.q
+
+    @property
+    def poses(self) -> bool:
+        """Whether any point is a pose point."""
+        return any(isinstance(p, PosePoint) for p in self.points)
+
+    def resolved(self, robot: RobotModel, to_base: Callable[[PosePoint], np.ndarray] | None = None,
+                 origin: str = "points") -> PointSet:  # fmt: skip
+        """The set with every pose point replaced by the joint point it is on ``robot`` (:meth:`PosePoint.solve`).
+
+        Args:
+            robot: the robot.
+            to_base: a pose point's pose in the robot's base frame (a job's frames and base placement); None: a
+                pose point is in the base frame, and one of a named frame is refused.
+            origin: how to name the set in messages.
+
+        Raises:
+            InvalidInputError: a pose point of a frame without ``to_base``, a hand that is not a branch.
+            InfeasibleError: a pose point out of reach (naming it).
+        """
+        out: list[Point] = []
+        for p in self.points:
+            if isinstance(p, PosePoint):
+                if to_base is None and p.frame:
+                    raise InvalidInputError(f"{origin}: point {p.name} is in frame {p.frame}: only a job knows its "
+                                            "frames (scara-pin job)")  # fmt: skip
+                pose = p.pose if to_base is None else to_base(p)
+                p = TaughtPoint(p.name, p.solve(robot, pose), np.asarray(pose, dtype=float))
+            out.append(p)
+        return replace(self, points=tuple(out))
+
     # ----------------------------------------------------------------- text
     def to_yaml(self) -> str:
         """The YAML points file (full precision, SI)."""
@@ -240,20 +405,35 @@ class PointSet:
         ]
         for p in self.points:
             lines.append(f"- name: {p.name}")
+            if isinstance(p, PosePoint):
+                lines.append(f"  xyz: [{', '.join(repr(float(v)) for v in p.xyz)}]")
+                lines += [f"  yaw: {p.yaw!r}", f"  hand: {p.hand}", f"  turns: {p.turns}"]
+                if p.frame:
+                    lines.append(f"  frame: {p.frame}")
+                continue
             lines.append(f"  q: [{', '.join(repr(float(v)) for v in p.q)}]")
             if p.pose is not None:
                 lines.append(f"  pose: [{', '.join(repr(float(v)) for v in p.pose)}]")
         return "\n".join(lines) + "\n"
 
     def to_csv(self) -> str:
-        """The CSV points file (full precision, SI; empty pose cells when a pose is unknown)."""
-        dof = max((p.q.size for p in self.points), default=4)
+        """The CSV points file (full precision, SI; empty pose cells when a pose is unknown).
+
+        Raises:
+            InvalidInputError: a pose point (a YAML points file holds them).
+        """
+        posed = [p.name for p in self.points if isinstance(p, PosePoint)]
+        if posed:
+            raise InvalidInputError(f"point {posed[0]} is a pose point: a CSV points file holds joint points only; "
+                                    "write a .yaml points file")  # fmt: skip
+        dof = max((p.q.size for p in self.points if isinstance(p, TaughtPoint)), default=4)
         out = io.StringIO()
         meta = " ".join(f"{k}={v}" for k, v in (("robot", self.robot), ("base", self.base), ("tool", self.tool)) if v)
         out.write(f"# {FORMAT}: {meta + ' ' if meta else ''}units=m,rad\n")
         writer = csv.writer(out, lineterminator="\n")
         writer.writerow(["name", *(f"q{i + 1}" for i in range(dof)), *_POSE_NAMES])
         for p in self.points:
+            assert isinstance(p, TaughtPoint)  # noqa: S101 - refused above
             pose = ["" for _ in _POSE_NAMES] if p.pose is None else [repr(float(v)) for v in p.pose]
             writer.writerow([p.name, *(repr(float(v)) for v in p.q), *pose])
         return out.getvalue()
@@ -352,11 +532,15 @@ def _parse_yaml(text: str, origin: str) -> PointSet:
     items = tree["points"]
     if len(items) > MAX_POINTS:
         raise InvalidInputError(f"{len(items):,} points: above the cap of {MAX_POINTS:,} points per file")
-    points = []
+    points: list[Point] = []
     for i, item in enumerate(items):
         where = _at(items, i)
+        if isinstance(item, dict) and "name" in item and "q" not in item and ("xyz" in item or "hand" in item):
+            points.append(_pose_point(item, where, i))
+            continue
         if not isinstance(item, dict) or "name" not in item or "q" not in item:
-            raise InvalidInputError(f"{where}point #{i + 1} must be a mapping with name and q (and optionally pose)")
+            raise InvalidInputError(f"{where}point #{i + 1} must be a mapping with name and q (and optionally pose), "
+                                    "or a pose point: name, xyz, yaw, hand (and optionally turns, frame)")  # fmt: skip
         extra = sorted(brief(k, 40) for k in item if k not in ("name", "q", "pose"))
         if extra:
             raise InvalidInputError(f"{where}point #{i + 1}: unknown key(s) {', '.join(extra[:10])} (keys: name, q, "
@@ -374,6 +558,32 @@ def _parse_yaml(text: str, origin: str) -> PointSet:
         except InvalidInputError as exc:
             raise InvalidInputError(f"{where}{exc}") from None
     return PointSet(tuple(points), **meta)
+
+
+_POSE_KEYS = ("name", "xyz", "yaw", "hand", "turns", "frame")
+
+
+def _pose_point(item: dict[str, Any], where: str, i: int) -> PosePoint:
+    """A pose point of a YAML points file (SI; unit tags read)."""
+    extra = sorted(brief(k, 40) for k in item if k not in _POSE_KEYS)
+    if extra:
+        raise InvalidInputError(f"{where}point #{i + 1}: unknown key(s) {', '.join(extra[:10])} (a pose point's keys: "
+                                f"{', '.join(_POSE_KEYS)})")  # fmt: skip
+    missing = [k for k in ("xyz", "yaw", "hand") if k not in item]
+    if missing:
+        raise InvalidInputError(f"{where}point #{i + 1}: a pose point needs {', '.join(missing)} (keys: "
+                                f"{', '.join(_POSE_KEYS)})")  # fmt: skip
+    try:
+        name = check_point_name(item["name"])
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{_at(item, 'name')}{exc}") from None
+    xyz = np.array(_yaml_numbers(f"{_at(item, 'xyz')}point {name}: xyz", item["xyz"]))
+    yaw = _yaml_numbers(f"{_at(item, 'yaw')}point {name}: yaw", [item["yaw"]])[0]
+    frame = item.get("frame", "")
+    try:
+        return PosePoint(name, xyz, yaw, item["hand"], item.get("turns", 0), frame if frame is not None else "")
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{where}{exc}") from None
 
 
 def _at(data: object, key: object) -> str:

@@ -59,6 +59,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "CSV_HEADER",
+    "CSV_UNITS",
     "SINGULAR_TOL",
     "CartesianPath",
     "CartesianSegment",
@@ -89,9 +90,27 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-def csv_header(dof: int = 4) -> tuple[str, ...]:
-    """Columns of the trajectory CSV of a robot with ``dof`` joints: t, q1..q<dof>, qd1.., qdd1.. (SI units)."""
-    return ("t",) + tuple(f"{k}{i}" for k in ("q", "qd", "qdd") for i in range(1, dof + 1))
+def csv_header(dof: int = 4, kinds: Sequence[str] | None = None) -> tuple[str, ...]:
+    """Columns of the trajectory CSV of a robot with ``dof`` joints: t, q1..q<dof>, qd1.., qdd1.. (SI units).
+
+    With ``kinds`` (what each joint value measures: ``"angle"`` or ``"length"``, ``robot.joint_kinds``) each
+    name carries its unit: ``t [s]``, ``q1 [rad]``, ``q3 [m]``, ``qd1 [rad/s]``, ``qdd3 [m/s^2]``; the readers
+    take both (:func:`~scara_pin.tables.csv_rows`, :data:`CSV_UNITS`).
+    """
+    if kinds is None:
+        return ("t",) + tuple(f"{k}{i}" for k in ("q", "qd", "qdd") for i in range(1, dof + 1))
+    if len(kinds) != dof:
+        raise ParameterError("kinds", list(kinds), f"must be {dof} (one per joint)")
+    units = [{"angle": "rad", "length": "m"}[k] for k in kinds]
+    return ("t [s]",) + tuple(f"{k}{i + 1} [{u}{per}]" for k, per in (("q", ""), ("qd", "/s"), ("qdd", "/s^2"))
+                              for i, u in enumerate(units))  # fmt: skip
+
+
+CSV_UNITS: dict[str, tuple[str, ...]] = {"t": ("s",)} | {
+    f"{k}{i}": tuple(f"{u}{per}" for u in ("rad", "m")) for k, per in (("q", ""), ("qd", "/s"), ("qdd", "/s^2"))
+    for i in range(1, 5)
+}
+"""The units a trajectory CSV's column may carry (SI): what :func:`load_trajectory` reads."""
 
 
 CSV_HEADER: tuple[str, ...] = csv_header(4)
@@ -395,9 +414,13 @@ class Samples:
         """(n, 1 + 3 dof) array in :func:`csv_header` order (13 columns for 4 joints)."""
         return np.column_stack([self.t, self.q, self.qd, self.qdd])
 
-    def csv_text(self) -> str:
-        """The CSV text (header, then one row per sample; shortest round-trip float text)."""
-        lines = [",".join(csv_header(self.q.shape[1]))]
+    def csv_text(self, kinds: Sequence[str] | None = None) -> str:
+        """The CSV text (header, then one row per sample; shortest round-trip float text).
+
+        ``kinds``: what each joint value measures (``robot.joint_kinds``): the header carries the units
+        (:func:`csv_header`).
+        """
+        lines = [",".join(csv_header(self.q.shape[1], kinds))]
         lines += [",".join(map(repr, row)) for row in self.table().tolist()]
         return "\n".join(lines) + "\n"
 
@@ -586,14 +609,16 @@ class Trajectory(Summarized):
         return Trajectory(self.pieces + other.pieces)
 
     # --------------------------------------------------------------------------------- export
-    def to_csv(self, path: str | os.PathLike[str], rate: float = 1000.0) -> Path:
-        """Write the samples at ``rate`` [Hz] as CSV (:data:`CSV_HEADER`), atomically; return the path."""
-        text = self.resample(rate).csv_text()
+    def to_csv(self, path: str | os.PathLike[str], rate: float = 1000.0, kinds: Sequence[str] | None = None) -> Path:
+        """Write the samples at ``rate`` [Hz] as CSV (``kinds``: units in the header), atomically; return the path."""
+        text = self.resample(rate).csv_text(kinds)
         return write_text_atomic(Path(path), text)
 
-    def save(self, path: str | os.PathLike[str], rate: float = 1000.0) -> Path:
+    def save(self, path: str | os.PathLike[str], rate: float = 1000.0, kinds: Sequence[str] | None = None) -> Path:
         """Write the samples at ``rate`` [Hz]: JSON for a name ending in ``.json``, else CSV; atomically."""
-        return (self.to_json if Path(path).suffix.lower() == ".json" else self.to_csv)(path, rate=rate)
+        if Path(path).suffix.lower() == ".json":
+            return self.to_json(path, rate=rate)
+        return self.to_csv(path, rate=rate, kinds=kinds)
 
     def to_json(self, path: str | os.PathLike[str], rate: float = 1000.0) -> Path:
         """Write the samples at ``rate`` [Hz] as JSON (see :meth:`Samples.to_dict`), atomically."""
@@ -653,7 +678,7 @@ def load_trajectory(path: str | os.PathLike[str]) -> Trajectory:
     if path.suffix.lower() != ".json":
         from ..tables import read_csv
 
-        table = read_csv(path, CSV_HEADER, exact=True, max_rows=MAX_SAMPLES)
+        table = read_csv(path, CSV_HEADER, exact=True, max_rows=MAX_SAMPLES, units=CSV_UNITS)
         try:
             return Trajectory.from_samples(Samples.from_table(table))
         except ParameterError as exc:

@@ -27,10 +27,12 @@ from ..summary import Summarized
 from .scene import DEFAULT_FPS
 
 if TYPE_CHECKING:
+    from ..cell import Cell
     from ..model import RobotModel
+    from ..motion.points import PointSet
     from ..motion.trajectory import Trajectory
 
-__all__ = ["SceneView", "show", "workspace_polylines"]
+__all__ = ["SceneView", "point_poses", "show", "workspace_polylines"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -77,6 +79,21 @@ def workspace_polylines(robot: RobotModel) -> list[np.ndarray]:
     return [arc.points(max(8, int(math.degrees(arc.sweep)))) for arc in ws.arcs]
 
 
+def point_poses(robot: RobotModel, points: PointSet | str | os.PathLike[str]) -> tuple[np.ndarray | None, list[str]]:
+    """The tool poses (P, 4) of taught points on ``robot`` and their names (a points file is read; pose points solved).
+
+    Returns (None, []) for no points.
+    """
+    from ..motion.points import PointSet, TaughtPoint, read_points
+
+    found = points if isinstance(points, PointSet) else read_points(Path(points), robot)
+    resolved = found.resolved(robot)
+    qs = [p.q for p in resolved if isinstance(p, TaughtPoint)]
+    if not qs:
+        return None, []
+    return np.array([robot.tool_pose(q) for q in qs]), [p.name for p in resolved]
+
+
 def show(
     robot: RobotModel,
     q: Any = None,
@@ -85,6 +102,8 @@ def show(
     workspace: bool = False,
     height: int = 480,
     loop: bool = True,
+    cell: Cell | None = None,
+    points: PointSet | str | os.PathLike[str] | None = None,
 ) -> SceneView:
     """The robot in 3-D, for a notebook cell: ``scara_pin.viz.show(robot, q)`` as the cell's last line.
 
@@ -95,6 +114,10 @@ def show(
         workspace: draw the workspace boundary (SCARA: on the floor; palletizer: its envelope in 3-D).
         height: the height of the inline frame [px], 100..4000.
         loop: replay the trajectory forever (else once).
+        cell: a cell (:func:`scara_pin.cell.load_cell`): its obstacles drawn and named, the part it carries on the
+            tool.
+        points: taught points (a :class:`~scara_pin.motion.points.PointSet` or a points file): each drawn as a
+            small frame at its pose, named.
 
     Returns:
         a :class:`SceneView` (Jupyter shows it; ``.save(path)`` writes the page; ``.html`` is the page).
@@ -113,7 +136,10 @@ def show(
         times = np.linspace(0.0, trajectory.duration, max(2, int(math.ceil(trajectory.duration * DEFAULT_FPS)) + 1))
         qs = trajectory.sample(times)[0]
     polylines = workspace_polylines(robot) if workspace else None
+    targets = names = None
+    if points is not None:
+        targets, names = point_poses(robot, points)
     title = f"scara-pin: {robot.name}"
     page = static_html(robot, q=None if q is None else robot.check_q(q), times=times, qs=qs, polylines=polylines,
-                       loop=loop, title=title)  # fmt: skip
+                       targets=targets, loop=loop, title=title, cell=cell, target_names=names)  # fmt: skip
     return SceneView(page, height, title)

@@ -18,6 +18,7 @@ and each box from the moment it is placed (the page's player shows a node only o
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -34,7 +35,8 @@ if TYPE_CHECKING:
     from ..job.results import JobResult
     from ..model import RobotModel
 
-__all__ = ["BOX_COLOR", "CARRYING_COLOR", "EMPTY_COLOR", "KIND_COLORS", "OBSTACLE_COLOR", "job_page", "plot_job"]
+__all__ = ["BOX_COLOR", "CARRYING_COLOR", "EMPTY_COLOR", "KIND_COLORS", "OBSTACLE_COLOR", "job_page", "plot_job",
+           "untangle"]
 
 KIND_COLORS = {"jump": "#9ec5e8", "move": "#f5c48a", "go": "#b9dfa8"}
 """The band colour of each kind of move."""
@@ -64,7 +66,7 @@ def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, r
         result: the planned job.
         path: the file to write, or None.
         robot: the robot it was planned for (its limits).
-        units: display units (the timeline's axes are times and ratios: kept for the one plotting signature).
+        units: display units: the plan and side views' lengths (the timeline's axes are times and ratios).
         title: the figure's title (default: the job's file, robot, total and parts per hour).
     """
     traj = result.trajectory
@@ -85,7 +87,7 @@ def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, r
     if views:
         parts: Any = fig.subfigures(2, 1, height_ratios=[5.0, 6.5])
         plan, side = parts[0].subplots(1, 2)
-        _draw_views(plan, side, result, robot)
+        _draw_views(plan, side, result, robot, units)
         bottom = parts[1]
     axes = bottom.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [0.6, 2.0, 2.0]})
     band, ax_v, ax_a = axes
@@ -121,6 +123,8 @@ def plot_job(result: JobResult, path: str | os.PathLike[str] | None = None, *, r
     else:
         rate_text = f", {result.places} places, {rate:,.0f} parts per hour" if rate is not None else ""
     fig.suptitle(title or f"{result.path.name} on {result.robot}: {T:.4f} s{rate_text}")
+    if views:
+        untangle(fig, (plan, side))
     return finish(fig, path)
 
 
@@ -139,22 +143,30 @@ def _tool_path(result: JobResult, robot: RobotModel) -> tuple[np.ndarray, np.nda
     return poses, carrying
 
 
-def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) -> None:
-    """The plan and side views of the job: obstacles, boxes placed (numbered), the tool path by gripper state."""
+def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel, units: DisplayUnits = SI) -> None:
+    """The plan and side views of the job: obstacles, boxes placed (numbered), the tool path by gripper state.
+
+    Lengths in ``units``. Labels at the same place in a view are one label (``1, 4``: boxes stacked in plan view,
+    or in one line of sight in the side view), so that no two are written over each other.
+    """
     from matplotlib.patches import Polygon, Rectangle
 
+    k = units.scale("length")
     poses, carrying = _tool_path(result, robot)
+    poses = poses * np.array([k, k, k, 1.0])
     shapes: list[tuple[Shape, str, str]] = []
     if result.cell is not None:
         shapes += [(o.shape, OBSTACLE_COLOR, o.name) for o in result.cell.obstacles]
     shapes += [(b.shape, BOX_COLOR, str(k + 1)) for k, b in enumerate(result.boxes)]
-    centres = np.array([b.shape.xyz for b in result.boxes]) if result.boxes else poses[:, :3]
+    centres = k * np.array([b.shape.xyz for b in result.boxes]) if result.boxes else poses[:, :3]
     across = int(np.argmin(np.ptp(centres[:, :2], axis=0)))  # the side view looks along this base axis
     along = 1 - across
     names = "xy"
     labels: dict[tuple[float, float], list[str]] = {}
+    side_labels: dict[tuple[float, float], list[str]] = {}
     for shape, color, name in shapes:
-        pts = shape_points(shape)
+        pts = k * shape_points(shape)
+        xyz = k * np.asarray(shape.xyz, dtype=float)
         is_box = color == BOX_COLOR
         edge = "#8b5a2b" if is_box else "0.35"
         plan.add_patch(Polygon(hull(pts[:, :2]), closed=True, facecolor=color, edgecolor=edge, lw=0.8,
@@ -162,16 +174,19 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
         side.add_patch(Rectangle((pts[:, along].min(), pts[:, 2].min()), float(np.ptp(pts[:, along])),
                                  float(np.ptp(pts[:, 2])), facecolor=color, edgecolor=edge, lw=0.8,
                                  zorder=2 if is_box else 1))  # fmt: skip
-        side.annotate(name, (float(shape.xyz[along]), float(shape.xyz[2])), fontsize=7, ha="center", va="center",
-                      zorder=4)  # fmt: skip
+        grain = 1e-3 * k  # positions within 1 mm: one label
+        key = (round(float(xyz[along]) / grain) * grain, round(float(xyz[2]) / grain) * grain)
+        side_labels.setdefault(key, []).append(name)  # one line of sight: "1, 4, 7" (the rows behind each other)
         if is_box:  # boxes stacked on each other share a label: "1, 4"
-            key = (round(float(shape.xyz[0]), 3), round(float(shape.xyz[1]), 3))
+            key = (round(float(xyz[0]) / grain) * grain, round(float(xyz[1]) / grain) * grain)
             labels.setdefault(key, []).append(name)
         else:  # an obstacle's name inside its top edge, clear of the boxes on it
-            plan.annotate(name, (float(shape.xyz[0]), float(pts[:, 1].max())), fontsize=7, ha="center", va="top",
+            plan.annotate(name, (float(xyz[0]), float(pts[:, 1].max())), fontsize=7, ha="center", va="top",
                           xytext=(0, -2), textcoords="offset points", zorder=4)  # fmt: skip
-    for (x, y), found in labels.items():
-        plan.annotate(", ".join(found), (x, y), fontsize=7, ha="center", va="center", zorder=4)
+    for ax, found_at in ((plan, labels), (side, side_labels)):
+        for (x, y), found in found_at.items():
+            ax.annotate(_listed(found), (x, y), fontsize=7, ha="center", va="center", zorder=4, xytext=(0, 0),
+                        textcoords="offset points")  # fmt: skip
     for ax, (i, j) in ((plan, (0, 1)), (side, (along, 2))):
         for state, color, label, style in ((False, EMPTY_COLOR, "tool, empty", "--"),
                                            (True, CARRYING_COLOR, "tool, holding the part", "-")):  # fmt: skip
@@ -182,22 +197,58 @@ def _draw_views(plan: Axes, side: Axes, result: JobResult, robot: RobotModel) ->
     plan.set_aspect("equal", adjustable="datalim")
     what = "the job"
     if result.boxes:  # the side view frames the stack: the boxes and the tool path above them
-        pts = np.concatenate([shape_points(b.shape) for b in result.boxes])
-        lo, hi = pts[:, along].min() - 0.25, pts[:, along].max() + 0.25
+        pts = k * np.concatenate([shape_points(b.shape) for b in result.boxes])
+        lo, hi = pts[:, along].min() - 0.25 * k, pts[:, along].max() + 0.25 * k
         near = (poses[:, along] >= lo) & (poses[:, along] <= hi)
-        z_hi = max(float(pts[:, 2].max()), float(poses[near, 2].max(initial=-np.inf))) + 0.1
+        z_hi = max(float(pts[:, 2].max()), float(poses[near, 2].max(initial=-np.inf))) + 0.1 * k
         side.set_xlim(lo, hi)
-        side.set_ylim(0.0 if pts[:, 2].min() >= 0.0 else float(pts[:, 2].min()) - 0.1, z_hi)
+        side.set_ylim(0.0 if pts[:, 2].min() >= 0.0 else float(pts[:, 2].min()) - 0.1 * k, z_hi)
         what = "the stack"
     side.set_aspect("equal", adjustable="box")
     plan.plot([0.0], [0.0], "k+", ms=10)
-    plan.set(xlabel="x [m]", ylabel="y [m]", title="plan view (J1 axis at +)")
-    side.set(xlabel=f"{names[along]} [m]", ylabel="z [m]", title=f"side view of {what} (seen along {names[across]})")
+    L = units.length
+    plan.set(xlabel=f"x [{L}]", ylabel=f"y [{L}]", title="plan view (J1 axis at +)")
+    side.set(xlabel=f"{names[along]} [{L}]", ylabel=f"z [{L}]",
+             title=f"side view of {what} (seen along {names[across]})")  # fmt: skip
     plan.legend(fontsize=7, loc="best")
 
 
+def untangle(fig: Figure, axes: Sequence[Axes], rounds: int = 3) -> None:
+    """Move the labels of ``axes`` that would be written over each other apart, up or down by whole line heights.
+
+    The figure is drawn to measure them (their sizes on the page); a label moved keeps its place along the other
+    axis. Drawn again until none overlaps (the layout may change as they move), at most ``rounds`` times.
+    """
+    for _ in range(rounds):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+        moved = False
+        for ax in axes:
+            placed: list[Any] = []
+            for text in ax.texts:
+                box = text.get_window_extent(renderer)
+                x0, y0 = getattr(text, "xyann", (0.0, 0.0))
+                k = 0
+                while any(box.overlaps(p) for p in placed) and k < 40 and hasattr(text, "xyann"):
+                    k += 1
+                    lines = (k + 1) // 2 * (1 if k % 2 else -1)  # +1, -1, +2, -2, ... line heights
+                    text.xyann = (x0, y0 + lines * 1.15 * box.height * 72.0 / fig.dpi)
+                    box = text.get_window_extent(renderer)
+                    moved = True
+                placed.append(box)
+        if not moved:
+            return
+
+
+def _listed(names: list[str]) -> str:
+    """Labels at one place as one: ``1, 4, 7``; a long list broken every 4 (it stays inside its box)."""
+    rows = [", ".join(names[i : i + 4]) for i in range(0, len(names), 4)]
+    return ",\n".join(rows)
+
+
 # ---------------------------------------------------------------------------------------------- the page
-def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str], *, rate: float = 200.0) -> None:
+def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str], *, rate: float = 200.0,
+             units: DisplayUnits | None = None) -> None:
     """The viewer page that plays the job: the cell, the part on the tool while held, each box once placed.
 
     The cell is drawn by :func:`~scara_pin.viz.meshcat.draw_cell` (the job's obstacles, the boxes placed, the
@@ -209,6 +260,7 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
         robot: the robot it was planned for.
         path: the HTML file to write (atomically).
         rate: [Hz] the samples handed to the page (it interpolates between them).
+        units: the units the page opens in (its switch: mm and deg, or m and rad); None: mm and deg.
     """
     from ..cell import Cell
     from ..files import write_text_atomic
@@ -223,7 +275,8 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
     if result.cell is not None or result.boxes or result.carry is not None:
         base = result.cell if result.cell is not None else Cell(origin="the job's boxes")
         cell = base.with_obstacles(boxes).with_carried(result.carry if result.carry is not None else base.carried)
-    scene, data = recorded_scene(robot, None, samples.t, samples.q, targets=targets, cell=cell)
+    scene, data = recorded_scene(robot, None, samples.t, samples.q, targets=targets, cell=cell,
+                                 target_names=list(ends) if ends else None)  # fmt: skip
     T = traj.duration
     shown: list[dict[str, object]] = []
     for b in result.boxes:
@@ -239,6 +292,8 @@ def job_page(result: JobResult, robot: RobotModel, path: str | os.PathLike[str],
         shown.append({"path": f"meshcat/{node}", "spans": [list(span) for span in _merged(held)]})
     if shown and "motion" in data:
         data["motion"]["shown"] = shown
+    if units is not None:
+        data["units"] = "mm" if units.length == "mm" else "m"
     rate_text = f", {result.boxes_per_hour:,.0f} boxes per hour" if result.boxes else ""
     write_text_atomic(path, scene.page(f"scara-pin job {result.path.name}: {result.total:.4f} s{rate_text}", data))
 

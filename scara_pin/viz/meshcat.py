@@ -100,10 +100,11 @@ def static_html(
     loop: bool = True,
     title: str | None = None,
     cell: Cell | None = None,
+    target_names: Iterable[str] | None = None,
 ) -> str:
     """Make a self-contained HTML page of the robot (no server needed; arguments as :func:`export_html`)."""
     scene, data = recorded_scene(robot, q, times, qs, polylines, path_points, targets, draw_tool_path=draw_tool_path,
-                                 fps=fps, loop=loop, cell=cell)  # fmt: skip
+                                 fps=fps, loop=loop, cell=cell, target_names=target_names)  # fmt: skip
     return scene.page(title or f"scara-pin: {robot.name}", data)
 
 
@@ -122,6 +123,7 @@ def export_html(
     loop: bool = True,
     title: str | None = None,
     cell: Cell | None = None,
+    target_names: Iterable[str] | None = None,
 ) -> Path:
     """Write one self-contained HTML page of the robot, that renders offline from ``file://``; atomically.
 
@@ -144,7 +146,8 @@ def export_html(
         fps: the player's samples per second (joint values are interpolated linearly between samples).
         loop: repeat the animation forever (else play it once and hold the last frame).
         title: the page title.
-        cell: a cell whose obstacles (and carried part, on the tool) are drawn (:func:`draw_cell`).
+        cell: a cell whose obstacles (and carried part, on the tool) are drawn (:func:`draw_cell`), each named.
+        target_names: the targets' names (taught points), written beside them.
 
     Returns:
         The path written.
@@ -155,7 +158,7 @@ def export_html(
     """
     text = static_html(
         robot, q, times, qs, polylines, path_points, targets,
-        draw_tool_path=draw_tool_path, fps=fps, loop=loop, title=title, cell=cell,
+        draw_tool_path=draw_tool_path, fps=fps, loop=loop, title=title, cell=cell, target_names=target_names,
     )  # fmt: skip
     return write_text_atomic(path, text)
 

@@ -98,6 +98,8 @@ _TEACH = """
 {cell}<p class="row">branch now: <b id="branch-now">?</b></p>
 <h2>Points</h2>
 <div class="row"><input id="point-name" placeholder="name (P1...)" size="10">
+<select id="point-form" title="record the joint values, or the pose with its branch and wrist turn">
+<option value="joint">joint</option><option value="pose">pose</option></select>
 <button type="button" id="record">record</button></div>
 <table id="points"><tbody></tbody></table>
 <div class="row"><button type="button" id="points-save" {save}>save</button>

@@ -17,7 +17,7 @@
 
   // --------------------------------------------------------------- units: display only, SI inside
   var DEG = Math.PI / 180;  // as Python's math.radians: v * (pi / 180)
-  var units = "mm";
+  var units = data.units === "m" ? "m" : "mm";  // the units the page opens in (job --html: the command line's)
   function human() { return units === "mm"; }
   function lengthUnit() { return human() ? "mm" : "m"; }
   function angleUnit() { return human() ? "deg" : "rad"; }
@@ -555,7 +555,9 @@
     $("record").addEventListener("click", function () {
       var name = $("point-name").value.trim(), before = lastPoints.map(function (p) { return p.name; });
       var added = function (r) { return (r.points || []).filter(function (p) { return before.indexOf(p.name) < 0; })[0]; };
-      post("/points/record", name ? { name: name } : {}, function (r) {
+      var body = { form: $("point-form").value };
+      if (name) body.name = name;
+      post("/points/record", body, function (r) {
         var p = added(r);
         return ["recorded " + p.name + " at x " + number(p.pose[0], "length") + ", y " + number(p.pose[1], "length") +
           ", z " + amount(p.pose[2], "length") + ", yaw " + amount(p.pose[3], "angle"), "ok"];
@@ -580,6 +582,11 @@
   var recorded = null;  // the point just recorded: its row is marked until the user's next action
   function showPoints(points) {
     lastPoints = points;
+    if (typeof setLabels === "function") {
+      setLabels("points", points.filter(function (p) { return p.pose; }).map(function (p) {
+        return { text: p.name, xyz: p.pose.slice(0, 3) };
+      }));
+    }
     var body = document.querySelector("#points tbody");
     if (!body) return;
     body.textContent = "";
@@ -618,6 +625,57 @@
       if (p.name === recorded) tr.className = "recorded";
       body.appendChild(tr);
     });
+  }
+
+  // --------------------------------------------------------------- labels: the obstacles' and the points' names
+  // Written over the scene at their places (base frame), projected with the camera on every frame: the
+  // obstacles of the cell, the poses a job reaches, the taught points of the pendant (updated as they change).
+  var labelLayer = document.createElement("div");
+  labelLayer.id = "labels";
+  labelLayer.style.cssText = "position:absolute;inset:0;pointer-events:none;overflow:hidden;";
+  $("scene").appendChild(labelLayer);
+  var labels = [], placing = false;
+  function setLabels(group, items) {
+    labels = labels.filter(function (l) {
+      if (l.group !== group) return true;
+      l.el.remove();
+      return false;
+    });
+    items.forEach(function (item) {
+      var el = document.createElement("span");
+      el.className = "label label-" + group;
+      el.textContent = item.text;
+      el.style.cssText = "position:absolute;transform:translate(-50%,-120%);font:11px system-ui,sans-serif;" +
+        "background:rgba(255,255,255,.8);border:1px solid #c9ced6;padding:0 3px;white-space:nowrap;";
+      labelLayer.appendChild(el);
+      labels.push({ group: group, xyz: item.xyz, el: el });
+    });
+    if (labels.length && !placing) {  // follow the camera on every frame while there are labels, only then
+      placing = true;
+      window.requestAnimationFrame(placeLabels);
+    }
+  }
+  function placeLabels() {
+    if (!labels.length) { placing = false; return; }
+    var base = node(data.base).object, rect = labelLayer.getBoundingClientRect();
+    base.updateMatrixWorld(true);
+    labels.forEach(function (l) {
+      var v = base.localToWorld(new THREE.Vector3(l.xyz[0], l.xyz[1], l.xyz[2])).project(viewer.camera);
+      var inside = v.z > -1 && v.z < 1 && Math.abs(v.x) <= 1.05 && Math.abs(v.y) <= 1.05;
+      l.el.style.display = inside ? "" : "none";
+      l.el.style.left = ((v.x + 1) / 2 * rect.width) + "px";
+      l.el.style.top = ((1 - v.y) / 2 * rect.height) + "px";
+    });
+    window.requestAnimationFrame(placeLabels);
+  }
+  var groups = {};
+  (data.labels || []).forEach(function (l) { (groups[l.group] = groups[l.group] || []).push(l); });
+  Object.keys(groups).forEach(function (g) { setLabels(g, groups[g]); });
+
+  if (units !== "mm") {  // open in the units asked for: the switch and every label follow
+    var opened = document.querySelector("input[name=units][value=" + units + "]");
+    if (opened) opened.checked = true;
+    relabel();
   }
 
   // camera: look at the workspace's centre (scene z-up -> three.js y-up: (x, y, z) -> (x, z, -y))

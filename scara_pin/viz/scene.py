@@ -281,6 +281,7 @@ class MeshcatScene:
         zero = robot.tool_placement(np.zeros(robot.dof))
         yaw0 = math.atan2(zero.rotation[1, 0], zero.rotation[0, 0])
         self.tool_r0 = pin.utils.rotate("z", -yaw0) @ zero.rotation
+        self.labels: dict[str, list[dict[str, Any]]] = {}  # the names the page writes over the scene, by group
         self._floor()
         self._camera()
         self.display(robot.default_q)
@@ -377,6 +378,7 @@ class MeshcatScene:
             "tool_frame": robot.tool_frame,
             "target": list(f.target),
             "camera": list(f.position),
+            "labels": [{"group": g, **item} for g, items in self.labels.items() for item in items],
         }
 
     def page(self, title: str, data: dict[str, Any] | None = None) -> str:
@@ -419,8 +421,11 @@ class MeshcatScene:
         pts = _points("points", points, 3)
         self._line(f"{OVERLAYS}/{name}", self._world(pts), color)
 
-    def draw_targets(self, poses: object, name: str) -> None:
-        """Target poses as triads oriented as the tool frame would be there: ``Rz(yaw) * R0``."""
+    def draw_targets(self, poses: object, name: str, names: Iterable[str] | None = None) -> None:
+        """Target poses as triads oriented as the tool frame would be there: ``Rz(yaw) * R0``.
+
+        ``names``: their labels, written beside them on the page (taught points).
+        """
         mg = load_meshcat().geometry
         arr = np.array(poses, dtype=float)
         if arr.ndim == 1:
@@ -433,6 +438,11 @@ class MeshcatScene:
             bMt = pin.SE3(pin.utils.rotate("z", yaw) @ self.tool_r0, np.array([x, y, z]))
             node[str(i)].set_object(mg.triad(0.15 * self.size))
             node[str(i)].set_transform((self.oMb * bMt).homogeneous)
+        if names is not None:
+            texts = [str(n) for n in names]
+            if len(texts) != len(arr):
+                raise InvalidInputError(f"{len(texts)} names for {len(arr)} poses")
+            self.labels[name] = [{"text": t, "xyz": row[:3]} for t, row in zip(texts, arr.tolist())]
 
     def draw_polylines(self, polylines: Iterable[object], name: str, z: float | None, color: int) -> None:
         """Draw (x, y) polylines at height ``z`` (None: the floor), or (x, y, z) ones; base frame [m]."""
@@ -453,10 +463,13 @@ class MeshcatScene:
         mg = load_meshcat().geometry
         self.vis[CELL_NODE].delete()
         self.vis[self.carried_path].delete()
+        self.labels[CELL_NODE] = []
         for o in cell.obstacles:
             material = mg.MeshLambertMaterial(color=OBSTACLE_COLOR, opacity=_CELL_OPACITY, transparent=True)
             self.vis[f"{CELL_NODE}/{o.name}"].set_object(_cell_object(o.shape), material)
             self.vis[f"{CELL_NODE}/{o.name}"].set_transform((self.oMb * o.shape.placement()).homogeneous)
+            top = float(o.shape.corners()[:, 2].max())  # the name on its top face, in the base frame
+            self.labels[CELL_NODE].append({"text": o.name, "xyz": [*map(float, o.shape.xyz[:2]), top]})
         if cell.carried is not None:
             tool = self.robot.model.frames[self.robot.tool_id]
             material = mg.MeshLambertMaterial(color=CARRIED_COLOR, opacity=1.0)
@@ -477,8 +490,11 @@ def _cell_object(shape: Shape) -> Any:
 def recorded_scene(robot: RobotModel, q: object | None = None, times: object | None = None, qs: object | None = None,
                    polylines: Iterable[object] | None = None, path_points: object | None = None,
                    targets: object | None = None, *, draw_tool_path: bool = True, fps: int = DEFAULT_FPS,
-                   loop: bool = True, cell: Cell | None = None) -> tuple[MeshcatScene, dict[str, Any]]:  # fmt: skip
+                   loop: bool = True, cell: Cell | None = None, target_names: Iterable[str] | None = None
+                   ) -> tuple[MeshcatScene, dict[str, Any]]:  # fmt: skip
     """Record a scene for a page (no server) from :func:`~scara_pin.viz.meshcat.export_html`'s arguments; its data too.
+
+    ``target_names``: the targets' names (taught points), written beside them; the cell's obstacles are named too.
 
     A motion is not a meshcat animation here: the page's player interpolates the joint values (resampled at
     ``fps``) and moves the joints through the same code as the sliders.
@@ -493,9 +509,10 @@ def recorded_scene(robot: RobotModel, q: object | None = None, times: object | N
     if path_points is not None:
         scene.draw_path(path_points, "path", PATH_COLOR)
     if targets is not None:
-        scene.draw_targets(targets, "targets")
+        scene.draw_targets(targets, "targets", target_names)
     if cell is not None:
         scene.draw_cell(cell)
+    data["labels"] = scene.page_data()["labels"]
     if times is not None:
         t, qq = checked_motion(robot, times, qs)
         if q is None:

@@ -58,7 +58,7 @@ from ..motion.manual import (
     jog_step,
     pose_ik,
 )
-from ..motion.points import PointSet, TaughtPoint, points_format, read_points, write_points
+from ..motion.points import PointSet, PosePoint, TaughtPoint, points_format, read_points, write_points
 
 if TYPE_CHECKING:
     from ..cell import Cell, PairDistance, Scene
@@ -502,10 +502,17 @@ class TeachSession:
     def _adopt(self, points: PointSet) -> PointSet:
         return PointSet(points.points, self.robot.name, self.robot.base_frame, self.robot.tool_frame)
 
-    def record(self, name: str | None = None) -> TeachReply:
-        """Record the current q as a point named ``name`` (default: the first free ``P1``, ``P2``, ...)."""
+    def record(self, name: str | None = None, form: str = "joint") -> TeachReply:
+        """Record the current q as a point named ``name`` (default: the first free ``P1``, ``P2``, ...).
+
+        ``form``: ``"joint"`` (the joint values: the point) or ``"pose"`` (the tool pose with its branch and wrist
+        turn, SPEL+'s ``XY() /R``: :class:`~scara_pin.motion.points.PosePoint`; a YAML points file holds it).
+        """
+        if form not in ("joint", "pose"):
+            raise InvalidInputError(f"form {form[:40]!r} must be joint or pose")
         name = self._points.next_name() if name in (None, "") else name
-        self._points = self._points.added(TaughtPoint.at(self.robot, str(name), self._q))
+        make = TaughtPoint.at if form == "joint" else PosePoint.at
+        self._points = self._points.added(make(self.robot, str(name), self._q))
         return self._reply(False, "OK", f"recorded {name}", points=True)
 
     def rename(self, old: str, new: str) -> TeachReply:
@@ -519,10 +526,10 @@ class TeachSession:
         return self._reply(False, points=True)
 
     def go_to_point(self, name: str) -> TeachReply:
-        """Move to point ``name``'s joint values (its own branch and J4 turn)."""
+        """Move to point ``name``'s joint values (its own branch and J4 turn; a pose point's IK on them)."""
         point = self._points[name]
         self._stop_hold()
-        return self.set_q(point.q)
+        return self.set_q(point.q if isinstance(point, TaughtPoint) else point.solve(self.robot))
 
     def save_points(self, path: str | Path | None = None) -> TeachReply:
         """Write the points to ``path`` (default: the session's points file), atomically."""
@@ -549,8 +556,8 @@ class TeachSession:
 
         Routes: ``state``; ``q`` {q}; ``jog`` {axis: x|y|z|yaw, frame: base|tool | joint: index, direction: +1|-1,
         step: > 0}; ``goto`` {pose, branch}; ``hold`` {the jog's fields without step, speed: percent in (0, 100]};
-        ``alive``; ``release``; ``points/record`` {name?}; ``points/rename`` {old, new}; ``points/delete``
-        {name}; ``points/goto`` {name}; ``points/save``; ``points/load``.
+        ``alive``; ``release``; ``points/record`` {name?, form?: joint|pose}; ``points/rename`` {old, new};
+        ``points/delete`` {name}; ``points/goto`` {name}; ``points/save``; ``points/load``.
 
         Raises:
             InvalidInputError: an unknown route or a malformed body (the message names the field).
@@ -576,7 +583,8 @@ class TeachSession:
         if route == "release":
             return self.release(now)
         if route == "points/record":
-            return self.record(None if body.get("name") is None else _text(body, "name"))
+            return self.record(None if body.get("name") is None else _text(body, "name"),
+                               "joint" if body.get("form") is None else _text(body, "form"))
         if route == "points/rename":
             return self.rename(_text(body, "old"), _text(body, "new"))
         if route == "points/delete":
