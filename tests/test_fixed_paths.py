@@ -150,7 +150,7 @@ def line_of(path: Path, needle: str) -> int:
 @pytest.fixture()
 def no_jump(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     """A jump planned fails the test (the job's goals are checked before any move is planned)."""
-    import scara_pin.job.planning as planning
+    import scara_pin.motion.jump as jump  # the job's planner imports jump_move from there when it plans a jump
 
     calls: list[str] = []
 
@@ -158,7 +158,7 @@ def no_jump(monkeypatch: pytest.MonkeyPatch) -> list[str]:
         calls.append("jump")
         raise AssertionError("a jump was planned before the job's goals were checked")
 
-    monkeypatch.setattr(planning, "jump_move", refused)
+    monkeypatch.setattr(jump, "jump_move", refused)
     return calls
 
 
