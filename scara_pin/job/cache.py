@@ -182,7 +182,7 @@ def cell_digest(cell: Cell | None) -> str:
 
 
 def move_key(robot: str, kind: str, q_from: np.ndarray, q_to: np.ndarray, *, speed: float, accel: float,
-             shape: Iterable[float | None] | None, jerk: Iterable[float] | None, torque: bool, payload_key: object,
+             shape: Iterable[object] | None, jerk: Iterable[float] | None, torque: bool, payload_key: object,
              cell: str) -> str:  # fmt: skip
     """The digest of one move's plan's inputs (module docstring); ``robot`` and ``cell`` are their digests."""
     digest = hashlib.sha256()

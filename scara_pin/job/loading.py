@@ -109,6 +109,8 @@ KEYS = ("format", "robot", "units", "points", "frames", "base", "poses", "speed"
 _POSE_KEYS = ("xyz", "yaw", "hand", "turns", "frame")
 _PALLET_KEYS = ("corners", "rows", "columns", "layers", "layer_height")
 _JUMP_KEYS = ("rise", "clearance_radius", "max_height")
+MAX_VIA = 16
+"""The most via points of one jump (hints of its way: a few are enough; each one is a warm start's corner)."""
 _STEP_KINDS = "speed, accel, jump, move, go, dwell, pick, place, for"
 
 
@@ -478,7 +480,7 @@ def _payload(at: _At) -> Payload:
     return Payload(mass, com)
 
 
-def _shape(keys: Mapping[str, _At]) -> dict[str, float]:
+def _shape(keys: Mapping[str, _At]) -> dict[str, Any]:
     """The jump clearance values among ``keys`` (rise, clearance_radius, max_height), checked, SI."""
     out = {}
     for name in _JUMP_KEYS:
@@ -511,6 +513,21 @@ def _pallet(at: _At, name: str, points: PointSet) -> Pallet:
         return Pallet(name, tuple(corners), rows, columns, layers, height)
     except InvalidInputError as exc:
         at.fail(str(exc))
+
+
+def _via(at: _At, points: PointSet) -> tuple[str, ...]:
+    """A jump's ``via:``: names of points (joint or pose), hints of its way through the cell, in order."""
+    names = []
+    items = at.elements()
+    if not 1 <= len(items) <= MAX_VIA:
+        at.fail(f"via: is a list of 1 to {MAX_VIA} point names (hints of the jump's way through the cell), "
+                f"got {len(items)}")  # fmt: skip
+    for item in items:
+        name = item.text(32)
+        if name not in points:
+            item.fail(_unknown_point(name, points))
+        names.append(name)
+    return tuple(names)
 
 
 def _unknown_point(name: str, points: PointSet) -> str:
@@ -581,9 +598,10 @@ def _step(at: _At, points: PointSet, pallets: Mapping[str, Pallet], scope: Mappi
         at.fail(f"one move per step: {', '.join(moves)} in one step")
     if moves:
         kind = MoveKind(moves[0])
-        entries = at.mapping((kind.value, *_JUMP_KEYS) if kind is MoveKind.JUMP else (kind.value,))
+        entries = at.mapping((kind.value, *_JUMP_KEYS, "via") if kind is MoveKind.JUMP else (kind.value,))
         target = _target(entries[kind.value], points, pallets, scope)
-        return MotionStep(kind, target, line, **_shape(entries))
+        via = _via(entries["via"], points) if "via" in entries else ()
+        return MotionStep(kind, target, line, **_shape(entries), via=via)
     if "dwell" in keys:
         entries = at.mapping(("dwell",))
         return Dwell(entries["dwell"].number(lambda v: 0 <= v <= MAX_DWELL, f">= 0 and at most {MAX_DWELL:,} (seconds "

@@ -200,7 +200,7 @@ def plan_move(
         rise, radius, ceiling = move.shape.resolved()
         jump = jump_move(robot, robot.tool_pose(q0), move.pose, rise=rise, clearance_radius=radius,
                          max_height=ceiling, payload=payload, torque=torque, limits=limits, start=q0, end=q1,
-                         cell=cell, jerk=jerk)  # fmt: skip
+                         cell=cell, jerk=jerk, via=move.shape.via)  # fmt: skip
         traj, method, bound, clearance = jump.trajectory, Method.JUMP.value, jump.lower_bound.duration, jump.distance
     elif jerk is not None:  # a fixed path, jerk-limited (plan_motion takes no scaled limits with a jerk limit)
         traj, method, clearance = _jerk_limited(robot, move, q0, q1, limits, jerk, torque, payload, cell)
@@ -358,7 +358,8 @@ class Planner:
         cell_key = self._cell_keys.get(id(cell))
         if cell_key is None:
             cell_key = self._cell_keys[id(cell)] = cell_digest(cell)
-        shape = None if move.shape is None else (move.shape.rise, move.shape.clearance_radius, move.shape.max_height)
+        shape = None if move.shape is None else (move.shape.rise, move.shape.clearance_radius, move.shape.max_height,
+                                                 move.shape.via)  # fmt: skip
         load = (payload.mass, tuple(payload.com)) if self.torque else None
         return move_key(self._robot_key, move.kind.value, q0, q1, speed=move.speed, accel=move.accel, shape=shape,
                         jerk=self.jerk, torque=self.torque, payload_key=load, cell=cell_key)  # fmt: skip
@@ -407,7 +408,9 @@ class Planner:
         return out
 
     def free(self, move: Move, q_from: np.ndarray, holding: bool = False) -> PlannedMove:
-        """The same move planned without the cell (the cost column: time in the cell minus this)."""
+        """The same move planned without the cell (the cost column: time in the cell minus this; no via hints)."""
+        if move.shape is not None and move.shape.via:
+            move = replace(move, shape=replace(move.shape, via=()))
         q0, q1 = np.asarray(q_from, dtype=float), np.asarray(move.q, dtype=float)
         payload = self.payload if self.carry is None or holding else Payload()
         state = ("free", holding)

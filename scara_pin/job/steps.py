@@ -133,11 +133,14 @@ class JumpShape:
         clearance_radius: [m] within this of a pose (horizontally) the tool may be lower; None: the standard
             (:data:`~scara_pin.motion.jump.STANDARD_CLEARANCE`).
         max_height: [m] a ceiling for the tool's z, or None.
+        via: joint configurations, hints of the jump's way through the cell (the step's ``via:`` points, in
+            order; :func:`~scara_pin.motion.jump.jump_move`'s ``via``).
     """
 
     rise: float | None = None
     clearance_radius: float | None = None
     max_height: float | None = None
+    via: tuple[tuple[float, ...], ...] = ()
 
     def resolved(self) -> tuple[float, float, float | None]:
         """(rise, clearance_radius, max_height) with the standard values for those not given [m]."""
@@ -158,7 +161,10 @@ class Setting:
 
 @dataclass(frozen=True)
 class MotionStep:
-    """A move to ``target``; ``rise``, ``clearance_radius``, ``max_height`` override the job's (jumps only)."""
+    """A move to ``target``; its jump's ``rise``, ``clearance_radius``, ``max_height`` and ``via`` points.
+
+    The three numbers override the job's; ``via`` names the points of the jump's way through the cell (jumps only).
+    """
 
     kind: MoveKind
     target: Target
@@ -166,6 +172,7 @@ class MotionStep:
     rise: float | None = None
     clearance_radius: float | None = None
     max_height: float | None = None
+    via: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -471,7 +478,8 @@ def _unroll(steps: tuple[Step, ...], env: dict[str, int], state: _State, resolve
             if step.kind is MoveKind.JUMP:
                 jump = JumpShape(shape.rise if step.rise is None else step.rise,
                                  shape.clearance_radius if step.clearance_radius is None else step.clearance_radius,
-                                 shape.max_height if step.max_height is None else step.max_height)  # fmt: skip
+                                 shape.max_height if step.max_height is None else step.max_height,
+                                 tuple(tuple(map(float, resolver.points.q_of(name))) for name in step.via))  # fmt: skip
             speed, accel = state.speed * state.override[0], state.accel * state.override[1]
             yield Move(step.kind, text, place, q, pose, speed, accel, jump, step.line)
             state.q, state.at = q, text
