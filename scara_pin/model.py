@@ -7,8 +7,8 @@ Conventions (used by every command of the package):
   as Pinocchio mimic joints: they follow their joint and are not in ``q`` (``Robot.geared``). Joints off the
   chain from the root to the tool (another arm) are locked (``Robot.locked``, :mod:`scara_pin.chain`).
   A URDF ``continuous`` joint (Pinocchio: nq = 2, its (cos q, sin q)) is one angle in ``q`` too: no position
-  limit (any finite q), IK solutions presented in [-pi, pi]; :meth:`Robot.to_pinocchio_q` /
-  :meth:`Robot.from_pinocchio_q` convert for raw Pinocchio calls.
+  limit (any finite q), IK solutions presented in [-pi, pi]; :meth:`RobotModel.to_pinocchio_q` /
+  :meth:`RobotModel.from_pinocchio_q` convert for raw Pinocchio calls.
 - Poses are of ``tool0`` in the robot's ``base`` frame (the controller's reference frame). The yaw is
   ``atan2(R[1, 0], R[0, 0])`` of that rotation: the heading of tool0's x axis in the base plane.
 - Pinocchio's world frame (``universe``) is the root link (``base_link``); Jacobians named after

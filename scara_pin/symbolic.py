@@ -131,7 +131,7 @@ def _joints(robot: RobotModel) -> tuple[list[_Joint], pin.SE3]:
 def frames_at(sym: SymbolicModel, Q: np.ndarray) -> np.ndarray:
     """(n, njoints, 12): :attr:`SymbolicModel.joint_frames` at each row of ``Q``, evaluated into numpy directly.
 
-    In blocks of :data:`_BLOCK` columns of one mapped function through CasADi's buffer interface (its DM results
+    In blocks of ``_BLOCK`` columns of one mapped function through CasADi's buffer interface (its DM results
     would cost ten times the evaluation to convert); the last block padded.
     """
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
@@ -165,7 +165,7 @@ _EVALUATORS: dict[int, _Evaluator] = {}
 
 
 def _evaluator(f: Any) -> _Evaluator:
-    """The mapped ``f`` over :data:`_BLOCK` columns with its numpy buffers, made once per function."""
+    """The mapped ``f`` over ``_BLOCK`` columns with its numpy buffers, made once per function."""
     hit = _EVALUATORS.get(id(f))
     if hit is None or hit.function is not f:
         mapped = f.map(_BLOCK)

@@ -269,7 +269,7 @@ def hull(points: np.ndarray) -> Any:
 
     The hull's own vertices are found by qhull (in scipy) and handed to coal. coal keeps at most 255 neighbours per
     vertex of a hull (a finely tessellated ball's pole has more: its hull could not be built, an internal error),
-    and a hull of 100,000 vertices costs seconds: more than :data:`_HULL_POINTS` points, or a hull coal refuses, are
+    and a hull of 100,000 vertices costs seconds: more than ``_HULL_POINTS`` points, or a hull coal refuses, are
     snapped to a grid of spacing ``h`` (1/256 of their size, then coarser) first, and the hull of the snapped points
     is inflated by the snap's largest move, ``h sqrt(3) / 2`` (coal's swept-sphere radius): every point is within
     that of a snapped one, so the inflated hull holds the original (a distance to it is never larger). A flat set

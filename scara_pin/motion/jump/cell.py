@@ -296,11 +296,11 @@ def _missed(prob: Problem, traj: Trajectory) -> DistanceRow | None:
 _FREE_CHECK = 400
 """Samples at which the motion without the cell is first checked against it (then verified, certified)."""
 SOLVED_WAYS = 2
-"""Ways (distinct: :func:`_same_way`) solved to the end before the fastest is kept."""
+"""Ways (distinct: ``_same_way``) solved to the end before the fastest is kept."""
 FAILED_WAYS = 4
 """Warm starts whose local solve may fail before the jump is given up."""
 _LADDER = 24
-"""Rungs of the ladder between a warm start and a motion solved already (:func:`_same_way`)."""
+"""Rungs of the ladder between a warm start and a motion solved already (``_same_way``)."""
 
 
 def _same_way(scene: Scene, waypoints: np.ndarray, path: np.ndarray, velocity: np.ndarray) -> bool:

@@ -77,7 +77,7 @@ NODES = -1
 class ConstraintPoint:
     """A constraint point inside interval ``k`` at fraction ``sigma`` of it, for one family of constraints.
 
-    ``k`` = :data:`NODES`: the family at every node instead (both sides; a lazy family, :data:`_LAZY`).
+    ``k`` = :data:`NODES`: the family at every node instead (both sides; a lazy family, ``_LAZY``).
     """
 
     k: int

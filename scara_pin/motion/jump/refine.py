@@ -210,7 +210,7 @@ def violations(prob: Problem, piece: PolynomialPiece, T: np.ndarray,
 def torque_stretch(prob: Problem, piece: PolynomialPiece) -> float:
     """The least k >= 1 with every torque of ``piece`` played k times slower within its limit (module docstring).
 
-    Sampled at :data:`_STRETCH_POINTS` + 1 points of every interval (its own acceleration at both ends).
+    Sampled at ``_STRETCH_POINTS`` + 1 points of every interval (its own acceleration at both ends).
     With d = tau - g (the dynamic part) and g the static load at a sample, |d / k^2 + g| <= E needs
     k^2 >= d / (E - g) if d > 0, k^2 >= -d / (E + g) if d < 0; a static load at or above the limit cannot be
     helped (1 is returned: the verification says why).
