@@ -112,7 +112,8 @@ class ResultStore:
         if not self._waiting:
             self._since = time.monotonic()
         self._waiting.append(dict(row))
-        self._kept.append(dict(row))
+        if self.folder is None:  # else read back from the part files (10^6 rows kept would be about a GB)
+            self._kept.append(dict(row))
         if len(self._waiting) >= self.batch or time.monotonic() - self._since >= self.every:
             self.flush()
 
