@@ -186,7 +186,7 @@ def test_ctrl_c_keeps_every_finished_row_and_a_rerun_completes(serial: pd.DataFr
     from sigint import default_sigint
 
     out = tmp_path / "r"
-    cmd = [sys.executable, "-m", "scara_pin.cli", "sweep", str(SPEC), "--out", str(out), "--workers", "2",
+    cmd = [sys.executable, "-m", "scara_pin.cli", "sweep", str(SPEC), "--out", str(out), "--workers", "1",
            "--batch", "1"]  # fmt: skip
     proc = subprocess.Popen(cmd, env=_child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True, preexec_fn=default_sigint)  # fmt: skip
@@ -274,6 +274,21 @@ def test_an_unreachable_scheduler_is_refused_in_one_line(tmp_path: Path, capsys:
 def test_a_variant_past_its_time_limit_is_a_timeout_row(tmp_path: Path) -> None:
     rows = sweep(_spec(tmp_path, "vary: {speed: [100]}\ntimeout: 1e-9\n"), workers=0)
     assert rows["status"].tolist() == ["timeout"] and "time limit" in rows["reason"][0]
+
+
+def test_a_urdf_robot_travels_as_its_text_and_plans_as_the_configured_one(tmp_path: Path) -> None:
+    """``robot: [default, default.urdf]``: the URDF's text goes to the worker (a Robot does not pickle), with the
+    sweep's acceleration limits; the same robot gives the same total by either route."""
+    from scara_pin import generate_urdf, load_robot
+
+    (tmp_path / "default.urdf").write_text(generate_urdf("default"))
+    acc = list(load_robot("default").limits.acceleration)
+    rows = sweep(_spec(tmp_path, f"vary: {{robot: [default, default.urdf], speed: [100]}}\nacceleration: {acc}\n"),
+                 workers=0)  # fmt: skip
+    assert rows["status"].tolist() == ["ok", "ok"], rows["reason"].tolist()
+    assert abs(rows["total"][0] - rows["total"][1]) <= 1e-12 and rows["key"].nunique() == 2
+    code = main(["sweep", _spec(tmp_path, "vary: {robot: [default.urdf]}\n"), "--out", str(tmp_path / "r")])
+    assert code == 2  # a URDF has no acceleration limits: refused at once, before any cluster starts
 
 
 def test_the_package_is_callable_as_the_issue_spells_it(serial: pd.DataFrame, serial_folder: Path) -> None:
