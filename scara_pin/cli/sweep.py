@@ -10,6 +10,7 @@ import time
 from typing import Any
 
 from ..errors import InvalidInputError, ParameterError
+from ..files import check_outputs
 from ._numbers import number_type
 from ._outputs import check_command_outputs
 
@@ -32,6 +33,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if args.batch < 1:
         raise ParameterError("--batch", args.batch, "must be >= 1")
     spec = load_spec(args.file)
+    check_outputs({"--plot": args.plot}, {"the job": [str(spec.job)]}, figures=("--plot",))  # nor over the job
     start = time.perf_counter()
     todo: list[Any] = []
     with _Bar(spec.count) as bar:

@@ -147,7 +147,8 @@ class SweepSpec:
 
     def key_of(self, values: Sequence[tuple[str, Any]]) -> str:
         """The content key of a variant with these values (module docstring)."""
-        recipe = self.robots.get(str(dict(values).get("robot", "")))
+        robot = dict(values).get("robot") or next(iter(self.robots))  # the job's own robot when not varied
+        recipe = self.robots.get(str(robot))
         text = json.dumps([self.digest, recipe.digest if recipe else "", list(values)], sort_keys=True,
                           separators=(",", ":"), allow_nan=False)  # fmt: skip
         return hashlib.sha256(text.encode("utf-8")).hexdigest()[:_KEY_DIGITS]
