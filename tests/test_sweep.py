@@ -185,8 +185,8 @@ def _child_env() -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
 
 
-def test_ctrl_c_keeps_every_finished_row_and_a_rerun_completes(serial: pd.DataFrame, client,  # noqa: ANN001
-                                                                tmp_path: Path) -> None:  # fmt: skip
+def test_ctrl_c_keeps_every_finished_row_and_a_rerun_completes(serial: pd.DataFrame, client, tmp_path: Path,  # noqa: ANN001
+                                                                capsys: pytest.CaptureFixture[str]) -> None:
     """Ctrl-C (SIGINT to the command's process group, as a terminal sends it): exit 130, the finished rows on disk,
     each once; the rerun runs only the rest and every variant is on disk exactly once. The command runs on the
     module's cluster (its workers, in another process group, ignore SIGINT anyway: the test above)."""
@@ -208,6 +208,9 @@ def test_ctrl_c_keeps_every_finished_row_and_a_rerun_completes(serial: pd.DataFr
     first = on_disk(out)
     assert 1 <= len(first) and first["key"].is_unique and set(first["status"]) <= {"ok", "infeasible"}
     assert main(["sweep", str(SPEC), "--out", str(out), "--scheduler", address]) == 0
+    report = capsys.readouterr().out
+    assert f"6 ok, 6 infeasible, 0 failed, 0 timeout; {12 - len(first)} run now, {len(first)} from earlier" in report
+    assert "best      5 by parts per hour:" in report
     disk = on_disk(out)
     assert sorted(disk["key"]) == sorted(serial["key"])  # the rest, and nothing twice
     assert_same_rows(disk.sort_values("variant").reset_index(drop=True), serial)
@@ -308,7 +311,7 @@ def test_the_package_is_callable_as_the_issue_spells_it(serial: pd.DataFrame, se
     assert_same_rows(rows, serial)
 
 
-def test_the_plot_is_a_heat_map_over_a_placement_grid(tmp_path: Path) -> None:
+def test_the_plot_is_a_heat_map_over_a_placement_grid(serial: pd.DataFrame, tmp_path: Path) -> None:
     from scara_pin.viz.sweep import pareto_front, placement_axes, plot_sweep
 
     xy = [[x, y, 0.0] for x in (0.0, 10.0, 20.0) for y in (0.0, 10.0)]
@@ -318,6 +321,9 @@ def test_the_plot_is_a_heat_map_over_a_placement_grid(tmp_path: Path) -> None:
     assert placement_axes(rows, ["base.xyz"]) == ("base.xyz", 0, 1)
     fig = plot_sweep(rows, ["base.xyz"], tmp_path / "h.png")
     assert (tmp_path / "h.png").stat().st_size > 1000 and "placement grid" in fig.axes[0].get_title()
+    assert placement_axes(serial, ["robot", "base.xyz", "speed"]) is None  # base.xyz varies in x alone
+    fig = plot_sweep(serial, ["robot", "base.xyz", "speed"], tmp_path / "f.svg")  # parts/h against speed, a front
+    assert "speed" in fig.axes[0].get_xlabel() and (tmp_path / "f.svg").read_text().startswith("<?xml")
     x, y = np.array([1.0, 2.0, 3.0, 2.0]), np.array([3.0, 2.0, 1.0, 1.0])
     assert pareto_front(x, y).tolist() == [0, 1, 2]  # (2, 1) is beaten by (3, 1) and (2, 2)
 
