@@ -216,6 +216,27 @@ def test_ctrl_c_keeps_every_finished_row_and_a_rerun_completes(serial: pd.DataFr
     assert_same_rows(disk.sort_values("variant").reset_index(drop=True), serial)
 
 
+@pytest.mark.heavy
+def test_ctrl_c_on_the_commands_own_local_cluster(serial: pd.DataFrame, tmp_path: Path) -> None:
+    """The default path: the command starts its own LocalCluster, and Ctrl-C reaches its workers too (one process
+    group): exit 130 without a worker's traceback, the finished rows each once (about 10 s of start-ups)."""
+    from sigint import default_sigint
+
+    out = tmp_path / "r"
+    cmd = [sys.executable, "-m", "scara_pin.cli", "sweep", str(SPEC), "--out", str(out), "--workers", "2",
+           "--batch", "1"]  # fmt: skip
+    proc = subprocess.Popen(cmd, env=_child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True, preexec_fn=default_sigint)  # fmt: skip
+    deadline = time.monotonic() + 60
+    while not list(out.glob("part-*.parquet")) and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in stderr and stderr.endswith("error: interrupted\n"), stderr
+    first = on_disk(out)
+    assert len(first) >= 1 and first["key"].is_unique and set(first["status"]) <= {"ok", "infeasible"}
+
+
 def test_a_scheduler_and_a_worker_started_apart_are_reached_by_address(serial: pd.DataFrame, tmp_path: Path,
                                                                         capsys: pytest.CaptureFixture[str]) -> None:
     import json
