@@ -324,6 +324,23 @@ def test_a_urdf_robot_travels_as_its_text_and_plans_as_the_configured_one(tmp_pa
     assert code == 2  # a URDF has no acceleration limits: refused at once, before any cluster starts
 
 
+@pytest.mark.heavy
+def test_in_a_cell_the_row_has_the_closest_pair_and_the_cells_cost(tmp_path: Path) -> None:
+    """The job of the tray with a camera post (tests/data/sweep/cell.yaml): the row's closest pair, its distance and
+    the cell's cost are the JobResult's, planned through the Job API (about 6 s: two plans in a cell)."""
+    from scara_pin import load_robot
+    from scara_pin.job import Job
+
+    spec = tmp_path / "s.yaml"
+    spec.write_text(f"job: {DATA / 'cell.yaml'}\nvary: {{speed: [100]}}\n")
+    row = sweep(spec, workers=0).iloc[0]
+    result = Job.load(DATA / "cell.yaml").replace(speed=100).plan(load_robot("default"), cache=False)
+    clearance = result.closest.clearance
+    assert row["status"] == "ok" and abs(row["total"] - result.total) <= 1e-12
+    assert row["closest_pair"] == clearance.pair and row["closest_distance"] == clearance.distance
+    assert row["cell_cost"] == pytest.approx(result.cell_cost, abs=1e-15)
+
+
 def test_the_package_is_callable_as_the_issue_spells_it(serial: pd.DataFrame, serial_folder: Path) -> None:
     """``scara_pin.sweep(spec)``: the subpackage is callable; resumed from a folder, nothing is planned again."""
     calls: list[int] = []
