@@ -304,6 +304,19 @@ def test_an_unreachable_scheduler_is_refused_in_one_line(tmp_path: Path, capsys:
 
 
 # ------------------------------------------------------------------------------------------ the rest
+@pytest.mark.parametrize("stop", [KeyboardInterrupt, RuntimeError])
+def test_whatever_stops_a_sweep_the_finished_rows_are_written(tmp_path: Path, stop: type[BaseException]) -> None:
+    """Ctrl-C in this process, or an error (a scheduler lost): the rows finished before it are on disk, once."""
+    def progress(done: int, total: int) -> None:
+        if done == 2:
+            raise stop()
+
+    spec = _spec(tmp_path, "vary: {robot: [s1], speed: [60, 80, 100]}\n")  # infeasible: quick rows
+    with pytest.raises(stop):
+        sweep(spec, workers=0, out=tmp_path / "r", progress=progress)
+    assert on_disk(tmp_path / "r")["variant"].tolist() == [0, 1]
+
+
 def test_a_variant_past_its_time_limit_is_a_timeout_row(tmp_path: Path) -> None:
     rows = sweep(_spec(tmp_path, "vary: {speed: [100]}\ntimeout: 1e-9\n"), workers=0)
     assert rows["status"].tolist() == ["timeout"] and "time limit" in rows["reason"][0]

@@ -118,8 +118,8 @@ def run_variants(recipe: Recipe, variants: list[Variant], store: ResultStore, cl
                  progress: Progress | None = None) -> None:  # fmt: skip
     """Run ``variants`` (in this process when ``client`` is None) and add each row to ``store`` as it finishes.
 
-    Ctrl-C (``KeyboardInterrupt``) or SIGTERM: the finished rows are written (:meth:`ResultStore.flush`), the
-    futures cancelled, and the interruption raised again.
+    Ctrl-C (``KeyboardInterrupt``), SIGTERM or any error (a scheduler lost): the finished rows are written
+    (:meth:`ResultStore.flush`), the futures cancelled, and the interruption or error raised again.
     """
     from ..signals import handled
 
@@ -131,12 +131,13 @@ def run_variants(recipe: Recipe, variants: list[Variant], store: ResultStore, cl
                     progress(n + 1, len(variants))
         else:
             _on_cluster(recipe, variants, store, client, progress)
-    except KeyboardInterrupt as exc:  # Terminated (SIGTERM) too
-        import signal
+    except BaseException as exc:  # Ctrl-C, SIGTERM (Terminated), a scheduler lost: the finished rows are written
+        if isinstance(exc, KeyboardInterrupt):
+            import signal
 
-        from ..signals import Terminated
+            from ..signals import Terminated
 
-        handled(signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT)  # the finished rows: written
+            handled(signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT)  # else the writer refuses
         store.flush()
         raise
     store.flush()
