@@ -370,10 +370,10 @@ def test_the_plot_is_a_heat_map_over_a_placement_grid(serial: pd.DataFrame, tmp_
                          "parts_per_hour": [1.0, 2.0, 3.0, 4.0, 5.0, math.nan], "closest_distance": [math.nan] * 6,
                          "variant": range(6)})  # fmt: skip
     assert placement_axes(rows, ["base.xyz"]) == ("base.xyz", 0, 1)
-    fig = plot_sweep(rows, ["base.xyz"], tmp_path / "h.png")
+    fig = plot_sweep(rows, tmp_path / "h.png", columns=["base.xyz"])
     assert (tmp_path / "h.png").stat().st_size > 1000 and "placement grid" in fig.axes[0].get_title()
     assert placement_axes(serial, ["robot", "base.xyz", "speed"]) is None  # base.xyz varies in x alone
-    fig = plot_sweep(serial, ["robot", "base.xyz", "speed"], tmp_path / "f.svg")  # parts/h against speed, a front
+    fig = plot_sweep(serial, tmp_path / "f.svg")  # the varied columns found; parts/h against the speed: a front
     assert "speed" in fig.axes[0].get_xlabel() and (tmp_path / "f.svg").read_text().startswith("<?xml")
     x, y = np.array([1.0, 2.0, 3.0, 2.0]), np.array([3.0, 2.0, 1.0, 1.0])
     assert pareto_front(x, y).tolist() == [0, 1, 2]  # (2, 1) is beaten by (3, 1) and (2, 2)

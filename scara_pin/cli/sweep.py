@@ -53,7 +53,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         from ..job import Job
         from ..viz.sweep import plot_sweep
 
-        plot_sweep(rows, spec.columns, args.plot, Job.load(spec.job, text=spec.job_text).units.length)
+        plot_sweep(rows, args.plot, columns=spec.columns, units=Job.load(spec.job, text=spec.job_text).units)
     counts = rows["status"].value_counts().to_dict() if len(rows) else {}
     if args.json:
         print(json.dumps({"sweep": str(spec.path), "variants": spec.count, "run": len(todo), "counts": counts,

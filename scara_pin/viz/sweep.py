@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..units import SI, DisplayUnits
 from .plots import finish, new_figure
 
 if TYPE_CHECKING:
@@ -49,16 +50,20 @@ def pareto_front(x: np.ndarray, y: np.ndarray, x_larger: bool = True) -> np.ndar
     return np.array(sorted(keep, key=lambda i: x[i]), dtype=int)
 
 
-def plot_sweep(rows: pd.DataFrame, columns: Sequence[str], path: str | os.PathLike[str] | None = None,
-               length_unit: str = "") -> Figure:  # fmt: skip
+def plot_sweep(rows: pd.DataFrame, path: str | os.PathLike[str] | None = None, *,
+               columns: Sequence[str] | None = None, units: DisplayUnits = SI) -> Figure:  # fmt: skip
     """Draw a sweep's rows (module docstring) and write the picture to ``path`` (PNG, SVG, PDF) if given.
 
     Args:
         rows: the sweep's rows (:func:`scara_pin.sweep.sweep`).
-        columns: the varied keys (the rows' first columns).
         path: the picture's file (PNG, SVG, PDF), or None.
-        length_unit: the placement's unit (the job file's lengths: ``m``, ``mm``), for the axes.
+        columns: the varied keys; default: the rows' columns before ``variant`` (where a sweep puts them).
+        units: the job file's units (the varied values are in them): the placement's axes say its length unit.
     """
+    if columns is None:
+        names = list(rows.columns)
+        columns = names[: names.index("variant")] if "variant" in names else []
+    length_unit = units.name("length")
     fig = new_figure(7.0, 5.5)
     ax = fig.add_subplot(1, 1, 1)
     ok = rows[rows["status"] == "ok"]
