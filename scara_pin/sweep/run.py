@@ -21,7 +21,9 @@ __all__ = ["recipe_of", "sweep"]
 def recipe_of(spec: SweepSpec) -> Recipe:
     """What every task of ``spec`` gets: the job's path and text, the robots' recipes, the time limit."""
     default = next(iter(spec.robots))
-    return Recipe(str(spec.job), spec.job_text, tuple(spec.robots.items()), default, spec.timeout)
+    # the job's absolute path: a worker elsewhere (another folder, another machine on a shared file system) finds
+    # the files the job names beside it
+    return Recipe(str(spec.job.resolve()), spec.job_text, tuple(spec.robots.items()), default, spec.timeout)
 
 
 def sweep(spec: SweepSpec | str | os.PathLike[str], client: Client | None = None, *, out: str | Path | None = None,

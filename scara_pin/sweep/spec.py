@@ -61,12 +61,14 @@ class RobotRecipe:
         urdf: the URDF file's text, or None for a configured robot.
         acceleration: a URDF robot's joint acceleration limits [rad/s^2, m/s^2], or None.
         digest: SHA-256 of what the robot is made from (its configuration files, or the URDF text).
+        folder: a configuration folder's absolute path (a worker in another folder finds it), or None for a name.
     """
 
     name: str
     urdf: str | None = None
     acceleration: tuple[float, ...] | None = None
     digest: str = ""
+    folder: str | None = None
 
 
 @dataclass(frozen=True)
@@ -317,7 +319,7 @@ def _integer(data: Mapping[str, Any], key: str, fail: Any, low: int) -> int | No
 
 def _recipe(name: str, folder: Path, acceleration: tuple[float, ...] | None, fail: Any) -> RobotRecipe:
     """The recipe of the robot a sweep names: a URDF file's text (``.urdf``), else a configured robot's name."""
-    from ..description import config_files
+    from ..description import available_robots, config_files
 
     if name.endswith(".urdf"):
         file = Path(name) if Path(name).is_absolute() else folder / name
@@ -333,7 +335,8 @@ def _recipe(name: str, folder: Path, acceleration: tuple[float, ...] | None, fai
     except (ValueError, OSError) as exc:
         raise fail(f"vary robot {name[:64]!r}: {exc}") from None
     body = b"".join(read_bytes(f, "robot file") for f in files)
-    return RobotRecipe(name, None, None, _sha(body))
+    place = None if name in available_robots() else str(files[0].parent.resolve())  # a folder: its absolute path
+    return RobotRecipe(name, None, None, _sha(body), place)
 
 
 def _sha(data: bytes) -> str:

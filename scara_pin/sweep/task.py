@@ -74,7 +74,7 @@ def robot_of(recipe: RobotRecipe) -> RobotModel:
 
     if recipe.urdf is not None:
         return RobotModel(recipe.urdf, kinematics=kinematics_for, acceleration=recipe.acceleration)
-    return RobotModel.from_config(recipe.name, kinematics=kinematics_for)
+    return RobotModel.from_config(recipe.folder or recipe.name, kinematics=kinematics_for)
 
 
 @functools.lru_cache(maxsize=4)
