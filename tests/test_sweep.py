@@ -354,6 +354,23 @@ def test_in_a_cell_the_row_has_the_closest_pair_and_the_cells_cost(tmp_path: Pat
     assert row["cell_cost"] == pytest.approx(result.cell_cost, abs=1e-15)
 
 
+def test_the_workers_get_absolute_paths(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A worker in another folder (another machine on a shared file system) finds the job and a robot's folder."""
+    import shutil
+
+    from scara_pin.description import urdf_dir
+    from scara_pin.sweep import recipe_of
+
+    shutil.copytree(urdf_dir() / "config" / "default", tmp_path / "mine")
+    (tmp_path / "job.yaml").write_text(JOB.read_text())
+    (tmp_path / "s.yaml").write_text("job: job.yaml\nvary: {robot: [default, mine]}\n")
+    monkeypatch.chdir(tmp_path)
+    recipe = recipe_of(load_spec("s.yaml"))
+    assert recipe.job == str(tmp_path.resolve() / "job.yaml")
+    robots = dict(recipe.robots)
+    assert robots["mine"].folder == str((tmp_path / "mine").resolve()) and robots["default"].folder is None
+
+
 def test_the_package_is_callable_as_the_issue_spells_it(serial: pd.DataFrame, serial_folder: Path) -> None:
     """``scara_pin.sweep(spec)``: the subpackage is callable; resumed from a folder, nothing is planned again."""
     calls: list[int] = []
