@@ -364,8 +364,8 @@ def test_the_workers_get_absolute_paths(tmp_path: Path, monkeypatch: pytest.Monk
     shutil.copytree(urdf_dir() / "config" / "default", tmp_path / "mine")
     (tmp_path / "job.yaml").write_text(JOB.read_text())
     (tmp_path / "s.yaml").write_text("job: job.yaml\nvary: {robot: [default, mine]}\n")
-    monkeypatch.chdir(tmp_path)
-    recipe = recipe_of(load_spec("s.yaml"))
+    monkeypatch.chdir(REPO)  # the folder is the sweep file's, not the current one
+    recipe = recipe_of(load_spec(os.path.relpath(tmp_path / "s.yaml")))
     assert recipe.job == str(tmp_path.resolve() / "job.yaml")
     robots = dict(recipe.robots)
     assert robots["mine"].folder == str((tmp_path / "mine").resolve()) and robots["default"].folder is None

@@ -318,7 +318,10 @@ def _integer(data: Mapping[str, Any], key: str, fail: Any, low: int) -> int | No
 
 
 def _recipe(name: str, folder: Path, acceleration: tuple[float, ...] | None, fail: Any) -> RobotRecipe:
-    """The recipe of the robot a sweep names: a URDF file's text (``.urdf``), else a configured robot's name."""
+    """The recipe of a robot the sweep names: a URDF file's text, a shipped robot's name, or a folder's path.
+
+    URDF files (``.urdf``) and configuration folders are relative to the sweep file, as its job is.
+    """
     from ..description import available_robots, config_files
 
     if name.endswith(".urdf"):
@@ -328,8 +331,9 @@ def _recipe(name: str, folder: Path, acceleration: tuple[float, ...] | None, fai
             raise fail(f"vary robot {name}: a URDF file has no acceleration limits: give acceleration: [...] "
                        "(one per joint)")  # fmt: skip
         return RobotRecipe(name, text, acceleration, _sha(text.encode() + repr(acceleration).encode()))
+    beside = folder / name  # a configuration folder, relative to the sweep file (as its job and URDF files)
     try:
-        files = config_files(name)
+        files = config_files(name if name in available_robots() or not beside.is_dir() else beside)
     except UnknownRobotError as exc:
         raise fail(f"vary robot: {exc}") from None
     except (ValueError, OSError) as exc:
