@@ -4,8 +4,9 @@
   are checked against.
 - Default: a ``distributed.LocalCluster`` of one single-threaded worker PROCESS per core (the planner holds the
   GIL), with Dask's per-worker housekeeping quieted (:data:`QUIET`: no statistical profiler, slow event-loop and
-  system monitors, glibc's memory trimming at 256 MiB instead of 64 KiB): with Dask's defaults a worker spends
-  30-40 % of a core beside its task. The workers leave Ctrl-C to the client (:mod:`~scara_pin.sweep.preload`).
+  system monitors, glibc's memory trimming at 256 MiB instead of 64 KiB): with Dask's defaults a worker spent
+  30-40 % of a core beside its task (measured before issue 36; not reproduced on the loaded machine since). The
+  workers leave Ctrl-C to the client (:mod:`~scara_pin.sweep.preload`).
 - An existing cluster: a scheduler's address (``tcp://host:8786``), its scheduler file (``dask scheduler
   --scheduler-file``; what dask-jobqueue and dask-mpi write), ``DASK_SCHEDULER_ADDRESS``, or a ``Client`` handed
   in: SLURM (dask-jobqueue), Kubernetes (dask-kubernetes) and the rest without code here.
