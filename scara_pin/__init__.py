@@ -62,6 +62,7 @@ __all__ = [
     "load_urdf",
     "pose_from_placement",
     "robot_from_urdf",
+    "sweep",
     "urdf_dir",
 ]
 
@@ -72,6 +73,15 @@ def load_cell(path: str | Path, **kwargs: Any) -> "Cell":
     from .cell import load_cell as _load_cell
 
     return _load_cell(path, **kwargs)
+
+
+def __getattr__(name: str) -> Any:
+    """``scara_pin.sweep``: the sweeps' package, imported on first use (it is callable: ``scara_pin.sweep(spec)``)."""
+    if name == "sweep":
+        import importlib
+
+        return importlib.import_module(".sweep", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

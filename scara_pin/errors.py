@@ -56,9 +56,25 @@ __all__ = [
 
 
 class ScaraError(Exception):
-    """Base class of the errors scara_pin raises on purpose."""
+    """Base class of the errors scara_pin raises on purpose.
+
+    Every one survives ``pickle`` (a task's error on a Dask worker travels to the client that way): it is rebuilt
+    from its message and its attributes, without calling an ``__init__`` that takes more than ``args`` keeps
+    (``ParameterError(name, value, rule)``, ``NoSolutionError(status, reason)``...).
+    """
 
     exit_code: ClassVar[int] = 1
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return _rebuild, (type(self), self.args, dict(self.__dict__))
+
+
+def _rebuild(cls: type[ScaraError], args: tuple[object, ...], state: dict[str, object]) -> ScaraError:
+    """A pickled :class:`ScaraError` again: its class, its ``args`` (the message) and its attributes."""
+    error = cls.__new__(cls)
+    Exception.__init__(error, *args)
+    error.__dict__.update(state)
+    return error
 
 
 class InvalidInputError(ScaraError, ValueError):

@@ -59,6 +59,7 @@ __all__ = [
     "MAX_PLAN_WORK",
     "MAX_ROWS",
     "MAX_SAMPLES",
+    "MAX_SWEEP_VARIANTS",
     "MAX_URDF_ELEMENTS",
     "MAX_VISUALS",
     "MAX_WALK_DEPTH",
@@ -146,6 +147,11 @@ MAX_CELL_MESH_BYTES = 256 * 1024 * 1024
 MAX_WORKSPACE_GRID = 250_000
 """Grid points of one collision-free region (``workspace --cell --height``: 500 x 500; each reachable point
 costs up to two IK solutions and their distance checks, about 10 s at the cap)."""
+
+# ----------------------------------------------------------------------- sweeps (many jobs, docs/sweep.md)
+MAX_SWEEP_VARIANTS = 1_000_000
+"""Variants of one sweep (``scara-pin sweep``: the grid's product, or ``samples`` times the lists'), counted before
+any is made: each is a job planned (0.3-60 s), so 10^6 is about a day on a thousand cores; a Parquet row each."""
 
 # ----------------------------------------------------------------------- files named by packages and meshes
 MAX_MESH_BYTES = 200 * 1024 * 1024

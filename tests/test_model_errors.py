@@ -81,6 +81,36 @@ def test_unknown_robot_error_lists_the_robots() -> None:
     assert err.robot == "nope" and err.available == ["default", "s1"]
 
 
+def _pickle_cases() -> list[ScaraError]:
+    from scara_pin.errors import JobFileError, JobStepError, NoSolutionError, YamlError
+    from scara_pin.kinematics.scara_geometry import IKStatus
+    from scara_pin.limits import UnreadableFileError
+
+    return [
+        ParameterError("l1", -1.0, "must be > 0", "m"),
+        NoSolutionError(IKStatus.OUT_OF_REACH, "0.54 m from the shoulder axis, beyond the reach 0.4 m"),
+        UnknownRobotError("nope", ["default", "s1"]),
+        YamlError("job file j.yaml", 3, "did not find expected node content"),
+        JobFileError(Path("j.yaml"), 7, "point feeder is out of reach"),
+        JobStepError(Path("j.yaml"), None, "the jump did not converge"),
+        UnreadableFileError("job file", Path("/nope.yaml"), "No such file or directory", 2),
+        InvalidInputError("a plain message"),
+    ]
+
+
+@pytest.mark.parametrize("error", _pickle_cases(), ids=lambda e: type(e).__name__)
+def test_errors_survive_pickle(error: ScaraError) -> None:
+    """A task's error on a Dask worker reaches the client by pickle: the same class, message, attributes and code
+    (ParameterError, NoSolutionError and UnknownRobotError took more in __init__ than args keeps: loads failed)."""
+    import pickle
+
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is type(error)
+    assert str(again) == str(error) and again.args == error.args
+    assert again.__dict__ == error.__dict__
+    assert again.exit_code == error.exit_code
+
+
 # ------------------------------------------------------------------------------------- bad URDFs
 def _link(name: str) -> str:
     return f'<link name="{name}"/>'

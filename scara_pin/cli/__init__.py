@@ -41,6 +41,7 @@ COMMANDS: dict[str, str] = {
     "traj": "motion", "jog": "motion",
     "cycle": "cycle",
     "job": "job",
+    "sweep": "sweep",
     "workspace": "workspace",
     "view": "view",
     "teach": "teach",

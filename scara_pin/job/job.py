@@ -31,9 +31,14 @@ class Job(JobSpec):
     """
 
     @classmethod
-    def load(cls, path: str | Path, overrides: Mapping[str, Any] | Iterable[Override] | None = None) -> Job:
-        """Read and check a job file (:func:`~scara_pin.job.loading.read_job`), with ``overrides`` (dotted keys)."""
-        return cls._of(read_job(path, as_overrides(overrides, "Job.load")))
+    def load(cls, path: str | Path, overrides: Mapping[str, Any] | Iterable[Override] | None = None, *,
+             text: str | None = None) -> Job:  # fmt: skip
+        """Read and check a job file (:func:`~scara_pin.job.loading.read_job`), with ``overrides`` (dotted keys).
+
+        ``text``: the file's text, read before (a sweep's worker gets the job as the client read it); the files it
+        names (points, cell) are still read beside ``path``.
+        """
+        return cls._of(read_job(path, as_overrides(overrides, "Job.load"), text=text))
 
     @classmethod
     def _of(cls, spec: JobSpec) -> Job:
