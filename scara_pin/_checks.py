@@ -73,16 +73,22 @@ def as_rows(name: str, value: object) -> np.ndarray:
     return arr
 
 
-def as_limit_vector(name: str, values: ArrayLike, unit: str, names: Sequence[str] = JOINT_NAMES) -> np.ndarray:
-    """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0 (``names``: the joints')."""
+def as_limit_vector(name: str, values: ArrayLike, unit: str, names: Sequence[str] = JOINT_NAMES,
+                    unbounded: bool = False) -> np.ndarray:  # fmt: skip
+    """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0 (``names``: the joints').
+
+    ``unbounded``: +inf is taken too, as no limit (the effort of a URDF joint without ``<limit>``).
+    """
     arr = np.array(values, dtype=float)
     if arr.ndim != 1 or len(arr) not in JOINT_COUNTS:
         raise ParameterError(name, values, "must hold one value per joint (4, or 3 without a wrist)")
     for joint, v in zip(names, arr.tolist()):
         if math.isnan(v):
             raise ParameterError(f"{joint}_{name}", v, "must be given (a URDF file has no acceleration limits)")
-        if not (math.isfinite(v) and v > 0.0):
-            raise ParameterError(f"{joint}_{name}", v, "must be finite and > 0", unit)
+        if not ((math.isfinite(v) or (unbounded and v == math.inf)) and v > 0.0):
+            hint = " (a URDF joint without <limit>, or a placeholder 0: load_robot(velocity=...), --velocity)" \
+                if name == "velocity" else ""  # fmt: skip
+            raise ParameterError(f"{joint}_{name}", v, "must be finite and > 0" + hint, unit)
     return arr
 
 

@@ -200,6 +200,18 @@ _CONTINUOUS = frozenset(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "
 """Pinocchio's continuous (unbounded revolute) joints: nq = 2 (cos, sin), nv = 1."""
 
 
+def _given(name: str, values: Sequence[float], model: pin.Model, dof: int) -> tuple[float, ...]:
+    """Limits given per joint of q (``velocity``, ``acceleration``): ``dof`` finite values > 0, or ParameterError."""
+    joints = [model.names[j] for j in range(1, model.njoints) if model.joints[j].nv > 0]
+    out = tuple(float(v) for v in values)
+    if len(out) != dof:
+        raise ParameterError(name, list(values), f"must hold {dof} values, one per joint ({', '.join(joints)})")
+    for joint, v in zip(joints, out):
+        if not (math.isfinite(v) and v > 0.0):
+            raise ParameterError(f"{name} of joint {joint}", v, "must be finite and > 0")
+    return out
+
+
 def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
     """Per joint of q (nv = 1 each; passive mimic joints, nv = 0, skipped): whether it is continuous.
 
@@ -278,6 +290,7 @@ class RobotModel:
         urdf: str,
         *,
         acceleration: Sequence[float] | None = None,
+        velocity: Sequence[float] | None = None,
         parameters: RobotParameters | None = None,
         base_frame: str | None = None,
         tool_frame: str | None = None,
@@ -293,6 +306,8 @@ class RobotModel:
             urdf: the URDF document.
             acceleration: acceleration limits per joint [rad/s^2 or m/s^2]; URDF has none. Without it
                 (a URDF file) they are NaN, meaning unknown: commands that need them ask for them.
+            velocity: velocity limits per joint [rad/s or m/s], in q order, instead of the URDF's (a continuous
+                joint without ``<limit>`` has none: Pinocchio reads inf; a placeholder 0). A URDF file only.
             parameters: the yaml parameters it was generated from, if any.
             base_frame: the link poses are expressed in; default ``base`` if present, else the root link.
             tool_frame: the tool link; default ``tool0`` if present, else the chain's last link
@@ -361,9 +376,10 @@ class RobotModel:
             self.limits = JointLimits(
                 lower=tuple(-math.pi if c else float(model.lowerPositionLimit[i]) for i, c in zip(iq, continuous)),
                 upper=tuple(math.pi if c else float(model.upperPositionLimit[i]) for i, c in zip(iq, continuous)),
-                velocity=tuple(float(v) for v in model.velocityLimit),
+                velocity=tuple(float(v) for v in model.velocityLimit) if velocity is None
+                else _given("velocity", velocity, model, len(continuous)),
                 acceleration=tuple(math.nan for _ in continuous) if acceleration is None
-                else tuple(float(v) for v in acceleration),
+                else _given("acceleration", acceleration, model, len(continuous)),
                 effort=tuple(float(v) for v in model.effortLimit),
                 validate=False,
             )

@@ -1,17 +1,22 @@
 """Real robots, round 4 (issue 39): every real file usable as written.
 
 Fixtures in ``tests/data/round4`` were written for these tests, shaped like the public descriptions the issue
-tried (never copied): an LS3-like SCARA exported for PyBullet (meshes named ``/Mesh/Visual/Base.stl``: item 5).
-The truth: the STL files' own extents, read here.
+tried (never copied): an LS3-like SCARA exported for PyBullet (meshes named ``/Mesh/Visual/Base.stl``, a
+continuous J4 without ``<limit>``: items 3 and 5).
+
+Truth from independent routes: the STL files' own extents, the unit conversions written here.
 """
 
 from __future__ import annotations
 
+import json
+import math
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
+from quirks import run, texts
 
 from scara_pin import load_robot
 from scara_pin.cell.meshes import visual_meshes
@@ -58,6 +63,46 @@ def pinocchio_loads(path: Path) -> tuple[pin.Model, int, int]:
     visual = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.VISUAL, package_dirs=[str(path.parent)])
     collision = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.COLLISION, package_dirs=[str(path.parent)])
     return model, visual.ngeoms, collision.ngeoms
+
+
+# ====================================================================== item 3: a continuous J4 without <limit>
+def test_cycle_on_a_continuous_j4_without_limit_asks_for_velocity(capsys: pytest.CaptureFixture[str]) -> None:
+    rc, out, err = run(capsys, ["cycle", "--urdf", str(LS3), *ACC])
+    assert rc == 2 and out == ""
+    (line,) = [e for e in err.splitlines() if e.startswith("error:")]
+    assert "joint joint_tool_rotate has no velocity limit (no <limit> in the URDF" in line
+    assert "give --velocity V1 V2 V3 V4" in line and "joint_3 [m/s]" in line and "joint_tool_rotate [rad/s]" in line
+    assert "_velocity is inf" not in line and "rad/s or m/s" not in line
+    rc, out, err = run(capsys, ["cycle", "--urdf", str(LS3), *ACC, "--set", "joint_tool_rotate_velocity=34.88"])
+    assert rc == 2 and "--velocity and --acceleration" in err  # what the issue tried says what to do instead
+    (info,) = check_urdf_file(LS3).find("motion-limits")  # check says before what cycle needs
+    assert "--velocity V1 V2 V3 V4" in info.message and "joint_tool_rotate (no <limit>)" in info.message
+    assert "--acceleration A1 A2 A3 A4" in info.message
+
+
+def test_cycle_velocity_in_the_units_rule(capsys: pytest.CaptureFixture[str]) -> None:
+    """--velocity beside --acceleration: SI by default, deg/s and mm/s with --mm --deg; jerk too."""
+    velocity = [6.5, 11.5, 1.2, 34.88]  # rad/s, rad/s, m/s, rad/s
+    rc, out, err = run(capsys, ["cycle", "--json", "--urdf", str(LS3), *ACC, "--velocity", *texts(velocity)])
+    assert rc == 0, err
+    si = json.loads(out)
+    assert si["limits"]["velocity"] == velocity and si["limits"]["effort"][3] is None  # no <limit>: no effort limit
+    human = [math.degrees(velocity[0]), math.degrees(velocity[1]), velocity[2] * 1000, math.degrees(velocity[3])]
+    acc = [math.degrees(20.0), math.degrees(30.0), 5000.0, math.degrees(60.0)]
+    rc, out, err = run(capsys, ["cycle", "--json", "--mm", "--deg", "--urdf", str(LS3), "--acceleration",
+                                *texts(acc), "--velocity", *texts(human)])  # fmt: skip
+    assert rc == 0, err
+    mm_deg = json.loads(out)
+    np.testing.assert_allclose(mm_deg["limits"]["velocity"], velocity, rtol=1e-12)
+    assert mm_deg["cycle_time"] == pytest.approx(si["cycle_time"], rel=1e-6)
+    rc, out, err = run(capsys, ["cycle", "--urdf", str(LS3), *ACC, "--velocity", "6.5", "11.5", "1.2"])
+    assert rc == 2 and "must be 4 values, one per joint: joint_1 [rad/s]" in err
+    rc, out, err = run(capsys, ["cycle", "--deg", "--urdf", str(LS3), *ACC, "--velocity", *texts(human)])
+    assert rc == 2 and "--deg without --mm: --velocity joint_3" in err  # a length typed under --deg alone
+    rc, out, err = run(capsys, ["cycle", "--json", "--mm", "--deg", "--jerk-limit", "200000"])
+    assert rc == 0, err
+    jerk = json.loads(out)["limits"]["jerk"]
+    np.testing.assert_allclose(jerk, [math.radians(2e5), math.radians(2e5), 200.0, math.radians(2e5)], rtol=1e-12)
 
 
 # ====================================================================== item 5: meshes written PyBullet's way

@@ -12,9 +12,9 @@ from ..files import check_outputs
 from ..limits import MAX_SAMPLES, check_count
 from ._joints import needs_wrist
 from ._numbers import number_type
-from ._options import add_acceleration, add_robot_options
+from ._options import add_motion_limits, add_robot_options
 from ._outputs import check_command_outputs
-from ._robot import robot_from_args, with_acceleration
+from ._robot import robot_from_args, with_motion_limits
 from ._units import Units
 
 _VIEW_RATE = 200.0
@@ -39,7 +39,7 @@ def cmd_job(args: argparse.Namespace) -> int:
     units = Units()  # a job's numbers are SI, and so is --acceleration here
     robot = robot_from_args(args, units)
     needs_wrist(robot, "job")
-    robot = with_acceleration(args, robot, units)
+    robot = with_motion_limits(args, robot, units)
     result = _plan(job, robot)
     written: dict[str, str] = {}
     if args.out:
@@ -95,6 +95,6 @@ def register(sub: Any) -> None:
                    "the boxes placed (.png, .svg, .pdf)")  # fmt: skip
     g.add_argument("--html", metavar="HTML", help="a self-contained viewer page that plays the job (with its cell, "
                    "the part while held and the boxes placed)")  # fmt: skip
-    add_acceleration(p)
+    add_motion_limits(p)
     add_robot_options(p)
     p.set_defaults(func=cmd_job)

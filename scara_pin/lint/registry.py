@@ -133,6 +133,8 @@ RULES: tuple[Rule, ...] = (
          scope.near_parallel, model=True),
     Rule("effort-limit", "scope", W, "an effort limit of 0, or below the static load: torque-limited timing refuses",
          scope.effort_limit, model=True),
+    Rule("motion-limits", "scope", I, "what cycle, traj, jog and job will need: --acceleration, --velocity",
+         scope.motion_limits, model=True),
     Rule("mesh-missing", "geometry", W, "a visual's mesh the viewer cannot find or read", geometry.mesh_missing),
     Rule("mesh-path", "geometry", W, "a mesh named PyBullet's way (/Mesh/..., missing): read from the file's folder",
          geometry.mesh_path),

@@ -334,7 +334,7 @@ def limits_in_force(robot: RobotModel, limits: JointLimits | None, tool_speed: f
     names = robot.joint_names
     v = as_limit_vector("velocity", lim.velocity, "rad/s or m/s", names)
     a = as_limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2", names)
-    e = as_limit_vector("effort", lim.effort, "N m or N", names) if torque else None
+    e = as_limit_vector("effort", lim.effort, "N m or N", names, unbounded=True) if torque else None  # inf: no <limit>
     vt = None if tool_speed is None else as_positive("tool_speed", tool_speed, "m/s")
     return LimitsInForce(v, a, e, vt)
 
