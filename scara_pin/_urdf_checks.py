@@ -139,6 +139,9 @@ def _materials(root: ET.Element, origin: str) -> None:
 
 def _link_names(root: ET.Element, origin: str) -> None:
     _named("link-name", root.findall("link"), origin)
+    if root.find("link") is None:
+        raise _refuse("link-name", origin, "the document has no <link> (a URDF has at least one; a xacro file of "
+                                           "macros only defines them: call one, or load the file that does)")
 
 
 def _inertial(root: ET.Element, origin: str) -> None:

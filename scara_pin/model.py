@@ -32,7 +32,7 @@ from ._checks import MAGNITUDE_MAX
 from .description import JOINT_COUNTS, JointLimits, RobotParameters, configured
 from .errors import InvalidInputError, ParameterError, UrdfError
 from .units import HUMAN, DisplayUnits, format_number
-from .urdf_rules import choose_frames, edges_of, read_tree, resolve_mimics
+from .urdf_rules import JointEdge, choose_frames, edges_of, read_tree, resolve_mimics
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -212,12 +212,12 @@ def _given(name: str, values: Sequence[float], model: pin.Model, dof: int) -> tu
     return out
 
 
-def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
+def _continuous_joints(model: pin.Model, origin: str, edges: Mapping[str, JointEdge]) -> tuple[bool, ...]:
     """Per joint of q (nv = 1 each; passive mimic joints, nv = 0, skipped): whether it is continuous.
 
     Raises:
         UrdfError: not 3 or 4 single-DOF joints (:data:`JOINT_COUNTS`; nv = 3 or 4, each nq = 1, or nq = 2
-            for a continuous joint).
+            for a continuous joint), listed with their URDF types as ``check`` counts them.
     """
     out = []
     ok = model.nv in JOINT_COUNTS
@@ -229,11 +229,17 @@ def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
         ok = ok and (cont or (jm.nq == 1 and jm.nv == 1))
         out.append(cont)
     if not ok or len(out) != model.nv or model.nq != model.nv + sum(out):
-        joints = ", ".join(f"{model.names[i]} (nq {model.joints[i].nq})" for i in range(1, model.njoints))
-        raise UrdfError(
-            f"{origin}: a SCARA has 4 single-DOF joints (or 3 without a wrist); this model has nq = {model.nq}, "
-            f"nv = {model.nv}: {joints}"
-        )
+        free = [j for j in range(1, model.njoints) if model.joints[j].nv > 0]
+
+        def kind(j: int) -> str:
+            edge = edges.get(model.names[j])
+            written = edge.type if edge is not None else model.joints[j].shortname()
+            nv = model.joints[j].nv
+            return written if nv == 1 else f"{written}: {nv} degrees of freedom"
+
+        listing = ", ".join(f"{model.names[j]} ({kind(j)})" for j in free[:12]) + (" ..." if len(free) > 12 else "")
+        raise UrdfError(f"{origin}: a SCARA has 4 single-DOF joints (or 3 without a wrist); this "
+                        f"file has {len(free)} movable joint{'s' if len(free) != 1 else ''}: {listing or 'none'}")
     return tuple(out)
 
 
@@ -343,7 +349,7 @@ class RobotModel:
 
             model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin)
         try:
-            continuous = _continuous_joints(model, origin)
+            continuous = _continuous_joints(model, origin, edges)
         except UrdfError as exc:
             if not self.locked:
                 raise

@@ -2,9 +2,11 @@
 
 Fixtures in ``tests/data/round4`` were written for these tests, shaped like the public descriptions the issue
 tried (never copied): an LS3-like SCARA exported for PyBullet (meshes named ``/Mesh/Visual/Base.stl``, a
-continuous J4 without ``<limit>``: items 3 and 5).
+continuous J4 without ``<limit>``: items 3 and 5), a lab R P R R SCARA whose 0.03 m/s lead-screw lift is read
+from a yaml file, a xacro file of macros only, a 2-joint "palletizer" (item 4).
 
-Truth from independent routes: the STL files' own extents, the unit conversions written here.
+Truth from independent routes: the STL files' own extents, the unit conversions written here, the limits
+written in the lab arm's yaml file.
 """
 
 from __future__ import annotations
@@ -103,6 +105,35 @@ def test_cycle_velocity_in_the_units_rule(capsys: pytest.CaptureFixture[str]) ->
     assert rc == 0, err
     jerk = json.loads(out)["limits"]["jerk"]
     np.testing.assert_allclose(jerk, [math.radians(2e5), math.radians(2e5), 200.0, math.radians(2e5)], rtol=1e-12)
+
+
+# ====================================================================== item 4: messages
+def test_a_xacro_file_of_macros_only_says_it_has_no_link(capsys: pytest.CaptureFixture[str]) -> None:
+    report = check_urdf_file(MACROS)
+    (f,) = report.find("disconnected")
+    assert "the document has no <link>" in f.message and "macros only" in f.message
+    assert "cycle" not in f.message and "none (a cycle)" not in report.format_text()
+    rc, out, err = run(capsys, ["fk", "--urdf", str(MACROS), "0", "0", "0", "0"])
+    assert rc == 2 and "the document has no <link>" in err and "macros only" in err
+
+
+def test_a_slow_lead_screw_lift_is_information(capsys: pytest.CaptureFixture[str]) -> None:
+    robot = load_robot(urdf=LAB, package_path=[ROUND4])
+    assert robot.limits.velocity[1] == 0.03  # read from config/joint_limits.yaml by the xacro file
+    (f,) = check_urdf_file(LAB, package_dirs=[ROUND4]).find("velocity-implausible")
+    assert f.severity.value == "info" and "0.03 m/s" in f.message and "lead-screw" in f.message
+    # a value that is a deg/s reading is still a warning (the KR5-like file's 2 deg/s)
+    (g,) = check_urdf_file(DATA / "third_party" / "kr5_scara_dh.urdf").find("velocity-implausible")
+    assert g.severity.value == "warning" and "2 deg/s" in g.message
+
+
+def test_a_two_joint_file_counts_joints_as_check_does(capsys: pytest.CaptureFixture[str]) -> None:
+    rc, out, err = run(capsys, ["fk", "--urdf", str(TWO_JOINTS), "0", "0"])
+    assert rc == 2
+    assert ("this file has 2 movable joints: base_to_torso (continuous), torso_to_arm (revolute)" in err), err
+    assert "nq =" not in err and "nv =" not in err
+    (f,) = check_urdf_file(TWO_JOINTS).find("joint-count")
+    assert "this file has 2" in f.message
 
 
 # ====================================================================== item 5: meshes written PyBullet's way

@@ -169,7 +169,10 @@ def velocity_placeholder(ctx: Context) -> None:
 
 
 def velocity_implausible(ctx: Context) -> None:
-    """A velocity limit outside 0.05..50 rad/s (revolute) or 0.05..10 m/s (prismatic); a deg/s reading offered."""
+    """A velocity limit outside 0.05..50 rad/s (revolute) or 0.05..10 m/s (prismatic); a deg/s reading offered.
+
+    A prismatic joint slower than the range is information, not a warning: a lead-screw lift at 0.03 m/s is real.
+    """
     for j, v in _velocities(ctx):
         low, high = PRISMATIC_VELOCITY if j.type == "prismatic" else REVOLUTE_VELOCITY
         if v == 0 or v in PLACEHOLDER_VELOCITIES or low <= v <= high:
@@ -178,6 +181,11 @@ def velocity_implausible(ctx: Context) -> None:
         as_deg = v * 180.0 / math.pi
         if abs(as_deg - round(as_deg)) < 1e-6 * max(1.0, as_deg) and round(as_deg) != 0:
             note = f"; it is {round(as_deg):g} deg/s converted to rad: a unit error?"
+        if j.type == "prismatic" and 0 < v < low and not note:
+            ctx.add(Severity.INFO, "velocity-implausible",
+                    f"joint {j.name}'s velocity limit {v:g} m/s is below {low:g} m/s: a slow axis (a lead-screw "
+                    "lift?); every motion is timed to it", j.limit_line, j.name)  # fmt: skip
+            continue
         ctx.add(Severity.WARNING, "velocity-implausible",
                 f"joint {j.name}'s velocity limit {v:g} {_unit(j)} is outside {low:g}..{high:g} {_unit(j)}{note}",
                 j.limit_line, j.name)  # fmt: skip

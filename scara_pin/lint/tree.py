@@ -167,11 +167,16 @@ def two_parents(ctx: Context) -> None:
 
 
 def disconnected(ctx: Context) -> None:
-    """Not one tree: several root links, or links the root does not reach (a cycle)."""
+    """Not one tree: no link, several root links, or links the root does not reach (a cycle)."""
     tree = ctx.tree
+    if not tree.links:
+        ctx.error("disconnected", "the document has no <link>: a URDF has at least one (a xacro file of macros only "
+                  "defines them: call one, or check the file that does)")  # fmt: skip
+        return
     roots = [name for name in tree.links if name not in tree.parent_of]
     if len(roots) != 1:
-        shown = ", ".join(f"{r} ({ctx.at(tree.links[r])})" for r in roots) or "none (a cycle)"
+        shown = ", ".join(f"{r} ({ctx.at(tree.links[r])})" for r in roots) or \
+            f"every one of its {len(tree.links)} links is a joint's child (a cycle)"  # fmt: skip
         ctx.error("disconnected", f"the tree must have one root link; this file has {len(roots)}: {shown}")
         return
     unreached = [n for n in tree.links if n not in tree.link_world]
