@@ -39,6 +39,8 @@ def bad_number(ctx: Context) -> None:
         for what, attr, values, default, line in (("origin", "xyz", j.xyz, 3, j.origin_line),
                                                   ("origin", "rpy", j.rpy, 3, j.origin_line),
                                                   ("axis", "xyz", j.axis, 3, j.axis_line)):  # fmt: skip
+            if what == "axis" and j.type in ("fixed", "floating"):  # urdfdom never reads their axis
+                continue
             if len(values) != default or not all(math.isfinite(v) for v in values):
                 el = j.el.find(what)
                 raw = "" if el is None else el.get(attr, "")
@@ -84,8 +86,15 @@ def limit_missing(ctx: Context) -> None:
                           j.limit_line, j.name)  # fmt: skip
         missing = [a for a in ("lower", "upper") if a not in lim]
         if j.type != "continuous" and missing:
-            ctx.error("limit-missing", f"joint {j.name}'s <limit> has no {' and '.join(missing)}: read as 0, the "
-                      "joint cannot move", j.limit_line, j.name)  # fmt: skip
+            lo, hi = ((j.numbers(a) or (0.0,))[0] for a in ("lower", "upper"))  # urdfdom reads an absent one as 0
+            if lo < hi:  # the loader's rule (joint_problem) takes the range
+                ctx.add(Severity.WARNING, "limit-missing", f"joint {j.name}'s <limit> has no {' and '.join(missing)}"
+                        f": read as 0 (urdfdom's default), the range is [{lo:g}, {hi:g}]", j.limit_line,
+                        j.name)  # fmt: skip
+            else:
+                ctx.error("limit-missing", f"joint {j.name}'s <limit> has no {' and '.join(missing)}: read as 0, "
+                          f"the range [{lo:g}, {hi:g}] is empty: the joint cannot move", j.limit_line,
+                          j.name)  # fmt: skip
 
 
 def _range(j: LintJoint) -> tuple[float, float] | None:
