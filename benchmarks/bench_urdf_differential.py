@@ -3,7 +3,8 @@
 
 Run with the project's interpreter from the repository (``.venv/bin/python benchmarks/bench_urdf_differential.py``):
 the corpus of tests/test_urdf_differential.py (every URDF and xacro file of tests/data, the shipped robots'
-URDF) and as many single-change mutants as asked (tests/urdf_mutants.py: the same mutations and the same judge,
+URDF), its systematic mutants (each kind of attribute emptied, then removed) and as many random single-change
+mutants as asked (tests/urdf_mutants.py: the same mutations and the same judge,
 Pinocchio's ``buildModelFromXML`` and ``buildGeomFromUrdfString``). It prints how many mutants Pinocchio and the
 toolkit each load and refuse, the rules that refused them, the mutants per second, and every disagreement
 (exit 1 when there is one): a crash, a refusal of what Pinocchio refuses that does not name the element, a
@@ -18,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import collections
+import itertools
 import json
 import os
 import sys
@@ -45,10 +47,12 @@ def main(argv: list[str] | None = None) -> int:
     loaded = checked = 0
     devnull = os.open(os.devnull, os.O_WRONLY)
     saved = os.dup(2)
+    k = -1
     start = time.perf_counter()
     os.dup2(devnull, 2)  # urdfdom's own lines on the C-level stderr (a benchmark process: nothing else writes there)
     try:
-        for k, m in enumerate(um.mutants(corpus, args.mutants, args.seed)):
+        made = itertools.chain(um.systematic(corpus), um.mutants(corpus, args.mutants, args.seed))
+        for k, m in enumerate(made):
             toolkit, problem = um.verdict(m, mesh)
             loaded += toolkit.loads
             if not toolkit.loads:
@@ -63,17 +67,19 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         os.dup2(saved, 2)
     seconds = time.perf_counter() - start
-    summary = {"files": len(corpus), "mutants": args.mutants, "seed": args.seed, "loaded": loaded,
-               "refused": args.mutants - loaded, "rules": dict(rules.most_common()), "checked": checked,
-               "disagreements": wrong, "seconds": seconds, "per_second": args.mutants / seconds}  # fmt: skip
+    total = k + 1
+    summary = {"files": len(corpus), "mutants": total, "seed": args.seed, "loaded": loaded,
+               "refused": total - loaded, "rules": dict(rules.most_common()), "checked": checked,
+               "disagreements": wrong, "seconds": seconds, "per_second": total / seconds}  # fmt: skip
     if args.json:
         print(json.dumps(summary))
     else:
         print(f"corpus      {len(corpus)} files (tests/data URDF and xacro, the shipped robots)")
-        print(f"mutants     {args.mutants:,} (seed {args.seed}): {loaded:,} loaded, {args.mutants - loaded:,} refused; "
+        print(f"mutants     {total:,} ({total - args.mutants} systematic, {args.mutants:,} random, seed {args.seed}): "
+              f"{loaded:,} loaded, {total - loaded:,} refused; "
               f"{checked:,} also through check")
         print("refused by  " + ", ".join(f"{r} {n}" for r, n in rules.most_common()))
-        print(f"time        {seconds:.1f} s, {args.mutants / seconds:.0f} mutants/s")
+        print(f"time        {seconds:.1f} s, {total / seconds:.0f} mutants/s")
         print(f"verdict     {len(wrong)} disagreement(s) with Pinocchio")
         for line in wrong[:50]:
             print(f"  {line}")
