@@ -212,6 +212,26 @@ def test_cycle_on_a_continuous_j4_without_limit_asks_for_velocity(capsys: pytest
     assert "--acceleration A1 A2 A3 A4" in info.message
 
 
+def test_the_python_route_names_the_joint_and_its_unit(capfd: pytest.CaptureFixture[str]) -> None:
+    """standard_cycle on the same robot: the joint of the file and rad/s, not an internal joint_tool_rotate_velocity
+    in "rad/s or m/s"; a configured robot's limit is still named by its --set parameter, in its joint's unit."""
+    import dataclasses
+
+    from scara_pin.errors import ParameterError
+    from scara_pin.motion.cycle import standard_cycle
+
+    robot = load_robot(urdf=LS3, acceleration=[20.0, 30.0, 5.0, 60.0])
+    with pytest.raises(ParameterError) as info:
+        standard_cycle(robot)
+    message = str(info.value)
+    assert message.startswith("the velocity limit of joint joint_tool_rotate is inf rad/s; it must be finite and > 0")
+    assert "load_robot(velocity=...), --velocity" in message and "rad/s or m/s" not in message
+    default = load_robot("default")
+    with pytest.raises(ParameterError, match=r"^joint3_velocity is 0.0 m/s; it must be finite and > 0"):
+        standard_cycle(default, limits=dataclasses.replace(default.limits, velocity=(1.0, 2.0, 0.0, 3.0),
+                                                            validate=False))  # fmt: skip
+
+
 def test_cycle_velocity_in_the_units_rule(capsys: pytest.CaptureFixture[str]) -> None:
     """--velocity beside --acceleration: SI by default, deg/s and mm/s with --mm --deg; jerk too."""
     velocity = [6.5, 11.5, 1.2, 34.88]  # rad/s, rad/s, m/s, rad/s
