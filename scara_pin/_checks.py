@@ -73,16 +73,28 @@ def as_rows(name: str, value: object) -> np.ndarray:
     return arr
 
 
-def as_limit_vector(name: str, values: ArrayLike, unit: str, names: Sequence[str] = JOINT_NAMES) -> np.ndarray:
-    """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0 (``names``: the joints')."""
+def as_limit_vector(name: str, values: ArrayLike, unit: str | Sequence[str], names: Sequence[str] = JOINT_NAMES,
+                    unbounded: bool = False) -> np.ndarray:  # fmt: skip
+    """Per-joint limits (velocity, acceleration...) as an array; each finite and > 0 (``names``: the joints').
+
+    ``unit``: one for every joint, or each joint's (``rad/s`` for a revolute joint, ``m/s`` for a prismatic one).
+    A refusal names a configured robot's parameter (``joint2_velocity``, what ``--set`` takes), else the joint of
+    the file (``the velocity limit of joint joint_tool_rotate``). ``unbounded``: +inf is taken too, as no limit
+    (the effort of a URDF joint without ``<limit>``).
+    """
     arr = np.array(values, dtype=float)
     if arr.ndim != 1 or len(arr) not in JOINT_COUNTS:
         raise ParameterError(name, values, "must hold one value per joint (4, or 3 without a wrist)")
-    for joint, v in zip(names, arr.tolist()):
+    units = [unit] * len(arr) if isinstance(unit, str) else list(unit)
+    configured = tuple(names[: len(arr)]) == JOINT_NAMES[: len(arr)]
+    for joint, v, u in zip(names, arr.tolist(), units):
+        label = f"{joint}_{name}" if configured else f"the {name} limit of joint {joint}"
         if math.isnan(v):
-            raise ParameterError(f"{joint}_{name}", v, "must be given (a URDF file has no acceleration limits)")
-        if not (math.isfinite(v) and v > 0.0):
-            raise ParameterError(f"{joint}_{name}", v, "must be finite and > 0", unit)
+            raise ParameterError(label, v, "must be given (a URDF file has no acceleration limits)")
+        if not ((math.isfinite(v) or (unbounded and v == math.inf)) and v > 0.0):
+            hint = " (a URDF joint without <limit>, or a placeholder 0: load_robot(velocity=...), --velocity)" \
+                if name == "velocity" else ""  # fmt: skip
+            raise ParameterError(label, v, "must be finite and > 0" + hint, u)
     return arr
 
 

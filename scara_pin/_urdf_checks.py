@@ -1,29 +1,43 @@
 """What urdfdom would refuse in a URDF, checked in Python first (private): the loader's pre-check.
 
-urdfdom reports its reasons on the C-level stderr and Pinocchio then raises a generic ``ValueError``.
-Capturing that stderr means redirecting file descriptor 2, which is process-wide state (another thread's
-messages are lost, a crash leaves fd 2 on a temporary file). Instead, the rules urdfdom enforces are
-checked here, on the parsed XML, with messages that name the element: urdfdom then only sees documents it
-accepts.
+urdfdom reports its reasons on the C-level stderr and Pinocchio then raises a generic ``ValueError`` ("The XML
+stream does not contain a valid URDF model."). Capturing that stderr means redirecting file descriptor 2,
+which is process-wide state. Instead, urdfdom's parser is mirrored here, on the parsed XML, with messages
+that name the element, the attribute and the value: urdfdom then only sees documents it accepts.
 
-The pre-check refuses exactly what ``pinocchio.buildModelFromXML`` refuses (tests/test_urdf_precheck.py runs
-every rule on mutated documents through both), except where a rule of :data:`PRECHECK_RULES` says why it is
-deliberately stricter: a document too large to load in bounded work; an ``<inertial>`` urdfdom would drop
-(the link silently massless) or a negative mass it would keep; a ``<visual>`` or ``<collision>`` urdfdom
-would drop, renumbering the link's others. What urdfdom reads and ignores (an inline ``<material>`` whose
-``<color>`` it cannot parse, a global material without colour) loads, as it does in Pinocchio.
+The mirror follows urdfdom as Pinocchio 4.1 ships it (tests/test_urdf_differential.py runs it against
+``pinocchio.buildModelFromXML`` and ``buildGeomFromUrdfString`` on a corpus and its mutations):
+
+- numbers: :func:`urdf_number` and :func:`urdf_vector` (a C++ stream reading a double: blanks before, none
+  after; vectors split at spaces only; no ``inf``, ``nan``, ``0x``, ``1_0``);
+- only the FIRST child of a kind is read where urdfdom reads one (``<origin>``, ``<limit>``, ``<axis>``,
+  ``<mimic>``, ``<inertial>``, ``<geometry>`` and its first element): a second one, or an unknown tag after
+  the shape, is ignored by both;
+- names: a ``name`` attribute must be there, and may be empty (``<robot name="">``, ``<joint name="">``,
+  ``<material name="">``, as in the Dobot MG400 and Kawasaki duAro descriptions);
+- a fixed (or floating) joint's ``<axis>`` is never read.
+
+The pre-check refuses exactly what urdfdom refuses, except where a rule of :data:`PRECHECK_RULES` says why it
+is deliberately stricter, and says in its message what urdfdom would do instead: a document too large to
+load in bounded work; an ``<inertial>``, a ``<visual>`` or a ``<collision>`` urdfdom cannot read (it stops
+reading the link there: a partial inertia, and Pinocchio then loads none of the link's visuals and collisions,
+or none of its collisions) or a negative mass (kept); a link that is the child of two joints (urdfdom keeps
+one, Pinocchio builds its branch twice). What urdfdom reads and
+ignores (an inline ``<material>`` whose ``<color>`` it cannot parse, a global material without colour)
+loads, as it does in Pinocchio.
 """
 
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from ._checks import number_text
-from .errors import UrdfError
 from .limits import MAX_URDF_ELEMENTS
+from .units import NUMBER_TEXT
+from .urdf_rules import UrdfRuleError
 
 __all__ = [
     "PRECHECK_RULES",
@@ -31,36 +45,67 @@ __all__ = [
     "PrecheckRule",
     "check_root",
     "check_urdf_tree",
+    "parse_urdf_xml",
+    "second_parents",
+    "urdf_number",
+    "urdf_vector",
     "urdfdom_ignores",
     "xacro_leftovers",
 ]
 
 _JOINT_TYPES = frozenset(("revolute", "continuous", "prismatic", "fixed", "floating", "planar"))
 _INERTIA = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-# (element path below a link or joint, attribute, number of values); numbers urdfdom parses
-_INERTIAL_NUMBERS = (
-    ("inertial/origin", "xyz", 3), ("inertial/origin", "rpy", 3), ("inertial/mass", "value", 1),
-    *(("inertial/inertia", a, 1) for a in _INERTIA),
-)  # fmt: skip
-_GEOMETRY_NUMBERS = (
-    ("origin", "xyz", 3), ("origin", "rpy", 3), ("geometry/box", "size", 3), ("geometry/cylinder", "radius", 1),
-    ("geometry/cylinder", "length", 1), ("geometry/sphere", "radius", 1), ("geometry/mesh", "scale", 3),
-)  # fmt: skip
-_JOINT_NUMBERS = (
-    ("origin", "xyz", 3), ("origin", "rpy", 3), ("axis", "xyz", 3),
-    *(("limit", a, 1) for a in ("lower", "upper", "effort", "velocity")),
-    ("dynamics", "damping", 1), ("dynamics", "friction", 1),
-    ("mimic", "multiplier", 1), ("mimic", "offset", 1),
-)  # fmt: skip
-_SHAPES = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",), "mesh": ("filename",)}
+_SHAPES = {"box": (("size", 3),), "cylinder": (("length", 1), ("radius", 1)), "sphere": (("radius", 1),),
+           "mesh": (("filename", 0), ("scale", -3))}  # fmt: skip
+"""urdfdom's shapes and their attributes: (name, count); 0 text, a negative count an optional vector."""
+_BLANKS = " \t\n\v\f\r"  # what a C++ stream skips before a number (isspace in the C locale)
+_VERSIONS = ((1, 0), (1, 1), (1, 2))
+"""The URDF versions Pinocchio's urdfdom reads (``<robot version="...">``; absent: 1.0)."""
 
 
-class PrecheckError(UrdfError):
+# ------------------------------------------------------------------------------------ urdfdom's numbers
+def urdf_number(text: str) -> float | None:
+    """A number as urdfdom reads one (``strToDouble``), or None when it refuses the text.
+
+    A C++ stream in the C locale: blanks before the number are skipped, nothing may follow it (``"1 "`` is
+    refused), ASCII digits with an optional sign, point and exponent (:data:`scara_pin.units.NUMBER_TEXT`),
+    no ``inf``/``nan``, and a value beyond the largest double is refused.
+    """
+    stripped = text.lstrip(_BLANKS)
+    if not NUMBER_TEXT.fullmatch(stripped):
+        return None
+    value = float(stripped)
+    return value if math.isfinite(value) else None
+
+
+def urdf_vector(text: str, n: int = 3) -> tuple[float, ...] | None:
+    """``n`` numbers as urdfdom reads a vector (split at spaces only, each by :func:`urdf_number`), or None."""
+    values = [urdf_number(piece) for piece in text.split(" ") if piece]
+    if len(values) != n or any(v is None for v in values):
+        return None
+    return tuple(values)  # type: ignore[arg-type]
+
+
+def _number_problem(raw: str, n: int) -> str:
+    """Why urdfdom refuses ``raw`` as ``n`` numbers (one, when ``n`` is 1), in a phrase."""
+    pieces = [raw] if n == 1 else [p for p in raw.split(" ") if p]
+    for piece in pieces:
+        if urdf_number(piece) is not None:
+            continue
+        core = piece.lstrip(_BLANKS)
+        if core and core[-1] in _BLANKS and urdf_number(core.rstrip(_BLANKS)) is not None:
+            return "a blank after a number (urdfdom reads nothing after it)"
+        if n > 1 and any(c in piece for c in _BLANKS):
+            return "numbers separated by a tab or a line break (urdfdom separates them by spaces only)"
+        if NUMBER_TEXT.fullmatch(core):
+            return f"{core[:40]!r} is beyond the largest double"
+        return f"{core[:40]!r} is not a number (ASCII digits, a sign, a point, an exponent)" if core else \
+            "no number"  # fmt: skip
+    return f"{len(pieces)} number{'s' if len(pieces) != 1 else ''}: urdfdom reads {n} finite number{'s' * (n > 1)} here"
+
+
+class PrecheckError(UrdfRuleError):
     """A document the loader's pre-check refuses; ``rule``: the name of the rule of :data:`PRECHECK_RULES`."""
-
-    def __init__(self, rule: str, message: str) -> None:
-        self.rule = rule
-        super().__init__(message)
 
 
 @dataclass(frozen=True)
@@ -71,7 +116,7 @@ class PrecheckRule:
         name: its name (``PrecheckError.rule``).
         check: refuses (:class:`PrecheckError`) a parsed document that breaks it; ``(root, origin)``.
         stricter: None when urdfdom (so Pinocchio) refuses the same documents; else why the toolkit refuses
-            documents urdfdom takes.
+            documents urdfdom takes (each refusal's message says what urdfdom would do with that document).
     """
 
     name: str
@@ -83,30 +128,33 @@ def _refuse(rule: str, origin: str, message: str) -> PrecheckError:
     return PrecheckError(rule, f"{origin}: not a valid URDF: {message}")
 
 
-def _numbers(rule: str, el: ET.Element, attr: str, n: int, where: str, origin: str) -> None:
-    raw = el.get(attr)
-    if raw is None:
+def _numbers(rule: str, el: ET.Element | None, attrs: tuple[tuple[str, int], ...], where: str, origin: str,
+             suffix: str = "") -> None:  # fmt: skip
+    """Refuse an attribute of ``el`` that urdfdom cannot read as its count of numbers (absent ones pass)."""
+    if el is None:
         return
-    values = [number_text(p) for p in raw.split()]  # urdfdom's grammar: no "1_0", no "0x1"
-    if len(values) != n or not all(math.isfinite(v) for v in values):
-        what = "a finite number" if n == 1 else f"{n} finite numbers"
-        raise _refuse(rule, origin, f"{where} {attr}={raw[:60]!r} must be {what}")
+    for attr, n in attrs:
+        raw = el.get(attr)
+        if raw is None:
+            continue
+        ok = urdf_number(raw) is not None if n == 1 else urdf_vector(raw, n) is not None
+        if not ok:
+            raise _refuse(rule, origin, f"{where} <{el.tag}> {attr}={raw[:60]!r}: {_number_problem(raw, n)}{suffix}")
 
 
-def _named(rule: str, elements: list[ET.Element], origin: str) -> None:
-    """Each element named, no name twice (links, joints)."""
-    seen: set[str] = set()
-    for el in elements:
-        name = el.get("name")
-        if not name:
-            raise _refuse(rule, origin, f"a <{el.tag}> has no name")
-        if name in seen:
-            raise _refuse(rule, origin, f"{el.tag} {name!r} is defined twice")
-        seen.add(name)
+_POSE = (("xyz", 3), ("rpy", 3))
 
 
 def _joints(root: ET.Element) -> Iterator[tuple[str, ET.Element]]:
     return ((el.get("name", ""), el) for el in root.findall("joint"))
+
+
+def _joint_where(name: str) -> str:
+    return f"joint {name}'s" if name else "joint ''s"
+
+
+def _link_where(link: ET.Element) -> str:
+    return f"link {link.get('name')}'s"
 
 
 # ------------------------------------------------------------------------------------------ the rules
@@ -124,122 +172,285 @@ def _size(root: ET.Element, origin: str) -> None:
 
 
 def _robot_name(root: ET.Element, origin: str) -> None:
-    if not root.get("name"):
-        raise _refuse("robot-name", origin, "the <robot> has no name")
+    if root.get("name") is None:
+        raise _refuse("robot-name", origin, "the <robot> has no name attribute (name=\"\" would do)")
+
+
+def _version_number(piece: str) -> int | None:
+    """The ``strToUnsigned`` of urdfdom: C's strtol (blanks and a sign first), the whole piece, >= 0, as uint32."""
+    core = piece.lstrip(_BLANKS)
+    if not re.fullmatch(r"[+-]?[0-9]+", core, re.ASCII):
+        return None
+    value = max(min(int(core), 2**63 - 1), -(2**63))
+    return None if value < 0 else value & 0xFFFFFFFF
+
+
+def _version(root: ET.Element, origin: str) -> None:
+    raw = root.get("version")
+    if raw is None:
+        return
+    pieces = raw.split(".")
+    if pieces and pieces[-1] == "":  # urdfdom's split keeps no empty last piece ("1.0." is 1.0)
+        pieces.pop()
+    numbers = [_version_number(p) for p in pieces] if len(pieces) == 2 else []
+    if len(numbers) != 2 or None in numbers or tuple(numbers) not in _VERSIONS:
+        shown = ", ".join(f"{a}.{b}" for a, b in _VERSIONS)
+        raise _refuse("urdf-version", origin, f"<robot> version={raw[:40]!r}: urdfdom reads the versions {shown} "
+                                              "(written major.minor)")  # fmt: skip
 
 
 def _materials(root: ET.Element, origin: str) -> None:
     seen: set[str] = set()
     for material in root.findall("material"):  # global ones; urdfdom ignores a colour it cannot read
-        name = material.get("name", "")
-        if name and name in seen:
-            raise _refuse("material-unique", origin, f"material {name!r} is defined twice")
+        name = material.get("name", "")  # a nameless one is kept under the name ""
+        if name in seen:
+            raise _refuse("material-unique", origin, f"<material name={name!r}> is defined twice")
         seen.add(name)
 
 
 def _link_names(root: ET.Element, origin: str) -> None:
-    _named("link-name", root.findall("link"), origin)
+    links = root.findall("link")
+    seen: set[str] = set()
+    for el in links:
+        name = el.get("name", "")
+        if not name and len(links) > 1:  # no joint can name it: urdfdom finds it a second root
+            what = "no name attribute" if el.get("name") is None else "name=\"\""
+            raise _refuse("link-name", origin, f"a <link> has {what}: no joint can name it as its parent or child, "
+                                               "so the tree would have two root links")  # fmt: skip
+        if name in seen:
+            raise _refuse("link-name", origin, f"<link name={name!r}> is defined twice")
+        seen.add(name)
+    if not links:
+        raise _refuse("link-name", origin, "the document has no <link> (a URDF has at least one; a xacro file of "
+                                           "macros only defines them: call one, or load the file that does)")
+
+
+def _lost(link: ET.Element, visuals: bool) -> str:
+    """What Pinocchio loses of a link when urdfdom stops reading it: ``none of the link's 2 <visual>s and ...``.
+
+    At its inertial or a visual: every visual and collision; at a collision: every collision (urdfdom then leaves
+    the link's first visual, or collision, unset, and Pinocchio reads a link's geometry from it).
+    """
+    nv = len(link.findall("visual")) if visuals else 0
+    nc = len(link.findall("collision"))
+    parts = [f"{n} <{tag}>{'s' if n != 1 else ''}" for n, tag in ((nv, "visual"), (nc, "collision")) if n]
+    return f"none of the link's {' and '.join(parts)}" if parts else "no geometry of the link (it has none)"
+
+
+def _ordinal(items: list[ET.Element], item: ET.Element) -> str:
+    return f"<{item.tag}>" if len(items) == 1 else f"<{item.tag}> #{items.index(item) + 1} of {len(items)}"
 
 
 def _inertial(root: ET.Element, origin: str) -> None:
     for link in root.findall("link"):
-        where = f"link {link.get('name')}'s"
-        for path, attr, n in _INERTIAL_NUMBERS:
-            for sub in link.findall(path):
-                _numbers("inertial", sub, attr, n, f"{where} <{path}>", origin)
-        for inertial in link.findall("inertial"):
-            for part in ("mass", "inertia"):
-                if inertial.find(part) is None:
-                    raise _refuse("inertial", origin, f"{where} <inertial> has no <{part}>")
-            inertia = inertial.find("inertia")
-            missing = [a for a in _INERTIA if inertia is not None and a not in inertia.attrib]
-            if missing:
-                raise _refuse("inertial", origin, f"{where} <inertia> has no {', '.join(missing)}")
-        mass = link.find("inertial/mass")
-        if mass is not None and float(mass.get("value", "0")) < 0:
-            raise _refuse("inertial", origin, f"{where} mass {mass.get('value')} must be >= 0")
+        inertial = link.find("inertial")  # urdfdom reads the first one only
+        if inertial is None:
+            continue
+        where = f"{_link_where(link)} <inertial>"
+        consequence = (f": urdfdom would stop reading link {link.get('name')} there (a partial inertia), and "
+                       f"Pinocchio would load {_lost(link, True)}; the toolkit refuses it")  # fmt: skip
+        _numbers("inertial", inertial.find("origin"), _POSE, where, origin, consequence)
+        for part in ("mass", "inertia"):
+            if inertial.find(part) is None:
+                raise _refuse("inertial", origin, f"{where} has no <{part}>{consequence}")
+        mass = inertial.find("mass")
+        if mass.get("value") is None:  # type: ignore[union-attr]
+            raise _refuse("inertial", origin, f"{where} <mass> has no value{consequence}")
+        _numbers("inertial", mass, (("value", 1),), where, origin, consequence)
+        inertia = inertial.find("inertia")
+        missing = [a for a in _INERTIA if a not in inertia.attrib]  # type: ignore[union-attr]
+        if missing:
+            raise _refuse("inertial", origin, f"{where} <inertia> has no {', '.join(missing)}{consequence}")
+        _numbers("inertial", inertia, tuple((a, 1) for a in _INERTIA), where, origin, consequence)
+        value = urdf_number(mass.get("value", ""))  # type: ignore[union-attr]
+        if value is not None and value < 0:
+            raise _refuse("inertial", origin, f"{where} <mass> value={mass.get('value')!r} is negative: urdfdom "  # type: ignore[union-attr]
+                                              "keeps it, and every torque and payload would be wrong")  # fmt: skip
+
+
+def _shape_problem(item: ET.Element) -> str | None:
+    """Why urdfdom cannot read a ``<visual>`` or ``<collision>`` (its origin, its shape; a visual's material)."""
+    origin = item.find("origin")
+    for attr, n in _POSE:
+        raw = None if origin is None else origin.get(attr)
+        if raw is not None and urdf_vector(raw, n) is None:
+            return f"<origin> {attr}={raw[:60]!r}: {_number_problem(raw, n)}"
+    geometry = item.find("geometry")
+    if geometry is None:
+        return "no <geometry>"
+    shape = next(iter(geometry), None)  # urdfdom reads the first element only (a second one is ignored)
+    if shape is None:
+        return "<geometry> holds nothing (urdfdom reads its first element: <box>, <cylinder>, <sphere>, <mesh>)"
+    if shape.tag not in _SHAPES:
+        return (f"<geometry>'s first element is <{shape.tag}>, not <box>, <cylinder>, <sphere> or <mesh> (urdfdom "
+                "reads the first element only)")  # fmt: skip
+    for attr, n in _SHAPES[shape.tag]:
+        raw = shape.get(attr)
+        if raw is None:
+            if n >= 0:
+                return f"<{shape.tag}> has no {attr}"
+            continue
+        if n and (urdf_number(raw) is None if n == 1 else urdf_vector(raw, abs(n)) is None):
+            return f"<{shape.tag}> {attr}={raw[:60]!r}: {_number_problem(raw, abs(n))}"
+    material = item.find("material")
+    if item.tag == "visual" and material is not None and material.get("name") is None:
+        return "<material> has no name attribute (name=\"\" would do)"
+    return None
 
 
 def _geometry(root: ET.Element, origin: str) -> None:
     for link in root.findall("link"):
         for part in ("visual", "collision"):
-            for item in link.findall(part):
-                where = f"link {link.get('name')}'s <{part}>"
-                for path, attr, n in _GEOMETRY_NUMBERS:
-                    for sub in item.findall(path):
-                        _numbers("geometry", sub, attr, n, where, origin)
-                geometry = item.find("geometry")
-                shapes = [] if geometry is None else list(geometry)
-                if len(shapes) != 1 or shapes[0].tag not in _SHAPES:
-                    found = ", ".join(f"<{c.tag}>" for c in shapes) or "nothing"
-                    raise _refuse("geometry", origin, f"{where} <geometry> must hold one of <box>, <cylinder>, "
-                                                      f"<sphere>, <mesh>; it holds {found}")  # fmt: skip
-                for attr in _SHAPES[shapes[0].tag]:
-                    if shapes[0].get(attr) is None:
-                        raise _refuse("geometry", origin, f"{where} <{shapes[0].tag}> has no {attr}")
-                material = item.find("material")
-                if part == "visual" and material is not None and not material.get("name"):
-                    raise _refuse("geometry", origin, f"{where} <material> has no name")
+            items = link.findall(part)
+            for item in items:
+                problem = _shape_problem(item)
+                if problem is None:
+                    continue
+                lost = _lost(link, part == "visual")
+                raise _refuse("geometry", origin, f"{_link_where(link)} {_ordinal(items, item)}: {problem}; urdfdom "
+                                                  f"would stop reading the link there, and Pinocchio would load "
+                                                  f"{lost}; the toolkit refuses it")  # fmt: skip
 
 
 def _joint_names(root: ET.Element, origin: str) -> None:
-    _named("joint-name", root.findall("joint"), origin)
+    seen: set[str] = set()
+    for el in root.findall("joint"):
+        name = el.get("name")
+        if name is None:
+            raise _refuse("joint-name", origin, "a <joint> has no name attribute (name=\"\" would do)")
+        if name in seen:
+            raise _refuse("joint-name", origin, f"<joint name={name!r}> is defined twice")
+        seen.add(name)
 
 
 def _joint_types(root: ET.Element, origin: str) -> None:
     for name, el in _joints(root):
         if el.get("type") not in _JOINT_TYPES:
-            raise _refuse("joint-type", origin, f"joint {name} has type {el.get('type')!r}")
+            raise _refuse("joint-type", origin, f"<joint name={name!r}> type={el.get('type')!r}: not a URDF joint "
+                                                f"type ({', '.join(sorted(_JOINT_TYPES))})")  # fmt: skip
 
 
 def _joint_links(root: ET.Element, origin: str) -> None:
-    links = {el.get("name") for el in root.findall("link")}
+    links = {el.get("name", "") for el in root.findall("link")}
     for name, el in _joints(root):
         for role in ("parent", "child"):
             tag = el.find(role)
             link = None if tag is None else tag.get("link")
             if not link:
-                raise _refuse("joint-links", origin, f"joint {name} has no {role} link")
+                written = f"<{role} link=\"\">" if link == "" else f"<{role}> without link=" if tag is not None \
+                    else f"no <{role}>"  # fmt: skip
+                raise _refuse("joint-links", origin, f"{_joint_where(name)} {written}: a joint names its {role} link")
             if link not in links:
-                raise _refuse("joint-links", origin, f"joint {name}'s {role} link {link!r} is not defined")
+                raise _refuse("joint-links", origin, f"{_joint_where(name)} <{role} link={link!r}>: no <link> of "
+                                                     "that name")  # fmt: skip
+
+
+_JOINT_NUMBERS: tuple[tuple[str, tuple[tuple[str, int], ...]], ...] = (
+    ("origin", _POSE),
+    ("limit", (("lower", 1), ("upper", 1), ("effort", 1), ("velocity", 1))),
+    ("safety_controller", (("soft_lower_limit", 1), ("soft_upper_limit", 1), ("k_position", 1), ("k_velocity", 1))),
+    ("calibration", (("rising", 1), ("falling", 1))),
+    ("mimic", (("multiplier", 1), ("offset", 1))),
+    ("dynamics", (("damping", 1), ("friction", 1))),
+)
+"""The numbers urdfdom reads in a joint: (its first child of that tag, the attributes and their counts)."""
 
 
 def _joint_numbers(root: ET.Element, origin: str) -> None:
     for name, el in _joints(root):
-        for path, attr, n in _JOINT_NUMBERS:
-            for sub in el.findall(path):
-                _numbers("joint-numbers", sub, attr, n, f"joint {name}'s <{path}>", origin)
+        where = _joint_where(name)
+        for tag, attrs in _JOINT_NUMBERS:
+            _numbers("joint-numbers", el.find(tag), attrs, where, origin)
+        if el.get("type") not in ("fixed", "floating"):  # urdfdom never reads a fixed joint's axis
+            _numbers("joint-numbers", el.find("axis"), (("xyz", 3),), where, origin)
 
 
 def _joint_limits(root: ET.Element, origin: str) -> None:
     for name, el in _joints(root):
         kind = el.get("type")
         limit = el.find("limit")
-        if kind in ("revolute", "prismatic") and (limit is None or limit.get("effort") is None
-                                                  or limit.get("velocity") is None):  # fmt: skip
-            raise _refuse("joint-limit", origin, f"{kind} joint {name} needs <limit> with effort and velocity")
+        if limit is None:
+            if kind in ("revolute", "prismatic"):
+                raise _refuse("joint-limit", origin, f"{kind} <joint name={name!r}> has no <limit> (urdfdom needs "
+                                                     "one, with effort and velocity)")  # fmt: skip
+            continue
+        missing = [a for a in ("effort", "velocity") if limit.get(a) is None]
+        if missing:  # any joint's <limit>, a fixed one's too
+            raise _refuse("joint-limit", origin, f"{_joint_where(name)} <limit> has no {' and no '.join(missing)} "
+                                                 "(urdfdom needs both)")  # fmt: skip
+
+
+def _joint_parts(root: ET.Element, origin: str) -> None:
+    """A ``<safety_controller>`` without k_velocity, a ``<dynamics>`` with neither damping nor friction."""
+    for name, el in _joints(root):
+        safety = el.find("safety_controller")
+        if safety is not None and safety.get("k_velocity") is None:
+            raise _refuse("joint-parts", origin, f"{_joint_where(name)} <safety_controller> has no k_velocity "
+                                                 "(urdfdom needs it)")  # fmt: skip
+        dynamics = el.find("dynamics")
+        if dynamics is not None and dynamics.get("damping") is None and dynamics.get("friction") is None:
+            raise _refuse("joint-parts", origin, f"{_joint_where(name)} <dynamics> has neither damping nor friction "
+                                                 "(urdfdom needs one)")  # fmt: skip
 
 
 def _mimic_joint(root: ET.Element, origin: str) -> None:
     for name, el in _joints(root):
         mimic = el.find("mimic")
-        if mimic is not None and not mimic.get("joint"):
-            raise _refuse("mimic-joint", origin, f"joint {name}'s <mimic> names no joint (joint=...)")
+        if mimic is not None and mimic.get("joint") is None:
+            raise _refuse("mimic-joint", origin, f"{_joint_where(name)} <mimic> has no joint attribute (the joint "
+                                                 "it follows)")  # fmt: skip
+
+
+def second_parents(root: ET.Element) -> list[tuple[str, str, str, bool]]:
+    """Links that are the child of two joints (or more): ``(link, joint kept, joint ignored, harmful)``.
+
+    urdfdom keeps one parent joint per link, the last by name, and Pinocchio builds the link once per joint
+    naming it: once more with the kept joint. That is harmless when the kept joint and every joint below the
+    link are fixed (the same frames again: the robot is the one with the kept joint), harmful otherwise (movable
+    joints built twice, under the same names).
+    """
+    joints = root.findall("joint")
+    by_child: dict[str, list[ET.Element]] = {}
+    children: dict[str, list[ET.Element]] = {}
+    for el in joints:
+        by_child.setdefault(el.find("child").get("link", ""), []).append(el)  # type: ignore[union-attr]
+        children.setdefault(el.find("parent").get("link", ""), []).append(el)  # type: ignore[union-attr]
+    out = []
+    for link, parents in by_child.items():
+        if len(parents) < 2:
+            continue
+        kept = max(parents, key=lambda el: el.get("name", "").encode())
+        movable = kept.get("type") != "fixed"
+        seen, stack = {link}, [link]
+        while stack and not movable:  # every joint below the link
+            for el in children.get(stack.pop(), []):
+                movable = movable or el.get("type") != "fixed"
+                child = el.find("child").get("link", "")  # type: ignore[union-attr]
+                if child not in seen:
+                    seen.add(child)
+                    stack.append(child)
+        for el in parents:
+            if el is not kept:
+                out.append((link, kept.get("name", ""), el.get("name", ""), movable))
+    return out
+
+
+def _two_parents(root: ET.Element, origin: str) -> None:
+    for link, kept, other, harmful in second_parents(root):
+        if harmful:
+            raise _refuse("two-parents", origin, f"<link name={link!r}> is the child of joints {other!r} and "
+                                                 f"{kept!r}: urdfdom keeps {kept!r}, and Pinocchio builds the link's "
+                                                 "branch twice, its movable joints named twice")  # fmt: skip
 
 
 def _tree(root: ET.Element, origin: str) -> None:
-    parent_of: dict[str, str] = {}
-    for name, el in _joints(root):
-        child = el.find("child").get("link")  # type: ignore[union-attr]  # (joint-links ran first)
-        if child in parent_of:
-            raise _refuse("tree", origin, f"link {child!r} is the child of joints {parent_of[child]} and {name}")
-        parent_of[child] = name  # type: ignore[index]
+    children = {el.find("child").get("link") for el in root.findall("joint")}  # type: ignore[union-attr]
     links = root.findall("link")
-    roots = [str(el.get("name")) for el in links if el.get("name") not in parent_of]
-    if len(roots) != 1 and links:
+    roots = [str(el.get("name", "")) for el in links if el.get("name", "") not in children]
+    if len(roots) != 1:
         shown = ", ".join(roots[:5]) + (" ..." if len(roots) > 5 else "")
-        raise _refuse("tree", origin, f"{len(roots)} root links ({shown or 'none: a cycle'}); a URDF tree has "
-                                      "exactly one root link")  # fmt: skip
+        raise _refuse("tree", origin, f"{len(roots)} root links ({shown or 'every link is a joint child: a cycle'}); "
+                                      "a URDF tree has exactly one root link")  # fmt: skip
 
 
 PRECHECK_RULES: tuple[PrecheckRule, ...] = (
@@ -247,31 +458,57 @@ PRECHECK_RULES: tuple[PrecheckRule, ...] = (
     PrecheckRule("size", _size, "the work is bounded: a document above MAX_URDF_ELEMENTS links and joints is refused "
                                 "before any is done"),
     PrecheckRule("robot-name", _robot_name),
+    PrecheckRule("urdf-version", _version),
     PrecheckRule("material-unique", _materials),
     PrecheckRule("link-name", _link_names),
-    PrecheckRule("inertial", _inertial, "urdfdom drops an <inertial> it cannot read (the link then has no mass) and "
-                                        "keeps a negative mass: torques, payloads and timing would be silently wrong"),
-    PrecheckRule("geometry", _geometry, "urdfdom drops a <visual> or <collision> it cannot read (a shape, a number, "
-                                        "a nameless material), renumbering the link's others, by which the viewer "
-                                        "pairs its meshes with Pinocchio's geometry: meshes on the wrong parts"),
+    PrecheckRule("inertial", _inertial, "urdfdom stops reading a link at an <inertial> it cannot read (a partial "
+                                        "inertia, and Pinocchio loads none of the link's visuals and collisions) and "
+                                        "keeps a negative mass: torques, payloads, pictures and collisions would be "
+                                        "silently wrong"),
+    PrecheckRule("geometry", _geometry, "urdfdom stops reading a link at a <visual> or <collision> it cannot read, "
+                                        "and Pinocchio then loads none of the link's visuals and collisions (none of "
+                                        "its collisions, at a collision): parts missing from the pictures and from "
+                                        "the collision checks"),
     PrecheckRule("joint-name", _joint_names),
     PrecheckRule("joint-type", _joint_types),
     PrecheckRule("joint-links", _joint_links),
     PrecheckRule("joint-numbers", _joint_numbers),
     PrecheckRule("joint-limit", _joint_limits),
+    PrecheckRule("joint-parts", _joint_parts),
     PrecheckRule("mimic-joint", _mimic_joint),
+    PrecheckRule("two-parents", _two_parents,
+                 "urdfdom takes a link that is the child of two joints (it keeps the last by name), and Pinocchio then "
+                 "builds that link's branch twice: its movable joints twice, under the same names (a branch of fixed "
+                 "joints only is the same frames again: loaded, with a warning)"),
     PrecheckRule("tree", _tree),
 )  # fmt: skip
 """The pre-check's rules, in the order they run (the first broken one refuses the document)."""
 
 
+def check_urdf_tree(root: ET.Element, origin: str) -> None:
+    """Refuse (:class:`PrecheckError`) what urdfdom would refuse, and what :data:`PRECHECK_RULES` refuses on purpose.
+
+    The robot: a name attribute, a version urdfdom reads. Global materials: no name twice. Links: named,
+    unique, at least one; the first ``<inertial>`` readable (mass >= 0), every visual and collision readable.
+    Joints: a name attribute, unique, a known type, parent and child links that exist, the numbers of their
+    first ``<origin>``, ``<axis>`` (not a fixed joint's), ``<limit>``, ``<safety_controller>``,
+    ``<calibration>``, ``<mimic>`` and ``<dynamics>`` readable, ``<limit>`` with effort and velocity (and
+    present on a revolute or prismatic joint), a ``<mimic>`` with its joint attribute. The tree: one root
+    link, a link the child of two joints only when nothing movable hangs from it (stricter than urdfdom). At
+    most :data:`~scara_pin.limits.MAX_URDF_ELEMENTS` links and joints.
+    """
+    for rule in PRECHECK_RULES:
+        rule.check(root, origin)
+
+
+# ------------------------------------------------------------------------------------ what urdfdom ignores
 def _colour_problem(color: ET.Element) -> str | None:
     """Why urdfdom cannot read a ``<color>``: ``"no rgba"`` (``rgb=`` is not URDF), ``"malformed"``, or None."""
     raw = color.get("rgba")
     if raw is None:
         return "no rgba"
-    pieces = [number_text(p) for p in raw.split()]
-    if not all(0.0 <= v <= 1.0 for v in pieces):  # NaN fails too: urdfdom throws and says so
+    pieces = [urdf_number(p) for p in raw.split(" ") if p]
+    if not all(v is not None and 0.0 <= v <= 1.0 for v in pieces):  # urdfdom throws and says so
         return "malformed"
     return None if len(pieces) == 4 else "no rgba"  # a wrong count: read as no colour, silently
 
@@ -313,19 +550,55 @@ def urdfdom_ignores(root: ET.Element) -> list[str]:
     return out
 
 
-def check_urdf_tree(root: ET.Element, origin: str) -> None:
-    """Refuse (:class:`PrecheckError`) what urdfdom would refuse, and what :data:`PRECHECK_RULES` refuses on purpose.
+# ------------------------------------------------------------------------------------ the document as urdfdom reads it
+_RAW_BLANK_VALUE = re.compile(r"\"[^\"<]*[\t\n\r][^\"<]*\"|'[^'<]*[\t\n\r][^'<]*'")
+"""A quoted value holding a tab or a line break (an attribute's; in a comment or text, changing it is harmless)."""
+_CHARACTER_REFERENCE = {"\r\n": "&#10;", "\r": "&#10;", "\n": "&#10;", "\t": "&#9;"}
 
-    Links: named, unique, inertial numbers finite (mass >= 0), visuals and collisions readable. Joints:
-    named, unique, a known type, parent and child links that exist, limits with effort and velocity where
-    required, numbers finite, a ``<mimic>`` naming its joint. The tree: one root link, each link the child of
-    at most one joint (hence no cycle). Global materials: no name twice. At most
-    :data:`~scara_pin.limits.MAX_URDF_ELEMENTS` links and joints.
+
+def _keep_blanks(value: re.Match[str]) -> str:
+    """A quoted value whose tabs and line breaks are kept as character references (its line breaks after it)."""
+    text = value.group()
+    breaks = text.count("\n") + text.count("\r") - text.count("\r\n")
+    return re.sub(r"\r\n|[\r\n\t]", lambda m: _CHARACTER_REFERENCE[m.group()], text) + "\n" * breaks
+
+
+def parse_urdf_xml(text: str, lines: bool = True) -> tuple[ET.Element, dict[ET.Element, int]]:
+    r"""The document as urdfdom's XML reader (tinyxml2) sees it, with each element's line (when ``lines``).
+
+    Two differences from a standard XML reader are undone: namespaces mean nothing to tinyxml2 (a prefix
+    never declared, ``<gazebo:plugin>``, is a tag like any other: read without namespaces here), and it keeps
+    the tabs and line breaks written inside an attribute value (``xyz="0 0\t1"``, which urdfdom refuses),
+    where XML turns them into spaces.
+
+    Raises:
+        xml.parsers.expat.ExpatError: the text is not well-formed XML (``lineno``, ``offset``).
     """
-    for rule in PRECHECK_RULES:
-        rule.check(root, origin)
+    from xml.parsers import expat
+
+    if "\t" in text or "\n" in text or "\r" in text:
+        text = _RAW_BLANK_VALUE.sub(_keep_blanks, text)
+    if not lines and "xmlns" not in text:  # no namespace declared: ElementTree's C reader reads the same tree
+        try:
+            return ET.fromstring(text), {}
+        except ET.ParseError:  # an undeclared prefix (or not XML): read as tinyxml2 reads it, below
+            pass
+    builder = ET.TreeBuilder()
+    found: dict[ET.Element, int] = {}
+    parser = expat.ParserCreate()
+    parser.buffer_text = True
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        found[builder.start(tag, attrs)] = parser.CurrentLineNumber
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = builder.end
+    parser.CharacterDataHandler = builder.data
+    parser.Parse(text, True)
+    return builder.close(), found
 
 
+# ------------------------------------------------------------------------------------ xacro left in a URDF
 _XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro", "http://wiki.ros.org/xacro")
 _INERT_XACRO = frozenset(("property", "arg"))
 """xacro declarations that change nothing in a document that never substitutes them (no ``${``, ``$(``)."""

@@ -11,7 +11,10 @@ only the joints that move the tool freely:
   Pinocchio's ``buildReducedModel``. The locked parts stay in the model as fixed bodies: the viewer still
   draws the whole robot, at the locked values. A geared joint whose source is locked is locked with it;
   one whose source stays free keeps following it, on the chain or off it (a parallelogram's rods beside
-  the arm: drawn, and their frames placed, where the arm puts them).
+  the arm: drawn, and their frames placed, where the arm puts them). Locking a geared joint locks its
+  source at the value that gives it. A geared joint Pinocchio cannot build as a mimic (its source built
+  after it: a gripper's second jaw named before the first) is handed to Pinocchio as a plain joint and
+  locked with its source, at the value its gearing gives (``unbuilt``).
 
 Lock values are SI (rad, m), as the rest of the robot's description (the CLI's ``--set`` likewise).
 """
@@ -26,7 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import ParameterError, UrdfError
-from .urdf_rules import JointEdge, zero_within
+from .urdf_rules import JointEdge, Mimic, UrdfRuleError, mimic_error, zero_within
 
 __all__ = [
     "AXIS_TOL",
@@ -129,12 +132,51 @@ def _mimic_sources(model: pin.Model) -> dict[int, int]:
             and model.joints[j].shortname() == "JointModelMimic"}  # fmt: skip
 
 
+def _set_q(model: pin.Model, q: np.ndarray, j: int, value: float) -> None:
+    """Joint ``j``'s value in Pinocchio's ``q`` (a continuous joint's as its cos, sin)."""
+    jm = model.joints[j]
+    if jm.nq == 2:
+        q[jm.idx_q : jm.idx_q + 2] = (math.cos(value), math.sin(value))
+    else:
+        q[jm.idx_q] = value
+
+
+def _asked_values(model: pin.Model, lock: Mapping[str, float], gearing: Mapping[str, tuple[str, float, float]],
+                  origin: str) -> dict[str, float]:  # fmt: skip
+    """The values of ``lock`` as the free joints take them: a mimic's value locks its source at the value giving it."""
+    movable = [model.names[j] for j in range(1, model.njoints)]
+    out: dict[str, float] = {}
+    for name, raw in lock.items():
+        if not model.existJointName(name) or name == "universe":
+            shown = ", ".join(movable[:40]) + (" ..." if len(movable) > 40 else "")
+            raise UrdfRuleError("lock", f"{origin}: --lock {name[:80]!r}: no movable joint of that name; movable "
+                                f"joints: {shown}")  # fmt: skip
+        value = float(raw)
+        if not math.isfinite(value):
+            raise ParameterError(f"--lock {name}", value, "must be finite")
+        if name not in gearing:
+            out.setdefault(name, value)
+            continue
+        source, m, c = gearing[name]  # the mimic is locked with its source, at the value that gives it
+        if m == 0.0:
+            raise ParameterError(f"--lock {name}", value, f"cannot be set: {name} = 0 * {source} + {c:.9g} is the "
+                                 f"constant {c:.9g} (lock {source} instead)")  # fmt: skip
+        at = (value - c) / m
+        given = lock.get(source, out.get(source))
+        if given is not None and abs(float(given) - at) > 1e-12 * max(1.0, abs(at)):
+            raise ParameterError(f"--lock {name}", value, f"gives {source} = {at:.9g} ({name} = {m:.9g} * {source} + "
+                                 f"{c:.9g}), but {source} is locked at {float(given):.9g}")  # fmt: skip
+        out[source] = at
+    return out
+
+
 def reduce_to_chain(
     model: pin.Model,
     tool: str,
     lock: Mapping[str, float],
     urdf_joints: Mapping[str, JointEdge],
     origin: str,
+    unbuilt: Mapping[str, Mimic] | None = None,
 ) -> tuple[pin.Model, tuple[LockedJoint, ...]]:
     """The model of the chain from the root to ``tool``, every other joint locked (see the module docstring).
 
@@ -142,68 +184,71 @@ def reduce_to_chain(
         model: the whole robot (mimic joints loaded).
         tool: the tool frame (a link of the model).
         lock: joints to lock and their values [rad, m]; joints off the chain not named here are locked at 0
-            (or the nearest limit when 0 is outside them).
+            (or the nearest limit when 0 is outside them). A mimic joint named here is locked with its source,
+            the source at the value that gives the mimic's.
         urdf_joints: the URDF's joints as written, by name (their types and limits).
         origin: how to name the source in error messages.
+        unbuilt: the mimics handed to Pinocchio without their ``<mimic>`` (it cannot build them: their source
+            comes after them), by name; each is locked with its source, at the value its gearing gives.
 
     Returns:
         (the model itself when nothing is locked, else the reduced model; the locked joints in model order).
 
     Raises:
-        UrdfError: a locked name that is no movable joint, or a geared joint (lock the joint it follows).
-        ParameterError: a lock value that is not finite, or outside the joint's limits.
+        UrdfRuleError: a locked name that is no movable joint; an unbuilt mimic whose source stays free.
+        ParameterError: a lock value that is not finite, or outside the joint's limits (a mimic's: its
+            source's value outside the source's limits, or another lock of its source).
     """
+    unbuilt = unbuilt or {}
     sources = _mimic_sources(model)
-    movable = [model.names[j] for j in range(1, model.njoints)]
-    for name in lock:
-        if not model.existJointName(name) or name == "universe":
-            shown = ", ".join(movable[:40]) + (" ..." if len(movable) > 40 else "")
-            raise UrdfError(f"{origin}: --lock {name[:80]!r}: no movable joint of that name; movable joints: {shown}")
-        j = model.getJointId(name)
-        if j in sources:
-            raise UrdfError(f"{origin}: --lock {name}: joint {name} follows {model.names[sources[j]]} (<mimic>); lock "
-                            f"{model.names[sources[j]]} instead")  # fmt: skip
+    gearing: dict[str, tuple[str, float, float]] = {m.joint: (m.source, m.multiplier, m.offset)
+                                                    for m in unbuilt.values()}  # fmt: skip
+    for j, src in sources.items():
+        mimic = model.joints[j].extract()
+        gearing[model.names[j]] = (model.names[src], float(mimic.scaling), float(mimic.offset))
+    asked = _asked_values(model, lock, gearing, origin)
     tool_joint = model.frames[model.getFrameId(tool, pin.FrameType.BODY)].parentJoint
     chain = set(model.supports[tool_joint])
     reasons: dict[int, str] = {}
     for j in range(1, model.njoints):
-        if model.names[j] in lock:
+        name = model.names[j]
+        if name in asked:
             reasons[j] = "asked"
-        elif j not in chain and j not in sources:
+        elif j not in chain and name not in gearing:
             reasons[j] = "off-chain"
-    for j, src in sources.items():  # a geared joint goes with its source: locked with it, else it follows it
-        if src in reasons:
-            reasons[j] = "geared"
+    for name, (source, _, _) in gearing.items():  # a geared joint goes with its source: locked with it, else follows
+        if model.getJointId(source) in reasons:
+            reasons[model.getJointId(name)] = "asked" if name in lock else "geared"
+        elif name in unbuilt:  # Pinocchio cannot make it follow a free source
+            raise mimic_error(unbuilt[name], origin)
     if not reasons:
         return model, ()
     q_ref = pin.neutral(model)
     values: dict[int, float] = {}
-    for j, why in reasons.items():
-        if why == "geared":
-            continue
+    for j in sorted(reasons):
         name = model.names[j]
+        if name in gearing:
+            continue
         edge = urdf_joints.get(name)
         kind, lower, upper = ("revolute", None, None) if edge is None else (edge.type, edge.lower, edge.upper)
-        if name in lock:
-            value = float(lock[name])
-            if not math.isfinite(value):
-                raise ParameterError(f"--lock {name}", value, "must be finite")
+        if name in asked:
+            value = asked[name]
             if kind != "continuous" and lower is not None and upper is not None and not lower <= value <= upper:
-                raise ParameterError(f"--lock {name}", value,
+                via = [m for m, (s, _, _) in gearing.items() if s == name and m in lock]
+                what = f"--lock {via[0]} (so {name} = {value:.9g})" if via and name not in lock else f"--lock {name}"
+                raise ParameterError(what, lock.get(via[0], value) if via and name not in lock else value,
                                      f"must be within the joint's limits [{lower:g}, {upper:g}]")  # fmt: skip
         else:
             value = 0.0 if kind == "continuous" else zero_within(lower, upper)
         values[j] = value
-        jm = model.joints[j]
-        if jm.nq == 2:  # continuous: (cos, sin)
-            q_ref[jm.idx_q : jm.idx_q + 2] = (math.cos(value), math.sin(value))
-        else:
-            q_ref[jm.idx_q] = value
-    for j in reasons:
-        if reasons[j] == "geared":
-            mimic = model.joints[j].extract()
-            values[j] = float(mimic.scaling) * values.get(sources[j], float(q_ref[model.joints[j].idx_q])) \
-                + float(mimic.offset)  # fmt: skip
+        _set_q(model, q_ref, j, value)
+    for j in sorted(reasons):
+        name = model.names[j]
+        if name in gearing:
+            source, m, c = gearing[name]
+            values[j] = m * values[model.getJointId(source)] + c
+            if name in unbuilt:  # a free joint in Pinocchio's model: placed where its gearing puts it
+                _set_q(model, q_ref, j, values[j])
     ids = sorted(reasons)
     try:
         reduced = pin.buildReducedModel(model, ids, np.asarray(q_ref, dtype=float))

@@ -23,7 +23,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol, Self
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol, Self
 
 import numpy as np
 import pinocchio as pin
@@ -32,7 +32,17 @@ from ._checks import MAGNITUDE_MAX
 from .description import JOINT_COUNTS, JointLimits, RobotParameters, configured
 from .errors import InvalidInputError, ParameterError, UrdfError
 from .units import HUMAN, DisplayUnits, format_number
-from .urdf_rules import choose_frames, edges_of, read_tree, resolve_mimics
+from .urdf_rules import (
+    FrameChoice,
+    JointEdge,
+    Mimic,
+    UrdfRuleError,
+    choose_frames,
+    locked_joints,
+    mimic_error,
+    read_tree,
+    resolve_mimics,
+)
 
 if TYPE_CHECKING:
     from ._typing import ArrayLike
@@ -113,60 +123,100 @@ def pose_from_placement(aMb: pin.SE3) -> np.ndarray:
     return np.array([p[0], p[1], p[2], math.atan2(R[1, 0], R[0, 0])])
 
 
-def _parse_urdf(urdf: str, origin: str, checked: bool = False) -> tuple[pin.Model, str]:
-    """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`.
-
-    ``checked``: the package generated it (its own xacro): the Python pre-checks are skipped.
-
-    Returns:
-        (the model, the text Pinocchio was given: the file's, less what urdfdom ignores noisily, mimics composed).
-    """
+def _parse_xml(urdf: str, origin: str, checked: bool) -> Any:
+    """The parsed document: urdfdom's view of a stranger's file (no namespaces, raw blanks in values), ET's of ours."""
     import xml.etree.ElementTree as ET
 
+    if checked:  # the package's own xacro output
+        return ET.fromstring(urdf)
+    from xml.parsers.expat import ExpatError
+
+    from ._urdf_checks import parse_urdf_xml
+
     try:
-        root = ET.fromstring(urdf)
-    except ET.ParseError as exc:
-        line, column = exc.position
-        raise UrdfError(f"{origin}: malformed XML at line {line}, column {column + 1}") from None
+        return parse_urdf_xml(urdf, lines=False)[0]
+    except (ExpatError, ValueError) as exc:
+        line, column = getattr(exc, "lineno", None), getattr(exc, "offset", None)
+        where = f" at line {line}, column {column + 1}" if line is not None and column is not None else ""
+        raise UrdfRuleError("malformed-xml", f"{origin}: malformed XML{where}") from None
+
+
+def _parse_urdf(urdf: str, origin: str, checked: bool, frames: Mapping[str, str | None],
+                lock: Mapping[str, float]) -> _Parsed:  # fmt: skip
+    """Build a Pinocchio model from URDF text, turning every failure into a clear :class:`UrdfError`.
+
+    ``checked``: the package generated it (its own xacro): the Python pre-checks are skipped. ``frames``: the
+    ``tool`` and ``base`` asked for; ``lock``: the joints to lock (a mimic Pinocchio cannot build is locked
+    with its source, when that source is locked).
+    """
+    root = _parse_xml(urdf, origin, checked)
     if root.tag != "robot":
-        raise UrdfError(f"{origin}: the root element is <{root.tag}>, not <robot>")
+        raise UrdfRuleError("root", f"{origin}: the root element is <{root.tag}>, not <robot>")
+    changed = False
     if not checked:
-        urdf = _check_urdf(urdf, root, origin)
+        changed = _check_urdf(urdf, root, origin)
+    links, joints = read_tree(root, origin)  # raises on an unusable joint (the rule `check` applies)
+    choice = choose_frames(links, joints, tool=frames.get("tool"), base=frames.get("base"), origin=origin)
     # <mimic> joints (passive, coupled) are honoured: Pinocchio makes them mimic joints, outside q
-    mimic = root.find("joint/mimic") is not None
-    if mimic:  # Pinocchio takes one level of mimic: a mimic of a mimic is handed to it composed
-        urdf = _composed_mimics(root, urdf, origin)
+    resolved = resolve_mimics(joints, origin) if any(j.mimic is not None for j in joints) else {}
+    unbuilt = {m.joint: m for m in resolved.values() if m.unbuildable is not None}
+    if unbuilt:  # locked with their source (a gripper's second jaw, off the arm), else refused
+        locked = locked_joints(links, joints, choice.tool, lock, resolved)
+        for m in unbuilt.values():
+            if m.source not in locked:
+                raise mimic_error(m, origin)
+    ignored = [j.name for j in joints if j.unnamed_mimic]
+    if ignored:
+        logging.getLogger("scara_pin").warning(
+            "%s: <mimic joint=\"\"> names no joint: ignored, as Pinocchio's parser reads it (%s %s free)", origin,
+            ", ".join(ignored[:6]) + (" ..." if len(ignored) > 6 else ""), "is" if len(ignored) == 1 else "are")
+    if any(m.via for m in resolved.values()) or unbuilt or ignored:
+        _mimics_for_pinocchio(root, resolved, set(unbuilt) | set(ignored))
+        changed = True
+    if changed:
+        import xml.etree.ElementTree as ET
+
+        urdf = ET.tostring(root, encoding="unicode")
+    mimic = any(m.unbuildable is None for m in resolved.values())
     try:
         model = pin.buildModelFromXML(urdf, mimic=True) if mimic else pin.buildModelFromXML(urdf)
     except (ValueError, RuntimeError) as exc:
         raise UrdfError(f"{origin}: not a valid URDF: {exc}") from None
     if model.nq == 0:
-        raise UrdfError(
+        raise UrdfRuleError("no-movable-joint",
             f"{origin}: the URDF has no movable joint connected to its root link "
             f"({model.nbodies - 1} bodies, nq = 0): the kinematic tree is empty or disconnected"
-        )
-    return model, urdf
+        )  # fmt: skip
+    return _Parsed(model, urdf, links, joints, choice, unbuilt)
 
 
-def _composed_mimics(root: Any, urdf: str, origin: str) -> str:
-    """The URDF text with each chain of ``<mimic>`` joints composed down to its free joint (the text when none).
+class _Parsed(NamedTuple):
+    """What the loader read: the model, the text Pinocchio was given, the tree, the frames, the mimics it left out."""
 
-    Raises:
-        UrdfError: a mimic that cannot be resolved (:func:`scara_pin.urdf_rules.resolve_mimics` names it).
-    """
-    import xml.etree.ElementTree as ET
+    model: pin.Model
+    text: str
+    links: list[str]
+    joints: list[JointEdge]
+    frames: FrameChoice
+    unbuilt: dict[str, Mimic]
 
-    resolved = resolve_mimics(edges_of(root)[1], origin)
-    if not any(m.via for m in resolved.values()):
-        return urdf
+
+def _mimics_for_pinocchio(root: Any, resolved: Mapping[str, Mimic], drop: set[str]) -> None:
+    """Each chain of ``<mimic>`` joints composed down to its free joint; the ``<mimic>`` of ``drop`` removed."""
     for el in root.findall("joint"):
-        m = resolved.get(el.get("name", ""))
+        name = el.get("name", "")
+        mimic = el.find("mimic")
+        if mimic is None:
+            continue
+        if name in drop:
+            el.remove(mimic)
+            continue
+        m = resolved.get(name)
         if m is not None and m.via:
-            el.find("mimic").attrib.update(joint=m.source, multiplier=repr(m.multiplier), offset=repr(m.offset))
-    return ET.tostring(root, encoding="unicode")
+            mimic.attrib.update(joint=m.source, multiplier=repr(m.multiplier), offset=repr(m.offset))
 
 
-def _check_urdf(urdf: str, root: Any, origin: str) -> str:
+def _check_urdf(urdf: str, root: Any, origin: str) -> bool:
     """The Python checks of a URDF from elsewhere, before urdfdom sees it (:mod:`scara_pin._urdf_checks`).
 
     urdfdom's reasons go to the C stderr (capturing them would redirect fd 2, process-wide state): its
@@ -174,38 +224,52 @@ def _check_urdf(urdf: str, root: Any, origin: str) -> str:
     ``scara-pin check`` applies (xacro-not-expanded / xacro-ignored; the text search spares a walk).
 
     Returns:
-        the text for Pinocchio: the file's, less the colours urdfdom would ignore noisily (said once here).
+        Whether ``root`` was changed: the colours urdfdom would ignore noisily removed (said once here).
     """
-    import xml.etree.ElementTree as ET
-
-    from ._urdf_checks import check_root, check_urdf_tree, urdfdom_ignores, xacro_leftovers
+    from ._urdf_checks import check_root, check_urdf_tree, second_parents, urdfdom_ignores, xacro_leftovers
 
     check_root(root, origin)
     leftover = xacro_leftovers(root) if "xacro" in urdf or "$" in urdf else None
     if leftover is not None:
         if leftover[0]:
-            raise UrdfError(f"{origin}: {leftover[1]}")
+            raise UrdfRuleError("xacro-not-expanded", f"{origin}: {leftover[1]}")
         logging.getLogger("scara_pin").warning("%s: %s", origin, leftover[1])
     check_urdf_tree(root, origin)
+    for link, kept, other, _ in second_parents(root):  # a branch of fixed joints: the same frames twice, harmless
+        logging.getLogger("scara_pin").warning("%s: link %r is the child of joints %r and %r: %r is ignored, as "
+                                               "urdfdom does (it keeps the last by name)", origin, link, other, kept,
+                                               other)  # fmt: skip
     ignored = urdfdom_ignores(root)  # colours urdfdom drops: said here once, not by urdfdom on fd 2
     if ignored:
         shown = ", ".join(ignored[:6]) + (f" and {len(ignored) - 6} more" if len(ignored) > 6 else "")
         logging.getLogger("scara_pin").warning("%s: colours URDF cannot read, ignored (as urdfdom does; a colour is "
                                                "<color rgba=\"r g b a\"/>, each in [0, 1]): %s", origin, shown)
-        return ET.tostring(root, encoding="unicode")
-    return urdf
+        return True
+    return False
 
 
 _CONTINUOUS = frozenset(("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"))
 """Pinocchio's continuous (unbounded revolute) joints: nq = 2 (cos, sin), nv = 1."""
 
 
-def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
+def _given(name: str, values: Sequence[float], model: pin.Model, dof: int) -> tuple[float, ...]:
+    """Limits given per joint of q (``velocity``, ``acceleration``): ``dof`` finite values > 0, or ParameterError."""
+    joints = [model.names[j] for j in range(1, model.njoints) if model.joints[j].nv > 0]
+    out = tuple(float(v) for v in values)
+    if len(out) != dof:
+        raise ParameterError(name, list(values), f"must hold {dof} values, one per joint ({', '.join(joints)})")
+    for joint, v in zip(joints, out):
+        if not (math.isfinite(v) and v > 0.0):
+            raise ParameterError(f"{name} of joint {joint}", v, "must be finite and > 0")
+    return out
+
+
+def _continuous_joints(model: pin.Model, origin: str, edges: Mapping[str, JointEdge]) -> tuple[bool, ...]:
     """Per joint of q (nv = 1 each; passive mimic joints, nv = 0, skipped): whether it is continuous.
 
     Raises:
-        UrdfError: not 3 or 4 single-DOF joints (:data:`JOINT_COUNTS`; nv = 3 or 4, each nq = 1, or nq = 2
-            for a continuous joint).
+        UrdfRuleError: (``joint-count``) not 3 or 4 single-DOF joints (:data:`JOINT_COUNTS`; nv = 3 or 4, each
+            nq = 1, or nq = 2 for a continuous joint).
     """
     out = []
     ok = model.nv in JOINT_COUNTS
@@ -217,11 +281,17 @@ def _continuous_joints(model: pin.Model, origin: str) -> tuple[bool, ...]:
         ok = ok and (cont or (jm.nq == 1 and jm.nv == 1))
         out.append(cont)
     if not ok or len(out) != model.nv or model.nq != model.nv + sum(out):
-        joints = ", ".join(f"{model.names[i]} (nq {model.joints[i].nq})" for i in range(1, model.njoints))
-        raise UrdfError(
-            f"{origin}: a SCARA has 4 single-DOF joints (or 3 without a wrist); this model has nq = {model.nq}, "
-            f"nv = {model.nv}: {joints}"
-        )
+        free = [j for j in range(1, model.njoints) if model.joints[j].nv > 0]
+
+        def kind(j: int) -> str:
+            edge = edges.get(model.names[j])
+            written = edge.type if edge is not None else model.joints[j].shortname()
+            nv = model.joints[j].nv
+            return written if nv == 1 else f"{written}: {nv} degrees of freedom"
+
+        listing = ", ".join(f"{model.names[j]} ({kind(j)})" for j in free[:12]) + (" ..." if len(free) > 12 else "")
+        raise UrdfRuleError("joint-count", f"{origin}: a SCARA has 4 single-DOF joints (or 3 without a wrist); this "
+                            f"file has {len(free)} movable joint{'s' if len(free) != 1 else ''}: {listing or 'none'}")
     return tuple(out)
 
 
@@ -278,6 +348,7 @@ class RobotModel:
         urdf: str,
         *,
         acceleration: Sequence[float] | None = None,
+        velocity: Sequence[float] | None = None,
         parameters: RobotParameters | None = None,
         base_frame: str | None = None,
         tool_frame: str | None = None,
@@ -293,6 +364,8 @@ class RobotModel:
             urdf: the URDF document.
             acceleration: acceleration limits per joint [rad/s^2 or m/s^2]; URDF has none. Without it
                 (a URDF file) they are NaN, meaning unknown: commands that need them ask for them.
+            velocity: velocity limits per joint [rad/s or m/s], in q order, instead of the URDF's (a continuous
+                joint without ``<limit>`` has none: Pinocchio reads inf; a placeholder 0). A URDF file only.
             parameters: the yaml parameters it was generated from, if any.
             base_frame: the link poses are expressed in; default ``base`` if present, else the root link.
             tool_frame: the tool link; default ``tool0`` if present, else the chain's last link
@@ -311,11 +384,10 @@ class RobotModel:
                 (inverted limits, zero axis: :func:`scara_pin.urdf_rules.joint_problem`), or a frame
                 asked for that is not a link of the file.
         """
-        model, self._pinocchio_urdf = _parse_urdf(urdf, origin, checked=generated)
-        links, joints = read_tree(urdf, origin)  # raises on an unusable joint (the rule `check` applies)
-        frames = choose_frames(links, joints, tool=tool_frame, base=base_frame, origin=origin)
+        parsed = _parse_urdf(urdf, origin, generated, {"tool": tool_frame, "base": base_frame}, lock or {})
+        model, self._pinocchio_urdf, frames = parsed.model, parsed.text, parsed.frames
         base_frame, tool_frame = frames.base, frames.tool
-        edges = {j.name: j for j in joints}
+        edges = {j.name: j for j in parsed.joints}
         # one arm of a multi-arm tree (or with --lock): the other joints fixed, the whole robot still drawn;
         # a model that is the chain alone (every joint moves the tool, none geared: the shipped robots) needs
         # neither (scara_pin.chain is not even imported: `scara-pin fk` starts faster)
@@ -326,15 +398,16 @@ class RobotModel:
         else:
             from .chain import geared_joints, reduce_to_chain
 
-            model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin)
+            model, self.locked = reduce_to_chain(model, tool_frame, lock or {}, edges, origin, parsed.unbuilt)
         try:
-            continuous = _continuous_joints(model, origin)
+            continuous = _continuous_joints(model, origin, edges)
         except UrdfError as exc:
             if not self.locked:
                 raise
             names = ", ".join(lj.name for lj in self.locked[:12]) + (" ..." if len(self.locked) > 12 else "")
-            raise UrdfError(f"{exc}, once {names} locked (not on the chain {frames.root} -> {tool_frame}, or "
-                            "--lock): --tool picks the link that ends an arm") from None  # fmt: skip
+            raise UrdfRuleError("joint-count", f"{exc}, once {names} locked (not on the chain {frames.root} -> "
+                                f"{tool_frame}, or --lock): --tool picks the link that ends an arm"
+                                ) from None  # fmt: skip
         if not alone:
             self.geared = geared_joints(model, edges)
         self.frame_note = frames.note
@@ -361,9 +434,10 @@ class RobotModel:
             self.limits = JointLimits(
                 lower=tuple(-math.pi if c else float(model.lowerPositionLimit[i]) for i, c in zip(iq, continuous)),
                 upper=tuple(math.pi if c else float(model.upperPositionLimit[i]) for i, c in zip(iq, continuous)),
-                velocity=tuple(float(v) for v in model.velocityLimit),
+                velocity=tuple(float(v) for v in model.velocityLimit) if velocity is None
+                else _given("velocity", velocity, model, len(continuous)),
                 acceleration=tuple(math.nan for _ in continuous) if acceleration is None
-                else tuple(float(v) for v in acceleration),
+                else _given("acceleration", acceleration, model, len(continuous)),
                 effort=tuple(float(v) for v in model.effortLimit),
                 validate=False,
             )

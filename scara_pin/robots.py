@@ -99,6 +99,7 @@ def load_robot(
     package_path: Sequence[str | Path] = (),
     lock: Mapping[str, float] | None = None,
     acceleration: Sequence[float] | None = None,
+    velocity: Sequence[float] | None = None,
 ) -> Robot:
     """Load a robot with the kinematics of its kind: a configured one (name or folder) or a URDF / xacro file.
 
@@ -115,6 +116,8 @@ def load_robot(
             ``robot.locked`` lists them all.
         acceleration: joint acceleration limits [rad/s^2, m/s^2], in q order: a URDF file has none; they replace
             a configured robot's (``joint_limits.yaml``; its generated URDF, which holds none, is the same).
+        velocity: joint velocity limits [rad/s, m/s], in q order, instead of the URDF's (a continuous joint
+            without ``<limit>`` has none) or a configured robot's (its URDF is generated with them).
 
     Raises:
         UrdfError: (exit code 2) among others a ``tool`` or ``base`` that is not a link of the robot.
@@ -124,17 +127,26 @@ def load_robot(
         kwargs["lock"] = dict(lock)
     if urdf is not None:
         if overrides:
-            raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file")
-        return Robot.from_file(urdf, package_dirs=package_path, acceleration=acceleration, **kwargs)
+            raise InvalidInputError("parameter overrides apply to configured robots, not to a URDF file (a URDF "
+                                    "robot's limits: --velocity and --acceleration, one value per joint)")
+        return Robot.from_file(urdf, package_dirs=package_path, acceleration=acceleration, velocity=velocity,
+                               **kwargs)  # fmt: skip
     if package_path:
         raise InvalidInputError("--package-path applies to a URDF or xacro file (--urdf), not to a configured robot")
+    if velocity is not None:  # in the generated URDF too
+        overrides = {**(overrides or {}), **_per_joint("velocity", velocity)}
     if acceleration is None:
         return Robot.from_config(robot, overrides, **kwargs)
     params, text = configured(robot, overrides)
-    if len(acceleration) != len(JOINT_NAMES):
-        raise ParameterError("acceleration", list(acceleration), f"must hold {len(JOINT_NAMES)} values, one per joint")
-    params = params.with_overrides({f"{j}_acceleration": a for j, a in zip(JOINT_NAMES, acceleration)})
+    params = params.with_overrides(_per_joint("acceleration", acceleration))
     return Robot(text, parameters=params, origin=f"robot {params.name!r}", generated=True, **kwargs)
+
+
+def _per_joint(name: str, values: Sequence[float]) -> dict[str, float]:
+    """A configured robot's parameters ``joint1_velocity``... from one value per joint."""
+    if len(values) != len(JOINT_NAMES):
+        raise ParameterError(name, list(values), f"must hold {len(JOINT_NAMES)} values, one per joint")
+    return {f"{j}_{name}": v for j, v in zip(JOINT_NAMES, values)}
 
 
 def load_urdf(path: str | Path, **kwargs: Any) -> Robot:

@@ -9,7 +9,10 @@ does:
 - :func:`resolve_mimics`: each ``<mimic>`` joint's free joint, through chains of mimics (a mimic of a
   mimic: multipliers and offsets composed), or why Pinocchio cannot take it;
 - :func:`joint_problem`: a joint the toolkit cannot use (zero axis, non-finite or inverted limits, a range
-  of zero width).
+  of zero width);
+- :func:`locked_joints`: the joints the loader locks (off the chain from the root to the tool, or asked for);
+- :data:`LOADER_RULES`: the toolkit's own refusals of files Pinocchio loads, each with its reason
+  (:class:`UrdfRuleError` names the rule of each refusal).
 """
 
 from __future__ import annotations
@@ -17,21 +20,26 @@ from __future__ import annotations
 import math
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 from .errors import UrdfError
 
 __all__ = [
+    "LOADER_RULES",
     "MOVABLE",
     "TOOL_NAMES",
     "FrameChoice",
     "JointEdge",
     "Mimic",
     "ToolCandidate",
+    "UrdfRuleError",
+    "axis_of",
     "choose_frames",
     "edges_of",
     "joint_problem",
+    "locked_joints",
+    "mimic_error",
     "read_tree",
     "resolve_mimics",
     "zero_within",
@@ -43,6 +51,39 @@ TOOL_NAMES = ("tool0", "flange", "tcp", "ee", "end_effector")
 """Names of a tool link, preferred in this order among links that end equally long chains (a name matches
 when its words, split at ``_``, ``-``, ``.`` and between letters and digits, contain them: ``mg400_flange``,
 ``magician_link_ee``, ``end_effector_shaft``)."""
+
+
+class UrdfRuleError(UrdfError):
+    """A URDF refused by a named rule.
+
+    ``rule``: a rule of the pre-check (urdfdom's, :data:`scara_pin._urdf_checks.PRECHECK_RULES`) or of the
+    toolkit (:data:`LOADER_RULES`).
+    """
+
+    def __init__(self, rule: str, message: str) -> None:
+        self.rule = rule
+        super().__init__(message)
+
+
+LOADER_RULES: dict[str, str] = {
+    "bad-number": "a movable joint whose axis is the zero vector (an <axis> without xyz) moves nothing: no "
+                  "kinematics, no Jacobian of full rank",
+    "limits-inverted": "lower above upper: no value of the joint is inside its limits (IK, trajectories, the "
+                       "workspace need one)",
+    "limits-empty": "lower equal to upper: the joint cannot move (--lock fixes a joint on purpose)",
+    "mimic-unresolved": "the toolkit honours <mimic> as Pinocchio's mimic parser does (mimic=True): a mimic "
+                        "that parser refuses (a loop, a missing or fixed source, a source built after it, "
+                        "a continuous joint following a bounded one) is refused too, unless it is locked with "
+                        "its source",
+    "joint-count": "a SCARA has 4 single-DOF joints on the chain from the root to the tool (3 without a wrist), "
+                   "a palletizer 4",
+    "no-movable-joint": "no movable joint is connected to the root link: nothing to compute",
+    "frame-missing": "a --tool or --base that is not a link of the file, or a base that moves",
+    "lock": "a --lock that names no movable joint, or a value outside the joint's limits",
+}  # fmt: skip
+"""The toolkit's own rules: what it refuses although Pinocchio's parser loads it, and why (the loader raises
+:class:`UrdfRuleError` with the rule's name; tests/test_urdf_differential.py checks every refusal against
+Pinocchio)."""
 
 
 @dataclass(frozen=True)
@@ -62,6 +103,7 @@ class JointEdge:
     mimic: str | None = None
     multiplier: float = 1.0
     offset: float = 0.0
+    unnamed_mimic: bool = False
 
     @property
     def free(self) -> bool:
@@ -74,6 +116,9 @@ class Mimic:
     """A ``<mimic>`` joint resolved down to the free joint it follows: ``value = multiplier * source + offset``.
 
     ``via``: the mimic joints between it and ``source`` (empty when it follows a free joint directly).
+    ``unbuildable``: why Pinocchio's mimic parser cannot build it (its source built after it, or a continuous
+    joint following a bounded one), else None: the loader then locks it with its source when that source is
+    locked (:func:`locked_joints`), and refuses it otherwise (:func:`mimic_error`).
     """
 
     joint: str
@@ -81,6 +126,7 @@ class Mimic:
     multiplier: float
     offset: float
     via: tuple[str, ...] = ()
+    unbuildable: str | None = None
 
 
 @dataclass(frozen=True)
@@ -176,8 +222,15 @@ def choose_frames(
     for what, name in (("tool", tool), ("base", base)):
         if name is not None and name not in links:
             shown = ", ".join(links[:40]) + (f", ... ({len(links) - 40} more)" if len(links) > 40 else "")
-            raise UrdfError(f"{origin}: no link named {name!r} for the {what} frame (--{what}); links: {shown}")
+            raise UrdfRuleError("frame-missing", f"{origin}: no link named {name!r} for the {what} frame (--{what}); "
+                                f"links: {shown}")
     root, order, children = _dfs(links, joints)
+    reached = {root} | {j.child for j in order}
+    for what, name in (("tool", tool if tool is not None else "tool0" if "tool0" in links else None),
+                       ("base", base if base is not None else "base" if "base" in links else None)):  # fmt: skip
+        if name is not None and name not in reached:
+            raise UrdfRuleError("frame-missing", f"{origin}: the {what} frame {name!r} is not connected to the root "
+                                f"link {root} (the joints above it form a cycle): --{what} picks another link")
     if base is None:
         base = "base" if "base" in links else root
     else:  # the base is fixed: no movable joint between it and the root
@@ -186,7 +239,7 @@ def choose_frames(
         while link in parent_of:
             if parent_of[link].type in MOVABLE:
                 fixed = ", ".join([root] + [j.child for j in order if j.child not in _downstream_of_movable(order)])
-                raise UrdfError(f"{origin}: the base frame (--base) {base!r} moves with joint "
+                raise UrdfRuleError("frame-missing", f"{origin}: the base frame (--base) {base!r} moves with joint "
                                 f"{parent_of[link].name}: the base must be fixed to the root link; "
                                 f"fixed links: {fixed}")  # fmt: skip
             link = parent_of[link].parent
@@ -308,42 +361,61 @@ def _float(text: str | None) -> float | None:
 
 
 def edges_of(root: ET.Element) -> tuple[list[str], list[JointEdge]]:
-    """The link names and the joints of a parsed URDF, in file order (nothing checked; NaN for bad numbers)."""
+    """The link names and the joints of a parsed URDF, in file order (nothing checked; NaN for bad numbers).
+
+    A ``<mimic joint="">`` names no joint (unless a joint is named ""): the joint is free, as Pinocchio's default
+    parser reads it (``unnamed_mimic``: the loader says so and hands Pinocchio the joint without it).
+    """
     links = [el.get("name", "") for el in root.findall("link")]
+    named_empty = any(el.get("name") == "" for el in root.findall("joint"))
     joints = []
     for el in root.findall("joint"):
         parent, child, limit, mimic = el.find("parent"), el.find("child"), el.find("limit"), el.find("mimic")
         lo = _float(limit.get("lower")) if limit is not None else None
         hi = _float(limit.get("upper")) if limit is not None else None
+        unnamed = mimic is not None and mimic.get("joint") == "" and not named_empty
+        if unnamed:
+            mimic = None
         joints.append(JointEdge(
             el.get("name", ""), el.get("type", ""), parent.get("link", "") if parent is not None else "",
             child.get("link", "") if child is not None else "", lo, hi,
             None if mimic is None else mimic.get("joint", ""),
             1.0 if mimic is None else float(_float(mimic.get("multiplier", "1"))),  # type: ignore[arg-type]
             0.0 if mimic is None else float(_float(mimic.get("offset", "0"))),  # type: ignore[arg-type]
+            unnamed,
         ))  # fmt: skip
     return links, joints
 
 
-def read_tree(urdf: str, origin: str) -> tuple[list[str], list[JointEdge]]:
-    """Read the links and joints of URDF text (file order), and check every movable joint (:func:`joint_problem`).
+def axis_of(el: ET.Element) -> list[float]:
+    """A joint's axis as urdfdom reads it (NaN where a number is malformed).
+
+    (1, 0, 0) without ``<axis>``, the zero vector for an ``<axis>`` without xyz.
+    """
+    axis_el = el.find("axis")
+    text = "1 0 0" if axis_el is None else axis_el.get("xyz", "0 0 0")
+    try:
+        return [float(v) for v in text.split()]
+    except ValueError:
+        return [math.nan]
+
+
+def read_tree(root: ET.Element, origin: str) -> tuple[list[str], list[JointEdge]]:
+    """The links and joints of a parsed URDF (file order), and check every movable joint (:func:`joint_problem`).
+
+    The joints checked are the free ones the root reaches (Pinocchio's tree: a joint in a cycle is not in it).
 
     Raises:
-        UrdfError: the first unusable joint (one line naming the joint and the rule).
+        UrdfRuleError: the first unusable joint (one line naming the joint and the rule).
     """
-    root = ET.fromstring(urdf)  # the caller has parsed it once already: it is well-formed
     links, joints = edges_of(root)
+    reached = {j.name for j in _dfs(links, joints)[1]}
     for el, j in zip(root.findall("joint"), joints):
-        if not j.free:  # a mimic joint follows another: not in q
+        if not j.free or j.name not in reached:  # a mimic joint follows another: not in q
             continue
-        axis_el = el.find("axis")
-        try:
-            axis = [float(v) for v in (axis_el.get("xyz", "1 0 0") if axis_el is not None else "1 0 0").split()]
-        except ValueError:
-            axis = [math.nan]
-        problem = joint_problem(j.name, j.type, axis, j.lower, j.upper)
+        problem = joint_problem(j.name, j.type, axis_of(el), j.lower, j.upper)
         if problem is not None:
-            raise UrdfError(f"{origin}: {problem[1]} [{problem[0]}]")
+            raise UrdfRuleError(problem[0], f"{origin}: {problem[1]} [{problem[0]}]")
     return links, joints
 
 
@@ -374,41 +446,77 @@ def resolve_mimics(joints: Sequence[JointEdge], origin: str) -> dict[str, Mimic]
     the composition: ``a = m1 b + c1``, ``b = m2 f + c2`` give ``a = (m1 m2) f + (m1 c2 + c1)``. Pinocchio
     takes one level only: the loader hands it the composed ``<mimic>`` (:class:`scara_pin.model.RobotModel`).
 
+    A mimic that Pinocchio's mimic parser cannot build is returned with the reason (``Mimic.unbuildable``): a
+    continuous joint following a bounded one or the reverse (Pinocchio's configurations differ: (cos, sin)
+    against an angle), or a source that Pinocchio builds after its mimic (it builds each link's child joints
+    in name order, and needs the source first). The loader locks such a mimic with its source when the source
+    is locked (a gripper's second jaw, off the arm), and refuses it otherwise (:func:`mimic_error`).
+
     Raises:
-        UrdfError: what cannot be resolved, naming the joints: a loop of mimics; a source that is no joint of
-            the file, or not a movable one; a continuous joint following a bounded one or the reverse
-            (Pinocchio's configurations differ: (cos, sin) against an angle); a source that Pinocchio builds
-            after its mimic (it builds each link's child joints in name order, and needs the source first).
+        UrdfRuleError: (``mimic-unresolved``) what has no free joint at its end, naming the joints: a loop of
+            mimics, a source that is no joint of the file, or not a movable one.
     """
     by_name = {j.name: j for j in joints}
     out: dict[str, Mimic] = {}
-    order: dict[str, int] | None = None
+    order = _pinocchio_order(joints)
     for j in joints:
-        if j.type not in MOVABLE or j.mimic is None:
-            continue
+        if j.type not in MOVABLE or j.mimic is None or j.name not in order:  # (a joint the root does not reach:
+            continue  # Pinocchio never builds it)
         m, c, path, name = j.multiplier, j.offset, [j.name], j.mimic
         while True:
             src = by_name.get(name)
             if src is None or src.type not in MOVABLE:
                 what = "which is no joint of the file" if src is None else f"a {src.type} joint"
-                raise UrdfError(f"{origin}: joint {path[-1]} follows {name!r} (<mimic>), {what}: a <mimic> follows a "
-                                "revolute, continuous or prismatic joint")  # fmt: skip
+                raise UrdfRuleError("mimic-unresolved", f"{origin}: joint {path[-1]} follows {name!r} (<mimic>), "
+                                    f"{what}: a <mimic> follows a revolute, continuous or prismatic joint")  # fmt: skip
             if src.name in path:
                 loop = " -> ".join([*path[path.index(src.name) :], src.name])
-                raise UrdfError(f"{origin}: the <mimic> joints {loop} follow one another in a loop: none of them is "
-                                "free, so none has a value")  # fmt: skip
+                raise UrdfRuleError("mimic-unresolved", f"{origin}: the <mimic> joints {loop} follow one another in "
+                                    "a loop: none of them is free, so none has a value")  # fmt: skip
+            if src.name not in order:
+                raise UrdfRuleError("mimic-unresolved", f"{origin}: joint {path[-1]} follows {src.name} (<mimic>), "
+                                    "which is not connected to the root link (its joints form a cycle): Pinocchio "
+                                    "never builds it")  # fmt: skip
             if src.mimic is None:
                 break
             path.append(src.name)
             m, c, name = m * src.multiplier, m * src.offset + c, src.mimic
+        unbuildable = None
         if (j.type == "continuous") != (src.type == "continuous"):
-            raise UrdfError(f"{origin}: joint {j.name} ({j.type}) follows {src.name} ({src.type}) (<mimic>): "
-                            "Pinocchio takes a mimic of a continuous joint only as a continuous joint, and the "
-                            "reverse")  # fmt: skip
-        order = _pinocchio_order(joints) if order is None else order
-        if order.get(src.name, -1) > order.get(j.name, -1):
-            raise UrdfError(f"{origin}: joint {j.name} follows {src.name} (<mimic>), but Pinocchio builds {src.name} "
-                            "after it (depth-first, each link's child joints in name order) and needs the followed "
-                            f"joint first: rename the branches so that {src.name}'s comes first")  # fmt: skip
-        out[j.name] = Mimic(j.name, src.name, m, c, tuple(path[1:]))
+            unbuildable = (f"joint {j.name} ({j.type}) follows {src.name} ({src.type}) (<mimic>): Pinocchio takes a "
+                           "mimic of a continuous joint only as a continuous joint, and the reverse")  # fmt: skip
+        elif order[src.name] > order[j.name]:
+            unbuildable = (f"joint {j.name} follows {src.name} (<mimic>), but Pinocchio builds {src.name} after "
+                           "it (depth-first, each link's child joints in name order) and needs the followed "
+                           "joint first")  # fmt: skip
+        out[j.name] = Mimic(j.name, src.name, m, c, tuple(path[1:]), unbuildable)
     return out
+
+
+def locked_joints(
+    links: Sequence[str], joints: Sequence[JointEdge], tool: str, lock: Collection[str], mimics: Mapping[str, Mimic]
+) -> set[str]:
+    """The free joints the loader locks (:mod:`scara_pin.chain`).
+
+    Those off the chain from the root to ``tool``, those named in ``lock``, and the source of each mimic named
+    in ``lock`` (a mimic is locked with its source).
+    """
+    _, order, _ = _dfs(links, joints)
+    parent_of = {j.child: j for j in order}
+    chain: set[str] = set()
+    link = tool
+    while link in parent_of and parent_of[link].name not in chain:
+        chain.add(parent_of[link].name)
+        link = parent_of[link].parent
+    out = {j.name for j in order if j.free and j.name not in chain}
+    for name in lock:
+        out.add(mimics[name].source if name in mimics else name)
+    return out
+
+
+def mimic_error(mimic: Mimic, origin: str) -> UrdfRuleError:
+    """The refusal of a mimic Pinocchio cannot build (``unbuildable``) whose source stays free."""
+    fix = (f"rename the branches so that {mimic.source}'s comes first" if "builds" in (mimic.unbuildable or "")
+           else f"give {mimic.joint} the type of {mimic.source}")  # fmt: skip
+    return UrdfRuleError("mimic-unresolved", f"{origin}: {mimic.unbuildable}; {mimic.source} moves freely, so "
+                         f"{mimic.joint} cannot be locked with it (--lock {mimic.source}=VALUE locks both): {fix}")

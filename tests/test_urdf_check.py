@@ -310,8 +310,8 @@ ROBOT = text_of("yk400xe_like.urdf")
         (lambda t: t.replace('<link name="tool0"/>', '<link name="tool0"/><link name="orphan"/>'), "disconnected",
          ["2", "base_link", "orphan"], None),
         (lambda t: t.replace("<parent link=\"base\"/>\n    <child link=\"arm1\"/>",
-                             "<parent link=\"flange\"/>\n    <child link=\"arm1\"/>"), "disconnected",
-         ["arm1", "cycle"], None),
+                             "<parent link=\"flange\"/>\n    <child link=\"arm1\"/>"), "frame-missing",
+         ["tool0", "cycle"], None),  # the links in the cycle: a warning (disconnected); the tool among them: an error
         (lambda t: t.replace("<robot ", "<robo ").replace("</robot>", "</robo>"), "root-not-robot", ["<robo>"],
          "<robo "),
         (lambda t: t.replace("</joint>", "</jiont>", 1), "malformed-xml", ["mismatched"], "</jiont>"),
@@ -333,8 +333,9 @@ ROBOT = text_of("yk400xe_like.urdf")
         (lambda t: t.replace('xyz="0 0.225 0"', 'xyz="0 0.225"'), "bad-number", ["j2"], 'xyz="0 0.225"'),
         (lambda t: t.replace('upper="0" velocity="0.5"', 'upper="zero" velocity="0.5"'), "bad-number",
          ["j3", "'zero'"], 'upper="zero"'),
-        (lambda t: t.replace('<joint name="j4" type="revolute">', '<joint name="j4" type="floating">'), "joint-type",
-         ["j4", "floating"], '<joint name="j4"'),
+        # a floating joint on the chain: the loader refuses it (joint-type only warns: off the chain it is locked)
+        (lambda t: t.replace('<joint name="j4" type="revolute">', '<joint name="j4" type="floating">'),
+         "not-loadable", ["j4 (floating: 6 degrees of freedom)"], None),
         (lambda t: t.replace('<joint name="j4" type="revolute">', '<joint name="j4" type="hinge">'), "joint-type",
          ["j4", "'hinge'"], '<joint name="j4"'),
         (lambda t: t.replace('<joint name="j4" type="revolute">', '<joint name="j4" type="fixed">')

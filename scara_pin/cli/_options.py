@@ -89,8 +89,11 @@ def add_cell_options(p: argparse.ArgumentParser, *, margin: bool = True) -> None
                    "{shape: box, size, xyz}); it collides as the job's part does (docs/job.md)")  # fmt: skip
 
 
-def add_acceleration(p: Any) -> None:
-    """``--acceleration A1 A2 A3 A4`` (one per joint): the joint acceleration limits (a URDF file has none)."""
+def add_motion_limits(p: Any) -> None:
+    """``--velocity V1 V2 V3 V4`` and ``--acceleration A1 A2 A3 A4`` (one per joint): the joint limits a URDF lacks."""
+    p.add_argument("--velocity", nargs="+", metavar="V",
+                   help="joint velocity limits [rad/s, m/s; deg/s, mm/s with --deg/--mm], one per joint; instead "
+                   "of the robot's (a URDF's continuous joint without <limit> has none)")  # fmt: skip
     p.add_argument("--acceleration", nargs="+", metavar="A",
                    help="joint acceleration limits [rad/s^2, m/s^2; deg/s^2, mm/s^2 with --deg/--mm]; needed "
                    "for a robot loaded from a URDF file (URDF has none); replaces the configured ones")  # fmt: skip

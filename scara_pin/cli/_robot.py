@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 from ..errors import InvalidInputError, ParameterError
 from ._numbers import number, parse_locks, parse_sets
 from ._options import UsageError
-from ._units import Q_NAMES, Units
+from ._units import Units
 
 if TYPE_CHECKING:
     from ..robots import Robot
@@ -45,37 +45,64 @@ def robot_from_args(args: argparse.Namespace, units: Units | None = None) -> Rob
     return robot
 
 
-def _load(args: argparse.Namespace, acceleration: Sequence[float] | None = None) -> Robot:
+def _load(args: argparse.Namespace, acceleration: Sequence[float] | None = None,
+          velocity: Sequence[float] | None = None) -> Robot:  # fmt: skip
     """:func:`scara_pin.robots.load_robot` with the robot options of ``args`` (``--lock`` read before ``--set``)."""
     from ..robots import load_robot
 
     locks = parse_locks(getattr(args, "lock", None))
     return load_robot(args.robot, parse_sets(args.set), urdf=args.urdf, tool=args.tool, base=args.base,
-                      package_path=args.package_path or (), lock=locks, acceleration=acceleration)  # fmt: skip
+                      package_path=args.package_path or (), lock=locks, acceleration=acceleration,
+                      velocity=velocity)  # fmt: skip
 
 
-def with_acceleration(args: argparse.Namespace, robot: Robot, units: Units) -> Robot:
-    """The robot with the acceleration limits of ``--acceleration``; refuse a robot without any.
+_LIMIT_OPTIONS = (("velocity", "/s"), ("acceleration", "/s^2"))
+
+
+def _per_joint(option: str, texts: Sequence[str], robot: Robot, units: Units, per: str) -> list[float]:
+    """``--velocity`` / ``--acceleration`` values: one per joint, in the user's units (the units rule), SI out."""
+    names = robot.joint_names
+    shown = ", ".join(f"{n} [{u}{per}]" for n, u in zip(names, units.names(units.q)))
+    if len(texts) != len(units.q):
+        raise ParameterError(f"--{option}", " ".join(texts), f"must be {len(units.q)} values, one per joint: {shown}")
+    units.guard([f"--{option} {n}" for n in names], texts, units.q)
+    values = [number(f"--{option} {n}", t) / sc for n, t, sc in zip(names, texts, units.scale(units.q))]
+    for name, value in zip(names, values):
+        if not (math.isfinite(value) and value > 0):
+            raise ParameterError(f"--{option} of joint {name}", value, "must be > 0")
+    return values
+
+
+def with_motion_limits(args: argparse.Namespace, robot: Robot, units: Units) -> Robot:
+    """The robot with the limits of ``--velocity`` and ``--acceleration``; refuse a robot missing any.
 
     Given, they replace the robot's: the robot of :func:`robot_from_args` is loaded again with them
-    (``load_robot(acceleration=...)``), the one given is left as it is. Not given: ``robot`` itself.
+    (``load_robot(velocity=..., acceleration=...)``), the one given is left as it is.
 
     Raises:
-        InvalidInputError: no acceleration limits known (a URDF file) and none given.
+        InvalidInputError: a joint without a velocity limit (a URDF's continuous joint without ``<limit>``, or a
+            placeholder 0), or no acceleration limits (a URDF file has none), and the option not given: the
+            message names each joint, its unit and the option.
     """
-    texts: Sequence[str] | None = args.acceleration
-    if texts:
-        if len(texts) != len(units.q):
-            raise ParameterError("--acceleration", " ".join(texts), f"must be {len(units.q)} values, one per joint")
-        units.guard([f"--acceleration {n}" for n in Q_NAMES], texts, units.q)
-        acc = [number(f"--acceleration {n}", t) / sc for n, t, sc in zip(Q_NAMES, texts, units.scale(units.q))]
-        for name, value in zip(Q_NAMES, acc):
-            if not value > 0:
-                raise ParameterError(f"--acceleration {name}", value, "must be > 0")
-        return _load(args, acc)
-    if not all(math.isfinite(v) for v in robot.limits.acceleration):
-        raise InvalidInputError(f"robot {robot.name!r} has no acceleration limits (a URDF file has none): give "
-                                "--acceleration with one value per joint [rad/s^2, m/s^2]")  # fmt: skip
+    given = {option: _per_joint(option, getattr(args, option), robot, units, per)
+             for option, per in _LIMIT_OPTIONS if getattr(args, option, None)}  # fmt: skip
+    if given:
+        robot = _load(args, given.get("acceleration"), given.get("velocity"))
+    names, kinds = robot.joint_names, units.q
+    for option, per in _LIMIT_OPTIONS:
+        values = getattr(robot.limits, option)
+        missing = [(n, v) for n, v in zip(names, values) if not (math.isfinite(v) and v > 0)]
+        if not missing:
+            continue
+        form = " ".join(f"{option[0].upper()}{i + 1}" for i in range(len(names)))
+        one = ", ".join(f"{n} [{u}{per}]" for n, u in zip(names, units.names(kinds)))
+        if option == "acceleration":
+            why = f"robot {robot.name!r} has no acceleration limits (a URDF file has none)"
+        else:
+            why = "; ".join(f"joint {n} has no velocity limit (" + ("no <limit> in the URDF: a continuous joint may "
+                            "omit it" if math.isinf(v) else f"{v:g} in the URDF: a placeholder") + ")"
+                            for n, v in missing)  # fmt: skip
+        raise InvalidInputError(f"{why}: give --{option} {form}, one per joint: {one}")
     return robot
 
 

@@ -11,10 +11,10 @@ from ..errors import InvalidInputError, ParameterError
 from ..files import outputs_together
 from ._joints import needs_wrist, read_pose
 from ._numbers import jerk_limits, number, number_type
-from ._options import add_acceleration, add_cell_options, add_robot_options, add_units
+from ._options import add_cell_options, add_motion_limits, add_robot_options, add_units
 from ._outputs import check_command_outputs
 from ._points import add_points_options, use_points
-from ._robot import cell_from_args, payload_from_args, robot_from_args, with_acceleration
+from ._robot import cell_from_args, payload_from_args, robot_from_args, with_motion_limits
 from ._units import Units
 
 
@@ -52,9 +52,9 @@ def cmd_cycle(args: argparse.Namespace) -> int:
     if args.from_pose is not None:
         start = read_pose(args.from_pose, units, "--from")
     direction = None if args.direction is None else [number("--direction", d) for d in args.direction]
-    robot = with_acceleration(args, robot, units)  # a URDF file has none: given, or refused
+    robot = with_motion_limits(args, robot, units)  # a URDF file has none: given, or refused
     limits = robot.limits
-    jerk = jerk_limits(args)
+    jerk = jerk_limits(args, units)
     cell = cell_from_args(args, units)
     common = {"start": start, "direction": direction, "span": span, "rise": rise,
               "payload": payload_from_args(args, units), "jerk": jerk, "limits": limits, "max_height": ceiling,
@@ -180,7 +180,7 @@ def register(sub: Any) -> None:
     g.add_argument("--jerk-limit", nargs="+", metavar="J", help="joint jerk limit, one or 4 (rad/s^3, m/s^3)")
     g.add_argument("--no-torque", action="store_true",
                    help="leave the effort limits out (a URDF's placeholder efforts); said in the output")
-    add_acceleration(g)
+    add_motion_limits(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip

@@ -12,9 +12,9 @@ from ..files import check_outputs, outputs_together
 from ..limits import MAX_SAMPLES, check_count
 from ._joints import needs_wrist
 from ._numbers import number_type
-from ._options import add_acceleration, add_robot_options, add_units
+from ._options import add_motion_limits, add_robot_options, add_units
 from ._outputs import check_command_outputs
-from ._robot import robot_from_args, with_acceleration
+from ._robot import robot_from_args, with_motion_limits
 from ._setpoints import add_setpoint_options, check_setpoint_options, write_setpoints
 from ._units import Units
 
@@ -42,7 +42,7 @@ def cmd_job(args: argparse.Namespace) -> int:
         args.robot = job.robot
     robot = robot_from_args(args, units)
     needs_wrist(robot, "job")
-    robot = with_acceleration(args, robot, units)
+    robot = with_motion_limits(args, robot, units)
     result = _plan(job, robot, not args.no_cache)
     written: dict[str, str] = {}
     with outputs_together():  # all of them, or none
@@ -159,7 +159,7 @@ def register(sub: Any) -> None:
                    "the part while held and the boxes placed)")  # fmt: skip
     add_setpoint_options(g)
     add_units(p, json_help=None)
-    add_acceleration(p)
+    add_motion_limits(p)
     add_robot_options(p, set_help="override a value: a key of the job file, in its grammar and units "
                       "(frames.tray.xyz=[0.3, 0, -0.1], base.yaw=0.1, robot=s1), or a robot parameter, SI (l1=0.25); "
                       "repeatable")  # fmt: skip

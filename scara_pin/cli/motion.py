@@ -13,10 +13,10 @@ from ..files import outputs_together
 from ..units import format_number, format_vector
 from ._joints import joint_arg, needs_wrist, read_pose
 from ._numbers import jerk_limits, number, number_type
-from ._options import add_acceleration, add_cell_options, add_robot_options, add_units
+from ._options import add_cell_options, add_motion_limits, add_robot_options, add_units
 from ._outputs import check_command_outputs, log
 from ._points import add_points_options, use_points
-from ._robot import cell_from_args, payload_from_args, robot_from_args, with_acceleration
+from ._robot import cell_from_args, payload_from_args, robot_from_args, with_motion_limits
 from ._setpoints import add_setpoint_options, check_setpoint_options, write_setpoints
 from ._units import POSE_KINDS, Units
 from .cycle import cell_summary, cell_text
@@ -37,7 +37,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
     for flag in ("linear", "arch", "plot", "payload"):
         if getattr(args, flag, None):
             needs_wrist(robot, f"traj --{flag}")  # 3-joint arms: joint-space trajectories (quintic, TOPP-RA)
-    robot = with_acceleration(args, robot, units)
+    robot = with_motion_limits(args, robot, units)
     if (args.from_q is None) == (args.from_pose is None):
         raise InvalidInputError("give the start as either --from Q1 Q2 Q3 Q4 or --from-pose X Y Z YAW")
     if (args.to_q is None) == (args.to_pose is None):
@@ -66,7 +66,7 @@ def cmd_traj(args: argparse.Namespace) -> int:
                                     "--via as hints of its way through a cell)")
         if args.duration is not None:
             raise InvalidInputError("--arch is time-optimal: --duration does not apply")
-    jerk = jerk_limits(args)
+    jerk = jerk_limits(args, units)
     if jerk is not None and robot.dof != 4:
         raise InvalidInputError("--jerk-limit needs a 4-joint robot for now")
     request = MotionRequest(
@@ -255,7 +255,7 @@ def cmd_jog(args: argparse.Namespace) -> int:
     if robot.kind != "scara":
         raise InvalidInputError(f"jog is SCARA-only for now; robot {robot.name!r} is a {robot.kind}")
     needs_wrist(robot, "jog")
-    robot = with_acceleration(args, robot, units)
+    robot = with_motion_limits(args, robot, units)
     q0 = joint_arg(robot, args.from_q, units, "--from")
     direction = [number(f"direction {i + 1}", t) for i, t in enumerate(args.direction)]
     if len(direction) not in (2, 3):
@@ -331,7 +331,7 @@ def register(sub: Any) -> None:
                    help="jump: within R of an end (horizontally) the tool may be lower (default 0.005 m)")
     g.add_argument("--max-height", metavar="Z", help="a ceiling for the tool's z (base frame)")
     g.add_argument("--blend", metavar="B", help="lines: blend distance at each corner (default: as large as allowed)")
-    add_acceleration(g)
+    add_motion_limits(g)
     g = p.add_argument_group("outputs (files in SI units)")
     g.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out and --json (default 1000)")  # fmt: skip
@@ -351,7 +351,7 @@ def register(sub: Any) -> None:
                    "with --cell, also the cell's margin (instead of its file's)")
     p.add_argument("--rate", type=number_type("--rate"), default=1000.0, metavar="HZ",
                    help="sampling rate of --out (default 1000)")  # fmt: skip
-    add_acceleration(p)
+    add_motion_limits(p)
     p.add_argument("--out", metavar="FILE", help="samples as CSV (or JSON for *.json), atomically")
     p.add_argument("--plot", metavar="PNG", help="q, qd, qdd against time and the tool path")
     add_units(p, inputs=True)

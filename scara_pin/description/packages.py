@@ -192,6 +192,14 @@ class PackagePath:
     dirs: tuple[Path, ...] = ()
     origin_dir: Path | None = None
     _walks: dict[Path, _Walk] = field(default_factory=dict, init=False, repr=False, compare=False, hash=False)
+    _said: set[str] = field(default_factory=set, init=False, repr=False, compare=False, hash=False)
+
+    def first_time(self, note: str) -> bool:
+        """Whether ``note`` is said for the first time about this robot's files (a warning said once, not per use)."""
+        if note in self._said:
+            return False
+        self._said.add(note)
+        return True
 
     def __post_init__(self) -> None:
         for d in self.dirs:

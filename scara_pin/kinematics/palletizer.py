@@ -177,6 +177,11 @@ class PalletizerGeometry:
         """The file's ``q`` in canonical coordinates ``t`` (module docstring)."""
         return [s * float(v) + c for s, v, c in zip(self.signs, q, self.offsets)]
 
+    def yaw_of(self, q: Sequence[float] | np.ndarray) -> float:
+        """The tool's yaw at the file's ``q``, unwrapped: q1 + q4 + tool_yaw in canonical coordinates [rad]."""
+        t = self.canonical(q)
+        return t[0] + t[3] + self.tool_yaw
+
     def user(self, t: Sequence[float] | np.ndarray) -> list[float]:
         """Canonical ``t`` as the file's ``q`` (the inverse of :meth:`canonical`)."""
         return [s * (float(v) - c) for s, v, c in zip(self.signs, t, self.offsets)]
@@ -215,12 +220,13 @@ def wrist_pitch(q: Sequence[float]) -> float:
 # ------------------------------------------------------------------------------------ kinematics
 def forward(geo: PalletizerGeometry, q: ArrayLike) -> np.ndarray:
     """S2's closed-form FK: (x, y, z, yaw) of tool0 in ``base`` at ``q`` (motor side) [m, rad]."""
-    q1, q2, t3, q4 = geo.canonical(as_vector("q", q))
+    q = as_vector("q", q)
+    q1, q2, t3, _ = geo.canonical(q)
     if geo.relative:
         t3 += q2
     r = geo.r0 + geo.a2 * math.sin(q2) + geo.a3 * math.sin(t3)
     z = geo.h0 + geo.a2 * math.cos(q2) + geo.a3 * math.cos(t3)
-    return np.array([r * math.cos(q1), r * math.sin(q1), z, q1 + q4 + geo.tool_yaw])
+    return np.array([r * math.cos(q1), r * math.sin(q1), z, geo.yaw_of(q)])
 
 
 def branch_of(q: ArrayLike, geo: PalletizerGeometry | None = None) -> str:

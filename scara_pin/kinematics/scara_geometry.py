@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, overload
 
@@ -297,6 +298,10 @@ class ScaraGeometry:
     def elbow_angle(self, q_elbow: float | np.ndarray) -> float | np.ndarray:
         """Gamma (angle from arm 1 to arm 2, counterclockwise from above) at an elbow joint value (or array)."""
         return self.signs[self.revolute[1]] * q_elbow + self.beta2 - self.beta1
+
+    def yaw_of(self, q: Sequence[float] | np.ndarray) -> float:
+        """The tool's yaw at ``q``, unwrapped: yaw0 + phi1 + phi2 + phi4 (equal to FK's modulo 2 pi) [rad]."""
+        return self.yaw0 + sum(self.signs[i] * float(q[i]) for i in self.revolute)
 
     def radius_range(self) -> tuple[float, float]:
         """(r_min, r_max) of the wrist axis from the shoulder axis allowed by the elbow's limits [m]."""

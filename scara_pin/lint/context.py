@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-from xml.etree.ElementTree import Element, TreeBuilder
+from xml.etree.ElementTree import Element
 
 import numpy as np
 
@@ -53,20 +53,10 @@ class _Quiet(logging.Filter):
 
 
 def parse(text: str) -> tuple[Element, dict[Element, int]]:
-    """An ElementTree of the text, with each element's line (expat's position of its start tag)."""
-    from xml.parsers import expat
+    """An ElementTree of the text as urdfdom reads it, with each element's line (the loader's reader)."""
+    from .._urdf_checks import parse_urdf_xml
 
-    builder = TreeBuilder()
-    lines: dict[Element, int] = {}
-    parser = expat.ParserCreate()
-
-    def start(tag: str, attrs: dict[str, str]) -> None:
-        lines[builder.start(tag, attrs)] = parser.CurrentLineNumber
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = builder.end
-    parser.Parse(text, True)
-    return builder.close(), lines
+    return parse_urdf_xml(text)
 
 
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
@@ -109,6 +99,7 @@ class LintJoint:
     limit: dict[str, str] | None = None
     limit_line: int | None = None
     mimic: tuple[str, float, float] | None = None
+    unnamed_mimic: bool = False
     world: np.ndarray = field(default_factory=lambda: np.eye(4))
 
     @property
@@ -162,8 +153,10 @@ class Tree:
 
     def supports(self, link: str) -> list[LintJoint]:
         """The joints between the root and ``link``, root first."""
-        out = []
-        while link in self.parent_of:
+        out: list[LintJoint] = []
+        seen: set[str] = set()
+        while link in self.parent_of and link not in seen:  # (a cycle ends the walk)
+            seen.add(link)
             out.append(self.parent_of[link])
             link = self.parent_of[link].parent
         return out[::-1]
@@ -257,6 +250,7 @@ class Context:
         """The document's links and joints as written (read once the ``too-large`` rule has sized it)."""
         root, lines = self.parsed
         links = [(el.get("name") or "", el) for el in root.findall("link")]
+        named_empty = any(el.get("name") == "" for el in root.findall("joint"))
         joints = []
         for el in root.findall("joint"):
             parent_el, child_el = el.find("parent"), el.find("child")
@@ -268,11 +262,13 @@ class Context:
             j.xyz = _triple(origin, "xyz", j.xyz)
             j.rpy = _triple(origin, "rpy", j.rpy)
             j.origin_line = lines.get(origin) if origin is not None else line
-            j.axis = _triple(axis, "xyz", j.axis)
+            j.axis = _triple(axis, "xyz", (0.0, 0.0, 0.0)) if axis is not None else j.axis  # urdfdom: <axis/> is 0
             j.axis_line = lines.get(axis) if axis is not None else line
             if limit is not None:
                 j.limit, j.limit_line = dict(limit.attrib), lines.get(limit)
-            if mimic is not None and j.movable:
+            if mimic is not None and mimic.get("joint") == "" and not named_empty:  # names no joint: ignored
+                j.unnamed_mimic = True
+            elif mimic is not None and j.movable:
                 m, c = (number_text(mimic.get(a, d)) for a, d in (("multiplier", "1"), ("offset", "0")))
                 j.mimic = (mimic.get("joint", ""), m, c)
             joints.append(j)
@@ -288,7 +284,7 @@ class Context:
         joints: dict[str, LintJoint] = {}
         for j in doc.joints:
             joints.setdefault(j.name, j)
-        parent_of = {j.child: j for j in joints.values()}
+        parent_of = {j.child: j for j in sorted(joints.values(), key=lambda j: j.name.encode())}  # urdfdom's choice
         children: dict[str, list[LintJoint]] = {}
         for j in joints.values():
             children.setdefault(j.parent, []).append(j)
@@ -299,7 +295,7 @@ class Context:
         stack = list(reversed(children.get(root, [])))
         while stack:
             j = stack.pop()
-            if j.child in link_world:  # reached twice: only through a cycle (the disconnected rule)
+            if j.child in link_world or parent_of[j.child] is not j:  # a cycle, or a second parent: not urdfdom's
                 continue
             M = np.eye(4)
             M[:3, :3] = rpy_matrix(*j.rpy)
@@ -324,13 +320,27 @@ class Context:
 
     @cached_property
     def mimics(self) -> tuple[dict[str, Mimic], Exception | None]:
-        """(each mimic joint resolved to its free joint, None), or ({}, why they cannot be: the loader's error)."""
+        """(each mimic joint resolved to its free joint, None), or ({}, why they cannot be: the loader's error).
+
+        A mimic Pinocchio cannot build (``Mimic.unbuildable``) is the loader's error unless its source is locked
+        (then it is locked with it; read once the frames are chosen).
+        """
         from ..errors import UrdfError
+        from ..urdf_rules import locked_joints, mimic_error
 
         try:
-            return resolve_mimics(self.edges, self.source), None
+            resolved = resolve_mimics(self.edges, self.source)
         except UrdfError as exc:
             return {}, exc
+        unbuilt = [m for m in resolved.values() if m.unbuildable is not None]
+        chosen = getattr(self, "chosen", None)
+        if unbuilt and chosen is not None:
+            links = list(self.tree.links)
+            locked = locked_joints(links, self.edges, chosen.tool, self.lock, resolved)
+            for m in unbuilt:
+                if m.source not in locked:
+                    return {}, mimic_error(m, self.source)
+        return resolved, None
 
     @cached_property
     def chain(self) -> Chain:
@@ -371,7 +381,8 @@ class Context:
         ranges = []
         for j in self.chain.joints:
             lo, hi = (j.numbers("lower") or (0.0,))[0], (j.numbers("upper") or (0.0,))[0]
-            ranges.append((-math.pi, math.pi) if j.type == "continuous" or not math.isfinite(lo + hi) else (lo, hi))
+            ranges.append((-math.pi, math.pi) if j.type == "continuous" or not math.isfinite(lo + hi)
+                          else (min(lo, hi), max(lo, hi)))  # inverted limits: their own error, sampled all the same
         if not ranges:
             return np.zeros((1, 0))
         grid = np.array(list(itertools.product(*[(lo, (lo + hi) / 2.0, hi) for lo, hi in ranges])))

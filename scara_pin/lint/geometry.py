@@ -12,7 +12,7 @@ from .._checks import number_text
 from .context import Context
 from .report import Severity
 
-__all__ = ["bad_inertial", "colour_ignored", "mesh_missing"]
+__all__ = ["bad_inertial", "colour_ignored", "mesh_missing", "mesh_path"]
 
 _INERTIAL = (("mass", ("value",)), ("inertia", ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")))
 
@@ -36,6 +36,23 @@ def bad_inertial(ctx: Context) -> None:
                     ctx.error("bad-inertial", f"link {name or '?'}'s {what} {attr}={raw!r} {rule}", doc.line(el))
 
 
+def _visual_meshes(ctx: Context) -> tuple[dict[str, list[str]], dict[str, int | None]]:
+    """Each visual mesh file name: the links naming it, and the line of its first ``<mesh>``."""
+    doc = ctx.document
+    links: dict[str, list[str]] = {}
+    first: dict[str, int | None] = {}
+    for name, el in doc.links:
+        for mesh in el.findall("visual/geometry/mesh"):
+            filename = mesh.get("filename", "")
+            links.setdefault(filename, []).append(name or "?")
+            first.setdefault(filename, doc.line(mesh))
+    return links, first
+
+
+def _shown(names: list[str]) -> str:
+    return ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+
+
 def mesh_missing(ctx: Context) -> None:
     """A visual's mesh the viewer cannot find or may not read (it draws a box instead).
 
@@ -47,20 +64,28 @@ def mesh_missing(ctx: Context) -> None:
     packages = ctx.load_kwargs.get("package_path")
     if packages is None:  # URDF text without a file: nowhere to look relative names up
         return
-    doc = ctx.document
-    links: dict[str, list[str]] = {}
-    first: dict[str, int | None] = {}
-    for name, el in doc.links:
-        for mesh in el.findall("visual/geometry/mesh"):
-            filename = mesh.get("filename", "")
-            links.setdefault(filename, []).append(name or "?")
-            first.setdefault(filename, doc.line(mesh))
+    links, first = _visual_meshes(ctx)
     for filename, names in links.items():
         try:
-            mesh_file(filename, packages)
+            mesh_file(filename, packages, warn=False)
         except MeshProblem as exc:
-            shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
-            ctx.add(Severity.WARNING, "mesh-missing", f"{exc}: the viewer draws link {shown} as a placeholder box",
+            ctx.add(Severity.WARNING, "mesh-missing", f"{exc}: the viewer draws link {_shown(names)} as a placeholder "
+                    "box", first[filename])  # fmt: skip
+
+
+def mesh_path(ctx: Context) -> None:
+    """A mesh named PyBullet's way (``/Mesh/Visual/Base.stl``, absolute but missing): read from the file's folder."""
+    from ..description.mesh_paths import pybullet_path
+
+    packages = ctx.load_kwargs.get("package_path")
+    if packages is None:
+        return
+    links, first = _visual_meshes(ctx)
+    for filename, names in links.items():
+        beside = pybullet_path(filename, packages)
+        if beside is not None:
+            ctx.add(Severity.WARNING, "mesh-path", f"mesh {filename!r} does not exist as written: the viewer reads "
+                    f"{beside} for link {_shown(names)}, relative to the file's folder (PyBullet's rule)",
                     first[filename])  # fmt: skip
 
 

@@ -39,6 +39,8 @@ def bad_number(ctx: Context) -> None:
         for what, attr, values, default, line in (("origin", "xyz", j.xyz, 3, j.origin_line),
                                                   ("origin", "rpy", j.rpy, 3, j.origin_line),
                                                   ("axis", "xyz", j.axis, 3, j.axis_line)):  # fmt: skip
+            if what == "axis" and j.type in ("fixed", "floating"):  # urdfdom never reads their axis
+                continue
             if len(values) != default or not all(math.isfinite(v) for v in values):
                 el = j.el.find(what)
                 raw = "" if el is None else el.get(attr, "")
@@ -84,8 +86,15 @@ def limit_missing(ctx: Context) -> None:
                           j.limit_line, j.name)  # fmt: skip
         missing = [a for a in ("lower", "upper") if a not in lim]
         if j.type != "continuous" and missing:
-            ctx.error("limit-missing", f"joint {j.name}'s <limit> has no {' and '.join(missing)}: read as 0, the "
-                      "joint cannot move", j.limit_line, j.name)  # fmt: skip
+            lo, hi = ((j.numbers(a) or (0.0,))[0] for a in ("lower", "upper"))  # urdfdom reads an absent one as 0
+            if lo < hi:  # the loader's rule (joint_problem) takes the range
+                ctx.add(Severity.WARNING, "limit-missing", f"joint {j.name}'s <limit> has no {' and '.join(missing)}"
+                        f": read as 0 (urdfdom's default), the range is [{lo:g}, {hi:g}]", j.limit_line,
+                        j.name)  # fmt: skip
+            else:
+                ctx.error("limit-missing", f"joint {j.name}'s <limit> has no {' and '.join(missing)}: read as 0, "
+                          f"the range [{lo:g}, {hi:g}] is empty: the joint cannot move", j.limit_line,
+                          j.name)  # fmt: skip
 
 
 def _range(j: LintJoint) -> tuple[float, float] | None:
@@ -169,7 +178,10 @@ def velocity_placeholder(ctx: Context) -> None:
 
 
 def velocity_implausible(ctx: Context) -> None:
-    """A velocity limit outside 0.05..50 rad/s (revolute) or 0.05..10 m/s (prismatic); a deg/s reading offered."""
+    """A velocity limit outside 0.05..50 rad/s (revolute) or 0.05..10 m/s (prismatic); a deg/s reading offered.
+
+    A prismatic joint slower than the range is information, not a warning: a lead-screw lift at 0.03 m/s is real.
+    """
     for j, v in _velocities(ctx):
         low, high = PRISMATIC_VELOCITY if j.type == "prismatic" else REVOLUTE_VELOCITY
         if v == 0 or v in PLACEHOLDER_VELOCITIES or low <= v <= high:
@@ -178,6 +190,11 @@ def velocity_implausible(ctx: Context) -> None:
         as_deg = v * 180.0 / math.pi
         if abs(as_deg - round(as_deg)) < 1e-6 * max(1.0, as_deg) and round(as_deg) != 0:
             note = f"; it is {round(as_deg):g} deg/s converted to rad: a unit error?"
+        if j.type == "prismatic" and 0 < v < low and not note:
+            ctx.add(Severity.INFO, "velocity-implausible",
+                    f"joint {j.name}'s velocity limit {v:g} m/s is below {low:g} m/s: a slow axis (a lead-screw "
+                    "lift?); every motion is timed to it", j.limit_line, j.name)  # fmt: skip
+            continue
         ctx.add(Severity.WARNING, "velocity-implausible",
                 f"joint {j.name}'s velocity limit {v:g} {_unit(j)} is outside {low:g}..{high:g} {_unit(j)}{note}",
                 j.limit_line, j.name)  # fmt: skip

@@ -14,8 +14,8 @@ import numpy as np
 from .context import Context
 from .report import Severity
 
-__all__ = ["EFFORT_SAMPLES", "closed_form_refused", "effort_limit", "near_parallel", "not_a_scara", "not_loadable",
-           "palletizer"]
+__all__ = ["EFFORT_SAMPLES", "closed_form_refused", "effort_limit", "motion_limits", "near_parallel", "not_a_scara",
+           "not_loadable", "palletizer"]
 
 EFFORT_SAMPLES = 64
 """Configurations (seeded, uniform in the joint ranges; q = 0 too) at which the static loads are compared with the
@@ -109,3 +109,28 @@ def effort_limit(ctx: Context) -> None:
                 f"{np.round(qs[i], 6).tolist()}) against its effort limit {effort[j]:g} {units[j]}: placeholder "
                 "efforts or masses? torque-limited timing (cycle, traj --torque) refuses to move it, the robot "
                 "cannot even hold still there; cycle --no-torque leaves the efforts out")  # fmt: skip
+
+
+def motion_limits(ctx: Context) -> None:
+    """What cycle, traj, jog and job will ask for that the file does not give.
+
+    Acceleration limits (URDF has none); the velocity limit of a joint without one (a continuous joint without
+    ``<limit>``, a placeholder 0).
+    """
+    robot = ctx.robot
+    if robot is None or robot.parameters is not None:
+        return
+    names = robot.joint_names
+    units = ["m" if k == "length" else "rad" for k in robot.joint_kinds]
+    needs = []
+    velocity = [(n, v) for n, v in zip(names, robot.limits.velocity) if not (math.isfinite(v) and v > 0.0)]
+    if velocity:
+        why = ", ".join(f"{n} ({'no <limit>' if math.isinf(v) else f'{v:g} in the file'})" for n, v in velocity)
+        needs.append(f"--velocity {' '.join(f'V{i + 1}' for i in range(len(names)))} [" + ", ".join(
+            f"{n} {u}/s" for n, u in zip(names, units)) + f"]: no velocity limit for {why}")  # fmt: skip
+    if not all(math.isfinite(a) for a in robot.limits.acceleration):
+        needs.append(f"--acceleration {' '.join(f'A{i + 1}' for i in range(len(names)))} [" + ", ".join(
+            f"{n} {u}/s^2" for n, u in zip(names, units)) + "]: a URDF has no acceleration limits")  # fmt: skip
+    if needs:
+        ctx.add(Severity.INFO, "motion-limits", "cycle, traj, jog and job need what the file does not give: "
+                + "; ".join(needs))

@@ -16,7 +16,8 @@ from .report import Finding, Severity
 
 __all__ = [
     "disconnected", "duplicate_name", "geared", "joint_count", "joint_type", "joints", "locked",
-    "malformed_xml", "mimic_unresolved", "missing_link", "missing_name", "no_wrist", "not_serial", "root_not_robot",
+    "malformed_xml", "mimic_ignored", "mimic_unresolved", "missing_link", "missing_name", "no_wrist", "not_serial",
+    "root_not_robot",
     "too_large", "two_parents", "unreadable", "xacro_failed", "xacro_ignored", "xacro_not_expanded",
 ]  # fmt: skip
 
@@ -103,14 +104,20 @@ def xacro_ignored(ctx: Context) -> None:
 
 
 def missing_name(ctx: Context) -> None:
-    """A ``<link>`` or ``<joint>`` without a name."""
+    """A ``<joint>`` without a name attribute, a ``<link>`` without a name (or named "") beside other links.
+
+    ``name=""`` is a name for urdfdom (and Pinocchio): a joint may have it; a link named "" cannot be any joint's
+    parent or child, so beside other links it makes a second root (the loader's rule, ``link-name``).
+    """
     doc = ctx.document
     for name, el in doc.links:
-        if not name:
-            ctx.error("missing-name", "a <link> has no name", doc.line(el))
+        if not name and len(doc.links) > 1:
+            what = "no name" if el.get("name") is None else 'name=""'
+            ctx.error("missing-name", f"a <link> has {what}: no joint can name it as its parent or child (a second "
+                      "root link)", doc.line(el))  # fmt: skip
     for j in doc.joints:
-        if not j.name:
-            ctx.error("missing-name", "a <joint> has no name", j.line)
+        if j.el.get("name") is None:
+            ctx.error("missing-name", 'a <joint> has no name attribute (name="" would do)', j.line)
 
 
 def duplicate_name(ctx: Context) -> None:
@@ -131,7 +138,7 @@ def duplicate_name(ctx: Context) -> None:
 
 
 def joint_type(ctx: Context) -> None:
-    """A joint type URDF does not have, or one a SCARA does not (floating, planar)."""
+    """A joint type URDF does not have (an error), or one a SCARA does not (floating, planar: a warning)."""
     for j in ctx.document.joints:
         if not j.name:
             continue
@@ -139,8 +146,9 @@ def joint_type(ctx: Context) -> None:
             ctx.error("joint-type", f"joint {j.name} has type {(j.type or None)!r}: not a URDF joint type", j.line,
                       j.name)  # fmt: skip
         elif j.type in ("floating", "planar"):
-            ctx.error("joint-type", f"joint {j.name} is {j.type}: a SCARA has revolute and prismatic joints",
-                      j.line, j.name)  # fmt: skip
+            ctx.add(Severity.WARNING, "joint-type", f"joint {j.name} is {j.type}: a SCARA has revolute and prismatic "
+                    "joints (off the arm's chain it is locked; on it, the file does not load)", j.line,
+                    j.name)  # fmt: skip
 
 
 def missing_link(ctx: Context) -> None:
@@ -157,27 +165,43 @@ def missing_link(ctx: Context) -> None:
 
 
 def two_parents(ctx: Context) -> None:
-    """A link that is the child of two joints."""
-    parent_of: dict[str, str] = {}
-    for j in ctx.tree.joints.values():
-        if j.child in parent_of:
-            ctx.error("two-parents", f"link {j.child} is the child of joints {parent_of[j.child]} and {j.name}",
-                      j.line, j.name)  # fmt: skip
-        parent_of.setdefault(j.child, j.name)
+    """A link that is the child of two joints: an error with movable joints below it, else a warning.
+
+    The loader's rule (:func:`scara_pin._urdf_checks.second_parents`).
+    """
+    from .._urdf_checks import second_parents
+
+    order = {j.name: k for k, j in enumerate(ctx.document.joints)}
+    for link, kept, other, harmful in second_parents(ctx.document.root):
+        j = ctx.tree.joints.get(max(kept, other, key=lambda n: order.get(n, -1)))  # the second written
+        line, name = (j.line, j.name) if j is not None else (None, None)
+        if harmful:
+            ctx.error("two-parents", f"link {link} is the child of joints {other} and {kept}: urdfdom keeps {kept}, "
+                      "and Pinocchio would build the link's branch twice, its movable joints named twice", line,
+                      name)  # fmt: skip
+        else:
+            ctx.add(Severity.WARNING, "two-parents", f"link {link} is the child of joints {other} and {kept}: {other} "
+                    "is ignored, as urdfdom does (it keeps the last by name)", line, name)  # fmt: skip
 
 
 def disconnected(ctx: Context) -> None:
-    """Not one tree: several root links, or links the root does not reach (a cycle)."""
+    """Not one tree: no link, several root links, every link a joint's child; links the root does not reach."""
     tree = ctx.tree
+    if not tree.links:
+        ctx.error("disconnected", "the document has no <link>: a URDF has at least one (a xacro file of macros only "
+                  "defines them: call one, or check the file that does)")  # fmt: skip
+        return
     roots = [name for name in tree.links if name not in tree.parent_of]
     if len(roots) != 1:
-        shown = ", ".join(f"{r} ({ctx.at(tree.links[r])})" for r in roots) or "none (a cycle)"
+        shown = ", ".join(f"{r} ({ctx.at(tree.links[r])})" for r in roots) or \
+            f"every one of its {len(tree.links)} links is a joint's child (a cycle)"  # fmt: skip
         ctx.error("disconnected", f"the tree must have one root link; this file has {len(roots)}: {shown}")
         return
     unreached = [n for n in tree.links if n not in tree.link_world]
-    if unreached:
-        ctx.error("disconnected", f"links not connected to the root {tree.root}: {', '.join(unreached)} (a cycle)",
-                  tree.links[unreached[0]])  # fmt: skip
+    if unreached:  # urdfdom and Pinocchio leave them out: the robot is the tree the root reaches
+        ctx.add(Severity.WARNING, "disconnected", f"links not connected to the root {tree.root}: "
+                f"{', '.join(unreached[:12])} (joints in a cycle): Pinocchio leaves them out",
+                tree.links[unreached[0]])  # fmt: skip
 
 
 def locked(ctx: Context) -> None:
@@ -200,9 +224,11 @@ def geared(ctx: Context) -> None:
             through = "" if r is None or not r.via else (
                 f"; {src} follows {' -> '.join(r.via[1:] + (r.source,))} in turn: {j.name} = {r.multiplier:.9g} * "
                 f"{r.source} + {r.offset:.9g} {unit}, as the toolkit hands it to Pinocchio")  # fmt: skip
+            locked = "" if r is None or r.unbuildable is None else (
+                f"; {r.unbuildable}: the loader locks it with {r.source} (off the arm, or --lock)")  # fmt: skip
             ctx.add(Severity.INFO, "geared", f"joint {j.name} follows {src} (<mimic>): {j.name} = {m:.9g} * {src} "
-                    f"+ {c:.9g} {unit}{through}; not a degree of freedom (not in q), reported beside it", j.line,
-                    j.name)  # fmt: skip
+                    f"+ {c:.9g} {unit}{through}; not a degree of freedom (not in q), reported beside it{locked}",
+                    j.line, j.name)  # fmt: skip
 
 
 def mimic_unresolved(ctx: Context) -> None:
@@ -215,6 +241,14 @@ def mimic_unresolved(ctx: Context) -> None:
         joint = ctx.tree.joints[min(at)[1]] if at else None  # the first joint the message names
         ctx.error("mimic-unresolved", text, joint.line if joint else None,
                   joint.name if joint else None)  # fmt: skip
+
+
+def mimic_ignored(ctx: Context) -> None:
+    """A ``<mimic joint="">``: it names no joint; ignored (the joint is free), as Pinocchio's parser reads it."""
+    for j in ctx.document.joints:
+        if j.unnamed_mimic:
+            ctx.add(Severity.WARNING, "mimic-ignored", f'joint {j.name}\'s <mimic joint=""> names no joint: ignored, '
+                    "as Pinocchio's parser reads it; the joint is free", j.line, j.name)  # fmt: skip
 
 
 def _listing(ctx: Context) -> str:

@@ -765,8 +765,12 @@ def _lines_bound(
 
 
 def limits_dict(robot: RobotModel, limits: JointLimits | None, jerk: tuple[float, ...] | None) -> dict[str, Any]:
-    """The limits used, JSON-ready (per joint, SI)."""
+    """The limits used, JSON-ready (per joint, SI; null where there is none: a URDF joint without ``<limit>``)."""
     lim = robot.limits if limits is None else limits
-    return {"velocity": list(lim.velocity), "acceleration": list(lim.acceleration), "effort": list(lim.effort),
+
+    def values(v: tuple[float, ...]) -> list[float | None]:
+        return [x if math.isfinite(x) else None for x in v]
+
+    return {"velocity": values(lim.velocity), "acceleration": values(lim.acceleration), "effort": values(lim.effort),
             "jerk": None if jerk is None else list(jerk)}  # fmt: skip
 

@@ -533,15 +533,15 @@ class CartesianPath(SegmentedPath):
 def joint_pose(robot: RobotModel, q: ArrayLike) -> np.ndarray:
     """The tool pose (x, y, z, yaw) at q with the yaw UNWRAPPED as the joints turn.
 
-    The yaw is yaw0 plus the signed revolute angles, equal to FK's yaw modulo 2 pi. A line between two
-    such poses turns the tool the way the joints go (through +/-pi if they do), so
+    The yaw is the kind's unwrapped yaw (``geometry.yaw_of``: a SCARA's yaw0 plus its signed revolute angles, a
+    palletizer's waist plus flange), equal to FK's yaw modulo 2 pi. A line between two such poses turns the tool
+    the way the joints go (through +/-pi if they do), so
     ``cartesian_path(robot, [joint_pose(robot, qa), joint_pose(robot, qb)], start=qa, end=qb)`` ends at qb
     whenever the line stays feasible.
     """
     q = robot.check_q(q)
-    geo = robot.kinematics.geometry
     pose = robot.tool_pose(q)
-    turned = geo.yaw0 + sum(geo.signs[i] * float(q[i]) for i in geo.revolute)
+    turned = robot.kinematics.geometry.yaw_of(q)
     pose[3] += 2.0 * math.pi * round((turned - pose[3]) / (2.0 * math.pi))
     return pose
 

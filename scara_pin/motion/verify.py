@@ -361,9 +361,11 @@ def limits_in_force(robot: RobotModel, limits: JointLimits | None, tool_speed: f
     """The limits in force, each refused when NaN, zero, negative or infinite."""
     lim = robot.limits if limits is None else limits
     names = robot.joint_names
-    v = as_limit_vector("velocity", lim.velocity, "rad/s or m/s", names)
-    a = as_limit_vector("acceleration", lim.acceleration, "rad/s^2 or m/s^2", names)
-    e = as_limit_vector("effort", lim.effort, "N m or N", names) if torque else None
+    per = ["m" if kind == "length" else "rad" for kind in robot.joint_kinds]  # each joint's unit
+    v = as_limit_vector("velocity", lim.velocity, [f"{u}/s" for u in per], names)
+    a = as_limit_vector("acceleration", lim.acceleration, [f"{u}/s^2" for u in per], names)
+    e = as_limit_vector("effort", lim.effort, ["N" if u == "m" else "N m" for u in per], names,
+                        unbounded=True) if torque else None  # inf: no <limit>  # fmt: skip
     vt = None if tool_speed is None else as_positive("tool_speed", tool_speed, "m/s")
     return LimitsInForce(v, a, e, vt)
 
