@@ -48,12 +48,18 @@ def one(seed: int) -> dict[str, object]:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=200)
+    ap.add_argument("--first", type=int, default=1, help="the first seed (a run in parts)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--markdown", action="store_true", help="print the docs/benchmarks.md table")
     args = ap.parse_args()
-    seeds = list(range(1, args.seeds + 1))
+    seeds = list(range(args.first, args.first + args.seeds))
+    rows = []
     with ProcessPoolExecutor(args.workers) as pool:
-        rows = list(pool.map(one, seeds))
+        for r in pool.map(one, seeds):  # in order, each printed as it is done (a long run can be read as it goes)
+            rows.append(r)
+            print(f"seed {r['seed']}: {r['status']} {r['kind']} {r['obstacles']} obstacles"
+                  f"{', carried' if r['carried'] else ''}: ours/reference {float(r.get('ratio', np.nan)):.4f}, "
+                  f"{float(r['seconds']):.1f} s", flush=True)  # type: ignore[arg-type]  # fmt: skip
     solved = [r for r in rows if r["status"] == "ok"]
     slower = [r for r in solved if float(r["ratio"]) > 1.0 + 1e-6]  # type: ignore[arg-type]
     for r in rows:
