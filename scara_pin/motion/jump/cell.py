@@ -88,15 +88,23 @@ def infeasible(scene: Scene, piece: PolynomialPiece, status: str) -> InfeasibleE
     return JumpError(status, f"no collision-free motion found within the limits: {blocking(scene, piece)}")
 
 
+class _SameWay(Exception):
+    """A solve in progress reached the way of a motion solved already (it would end in that motion again)."""
+
+
 def solve_avoiding(prob: Problem, options: JumpOptions, waypoints: np.ndarray, *, buffer: float = BUFFER,
-                   seed: tuple[DistanceRow, ...] = ()) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:  # fmt: skip
+                   seed: tuple[DistanceRow, ...] = (), free: PolynomialPiece | None = None,
+                   known: tuple[np.ndarray, ...] = ()) -> tuple[PolynomialPiece, np.ndarray, SolverStats]:  # fmt: skip
     """The jump's solve (the jump's own solve) with the distance rows (module docstring).
 
     From the warm start ``waypoints``: solve; check densely; add rows; re-set every row's plane; solve again,
     warm-started, until nothing is added, the dense check holds and the duration has settled. A re-solve the
     solver finds infeasible (the planes taken from the last solution conflict) is retried once from the
     last motion that was clear of the cell, with every plane taken there: that motion satisfies them all.
-    ``buffer``: the rows keep margin + buffer; ``seed``: rows there from the start (a near miss solved again).
+    ``buffer``: the rows keep margin + buffer; ``seed``: rows there from the start (a near miss solved again);
+    ``free``: the motion without the cell, whose collisions are rows from the start (a first solve without them
+    only finds that motion again); ``known``: motions solved already (``_LADDER`` samples each): a clear solution on
+    the way of one of them ends this solve (``_SameWay``), the local solve would find that motion again.
 
     Returns:
         (piece, phase durations, solver statistics) as ``solve``.
@@ -110,6 +118,8 @@ def solve_avoiding(prob: Problem, options: JumpOptions, waypoints: np.ndarray, *
     points: tuple[ConstraintPoint, ...] = ()
     warm = warm_start(prob, waypoints)
     rows = Rows(scene, prob.sym, buffer)
+    if free is not None:
+        rows.add(rows.check(free)[0])
     piece = rebuild(prob, warm[0], warm[2])
     fresh, worst = rows.check(piece)
     rows.add(list(seed) + fresh)
@@ -149,6 +159,10 @@ def solve_avoiding(prob: Problem, options: JumpOptions, waypoints: np.ndarray, *
         added = rows.add(fresh)
         log.debug("jump in a cell: %.6f s, worst %.3g mm beyond the margin, %d rows added, %d limit points",
                   piece.duration, worst * 1e3, len(fresh), len(new))  # fmt: skip
+        if known and worst >= 0.0:
+            ladder = piece.evaluate(np.linspace(0.0, piece.duration, _LADDER))[0]
+            if any(_same_way(scene, ladder, path, prob.velocity) for path in known):
+                raise _SameWay
         params = rows.parameters(piece, None if clear is None else clear[0])
         if worst >= -CONVERGED:
             clear = (piece, sol["x"])
@@ -196,7 +210,7 @@ def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: fl
     vel, acc = prob.velocity, prob.acceleration
     # the fastest motion without the cell bounds every motion in it from below; when it is clear, it is the answer
     piece, T, stats = solve(replace(prob, scene=None), options)
-    free = piece.duration
+    free, free_piece = piece.duration, piece
     if not hints and float(scene.minimum_array(piece.evaluate(np.linspace(0.0, free, _FREE_CHECK))[0]).min()) \
             >= scene.margin:  # fmt: skip
         traj = Trajectory((piece,))
@@ -231,7 +245,10 @@ def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: fl
         log.debug("jump in a cell: warm start %s (%.4g s, clearance %.3g m)", cand.way, cand.duration,
                   cand.clearance)  # fmt: skip
         try:
-            piece, T, stats, traj, check = _solved(prob, options, cand.waypoints)
+            piece, T, stats, traj, check = _solved(prob, options, cand.waypoints, free_piece, tuple(solved))
+        except _SameWay:
+            log.debug("jump in a cell: warm start %s reached the way of one solved already", cand.way)
+            continue
         except JumpError as exc:
             error = exc
             failures += 1
@@ -248,16 +265,17 @@ def solve_in_cell(prob: Problem, options: JumpOptions, scene: Scene, ceiling: fl
     return best[0], best[1], replace(best[2], iterations=iterations), best[3], best[4]
 
 
-def _solved(prob: Problem, options: JumpOptions,
-            waypoints: np.ndarray) -> tuple[PolynomialPiece, np.ndarray, SolverStats, Trajectory, Check]:  # fmt: skip
-    """One warm start solved and verified.
+def _solved(prob: Problem, options: JumpOptions, waypoints: np.ndarray, free: PolynomialPiece | None = None,
+            known: tuple[np.ndarray, ...] = ()) -> tuple[PolynomialPiece, np.ndarray, SolverStats, Trajectory,
+                                                         Check]:  # fmt: skip
+    """One warm start solved and verified (``free``, ``known``: :func:`solve_avoiding`'s).
 
     A near miss (its certificate fails by micrometres) is solved again with a larger buffer and a row where it failed.
     """
     buffer = BUFFER
     seed: tuple[DistanceRow, ...] = ()
     for attempt in range(2):
-        piece, T, stats = solve_avoiding(prob, options, waypoints, buffer=buffer, seed=seed)
+        piece, T, stats = solve_avoiding(prob, options, waypoints, buffer=buffer, seed=seed, free=free, known=known)
         traj = Trajectory((piece,))
         try:
             return piece, T, stats, traj, verify_move(prob, traj)
@@ -307,12 +325,14 @@ def _same_way(scene: Scene, waypoints: np.ndarray, path: np.ndarray, velocity: n
     """Whether a warm start goes the way of a solved motion (the local solve would find the same motion again).
 
     The ladder between them (corresponding points at the same fraction of their joint-space length joined by straight
-    joint lines) is clear of the cell: one deforms into the other through free space.
+    joint lines) is clear of the cell: one deforms into the other through free space. Clear here is half the margin:
+    the ladder's ends are joint lines between samples of the motions, whose chords cut the corners a motion turns at
+    the margin (by 15 um for a post's jump), and a way is a way round or over the obstacles, not the margin's width.
     """
     a, b = _resampled(waypoints, velocity), _resampled(path, velocity)
     s = np.linspace(0.0, 1.0, 12)[None, :, None]
     rungs = (a[:, None, :] + s * (b - a)[:, None, :]).reshape(-1, a.shape[1])
-    return bool(clear_mask(scene, rungs).all())
+    return bool(clear_mask(scene, rungs, margin=0.5 * scene.margin).all())
 
 
 def _resampled(points: np.ndarray, velocity: np.ndarray) -> np.ndarray:
