@@ -29,6 +29,7 @@ loads, as it does in Pinocchio.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import re
 import xml.etree.ElementTree as ET
@@ -579,10 +580,8 @@ def parse_urdf_xml(text: str, lines: bool = True) -> tuple[ET.Element, dict[ET.E
     if "\t" in text or "\n" in text or "\r" in text:
         text = _RAW_BLANK_VALUE.sub(_keep_blanks, text)
     if not lines and "xmlns" not in text:  # no namespace declared: ElementTree's C reader reads the same tree
-        try:
+        with contextlib.suppress(ET.ParseError):  # an undeclared prefix (or not XML): read as tinyxml2 reads it, below
             return ET.fromstring(text), {}
-        except ET.ParseError:  # an undeclared prefix (or not XML): read as tinyxml2 reads it, below
-            pass
     builder = ET.TreeBuilder()
     found: dict[ET.Element, int] = {}
     parser = expat.ParserCreate()
