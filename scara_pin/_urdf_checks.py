@@ -416,7 +416,7 @@ def second_parents(root: ET.Element) -> list[tuple[str, str, str, bool]]:
     for el in joints:
         by_child.setdefault(el.find("child").get("link", ""), []).append(el)  # type: ignore[union-attr]
         children.setdefault(el.find("parent").get("link", ""), []).append(el)  # type: ignore[union-attr]
-    out = []
+    out: list[tuple[str, str, str, bool]] = []
     for link, parents in by_child.items():
         if len(parents) < 2:
             continue
@@ -430,9 +430,7 @@ def second_parents(root: ET.Element) -> list[tuple[str, str, str, bool]]:
                 if child not in seen:
                     seen.add(child)
                     stack.append(child)
-        for el in parents:
-            if el is not kept:
-                out.append((link, kept.get("name", ""), el.get("name", ""), movable))
+        out.extend((link, kept.get("name", ""), el.get("name", ""), movable) for el in parents if el is not kept)
     return out
 
 
