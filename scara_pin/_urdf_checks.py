@@ -29,6 +29,7 @@ loads, as it does in Pinocchio.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import re
 import xml.etree.ElementTree as ET
@@ -415,7 +416,7 @@ def second_parents(root: ET.Element) -> list[tuple[str, str, str, bool]]:
     for el in joints:
         by_child.setdefault(el.find("child").get("link", ""), []).append(el)  # type: ignore[union-attr]
         children.setdefault(el.find("parent").get("link", ""), []).append(el)  # type: ignore[union-attr]
-    out = []
+    out: list[tuple[str, str, str, bool]] = []
     for link, parents in by_child.items():
         if len(parents) < 2:
             continue
@@ -429,9 +430,7 @@ def second_parents(root: ET.Element) -> list[tuple[str, str, str, bool]]:
                 if child not in seen:
                     seen.add(child)
                     stack.append(child)
-        for el in parents:
-            if el is not kept:
-                out.append((link, kept.get("name", ""), el.get("name", ""), movable))
+        out.extend((link, kept.get("name", ""), el.get("name", ""), movable) for el in parents if el is not kept)
     return out
 
 
@@ -579,10 +578,8 @@ def parse_urdf_xml(text: str, lines: bool = True) -> tuple[ET.Element, dict[ET.E
     if "\t" in text or "\n" in text or "\r" in text:
         text = _RAW_BLANK_VALUE.sub(_keep_blanks, text)
     if not lines and "xmlns" not in text:  # no namespace declared: ElementTree's C reader reads the same tree
-        try:
+        with contextlib.suppress(ET.ParseError):  # an undeclared prefix (or not XML): read as tinyxml2 reads it, below
             return ET.fromstring(text), {}
-        except ET.ParseError:  # an undeclared prefix (or not XML): read as tinyxml2 reads it, below
-            pass
     builder = ET.TreeBuilder()
     found: dict[ET.Element, int] = {}
     parser = expat.ParserCreate()

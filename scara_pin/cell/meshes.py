@@ -40,6 +40,7 @@ so Pinocchio never reads a mesh file; :func:`visual_meshes` gives the real shape
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import functools
 import gzip
@@ -620,10 +621,8 @@ def load_meshes(uses: list[MeshUse], origin: str) -> dict[Path, MeshGeometry]:
         count[use.path] = count.get(use.path, 0) + 1
     size = 0
     for path in first:
-        try:
+        with contextlib.suppress(OSError):  # read_mesh_file says what is wrong with it
             size += os.stat(path).st_size
-        except OSError:
-            pass  # read_mesh_file says what is wrong with it
     check_count(f"bytes of the mesh files of {origin} ({len(first)} file(s), on disk)", size, MAX_CELL_MESH_BYTES)
     files: dict[Path, MeshFile] = {}
     read = 0

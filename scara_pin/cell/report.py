@@ -204,10 +204,8 @@ def reach_envelope(scene: Scene) -> Envelope:
             chain.append(k)
             k = model.parents[k]
         chain.reverse()
-        if chain[0] != first:  # another branch of the tree: bounded by whole lengths below
-            parallel = False
-        else:
-            parallel = all(_parallel(model, data, i, a) for i in chain)
+        # another branch of the tree (chain[0] != first): not parallel, bounded by whole lengths below
+        parallel = chain[0] == first and all(_parallel(model, data, i, a) for i in chain)
         corners = _corners(g)  # in joint j's frame
         world = corners @ data.oMi[j].rotation.T  # offsets from joint j's origin, at q = 0
         strokes = [(lo_q[i], hi_q[i]) for i in chain if _is_prismatic(model, i)]

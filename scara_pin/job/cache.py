@@ -41,7 +41,7 @@ import hashlib
 import json
 import logging
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -359,13 +359,4 @@ class StoredPiece(Piece):
 def built(piece: Piece) -> Piece:
     """``piece`` itself, or the piece a :class:`StoredPiece` stands for (built now)."""
     return piece.piece if isinstance(piece, StoredPiece) else piece
-
-
-def stored_or_none(read: Callable[[], Any]) -> Any:
-    """``read()``, or None after one warning when an entry that passed its digest still cannot be rebuilt."""
-    try:
-        return read()
-    except (KeyError, TypeError, ValueError, IndexError) as exc:
-        log.warning("plan cache entry not usable (%s): the move is planned again", exc)
-        return None
 

@@ -60,7 +60,7 @@ import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, NoReturn, TypeVar
 
 import numpy as np
 
@@ -112,6 +112,7 @@ _JUMP_KEYS = ("rise", "clearance_radius", "max_height")
 MAX_VIA = 16
 """The most via points of one jump (hints of its way: a few are enough; each one is a warm start's corner)."""
 _STEP_KINDS = "speed, accel, jump, move, go, dwell, pick, place, for"
+_T = TypeVar("_T")
 
 
 class _At:
@@ -131,6 +132,13 @@ class _At:
         if self.origin is not None:
             raise JobFileError(self.path, None, f"{self.origin}: {reason}")
         raise JobFileError(self.path, self.line, reason)
+
+    def checked(self, make: Callable[[], _T]) -> _T:
+        """``make()``, an InvalidInputError it raises refused here (:meth:`fail`) with its message."""
+        try:
+            return make()
+        except InvalidInputError as exc:
+            self.fail(str(exc))
 
     def child(self, key: str | int, name: str | None = None) -> _At:
         """The value at ``key`` of this mapping (or index of this list), with its line (the shared loader's)."""
@@ -370,12 +378,7 @@ def _poses(at: _At, points: PointSet) -> PointSet:
         at.fail("poses must be a mapping of names to {xyz, yaw, hand[, turns, frame]}")
     for name in at.value:
         item = at.child(name, f"pose {name}")
-        try:
-            check_point_name(name)
-        except InvalidInputError:
-            item.fail(f"pose name {_shown(name)} must be a letter then up to 31 letters, digits, _, - or .")
-        if name in points:
-            item.fail(f"pose {name} has the name of a point of the points file: name it otherwise")
+        _new_name(item, "pose", name, points)
         keys = item.mapping(_POSE_KEYS, required=("xyz", "yaw", "hand"))
         xyz = _three(keys["xyz"], "xyz is 3 lengths [{unit}] (the tool's position in its frame)", kind="length")
         yaw = keys["yaw"].angle(math.isfinite, "a number (the tool's yaw in its frame)")
@@ -386,6 +389,16 @@ def _poses(at: _At, points: PointSet) -> PointSet:
         except InvalidInputError as exc:
             item.fail(str(exc))
     return points
+
+
+def _new_name(at: _At, what: str, name: Any, points: PointSet) -> None:
+    """A pose's or a pallet's name: a point's name (:func:`check_point_name`), none of the points file's."""
+    try:
+        check_point_name(name)
+    except InvalidInputError:
+        at.fail(f"{what} name {_shown(name)} must be a letter then up to 31 letters, digits, _, - or .")
+    if name in points:
+        at.fail(f"{what} {name} has the name of a point of the points file: name it otherwise")
 
 
 def _pose_frames(points: PointSet, frames: FrameTree, entries: Mapping[str, _At]) -> None:
@@ -407,18 +420,12 @@ def _jerk(at: _At) -> tuple[float, ...]:
 
 def _points(at: _At, job: Path) -> tuple[Path, PointSet]:
     file = job.parent / at.text(4096)
-    try:
-        return file, read_points(file)
-    except InvalidInputError as exc:
-        at.fail(str(exc))
+    return file, at.checked(lambda: read_points(file))
 
 
 def _cell(at: _At, job: Path) -> Path:
     file = job.parent / at.text(4096)
-    try:
-        return check_input_file(file, "cell file", MAX_DOCUMENT_BYTES)
-    except InvalidInputError as exc:
-        at.fail(str(exc))
+    return at.checked(lambda: check_input_file(file, "cell file", MAX_DOCUMENT_BYTES))
 
 
 def _carry(at: _At) -> Carry:
@@ -492,12 +499,7 @@ def _shape(keys: Mapping[str, _At]) -> dict[str, Any]:
 
 
 def _pallet(at: _At, name: str, points: PointSet) -> Pallet:
-    try:
-        check_point_name(name)
-    except InvalidInputError:
-        at.fail(f"pallet name {_shown(name)} must be a letter then up to 31 letters, digits, _, - or .")
-    if name in points:
-        at.fail(f"pallet {name} has the name of a point of the points file: name it otherwise")
+    _new_name(at, "pallet", name, points)
     keys = at.mapping(_PALLET_KEYS, required=("corners", "rows", "columns"))
     corners = []
     for c in keys["corners"].elements():
@@ -509,10 +511,7 @@ def _pallet(at: _At, name: str, points: PointSet) -> Pallet:
     columns = keys["columns"].whole(1, MAX_JOB_STEPS)
     layers = keys["layers"].whole(1, MAX_JOB_STEPS) if "layers" in keys else 1
     height = keys["layer_height"].length(lambda v: v > 0, "> 0") if "layer_height" in keys else 0.0
-    try:
-        return Pallet(name, tuple(corners), rows, columns, layers, height)
-    except InvalidInputError as exc:
-        at.fail(str(exc))
+    return at.checked(lambda: Pallet(name, tuple(corners), rows, columns, layers, height))
 
 
 def _via(at: _At, points: PointSet) -> tuple[str, ...]:
@@ -536,10 +535,7 @@ def _unknown_point(name: str, points: PointSet) -> str:
 
 
 def _target(at: _At, points: PointSet, pallets: Mapping[str, Pallet], scope: Mapping[str, _Scope]) -> Target:
-    try:
-        target = parse_target(at.value)
-    except InvalidInputError as exc:
-        at.fail(str(exc))
+    target = at.checked(lambda: parse_target(at.value))
     if target.index is None:
         if target.name in pallets:
             at.fail(f"{target.name} is a pallet: name one of its places, {target.name}[1] to "

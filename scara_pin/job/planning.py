@@ -263,14 +263,14 @@ def _binding(robot: RobotModel, traj: Trajectory, limits: JointLimits, torque: b
     """The limits at >= :data:`~scara_pin.motion.jump.BINDING` on the 10 kHz grid, with their share of the time."""
     from ..description import JOINT_NAMES
     from ..motion.jump import BINDING
-    from ..motion.verify import VERIFY_RATE, limits_in_force, state_ratios
+    from ..motion.verify import VERIFY_RATE, limits_in_force, pieces_jerk, state_ratios
 
     lim = limits_in_force(robot, limits, None, torque)
     loaded = with_payload(robot, payload) if torque else robot
     t = np.append(np.arange(math.floor(traj.duration * VERIFY_RATE) + 1) / VERIFY_RATE, traj.duration)
     states: tuple[np.ndarray, ...] = traj.sample(t)
     if jerk is not None:
-        states = (*states, _jerks(traj, t))
+        states = (*states, pieces_jerk(traj, t, [built(p) for p in traj.pieces]))
     found, worst = [], LimitShare("velocity", JOINT_NAMES[0], -1.0, 0.0)
     for quantity, r in state_ratios(loaded, lim, states, None if jerk is None else np.asarray(jerk)).items():
         for j in range(r.shape[1]):
@@ -282,27 +282,6 @@ def _binding(robot: RobotModel, traj: Trajectory, limits: JointLimits, torque: b
                 found.append(LimitShare(quantity.value, who, top, float(np.mean(r[:, j] >= BINDING))))
     found.sort(key=lambda b: -b.share)
     return tuple(found), worst
-
-
-def _jerks(traj: Trajectory, t: np.ndarray) -> np.ndarray:
-    """The joint jerk at times ``t`` of the pieces that have one (a jump's polynomial, a jerk-limited law); else 0."""
-    from ..motion.trajectory import Motion
-    from ..motion.verify import motion_states
-
-    out = np.zeros((len(t), traj.dof))
-    for start, end, stored in zip(traj.starts[:-1].tolist(), traj.starts[1:].tolist(), traj.pieces):
-        piece = built(stored)
-        inside = (t >= start) & (t <= end)
-        if not inside.any():
-            continue
-        tau = t[inside] - start
-        if isinstance(piece, PolynomialPiece):
-            out[inside] = piece.jerk(tau)
-        elif isinstance(piece, Motion):
-            qddd = motion_states(piece, tau).qddd
-            if qddd is not None:
-                out[inside] = qddd
-    return out
 
 
 class Planner:

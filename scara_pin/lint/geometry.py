@@ -97,6 +97,5 @@ def colour_ignored(ctx: Context) -> None:
 
     ignored = urdfdom_ignores(copy.deepcopy(ctx.parsed[0]))
     if ignored:
-        shown = ", ".join(ignored[:6]) + (f" and {len(ignored) - 6} more" if len(ignored) > 6 else "")
         ctx.add(Severity.WARNING, "colour-ignored", f"colours URDF cannot read, ignored by urdfdom and the toolkit "
-                f"(a colour is <color rgba=\"r g b a\"/>, each in [0, 1]): {shown}")  # fmt: skip
+                f"(a colour is <color rgba=\"r g b a\"/>, each in [0, 1]): {_shown(ignored)}")  # fmt: skip

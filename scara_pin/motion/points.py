@@ -626,8 +626,7 @@ def _parse_csv(text: str, origin: str) -> PointSet:
             continue
         if stripped.startswith("#"):
             if number == 1 and stripped.lstrip("# ").startswith(FORMAT):
-                for key, value in re.findall(r"\b(robot|base|tool)=(\S+)", stripped):
-                    meta[key] = value
+                meta.update(re.findall(r"\b(robot|base|tool)=(\S+)", stripped))
             continue
         rows.append((number, line))
     if not rows:

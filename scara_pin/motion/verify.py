@@ -90,6 +90,7 @@ __all__ = [
     "jerk_vector",
     "joint_jerk",
     "motion_states",
+    "pieces_jerk",
     "path_third_derivative",
     "state_ratios",
     "static_load",
@@ -614,14 +615,28 @@ def trajectory_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
     Raises:
         InvalidInputError: a piece is not a motion (imported samples have no jerk of their own).
     """
-    t = np.asarray(t, dtype=float)
+    if not all(isinstance(p, Motion) for p in traj.pieces):
+        raise InvalidInputError("jerk needs a trajectory of motions")
+    return pieces_jerk(traj, np.asarray(t, dtype=float))
+
+
+def pieces_jerk(traj: Trajectory, t: np.ndarray, pieces: list[Any] | None = None, *, motions: bool = True
+                ) -> np.ndarray:  # fmt: skip
+    """Joint jerk (n, dof) at times t: a motion's (:func:`joint_jerk`), another piece's own ``jerk``, else zero.
+
+    Args:
+        traj: the trajectory (its start times).
+        t: the times [s].
+        pieces: its pieces as built, for a trajectory of stand-ins (the plan cache's); default ``traj.pieces``.
+        motions: every motion's jerk; False: only a motion whose law has a path jerk (:func:`has_jerk`).
+    """
     out = np.zeros((len(t), traj.dof))
-    for start, p in zip(traj.starts.tolist(), traj.pieces):
-        if not isinstance(p, Motion):
-            raise InvalidInputError("jerk needs a trajectory of motions")
-        sel = (t >= start) & (t <= start + p.duration)
-        if sel.any():
-            out[sel] = joint_jerk(p, t[sel] - start)
+    starts = traj.starts.tolist()
+    for start, end, p in zip(starts, starts[1:], traj.pieces if pieces is None else pieces):
+        sel = (t >= start) & (t <= end)
+        if sel.any() and (has_jerk(p) or (motions and isinstance(p, Motion))):
+            tau = t[sel] - start
+            out[sel] = joint_jerk(p, tau) if isinstance(p, Motion) else p.jerk(tau)
     return out
 
 
@@ -742,7 +757,7 @@ def verify(
         if analytic:
             sel = (t >= 0.0) & (t <= T)
             qddd = np.zeros_like(q)
-            qddd[sel] = _analytic_jerk(trajectory, t[sel])
+            qddd[sel] = pieces_jerk(trajectory, t[sel], motions=False)
         for quantity, r in state_ratios(loaded, lim, (q, qd, qdd, qddd), jv).items():
             worst.add(quantity, r, t, tool=quantity is Quantity.TOOL_SPEED)
     for start, piece in zip(trajectory.starts.tolist(), trajectory.pieces):
@@ -802,13 +817,3 @@ def clear_of(robot: RobotModel, trajectory: Trajectory, cell: Cell) -> Clearance
     sc.check(trajectory.q_end, "the end")
     return verify(robot, trajectory, scene=sc).check_clearance().clearance
 
-
-def _analytic_jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
-    """The analytic joint jerk at times t of the pieces that have one (zero elsewhere)."""
-    out = np.zeros((len(t), traj.dof))
-    for start, p in zip(traj.starts.tolist(), traj.pieces):
-        sel = (t >= start) & (t <= start + p.duration)
-        if sel.any() and has_jerk(p):
-            tau = t[sel] - start
-            out[sel] = joint_jerk(p, tau) if isinstance(p, Motion) else p.jerk(tau)  # type: ignore[attr-defined]
-    return out

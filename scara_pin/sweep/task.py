@@ -18,6 +18,7 @@ step and is ``timeout`` (a single move of the planner is not interrupted).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import socket
 import sys
@@ -158,8 +159,6 @@ def _worker() -> str:
     if "distributed" in sys.modules:
         from distributed import get_worker
 
-        try:
+        with contextlib.suppress(ValueError):  # not in a worker
             return str(get_worker().address)
-        except ValueError:  # not in a worker
-            pass
     return f"local {socket.gethostname()}"

@@ -153,11 +153,8 @@ def _jerk(traj: Trajectory, t: np.ndarray) -> np.ndarray:
     """Joint jerk at times t: each piece's own (a jump's polynomial), else the motions' chain rule."""
     from ..motion.cycle import trajectory_jerk
     from ..motion.polynomial import PolynomialPiece
+    from ..motion.verify import pieces_jerk
 
     if not all(isinstance(p, PolynomialPiece) for p in traj.pieces):
         return trajectory_jerk(traj, t)
-    out = np.zeros((len(t), traj.dof))
-    for start, piece in zip(traj.starts.tolist(), traj.pieces):
-        sel = (t >= start) & (t <= start + piece.duration)
-        out[sel] = piece.jerk(t[sel] - start)  # type: ignore[attr-defined]
-    return out
+    return pieces_jerk(traj, t)

@@ -75,9 +75,7 @@ def verify_move(prob: Problem, traj: Trajectory) -> Check:
     qddd = None if prob.jerk is None else piece.jerk(t)
     ratios = state_ratios(prob.robot, lim, (q, qd, qdd, qddd), prob.jerk)
     table = {quantity.value: r for quantity, r in ratios.items()}
-    worst: dict[str, float | None] = {name: None for name in _QUANTITIES}
-    for name, value in found.ratios().items():
-        worst[name] = value
+    worst: dict[str, float | None] = {**dict.fromkeys(_QUANTITIES), **found.ratios()}
     for name, r in table.items():
         top = float(np.max(r))
         worst[name] = top if worst.get(name) is None else max(top, worst[name] or 0.0)
