@@ -446,4 +446,4 @@ class _Lattice:
             return "the tool cannot stay at the traverse height"
         top = sorted(self.blocked_by.items(), key=lambda kv: -kv[1])[:3]
         total = self.size
-        return ", ".join(f"{self.scene.pairs[k].label} closes {100.0 * n / total:.0f} %" for k, n in top if n)
+        return ", ".join(f"{self.scene.pairs[k].label} closes {100.0 * n / total:.2g} %" for k, n in top if n)
