@@ -5,15 +5,12 @@ from __future__ import annotations
 import argparse
 import re
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, TypeVar
+from typing import TypeVar
 
 from .._checks import NUMBER_TEXT
 from ..errors import InvalidInputError, ParameterError
 from ..limits import MAX_NUMBER
 from ..units import format_number
-
-if TYPE_CHECKING:
-    from ._units import Units
 
 _INTEGER_TEXT = re.compile(r"[+-]?\d+", re.ASCII)
 _T = TypeVar("_T")
@@ -72,25 +69,6 @@ def _argparse_type(parse: Callable[[str], _T]) -> Callable[[str], _T]:
             raise argparse.ArgumentTypeError(f"got {exc.value!r}; it {exc.rule}") from None
 
     return parsed
-
-
-def jerk_limits(args: argparse.Namespace, units: Units) -> list[float] | None:
-    """``--jerk-limit J`` or ``J1 J2 J3 J4``, SI out, or None.
-
-    In the user's units (the units rule): each joint's value in its own unit, rad/s^3 or m/s^3 (deg/s^3, mm/s^3
-    with --deg/--mm); one value stands for every joint, each in its unit.
-    """
-    if getattr(args, "jerk_limit", None) is None:
-        return None
-    n = len(units.q)
-    if len(args.jerk_limit) not in (1, n):
-        raise ParameterError("--jerk-limit", " ".join(args.jerk_limit), f"must be one number or {n} (one per joint)")
-    texts = list(args.jerk_limit) * n if len(args.jerk_limit) == 1 else list(args.jerk_limit)
-    units.guard([f"--jerk-limit q{i + 1}" for i in range(n)], texts, units.q)
-    values = [number("--jerk-limit", t) / sc for t, sc in zip(texts, units.scale(units.q))]
-    if not all(v > 0 for v in values):
-        raise ParameterError("--jerk-limit", values, "must be > 0", "rad/s^3 or m/s^3")
-    return values
 
 
 def parse_sets(items: Sequence[str] | None, option: str = "--set", form: str = "key=value (e.g. l1=0.25)"

@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, ParameterError
 from ..units import DisplayUnits
 from ._numbers import number
 
@@ -93,3 +93,22 @@ class Units:
     def num(self, value: float, kind: str) -> str:
         """One SI value in the user's units, rounded to the unit's resolution (no unit name)."""
         return self.display.format(value, kind)
+
+
+def jerk_limits(args: argparse.Namespace, units: Units) -> list[float] | None:
+    """``--jerk-limit J`` or ``J1 J2 J3 J4``, SI out, or None.
+
+    In the user's units (the units rule): each joint's value in its own unit, rad/s^3 or m/s^3 (deg/s^3, mm/s^3
+    with --deg/--mm); one value stands for every joint, each in its unit.
+    """
+    if getattr(args, "jerk_limit", None) is None:
+        return None
+    n = len(units.q)
+    if len(args.jerk_limit) not in (1, n):
+        raise ParameterError("--jerk-limit", " ".join(args.jerk_limit), f"must be one number or {n} (one per joint)")
+    texts = list(args.jerk_limit) * n if len(args.jerk_limit) == 1 else list(args.jerk_limit)
+    units.guard([f"--jerk-limit q{i + 1}" for i in range(n)], texts, units.q)
+    values = [number("--jerk-limit", t) / sc for t, sc in zip(texts, units.scale(units.q))]
+    if not all(v > 0 for v in values):
+        raise ParameterError("--jerk-limit", values, "must be > 0", "rad/s^3 or m/s^3")
+    return values

@@ -10,12 +10,12 @@ from typing import Any
 from ..errors import InvalidInputError, ParameterError
 from ..files import outputs_together
 from ._joints import needs_wrist, read_pose
-from ._numbers import jerk_limits, number, number_type
+from ._numbers import number, number_type
 from ._options import add_cell_options, add_motion_limits, add_robot_options, add_units
 from ._outputs import check_command_outputs
 from ._points import add_points_options, use_points
 from ._robot import cell_from_args, payload_from_args, robot_from_args, with_motion_limits
-from ._units import Units
+from ._units import Units, jerk_limits
 
 
 def cmd_cycle(args: argparse.Namespace) -> int:

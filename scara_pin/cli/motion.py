@@ -12,13 +12,13 @@ from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..files import outputs_together
 from ..units import format_number, format_vector
 from ._joints import joint_arg, needs_wrist, read_pose
-from ._numbers import jerk_limits, number, number_type
+from ._numbers import number, number_type
 from ._options import add_cell_options, add_motion_limits, add_robot_options, add_units
 from ._outputs import check_command_outputs, log
 from ._points import add_points_options, use_points
 from ._robot import cell_from_args, payload_from_args, robot_from_args, with_motion_limits
 from ._setpoints import add_setpoint_options, check_setpoint_options, write_setpoints
-from ._units import POSE_KINDS, Units
+from ._units import POSE_KINDS, Units, jerk_limits
 from .cycle import cell_summary, cell_text
 
 
