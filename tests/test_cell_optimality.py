@@ -19,9 +19,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from cell_reference import LowBox, Post, minimum_time
+from test_cell_motion import _cell  # the cell of posts and low boxes as tests/cell_reference.py models them
 
 from scara_pin import load_robot
-from scara_pin.cell import Cell, Obstacle, Shape
 from scara_pin.motion.jump import jump_move
 
 MARGIN = 0.002
@@ -48,18 +48,6 @@ REFERENCES = {  # [s] minimum_time(robot, A, B, posts=, boxes=, vias=) of each c
     "two posts": 0.38611705376076455,
     "wall and post": 0.37797235362941517,
 }
-
-
-def _cell(posts: list[Post], boxes: list[LowBox]) -> Cell:
-    obstacles = []
-    for i, p in enumerate(posts):
-        lo, hi = max(p.bottom, -0.3), min(p.top, 0.3)
-        centre = np.array([p.x, p.y, (lo + hi) / 2])
-        obstacles.append(Obstacle(f"post{i}", Shape("cylinder", (p.radius, hi - lo), centre, np.zeros(3))))
-    for i, b in enumerate(boxes):
-        centre = np.array([b.x, b.y, b.top - 0.05])
-        obstacles.append(Obstacle(f"box{i}", Shape("box", (2 * b.hx, 2 * b.hy, 0.1), centre, np.zeros(3))))
-    return Cell(tuple(obstacles), MARGIN)
 
 
 @pytest.fixture(scope="module")
