@@ -56,7 +56,7 @@ when its words, split at ``_``, ``-``, ``.`` and between letters and digits, con
 class UrdfRuleError(UrdfError):
     """A URDF refused by a named rule.
 
-    ``rule``: a rule of the pre-check (urdfdom's, :data:`scara_pin._urdf_checks.PRECHECK_RULES`) or of the
+    ``rule``: a rule of the pre-check (urdfdom's, ``scara_pin._urdf_checks.PRECHECK_RULES``) or of the
     toolkit (:data:`LOADER_RULES`).
     """
 

@@ -167,7 +167,7 @@ def missing_link(ctx: Context) -> None:
 def two_parents(ctx: Context) -> None:
     """A link that is the child of two joints: an error with movable joints below it, else a warning.
 
-    The loader's rule (:func:`scara_pin._urdf_checks.second_parents`).
+    The loader's rule (``scara_pin._urdf_checks.second_parents``).
     """
     from .._urdf_checks import second_parents
 
