@@ -450,7 +450,9 @@ def pair_joints(scene: Scene, lower: np.ndarray | None = None, upper: np.ndarray
     for j in range(robot.dof):
         Qj = Q.copy()
         Qj[:, j] = lo[j] + (hi[j] - lo[j]) * rng.random(len(Q))
-        moved[j] = np.max(np.abs(scene.distance_array(Qj) - base), axis=0) > 1e-9
+        with np.errstate(invalid="ignore"):  # coal's failed depth (-inf) on both sides: unknown, so moved
+            change = np.abs(scene.distance_array(Qj) - base)
+        moved[j] = np.max(np.where(np.isnan(change), np.inf, change), axis=0) > 1e-9
     gm = scene.geometry_model
     out = []
     for k, pr in enumerate(scene.pairs):
