@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...cell.sweep import clear_mask
 from ..trajectory import line_optimal_duration
 
 if TYPE_CHECKING:
@@ -78,6 +79,15 @@ def score(scene: Scene, waypoints: np.ndarray, velocity: np.ndarray, acceleratio
     return float(t), float(d.min(initial=math.inf)) - scene.margin - SLACK
 
 
+def _clears(scene: Scene, waypoints: np.ndarray) -> bool:
+    """Whether :func:`score`'s clearance of these joint lines is >= 0.
+
+    Without the exact distance of every pair at every sample (:func:`~scara_pin.cell.sweep.clear_mask`'s filters
+    first): the scans try many ways that do not clear.
+    """
+    return bool(clear_mask(scene, line_samples(waypoints), margin=scene.margin + SLACK).all())
+
+
 def _ik(robot: RobotModel, pose: np.ndarray, near: np.ndarray) -> np.ndarray | None:
     res = robot.ik(pose)
     sol = res.nearest(near, branch=robot.branch_of(near)) if res.success else None
@@ -123,9 +133,8 @@ def candidates(
         if len(raised) < 1 + _RAISED_AROUND:
             raised[z] = (ta, tb)
         way = np.array([qA, ta, tb, qB])
-        t, clear = score(scene, way, velocity, acceleration)
-        if clear >= 0.0:
-            found.append(Candidate("over", way, t, clear))
+        if _clears(scene, way):
+            found.append(Candidate("over", way, *score(scene, way, velocity, acceleration)))
             break
         z += _STEP
     # AROUND: a via point beside the first collision of the straight lines, moved out on either side, at the
@@ -150,9 +159,9 @@ def candidates(
                 via = _ik(robot, np.array([xy[0], xy[1], zv, yaw]), (ta + tb) / 2.0)
                 if via is not None:
                     way = np.array([qA, ta, via, tb, qB])
-                    t, clear = score(scene, way, velocity, acceleration)
-                    if clear >= 0.0:
-                        found.append(Candidate(side if k == 0 else f"{side}, raised", way, t, clear))
+                    if _clears(scene, way):
+                        found.append(Candidate(side if k == 0 else f"{side}, raised", way,
+                                               *score(scene, way, velocity, acceleration)))  # fmt: skip
                         break
                 offset += step
     clear_ones = sorted((c for c in found if c.clearance >= 0.0), key=lambda c: c.duration)
