@@ -144,8 +144,8 @@ class BoundingShapes:
     Per geometry (index into the scene's ``GeometryModel``): its joint, a bounding sphere (centre, radius) and a
     bounding capsule (segment ends, radius), both from coal's local bounding box: the sphere around the box, the
     capsule along its longest side with the radius of its cross-section's diagonal (a cylinder's or a
-    sphere's own axis and radius); and that box itself (an obstacle's, fixed in the world, is a tighter bound
-    than its sphere for a long thin table or wall).
+    sphere's own axis and radius); and that box itself, centred on the sphere's centre (a tighter bound than the
+    sphere or the capsule for a long thin table or wall, a flat flange under an arm).
     """
 
     joint: np.ndarray  # (g,)
@@ -154,8 +154,7 @@ class BoundingShapes:
     end0: np.ndarray  # (g, 3)
     end1: np.ndarray  # (g, 3)
     capsule: np.ndarray  # (g,)
-    box_rotation: np.ndarray  # (g, 3, 3): the local bounding box's axes, in the joint's frame
-    box_center: np.ndarray  # (g, 3)
+    box_rotation: np.ndarray  # (g, 3, 3): the local bounding box's axes, in the joint's frame (its centre: center)
     box_half: np.ndarray  # (g, 3): its half sides
 
     @property
@@ -202,8 +201,7 @@ def bounding_shapes(scene: Scene) -> BoundingShapes:
         half_sides.append(half)
     out = BoundingShapes(np.array(joint, dtype=int), np.array(center).reshape(-1, 3), np.array(radius),
                          np.array(end0).reshape(-1, 3), np.array(end1).reshape(-1, 3), np.array(capsule),
-                         np.array(box_r).reshape(-1, 3, 3), np.array(center).reshape(-1, 3),
-                         np.array(half_sides).reshape(-1, 3))  # fmt: skip
+                         np.array(box_r).reshape(-1, 3, 3), np.array(half_sides).reshape(-1, 3))  # fmt: skip
     _BOUNDS[scene] = out
     return out
 
@@ -212,8 +210,8 @@ def bounding_shapes(scene: Scene) -> BoundingShapes:
 def clear_mask(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margin: float | None = None) -> np.ndarray:
     """(n,) whether each configuration (row of ``Q``) has every checked pair at least the margin apart.
 
-    Pairs whose bounding spheres, then capsules, are farther apart than the margin are clear without a distance
-    query (module docstring); the others get coal's exact distance, pair by pair, and a configuration already
+    Pairs whose bounding spheres, capsules or boxes are farther apart than the margin are clear without a distance
+    query (:func:`pair_masks`); the others get coal's exact distance, pair by pair, and a configuration already
     found in collision is not asked again. ``pairs``: only these (indices; default every checked pair);
     ``margin``: another distance than the cell's.
     """
@@ -238,7 +236,8 @@ def pair_masks(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margi
     distance there, its bounding capsules' (:func:`clearance_bound`).
 
     The joint placements are computed once for all the pairs, and only for the geometries they name (an
-    obstacle's are fixed); the spheres, then the capsules, spare the exact distance where they are apart, and each
+    obstacle's are fixed); the spheres, the capsules, then the boxes (:func:`_boxes_apart`) spare the exact distance
+    where they are apart, and each
     configuration asks coal for its candidate pairs in turn (one placement of the geometries per configuration). A
     pair of two shapes fixed to the world (the robot's base and an obstacle) is asked once: its distance is the
     same at every configuration (a sleeve around the base column, a mesh, cost 0.65 ms a configuration:
@@ -260,14 +259,14 @@ def pair_masks(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margi
     joint = b.joint[used]
     shape = (n, len(used), 3)
     c, e0, e1 = (np.broadcast_to(x[used], shape).copy() for x in (b.center, b.end0, b.end1))
-    axes = np.broadcast_to(b.box_rotation[used], (n, len(used), 3, 3)).copy()
+    axes = np.broadcast_to(b.box_rotation[used], (n, len(used), 3, 3)).copy() if exact else None
     moving = np.flatnonzero(joint > 0)
     if moving.size:
         R, p = joint_placements(scene.robot, Q)
         Rg, pg = R[:, joint[moving]], p[:, joint[moving]]  # (n, m, 3, 3), (n, m, 3)
         for x, local in ((c, b.center), (e0, b.end0), (e1, b.end1)):
             x[:, moving] = np.einsum("ngab,gb->nga", Rg, local[np.asarray(used)[moving]]) + pg
-        if exact:
+        if axes is not None:
             axes[:, moving] = Rg @ b.box_rotation[np.asarray(used)[moving]]
     margin = scene.margin if margin is None else margin
     ia = np.array([slot[p.first] for p in chosen])
@@ -285,16 +284,19 @@ def pair_masks(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margi
                        - b.capsule[gi[cols]] - b.capsule[gj[cols]])  # fmt: skip
     if not exact or want_bound:
         bound = gap
-    if exact:
+    if axes is not None:
         near &= gap <= margin
         r, k = np.nonzero(near)  # then the boxes, each grown by the margin: separated on an axis, apart
         apart = _boxes_apart(axes[r, ia[k]], c[r, ia[k]], b.box_half[gi[k]], axes[r, ib[k]], c[r, ib[k]],
                              b.box_half[gj[k]], margin)  # fmt: skip
         near[r[apart], k[apart]] = False
-        fixed = np.flatnonzero((b.joint[gi] == 0) & (b.joint[gj] == 0))  # (the robot's base and an obstacle)
-        near[:, fixed] = False  # asked once below: the same distance at every configuration
+        # a pair of two world-fixed shapes (the robot's base and an obstacle): the same at every configuration, asked
+        # once, and only when the filters leave it near
+        fixed = np.flatnonzero((b.joint[gi] == 0) & (b.joint[gj] == 0))
+        fixed_near = [int(k) for k in fixed if near[0, k]]
+        near[:, fixed] = False
         first = scene.first_closer(Q, [p.index for p in chosen], near, margin)
-        closed = [int(k) for k in fixed if scene.distance_array(Q[:1], pairs=[chosen[k].index])[0, 0] < margin]
+        closed = [k for k in fixed_near if scene.distance_array(Q[:1], pairs=[chosen[k].index])[0, 0] < margin]
         if closed:
             first = np.where((first < 0) | (first > closed[0]), closed[0], first)
         hit = np.flatnonzero(first >= 0)
