@@ -216,7 +216,7 @@ class _Lattice:
         safe = np.ones(self.shape, dtype=bool)
         self.near_pairs: list[int] = []  # the pairs that come within the margin and half an edge somewhere
         for dims, pairs in groups.items():  # per pair: the nodes it closes first (for the reason of a refusal)
-            both = self._on_dims(list(dims), lambda Q, p=pairs: self._pairs_where_valid(Q, p))
+            both = self._on_dims(list(dims), lambda Q, p=pairs, d=dims: self._pairs_where_valid(Q, p, d))
             for col, k in enumerate(pairs):
                 ok = both[..., col].astype(bool)
                 self.blocked_by[k] = int((~ok & valid).sum())
@@ -228,23 +228,25 @@ class _Lattice:
         self.valid = valid
         self.safe = (safe & valid).ravel()
 
-    def _pairs_where_valid(self, Q: np.ndarray, pairs: list[int]) -> np.ndarray:
-        """(n, 2k): :func:`~scara_pin.cell.sweep.pair_masks` of ``pairs`` (masks, then bounds) where the tool is valid.
+    def _pairs_where_valid(self, Q: np.ndarray, pairs: list[int], dims: tuple[int, ...]) -> np.ndarray:
+        """(n, 2k): :func:`~scara_pin.cell.sweep.pair_masks` of ``pairs`` (masks, then bounds) on a lattice of ``dims``.
 
-        Only the rows of ``Q`` whose tool is at a valid height are asked; the others (invalid whatever the pairs)
-        are clear, their bounds +inf.
+        Where the tool's height depends on ``dims`` only, the rows whose tool is below the traverse height (or above
+        the ceiling: invalid whatever the pairs) are not asked for coal's distances: their masks are clear, and their
+        bounds are the capsules' alone (every node keeps a bound: the lines between nodes rely on it).
         """
-        out = np.ones((len(Q), 2 * len(pairs)))
-        out[:, len(pairs):] = np.inf
-        rows = np.arange(len(Q))
-        if self.z_dims and set(self.z_dims) <= {j for j in range(self.robot.dof) if len(np.unique(Q[:, j])) > 1}:
+        k = len(pairs)
+        out = np.ones((len(Q), 2 * k))
+        keep = np.ones(len(Q), dtype=bool)
+        if self.z_dims and set(self.z_dims) <= set(dims):
             z = self._z(Q)
             keep = z >= self.z_top - 1e-9
             if self.ceiling is not None:
                 keep &= z <= self.ceiling + 1e-9
-            rows = rows[keep]
-        if len(rows):
-            out[rows] = np.hstack(pair_masks(self.scene, Q[rows], pairs))
+        if keep.any():
+            out[keep] = np.hstack(pair_masks(self.scene, Q[keep], pairs))
+        if not keep.all():
+            out[~keep, k:] = pair_masks(self.scene, Q[~keep], pairs, exact=False)[1]
         return out
 
     def _on_dims(self, dims: list[int], f: object) -> np.ndarray:
