@@ -236,7 +236,7 @@ def pair_masks(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margi
     distance there, its bounding capsules' (:func:`clearance_bound`).
 
     The joint placements are computed once for all the pairs, and only for the geometries they name (an
-    obstacle's are fixed); the spheres, the capsules, then the boxes (:func:`_boxes_apart`) spare the exact distance
+    obstacle's are fixed); the spheres, the capsules, then the boxes (``_boxes_apart``) spare the exact distance
     where they are apart, and each
     configuration asks coal for its candidate pairs in turn (one placement of the geometries per configuration). A
     pair of two shapes fixed to the world (the robot's base and an obstacle) is asked once: its distance is the
