@@ -92,6 +92,41 @@ def test_a_changed_job_is_a_new_key(tmp_path: Path) -> None:
     assert not set(old) & set(new)
 
 
+def _box_stl(path: Path, half: float) -> None:
+    """An ASCII STL of a closed cube of half-side ``half`` [m], written here (twelve triangles)."""
+    v = [(x, y, z) for x in (-half, half) for y in (-half, half) for z in (-half, half)]
+    faces = [(0, 2, 1), (1, 2, 3), (4, 5, 6), (5, 7, 6), (0, 1, 4), (1, 5, 4), (2, 6, 3), (3, 6, 7), (0, 4, 2),
+             (2, 4, 6), (1, 3, 5), (3, 7, 5)]  # fmt: skip
+    body = "".join("facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in
+                   (v[i] for i in f)) + "endloop\nendfacet\n" for f in faces)  # fmt: skip
+    path.write_text(f"solid box\n{body}endsolid box\n")
+
+
+def test_the_key_digests_the_cell_and_its_meshes_and_each_varied_file(tmp_path: Path) -> None:
+    """A rerun after a mesh is edited plans again (the key holds the triangles, not the file's name); with the cell
+    varied, an edit of one cell's mesh changes the keys of that cell's variants only."""
+    for name in ("a", "b"):
+        _box_stl(tmp_path / f"{name}.stl", 0.02)
+        (tmp_path / f"{name}.yaml").write_text(f"obstacles:\n  - {{name: crate, shape: mesh, file: {name}.stl, "
+                                               "xyz: [0.0, 0.45, -0.1]}\n")  # fmt: skip
+    job = JOB.read_text().replace("start: feeder", "cell: a.yaml\nstart: feeder")
+    (tmp_path / "job.yaml").write_text(job)
+    (tmp_path / "one.yaml").write_text("job: job.yaml\nvary:\n  speed: [60, 80]\n")
+    (tmp_path / "two.yaml").write_text("job: job.yaml\nvary:\n  cell: [a.yaml, b.yaml]\n  speed: [60, 80]\n")
+
+    def keys(name: str) -> list[str]:
+        return [v.key for v in load_spec(tmp_path / name).variants()]
+
+    one, two = keys("one.yaml"), keys("two.yaml")
+    _box_stl(tmp_path / "b.stl", 0.03)  # b's mesh grows: the variants on cell b only
+    assert keys("one.yaml") == one
+    again = keys("two.yaml")
+    assert again[:2] == two[:2] and not set(again[2:]) & set(two)
+    _box_stl(tmp_path / "a.stl", 0.025)  # the job's own cell's mesh: every key
+    assert not set(keys("one.yaml")) & set(one)
+    assert keys("two.yaml")[2:] == again[2:] and not set(keys("two.yaml")[:2]) & set(two)
+
+
 def test_sobol_samples_are_seeded_scrambled_and_inside_the_ranges(tmp_path: Path) -> None:
     text = (f"job: {JOB}\nvary:\n  base.xyz: {{from: [-10, -20, 0], to: [10, 20, 0], steps: [5, 5, 1]}}\n"
             "  speed: [70, 100]\nsamples: 16\nseed: SEED\n")  # fmt: skip

@@ -22,8 +22,10 @@ points of a scrambled Sobol sequence (``scipy.stats.qmc``, seeded) over every ra
 crossed with the lists. The count is known before any variant is made and refused above
 :data:`~scara_pin.limits.MAX_SWEEP_VARIANTS`.
 
-Each variant has a content key (:attr:`Variant.key`): a digest of what its plan depends on (the job's text and the
-files it names, the robot's description, the values, this package's version). A rerun skips the keys already
+Each variant has a content key (:attr:`Variant.key`): a digest of what its plan depends on (the job's text, the
+files it names by content: its points' bytes, its cell's shapes with a mesh's triangles, a varied file's each; the
+robot's description; the values; the planner: this package's version and planning sources, the solvers' versions,
+as the plan cache's). A rerun skips the keys already
 answered (:mod:`~scara_pin.sweep.store`).
 """
 
@@ -34,7 +36,7 @@ import itertools
 import json
 import math
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +50,8 @@ FORMAT = "scara-pin sweep 1"
 KEYS = ("format", "job", "vary", "samples", "seed", "timeout", "acceleration")
 """The top-level keys of a sweep file."""
 _RANGE_KEYS = ("from", "to", "steps")
+_FILE_KEYS = ("points", "cell")
+"""The job's keys that name a file: a varied one keys each variant by its file's content."""
 _KEY_DIGITS = 32
 """Hex digits of a variant's key (128 bits of SHA-256)."""
 
@@ -108,7 +112,8 @@ class SweepSpec:
         seed: the Sobol sequence's scrambling seed.
         timeout: [s] a variant's planning time limit, or None.
         robots: the robot recipes by the sweep's value (the job's own robot when ``robot`` is not varied).
-        digest: SHA-256 of what every variant shares (job text, the files it names, the robots, the version).
+        digest: SHA-256 of what every variant shares (job text, the files it names, the planner).
+        files: a varied file's digest (its content, as the job reads it) by ``key=value``.
     """
 
     path: Path
@@ -120,6 +125,7 @@ class SweepSpec:
     timeout: float | None
     robots: Mapping[str, RobotRecipe]
     digest: str
+    files: Mapping[str, str] = field(default_factory=dict)
 
     @property
     def columns(self) -> tuple[str, ...]:
@@ -151,7 +157,8 @@ class SweepSpec:
         """The content key of a variant with these values (module docstring)."""
         robot = dict(values).get("robot") or next(iter(self.robots))  # the job's own robot when not varied
         recipe = self.robots.get(str(robot))
-        text = json.dumps([self.digest, recipe.digest if recipe else "", list(values)], sort_keys=True,
+        files = [self.files.get(_file_key(k, v), "") for k, v in values if k in _FILE_KEYS]
+        text = json.dumps([self.digest, recipe.digest if recipe else "", list(values), *files], sort_keys=True,
                           separators=(",", ":"), allow_nan=False)  # fmt: skip
         return hashlib.sha256(text.encode("utf-8")).hexdigest()[:_KEY_DIGITS]
 
@@ -202,6 +209,7 @@ def load_spec(path: str | Path) -> SweepSpec:
     from ..errors import YamlError
     from ..job import KEYS as JOB_KEYS
     from ..job import Job
+    from ..job.cache import planner_digest
 
     path = Path(path)
     text = read_text(path, "sweep file", MAX_JOB_BYTES)
@@ -251,12 +259,14 @@ def load_spec(path: str | Path) -> SweepSpec:
     if not all(isinstance(n, str) and n for n in names):
         raise fail("vary robot: robot names, configuration folders or URDF files")
     robots = {n: _recipe(n, path.parent, acceleration, fail) for n in names}
-    files = [f for f in (job.points_file, job.cell) if f is not None]
-    shared = {"format": FORMAT, "version": _version(), "job": _sha(job_text.encode()),
-              "files": {str(f.name): _sha(read_bytes(f, "file", MAX_DOCUMENT_BYTES)) for f in files}}  # fmt: skip
+    shared = {"format": FORMAT, "planner": planner_digest(), "job": _sha(job_text.encode()),
+              "files": _files(job, skip=checked)}  # a varied file is in its own variants' keys (below)
+    files = {_file_key(key, value): _sha(json.dumps(_files(Job.load(job_path, {key: value}, text=job_text))).encode())
+             for key in checked if key in _FILE_KEYS and isinstance(checked[key], list)
+             for value in checked[key]}  # fmt: skip
     spec = SweepSpec(path=path, job=job_path, job_text=job_text, vary=checked, samples=samples, seed=seed or 0,
                      timeout=None if timeout is None else float(timeout), robots=robots,
-                     digest=_sha(json.dumps(shared, sort_keys=True).encode()))  # fmt: skip
+                     digest=_sha(json.dumps(shared, sort_keys=True).encode()), files=files)  # fmt: skip
     check_count(f"variants of sweep {path}", spec.count, MAX_SWEEP_VARIANTS, "vary fewer values, or sample: samples: N")
     head = next(spec.variants())
     Job.load(job_path, head.overrides(), text=job_text)  # a value the job refuses: refused now, not per variant
@@ -347,7 +357,22 @@ def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def _version() -> str:
-    from .._version import __version__
+def _file_key(key: str, value: Any) -> str:
+    return f"{key}={json.dumps(value, sort_keys=True)}"
 
-    return __version__
+
+def _files(job: Any, skip: Any = ()) -> dict[str, str]:
+    """The digests of the files a job reads: its points' bytes, its cell's content (a mesh's triangles included)."""
+    from ..cell import load_cell
+    from ..errors import ScaraError
+    from ..job.cache import cell_digest
+
+    out = {}
+    if job.points_file is not None and "points" not in skip:
+        out["points"] = _sha(read_bytes(job.points_file, "points file", MAX_DOCUMENT_BYTES))
+    if job.cell is not None and "cell" not in skip:
+        try:
+            out["cell"] = cell_digest(load_cell(job.cell))
+        except ScaraError as exc:
+            raise InvalidInputError(f"{job.path}: cell {job.cell}: {exc}") from None
+    return out
