@@ -14,23 +14,45 @@ raise, so a swallowed one is not lost:
 
 The record is process-wide, as signals are; it is cleared when :func:`kept` starts. Outside :func:`kept`
 (a library user's own program) nothing is installed and :func:`raise_pending` never raises.
+
+A time limit is the same kind of interruption, kept by the thread that set it (a sweep's variant on a Dask worker
+runs in a worker's thread, where no alarm signal reaches): within :func:`time_limit`, :func:`check_time` raises
+:class:`TimeLimit` once the time is up. The planners call it where a stop is cheap (before each solver call, each
+step of a job), so a computation past its limit stops within one solver call.
 """
 
 from __future__ import annotations
 
 import signal
 import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
 
-__all__ = ["Terminated", "handled", "kept", "raise_pending"]
+__all__ = ["Terminated", "TimeLimit", "check_time", "handled", "kept", "raise_pending", "time_limit"]
 
 _received: list[int] = []  # the signals received while a command runs, in order
+_limit = threading.local()  # .at: (the perf_counter time past which check_time raises, the limit) or None
 
 
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised like Ctrl-C so that the same clean-up runs (temporary files removed)."""
+
+
+class TimeLimit(Exception):
+    """A computation past the time limit of :func:`time_limit` (raised by :func:`check_time`).
+
+    Attributes:
+        limit: [s] the limit.
+    """
+
+    def __init__(self, limit: float) -> None:
+        super().__init__(limit)
+        self.limit = limit
+
+    def __str__(self) -> str:
+        return f"past the time limit of {self.limit:g} s"
 
 
 def _raise(signum: int) -> None:
@@ -81,3 +103,29 @@ def raise_pending() -> None:
 def handled(signum: int = signal.SIGINT) -> None:
     """Forget the received ``signum`` signals: the command handled them (a server stopped by Ctrl-C)."""
     _received[:] = [s for s in _received if s != signum]
+
+
+@contextmanager
+def time_limit(seconds: float | None) -> Iterator[None]:
+    """Within: :func:`check_time` raises :class:`TimeLimit` once ``seconds`` have passed, in this thread.
+
+    None: no limit of its own; an outer limit that ends sooner stays in force.
+    """
+    outer = getattr(_limit, "at", None)
+    if seconds is not None and (outer is None or time.perf_counter() + seconds < outer[0]):
+        _limit.at = (time.perf_counter() + seconds, seconds)
+    try:
+        yield
+    finally:
+        _limit.at = outer
+
+
+def check_time() -> None:
+    """Raise :class:`TimeLimit` if this thread's :func:`time_limit` has passed; else nothing (cheap: a clock read).
+
+    Raises:
+        TimeLimit: the time is up.
+    """
+    at = getattr(_limit, "at", None)
+    if at is not None and time.perf_counter() > at[0]:
+        raise TimeLimit(at[1])

@@ -357,6 +357,46 @@ def test_a_variant_past_its_time_limit_is_a_timeout_row(tmp_path: Path) -> None:
     assert rows["status"].tolist() == ["timeout"] and "time limit" in rows["reason"][0]
 
 
+def test_a_time_limit_stops_a_move_inside_its_planning() -> None:
+    """The limit reaches inside one move (a worker's task runs in a thread no alarm signal reaches): a jump round a
+    post (the search on the lattice, IPOPT solves) stopped at its first check, long before the move is planned in
+    full; an outer limit that ends sooner stays in force; another thread is not limited."""
+    import threading
+
+    from scara_pin import load_robot
+    from scara_pin.cell import Cell, Obstacle, Shape
+    from scara_pin.motion.jump import jump_move
+    from scara_pin.signals import TimeLimit, check_time, time_limit
+
+    robot = load_robot("default")
+    start = np.array([0.2608695652173913, -0.1525, -0.0875, 0.0])  # the standard cycle's, a post in its way
+    post = Obstacle("post", Shape("cylinder", (0.02, 0.6), np.array([0.306, -0.052, 0.0]), np.zeros(3)))
+    cell = Cell((post,), 0.002)
+    clock = time.perf_counter()
+    with pytest.raises(TimeLimit, match="past the time limit of 0 s"), time_limit(0.0):
+        jump_move(robot, start, start + [0, 0.305, 0, 0], cell=cell)
+    stopped = time.perf_counter() - clock
+    clock = time.perf_counter()
+    jump_move(robot, start, start + [0, 0.305, 0, 0], cell=cell)  # no limit in force any more
+    assert stopped < (time.perf_counter() - clock) / 3
+    with time_limit(0.0), time_limit(60.0), pytest.raises(TimeLimit, match="of 0 s"):
+        check_time()
+    elsewhere: list[BaseException] = []
+
+    def probe() -> None:
+        try:
+            check_time()
+        except BaseException as exc:  # noqa: BLE001 - recorded for the assertion below
+            elsewhere.append(exc)
+
+    with time_limit(0.0):
+        thread = threading.Thread(target=probe)
+        thread.start()
+        thread.join()
+    assert not elsewhere
+    check_time()  # none in force
+
+
 def test_a_urdf_robot_travels_as_its_text_and_plans_as_the_configured_one(tmp_path: Path) -> None:
     """``robot: [default, default.urdf]``: the URDF's text goes to the worker (a Robot does not pickle), with the
     sweep's acceleration limits; the same robot gives the same total by either route."""

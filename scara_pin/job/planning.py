@@ -49,7 +49,7 @@ from ..errors import InvalidInputError, JobFileError, ScaraError
 from ..motion.payload import Payload, PayloadLike, as_payload, with_payload
 from ..motion.polynomial import PolynomialPiece
 from ..motion.trajectory import Piece, Trajectory
-from ..signals import raise_pending
+from ..signals import check_time, raise_pending
 from .cache import FORMAT as CACHE_FORMAT
 from .cache import PlanStore, built, cell_digest, decode_trajectory, encode_trajectory, move_key, robot_digest
 from .results import JobResult, LimitShare, PlacedBox, PlanningStats, StepResult
@@ -549,6 +549,7 @@ def plan_job(job: JobSpec, robot: RobotModel, *, progress: Callable[[int, int], 
             t += planned.duration
             q, at, pose = np.asarray(action.q, dtype=float), action.target, action.pose
         raise_pending()  # a signal the solver swallowed stops the job here
+        check_time()  # and so does a time limit (a sweep's variant)
         if progress is not None:
             progress(k + 1, n)
     if not pieces:

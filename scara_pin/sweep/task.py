@@ -12,8 +12,9 @@ total, the parts per hour (and in the steady state), the binding limit, the clos
 time and the worker. An infeasible variant (a place out of reach, a move the planner cannot make) is a row, not a
 failure; an invalid one (a value the job file refuses) or a bug is ``failed`` with the reason.
 
-The time limit is checked between the job's steps (``Job.plan``'s progress): a variant past it stops at the next
-step and is ``timeout`` (a single move of the planner is not interrupted).
+The time limit (:func:`~scara_pin.signals.time_limit`, this task's thread) is checked between the job's steps and
+inside a move's planning before each solver call and each search on the lattice: a variant past it stops there and
+is ``timeout`` (one call into IPOPT is not interrupted: the overrun is at most one solve).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InfeasibleError, ScaraError
+from ..signals import TimeLimit, time_limit
 
 if TYPE_CHECKING:
     from ..job import Job, JobResult
@@ -63,10 +65,6 @@ class Recipe:
     timeout: float | None = None
 
 
-class _Timeout(Exception):
-    """A variant past its time limit (raised between two steps of its job)."""
-
-
 @functools.lru_cache(maxsize=_ROBOTS_KEPT)
 def robot_of(recipe: RobotRecipe) -> RobotModel:
     """The robot of a recipe, made once per worker process and kept (the few most recent)."""
@@ -91,6 +89,11 @@ def run_variant(recipe: Recipe, variant: Variant) -> dict[str, Any]:
     start = time.perf_counter()
     values = dict(variant.values)
     row: dict[str, Any] = {**values, "variant": variant.index, "key": variant.key, "status": "ok", "reason": ""}
+    steps = [0, 0]  # (steps planned, steps): how far a variant past its time limit got
+
+    def count(done: int, total: int) -> None:
+        steps[:] = done, total
+
     try:
         robots = dict(recipe.robots)
         robot = robot_of(robots[variant.robot if variant.robot is not None else recipe.default_robot])
@@ -98,10 +101,12 @@ def run_variant(recipe: Recipe, variant: Variant) -> dict[str, Any]:
         if variant.robot is not None:
             overrides["robot"] = robot.name
         job = job_of(recipe.job, recipe.text).replace(overrides)
-        result = job.plan(robot, progress=_deadline(start, recipe.timeout), cache=False)
+        with time_limit(recipe.timeout):
+            result = job.plan(robot, progress=count, cache=False)
         row.update(row_of(result))
-    except _Timeout as exc:
-        row.update(status="timeout", reason=str(exc))
+    except TimeLimit as exc:
+        row.update(status="timeout", reason=f"{exc}, {steps[0]} of {steps[1]} moves and dwells planned" if steps[1]
+                   else f"{exc}, in its first move")  # fmt: skip
     except InfeasibleError as exc:
         row.update(status="infeasible", reason=_one_line(exc))
     except ScaraError as exc:
@@ -133,17 +138,6 @@ def row_of(result: JobResult) -> dict[str, Any]:
         "closest_distance": float("nan") if clearance is None else clearance.distance,
         "cell_cost": _or_nan(result.cell_cost),
     }
-
-
-def _deadline(start: float, timeout: float | None) -> Any:
-    if timeout is None:
-        return None
-
-    def check(done: int, total: int) -> None:
-        if time.perf_counter() - start > timeout:
-            raise _Timeout(f"past the time limit of {timeout:g} s after {done} of {total} steps")
-
-    return check
 
 
 def _or_nan(value: float | None) -> float:

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from ...signals import check_time
 from .problem import NODES, ConstraintPoint, Problem, propagate
 from .rows import DISTANCE_SCALE, RESOLVE_ITERATIONS, DistanceRow, Rows
 from .types import JumpOptions
@@ -211,6 +212,7 @@ class Transcription:
             kwargs["lam_x0"] = lam_x
         if lam_g is not None:
             kwargs["lam_g0"] = lam_g
+        check_time()  # a sweep's time limit: stopped before a solver call, not in one
         sol = self.solver(**kwargs)
         stats = self.solver.stats()
         return {"x": np.array(sol["x"]).ravel(), "lam_x": np.array(sol["lam_x"]).ravel(),

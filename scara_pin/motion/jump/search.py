@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ...cell.sweep import clear_mask, pair_joints, pair_masks
+from ...signals import check_time
 
 if TYPE_CHECKING:
     from ...cell import Scene
@@ -187,6 +188,7 @@ class _Lattice:
     # ------------------------------------------------------------------------------------------ the lattice
     def build(self, steps: tuple[float, float]) -> None:
         """The lattice at ``steps`` and which of its nodes are valid (module docstring)."""
+        check_time()
         dof = self.robot.dof
         self.axes: list[np.ndarray] = []
         for j in range(dof):
@@ -355,6 +357,7 @@ class _Lattice:
     def _way(self, start: tuple[int, ...], goal: tuple[int, ...], penalty: np.ndarray | None) -> Way | None:
         from scipy.sparse.csgraph import dijkstra
 
+        check_time()
         graph = self._graph(penalty)
         s = int(np.ravel_multi_index(start, self.shape))
         g = int(np.ravel_multi_index(goal, self.shape))
