@@ -6,14 +6,17 @@ reported, not enforced (tests/test_sweep.py checks that the rows are the same; t
 The sweep: docs/examples/tray/frames.yaml (the tray's first two places in a frame, then home: 2 jumps and a straight
 move to plan, about 1 s a variant on an idle core), its base moved over a grid of N placements in x (millimetres).
 
-1. Serial: ``sweep(spec, workers=0)``, after one variant planned to warm the process (imports, the robot): the
-   wall time T0 (the best of ``--rounds`` runs, 2 by default; so is every time below), and a variant's planning
-   time t = T0 / N.
+1. Serial: ``sweep(spec, workers=0)``, after one variant planned to warm the process (imports, the robot).
 2. For W = 1 .. the cores: a ``LocalCluster`` of W single-threaded worker processes with the sweep's quiet settings
-   (its start-up timed apart), each worker warmed (the package imported, the robot made, one variant planned), then
-   the same sweep: the wall time T_W, the speed-up T0 / T_W and the parallel efficiency per worker T0 / (W T_W)
-   (the issue's promise: >= 0.85); with W = 1, Dask's overhead per variant (T_1 - T0) / N against t (< 5 %).
-3. Dask's own cost: 2,000 trivial tasks through the 1-worker cluster at once (the scheduler's tasks per second),
+   (its start-up timed apart), each worker warmed (the package imported, the robot made, one variant planned).
+3. Rounds (``--rounds``, 3 by default): in each, the serial sweep, then the same sweep on every cluster, one
+   after the other, so that each round's runs share the machine's state; a round gives the speed-up T0 / T_W and the
+   parallel efficiency per worker T0 / (W T_W) (the issue's promise: >= 0.85), and with W = 1 Dask's overhead per
+   variant (T_1 - T0) / N against a variant's planning time T0 / N (< 5 %). The medians over the rounds are printed,
+   and beside them the mean planning time a row reports (its own clock, in the worker): when the workers slow each
+   other down (two planners on two cores beside the scheduler and this process), it grows with W, and that part of
+   a lost efficiency is the machine's, not Dask's.
+4. Dask's own cost: 2,000 trivial tasks through the 1-worker cluster at once (the scheduler's tasks per second),
    and a row's bytes in Parquet (the serial rows copied to about 10,000, every key and number made distinct).
 
 Machines shared with other work give noisy numbers: the load average is printed before and after. This process
@@ -29,7 +32,6 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # 
     os.environ.setdefault(_name, "1")
 
 import argparse  # noqa: E402
-import math  # noqa: E402
 import shutil  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -60,12 +62,15 @@ def _trivial() -> None:
 
 
 def main() -> int:
+    import contextlib
+    import statistics
+
     from scara_pin.sweep import open_client, sweep
     from scara_pin.sweep.engine import cores
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--variants", type=int, default=16)
-    parser.add_argument("--rounds", type=int, default=2, help="each run this many times, the best kept")
+    parser.add_argument("--variants", type=int, default=24)
+    parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (serial, 1, 2, ... workers)")
     parser.add_argument("--workers", type=int, default=cores(), help="the largest cluster (default: every core)")
     args = parser.parse_args()
     n = args.variants
@@ -77,41 +82,51 @@ def main() -> int:
 
         loaded = load_spec(spec)
         run_variant(recipe_of(loaded), next(loaded.variants()))  # warm this process
-        t0 = math.inf
-        for _ in range(args.rounds):  # the best of the rounds: the least disturbed by the machine's other work
-            start = time.perf_counter()
-            serial = sweep(spec, workers=0)
-            t0 = min(t0, time.perf_counter() - start)
-        assert (serial["status"] == "ok").all(), serial[["status", "reason"]]
-        per = t0 / n
-        print(f"\n{n} variants of {JOB.relative_to(REPO)} (base.xyz over {n} placements)")
-        print(f"serial    {t0:8.2f} s   {per:.3f} s per variant")
-        header = "| run | start-up [s] | wall [s] | variants/s | speed-up | efficiency per worker |"
-        lines = [header, "|---|---|---|---|---|---|",
-                 f"| serial (`--workers 0`) | - | {t0:.2f} | {n / t0:.2f} | 1.00 | - |"]  # fmt: skip
-        overhead = None
-        for w in range(1, args.workers + 1):
-            begin = time.perf_counter()
-            with open_client(workers=w) as client:
-                up = time.perf_counter() - begin
-                _warm(client, spec)
-                tw = math.inf
-                for _ in range(args.rounds):
+        sizes = list(range(1, args.workers + 1))
+        with contextlib.ExitStack() as stack:
+            clients, ups = {}, {}
+            for w in sizes:
+                begin = time.perf_counter()
+                clients[w] = stack.enter_context(open_client(workers=w))
+                ups[w] = time.perf_counter() - begin
+                _warm(clients[w], spec)
+            walls: dict[int, list[float]] = {w: [] for w in [0, *sizes]}
+            planning: dict[int, list[float]] = {w: [] for w in [0, *sizes]}
+            serial = None
+            for r in range(args.rounds):
+                for w in [0, *sizes]:
                     start = time.perf_counter()
-                    rows = sweep(spec, client)
-                    tw = min(tw, time.perf_counter() - start)
+                    rows = sweep(spec, workers=0) if w == 0 else sweep(spec, clients[w])
+                    walls[w].append(time.perf_counter() - start)
+                    planning[w].append(float(rows["planning_time"].mean()))
+                    if serial is None:
+                        serial = rows
+                        assert (serial["status"] == "ok").all(), serial[["status", "reason"]]
                     assert (rows["total"].to_numpy() == serial["total"].to_numpy()).all()
-                if w == 1:
-                    overhead = (tw - t0) / n
-                    k = 2000
-                    start = time.perf_counter()
-                    client.gather([client.submit(_trivial, pure=False) for _ in range(k)])
-                    tasks = k / (time.perf_counter() - start)
-            eff = t0 / (w * tw)
-            print(f"{w} worker(s) start-up {up:5.2f} s, sweep {tw:8.2f} s: speed-up {t0 / tw:.2f}, "
-                  f"efficiency {eff:.2f}",
-                  flush=True)
-            lines.append(f"| {w} worker(s) | {up:.1f} | {tw:.2f} | {n / tw:.2f} | {t0 / tw:.2f} | {eff:.2f} |")
+                print(f"round {r + 1}: " + ", ".join(f"{w or 'serial'}: {walls[w][-1]:.2f} s" for w in walls),
+                      flush=True)
+            k = 2000
+            start = time.perf_counter()
+            clients[1].gather([clients[1].submit(_trivial, pure=False) for _ in range(k)])
+            tasks = k / (time.perf_counter() - start)
+        assert serial is not None
+        t0s = walls[0]
+        t0 = statistics.median(t0s)
+        per = t0 / n
+        print(f"\n{n} variants of {JOB.relative_to(REPO)} (base.xyz over {n} placements), {args.rounds} rounds")
+        header = ("| run | start-up [s] | wall [s] | variants/s | speed-up | efficiency per worker "
+                  "| a row's planning time [s] |")
+        lines = [header, "|---|---|---|---|---|---|---|",
+                 f"| serial (`--workers 0`) | - | {t0:.2f} | {n / t0:.2f} | 1.00 | - "
+                 f"| {statistics.median(planning[0]):.3f} |"]  # fmt: skip
+        for w in sizes:
+            tw = statistics.median(walls[w])
+            speed = statistics.median(a / b for a, b in zip(t0s, walls[w]))
+            eff = statistics.median(a / (w * b) for a, b in zip(t0s, walls[w]))
+            lines.append(f"| {w} worker(s) | {ups[w]:.1f} | {tw:.2f} | {n / tw:.2f} | {speed:.2f} | {eff:.2f} "
+                         f"| {statistics.median(planning[w]):.3f} |")  # fmt: skip
+        overhead = statistics.median((b - a) / n for a, b in zip(t0s, walls[1]))
+        share = statistics.median((b - a) / a for a, b in zip(t0s, walls[1]))  # of a variant's time, paired
         from scara_pin.sweep import ResultStore, row_schema
 
         copies = 10_000 // n + 1  # a part file of about 10,000 rows (each key made distinct): bytes per row
@@ -127,10 +142,9 @@ def main() -> int:
         store.flush()
         rows_written = copies * n
         size = sum(p.stat().st_size for p in store.parts())
-        assert overhead is not None
         print("\n" + "\n".join(lines))
         print(f"\nDask's overhead per variant (1 worker against serial): {overhead * 1e3:.1f} ms = "
-              f"{100 * overhead / per:.1f} % of a variant's {per:.3f} s")  # fmt: skip
+              f"{100 * share:.1f} % of a variant's {per:.3f} s (medians of the rounds' pairs)")  # fmt: skip
         print(f"trivial tasks through the scheduler, 2,000 at once: {tasks:,.0f} tasks/s "
               f"({1e3 / tasks:.2f} ms a task)")  # fmt: skip
         print(f"Parquet: {size:,} bytes for {rows_written:,} rows in one part file ({size / rows_written:.0f} bytes "
