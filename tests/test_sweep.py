@@ -178,6 +178,25 @@ def test_a_local_cluster_gives_the_serial_rows(serial: pd.DataFrame, client, tmp
     assert_same_rows(disk.sort_values("variant").reset_index(drop=True), serial)
 
 
+def test_variants_batched_per_task_give_the_serial_rows(serial: pd.DataFrame, client, tmp_path: Path) -> None:  # noqa: ANN001
+    """``per_task=5``: the 12 variants in 3 tasks (5, 5, 2), each row as the serial run's, every variant once."""
+    from distributed import get_task_stream
+
+    with get_task_stream(client) as stream:
+        rows = sweep(SPEC, client, out=tmp_path / "r", per_task=5)
+    assert_same_rows(rows, serial)
+    assert sorted(on_disk(tmp_path / "r")["key"]) == sorted(serial["key"])
+    assert len([t for t in stream.data if str(t["key"]).startswith("sweep-")]) == 3
+
+
+def test_a_bad_per_task_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["sweep", str(SPEC), "--out", str(tmp_path / "r"), "--per-task", "0"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("error: --per-task") and err.count("\n") == 1 and not (tmp_path / "r").exists()
+    with pytest.raises(scara_pin.errors.ParameterError, match="per_task"):
+        sweep(SPEC, workers=0, per_task=2.5)  # type: ignore[arg-type]
+
+
 def test_the_local_workers_are_quiet_and_single_threaded(client) -> None:  # noqa: ANN001
     import dask
 

@@ -30,15 +30,16 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         value = getattr(args, name)
         if value is not None and not 0 < value < math.inf:
             raise ParameterError(f"--{name.replace('_', '-')}", value, "must be > 0", "s")
-    if args.batch < 1:
-        raise ParameterError("--batch", args.batch, "must be >= 1")
+    for name in ("batch", "per_task"):
+        if getattr(args, name) < 1:
+            raise ParameterError(f"--{name.replace('_', '-')}", getattr(args, name), "must be >= 1")
     spec = load_spec(args.file)
     check_outputs({"--plot": args.plot}, {"the job": [str(spec.job)]}, figures=("--plot",))  # nor over the job
     start = time.perf_counter()
     todo: list[Any] = []
     with _Bar(spec.count) as bar:
-        common = {"out": args.out, "timeout": args.timeout, "batch": args.batch, "pending": todo,
-                  "progress": bar.update}  # fmt: skip
+        common = {"out": args.out, "timeout": args.timeout, "batch": args.batch, "per_task": args.per_task,
+                  "pending": todo, "progress": bar.update}  # fmt: skip
         if args.workers == 0:
             rows = sweep(spec, None, workers=0, **common)
         else:
@@ -132,6 +133,9 @@ def register(sub: Any) -> None:
                    help="how long an existing scheduler is waited for (default 10 s)")  # fmt: skip
     g.add_argument("--timeout", type=number_type("--timeout"), metavar="S",
                    help="a variant's time limit (replaces the sweep file's timeout:)")  # fmt: skip
+    g.add_argument("--per-task", type=int, default=1, metavar="K",
+                   help="variants planned in one task (default 1; more: fewer tasks for a large cluster's scheduler; "
+                   "a killed worker's task runs again whole)")  # fmt: skip
     g.add_argument("--batch", type=int, default=256, metavar="N",
                    help="rows per Parquet part file (default 256; a part is also written every 30 s)")  # fmt: skip
     g = p.add_argument_group("outputs")

@@ -11,11 +11,14 @@
   --scheduler-file``; what dask-jobqueue and dask-mpi write), ``DASK_SCHEDULER_ADDRESS``, or a ``Client`` handed
   in: SLURM (dask-jobqueue), Kubernetes (dask-kubernetes) and the rest without code here.
 
-The client keeps a bounded window of variants in flight (a few per worker thread: 10^6 futures at once would
-burden the scheduler), writes each finished row through the store, and resubmits nothing itself: a worker that
-dies takes its tasks with it and the scheduler runs them elsewhere (a task whose workers die three times is a
-``failed`` row). Rows are written by the client only, once per key. Ctrl-C writes every finished row, cancels the
-rest and stops (a rerun runs what is left).
+A task is one variant, or ``per_task`` variants in a row (:func:`~scara_pin.sweep.task.run_batch`): on a large
+cluster with short variants the scheduler's cost per task (milliseconds) is what batching divides; the price is
+that a killed worker's batch runs again whole and its rows reach the client together. The client keeps a bounded
+window of tasks in flight (a few per worker thread: 10^6 futures at once would burden the scheduler), writes each
+finished row through the store, and resubmits nothing itself: a worker that dies takes its tasks with it and the
+scheduler runs them elsewhere (a task whose workers die three times is a ``failed`` row for each of its variants).
+Rows are written by the client only, once per key. Ctrl-C writes every finished row, cancels the rest and stops (a
+rerun runs what is left).
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError
-from .task import Recipe, run_variant
+from .task import Recipe, run_batch, run_variant
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -116,8 +119,10 @@ def open_client(workers: int | None = None, scheduler: str | None = None, schedu
 
 
 def run_variants(recipe: Recipe, variants: list[Variant], store: ResultStore, client: Client | None,
-                 progress: Progress | None = None) -> None:  # fmt: skip
+                 progress: Progress | None = None, per_task: int = 1) -> None:  # fmt: skip
     """Run ``variants`` (in this process when ``client`` is None) and add each row to ``store`` as it finishes.
+
+    ``per_task`` variants make one task on a cluster (module docstring).
 
     Ctrl-C (``KeyboardInterrupt``), SIGTERM or any error (a scheduler lost): the finished rows are written
     (:meth:`ResultStore.flush`), the futures cancelled, and the interruption or error raised again.
@@ -131,7 +136,7 @@ def run_variants(recipe: Recipe, variants: list[Variant], store: ResultStore, cl
                 if progress is not None:
                     progress(n + 1, len(variants))
         else:
-            _on_cluster(recipe, variants, store, client, progress)
+            _on_cluster(recipe, variants, store, client, progress, per_task)
     except BaseException as exc:  # Ctrl-C, SIGTERM (Terminated), a scheduler lost: the finished rows are written
         if isinstance(exc, KeyboardInterrupt):
             import signal
@@ -145,20 +150,22 @@ def run_variants(recipe: Recipe, variants: list[Variant], store: ResultStore, cl
 
 
 def _on_cluster(recipe: Recipe, variants: list[Variant], store: ResultStore, client: Client,
-                progress: Progress | None) -> None:  # fmt: skip
+                progress: Progress | None, per_task: int) -> None:  # fmt: skip
     from distributed import as_completed
 
     run = uuid.uuid4().hex[:8]  # a task key per run: a result kept from an earlier run of this client is not reused
-    todo = iter(variants)
-    of: dict[str, Variant] = {}
+    todo = iter([variants[k:k + per_task] for k in range(0, len(variants), per_task)])
+    of: dict[str, list[Variant]] = {}
     flying = as_completed(loop=client.loop)
 
     def submit() -> bool:
-        v = next(todo, None)
-        if v is None:
+        batch = next(todo, None)
+        if batch is None:
             return False
-        future = client.submit(run_variant, recipe, v, key=f"sweep-{v.key}-{run}", pure=False)
-        of[str(future.key)] = v
+        key = f"sweep-{batch[0].key}-{run}"
+        future = (client.submit(run_variant, recipe, batch[0], key=key, pure=False) if per_task == 1 else
+                  client.submit(run_batch, recipe, batch, key=key, pure=False))  # fmt: skip
+        of[str(future.key)] = batch
         flying.add(future)
         return True
 
@@ -169,16 +176,18 @@ def _on_cluster(recipe: Recipe, variants: list[Variant], store: ResultStore, cli
     done = 0
     try:
         for future in flying:
-            v = of.pop(str(future.key))
+            batch = of.pop(str(future.key))
             try:
-                row = future.result()
+                rows = future.result()
+                rows = [rows] if per_task == 1 else rows
             except Exception as exc:  # the task never raises: its workers died (KilledWorker), a lost connection
                 reason = f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:2000]
-                row = {**dict(v.values), "variant": v.index, "key": v.key, "status": "failed", "reason": reason,
-                       "worker": ""}  # fmt: skip
+                rows = [{**dict(v.values), "variant": v.index, "key": v.key, "status": "failed", "reason": reason,
+                         "worker": ""} for v in batch]  # fmt: skip
             future.release()
-            store.add(row)
-            done += 1
+            for row in rows:
+                store.add(row)
+            done += len(rows)
             if progress is not None:
                 progress(done, len(variants))
             submit()

@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..errors import ParameterError
 from .engine import Progress, open_client, run_variants
 from .spec import SweepSpec, load_spec
 from .store import ResultStore, row_schema
@@ -28,7 +29,7 @@ def recipe_of(spec: SweepSpec) -> Recipe:
 
 def sweep(spec: SweepSpec | str | os.PathLike[str], client: Client | None = None, *, out: str | Path | None = None,
           workers: int | None = None, scheduler: str | None = None, scheduler_file: str | None = None,
-          timeout: float | None = None, batch: int = 256, progress: Progress | None = None,
+          timeout: float | None = None, batch: int = 256, per_task: int = 1, progress: Progress | None = None,
           pending: list[Any] | None = None) -> pd.DataFrame:  # fmt: skip
     """Plan every variant of a sweep (docs/sweep.md) and return one row per variant, in the sweep's order.
 
@@ -44,6 +45,8 @@ def sweep(spec: SweepSpec | str | os.PathLike[str], client: Client | None = None
         scheduler_file: an existing scheduler's file (``dask scheduler --scheduler-file``), when ``client`` is None.
         timeout: [s] a variant's time limit (replaces the file's ``timeout``).
         batch: rows per part file.
+        per_task: variants planned in one task on a cluster (1: a task each; more: fewer tasks for the scheduler of
+            a large cluster, a killed worker's batch run again whole; docs/sweep.md).
         progress: called with (variants finished, variants to run) after each.
         pending: if a list, the variants this call runs are put in it before they run (the command line's count).
 
@@ -52,6 +55,8 @@ def sweep(spec: SweepSpec | str | os.PathLike[str], client: Client | None = None
         ``status``, ``reason``, ``total``, ``parts_per_hour``, ``steady_parts_per_hour``, ``binding``,
         ``binding_share``, ``closest_pair``, ``closest_distance``, ``cell_cost``, ``planning_time``, ``worker``.
     """
+    if isinstance(per_task, bool) or not isinstance(per_task, int) or per_task < 1:
+        raise ParameterError("per_task", per_task, "must be a whole number >= 1")
     if not isinstance(spec, SweepSpec):
         spec = load_spec(Path(spec))
     recipe = recipe_of(spec)
@@ -65,10 +70,10 @@ def sweep(spec: SweepSpec | str | os.PathLike[str], client: Client | None = None
         pending[:] = todo
     if todo:
         if client is not None or workers == 0:
-            run_variants(recipe, todo, store, client, progress)
+            run_variants(recipe, todo, store, client, progress, per_task)
         else:
             with open_client(workers, scheduler, scheduler_file) as own:
-                run_variants(recipe, todo, store, own, progress)
+                run_variants(recipe, todo, store, own, progress, per_task)
     return store.rows([v.key for v in variants])
 
 

@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from ..model import RobotModel
     from .spec import RobotRecipe, Variant
 
-__all__ = ["ROW_COLUMNS", "STATUSES", "Recipe", "job_of", "robot_of", "row_of", "run_variant"]
+__all__ = ["ROW_COLUMNS", "STATUSES", "Recipe", "job_of", "robot_of", "row_of", "run_batch", "run_variant"]
 
 STATUSES = ("ok", "infeasible", "failed", "timeout")
 """A row's ``status``: planned; refused by the robot or the planner (the reason says why); an error; too long."""
@@ -116,6 +116,11 @@ def run_variant(recipe: Recipe, variant: Variant) -> dict[str, Any]:
     row["planning_time"] = time.perf_counter() - start
     row["worker"] = _worker()
     return row
+
+
+def run_batch(recipe: Recipe, variants: list[Variant]) -> list[dict[str, Any]]:
+    """Plan several variants in one task (``per_task``: fewer tasks for the scheduler), a row each, in order."""
+    return [run_variant(recipe, v) for v in variants]
 
 
 def row_of(result: JobResult) -> dict[str, Any]:
