@@ -9,13 +9,14 @@ move to plan, about 1 s a variant on an idle core), its base moved over a grid o
 1. Serial: ``sweep(spec, workers=0)``, after one variant planned to warm the process (imports, the robot).
 2. For W = 1 .. the cores: a ``LocalCluster`` of W single-threaded worker processes with the sweep's quiet settings
    (its start-up timed apart), each worker warmed (the package imported, the robot made, one variant planned).
-3. Rounds (``--rounds``, 3 by default): in each, the serial sweep, then the same sweep on every cluster, one
-   after the other, so that each round's runs share the machine's state; a round gives the speed-up T0 / T_W and the
-   parallel efficiency per worker T0 / (W T_W) (the issue's promise: >= 0.85), and with W = 1 Dask's overhead per
-   variant (T_1 - T0) / N against a variant's planning time T0 / N (< 5 %). The medians over the rounds are printed,
-   and beside them the mean planning time a row reports (its own clock, in the worker): when the workers slow each
-   other down (two planners on two cores beside the scheduler and this process), it grows with W, and that part of
-   a lost efficiency is the machine's, not Dask's.
+3. Rounds (``--rounds``, 3 by default): in each, the serial sweep, then the same sweep on every cluster, and on
+   the largest with ``--per-task`` variants a task (4 by default), one after the other, so that each round's runs
+   share the machine's state; a round gives the speed-up T0 / T_W and the parallel efficiency per worker
+   T0 / (W T_W) (the issue's promise: >= 0.85), and with W = 1 Dask's overhead per variant (T_1 - T0) / N against
+   a variant's planning time T0 / N (< 5 %). The medians over the rounds are printed, and beside them the mean
+   planning time a row reports (its own clock, in the worker): when the workers slow each other down (two planners
+   on two cores beside the scheduler and this process), it grows with W, and that part of a lost efficiency is the
+   machine's, not Dask's.
 4. Dask's own cost: 2,000 trivial tasks through the 1-worker cluster at once (the scheduler's tasks per second),
    and a row's bytes in Parquet (the serial rows copied to about 10,000, every key and number made distinct).
 
@@ -72,6 +73,7 @@ def main() -> int:
     parser.add_argument("--variants", type=int, default=24)
     parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (serial, 1, 2, ... workers)")
     parser.add_argument("--workers", type=int, default=cores(), help="the largest cluster (default: every core)")
+    parser.add_argument("--per-task", type=int, default=4, help="also the largest cluster with K variants a task")
     args = parser.parse_args()
     n = args.variants
     folder = Path(tempfile.mkdtemp(prefix="bench-sweep-"))
@@ -90,21 +92,23 @@ def main() -> int:
                 clients[w] = stack.enter_context(open_client(workers=w))
                 ups[w] = time.perf_counter() - begin
                 _warm(clients[w], spec)
-            walls: dict[int, list[float]] = {w: [] for w in [0, *sizes]}
-            planning: dict[int, list[float]] = {w: [] for w in [0, *sizes]}
+            runs = [0, *sizes, -1]  # -1: the largest cluster, --per-task variants a task
+            walls: dict[int, list[float]] = {w: [] for w in runs}
+            planning: dict[int, list[float]] = {w: [] for w in runs}
             serial = None
             for r in range(args.rounds):
-                for w in [0, *sizes]:
+                for w in runs:
                     start = time.perf_counter()
-                    rows = sweep(spec, workers=0) if w == 0 else sweep(spec, clients[w])
+                    rows = (sweep(spec, workers=0) if w == 0 else sweep(spec, clients[w]) if w > 0 else
+                            sweep(spec, clients[sizes[-1]], per_task=args.per_task))  # fmt: skip
                     walls[w].append(time.perf_counter() - start)
                     planning[w].append(float(rows["planning_time"].mean()))
                     if serial is None:
                         serial = rows
                         assert (serial["status"] == "ok").all(), serial[["status", "reason"]]
                     assert (rows["total"].to_numpy() == serial["total"].to_numpy()).all()
-                print(f"round {r + 1}: " + ", ".join(f"{w or 'serial'}: {walls[w][-1]:.2f} s" for w in walls),
-                      flush=True)
+                print(f"round {r + 1}: " + ", ".join(f"{w if w > 0 else 'serial' if w == 0 else 'batched'}: "
+                                                     f"{walls[w][-1]:.2f} s" for w in walls), flush=True)  # fmt: skip
             k = 2000
             start = time.perf_counter()
             clients[1].gather([clients[1].submit(_trivial, pure=False) for _ in range(k)])
@@ -119,11 +123,13 @@ def main() -> int:
         lines = [header, "|---|---|---|---|---|---|---|",
                  f"| serial (`--workers 0`) | - | {t0:.2f} | {n / t0:.2f} | 1.00 | - "
                  f"| {statistics.median(planning[0]):.3f} |"]  # fmt: skip
-        for w in sizes:
+        for w in [*sizes, -1]:
+            workers = w if w > 0 else sizes[-1]
             tw = statistics.median(walls[w])
             speed = statistics.median(a / b for a, b in zip(t0s, walls[w]))
-            eff = statistics.median(a / (w * b) for a, b in zip(t0s, walls[w]))
-            lines.append(f"| {w} worker(s) | {ups[w]:.1f} | {tw:.2f} | {n / tw:.2f} | {speed:.2f} | {eff:.2f} "
+            eff = statistics.median(a / (workers * b) for a, b in zip(t0s, walls[w]))
+            name = f"{w} worker(s)" if w > 0 else f"{workers} worker(s), {args.per_task} variants a task"
+            lines.append(f"| {name} | {ups[workers]:.1f} | {tw:.2f} | {n / tw:.2f} | {speed:.2f} | {eff:.2f} "
                          f"| {statistics.median(planning[w]):.3f} |")  # fmt: skip
         overhead = statistics.median((b - a) / n for a, b in zip(t0s, walls[1]))
         share = statistics.median((b - a) / a for a, b in zip(t0s, walls[1]))  # of a variant's time, paired
