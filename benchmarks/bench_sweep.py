@@ -16,7 +16,8 @@ move to plan, about 1 s a variant on an idle core), its base moved over a grid o
    a variant's planning time T0 / N (< 5 %). The medians over the rounds are printed, and beside them the mean
    planning time a row reports (its own clock, in the worker): when the workers slow each other down (two planners
    on two cores beside the scheduler and this process), it grows with W, and that part of a lost efficiency is the
-   machine's, not Dask's.
+   machine's, not Dask's. One more cluster of 1 worker runs with Dask's default worker settings instead of the quiet
+   ones (:data:`scara_pin.sweep.QUIET`): what quieting them is worth.
 4. Dask's own cost: 2,000 trivial tasks through the 1-worker cluster at once (the scheduler's tasks per second),
    and a row's bytes in Parquet (the serial rows copied to about 10,000, every key and number made distinct).
 
@@ -33,6 +34,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # 
     os.environ.setdefault(_name, "1")
 
 import argparse  # noqa: E402
+import contextlib  # noqa: E402
 import shutil  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -58,12 +60,23 @@ def _warm(client: object, spec_path: Path) -> None:
     client.run(run_variant, recipe, first)  # type: ignore[attr-defined]
 
 
+def _defaults_client(stack: contextlib.ExitStack) -> object:
+    """A 1-worker local cluster with Dask's default worker settings (profiler, ticks, memory trimming): the quiet
+    settings' effect."""
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    cluster = stack.enter_context(LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                               dashboard_address=":0", silence_logs=logging.ERROR))  # fmt: skip
+    return stack.enter_context(Client(cluster, set_as_default=False))
+
+
 def _trivial() -> None:
     return None
 
 
 def main() -> int:
-    import contextlib
     import statistics
 
     from scara_pin.sweep import open_client, sweep
@@ -92,23 +105,30 @@ def main() -> int:
                 clients[w] = stack.enter_context(open_client(workers=w))
                 ups[w] = time.perf_counter() - begin
                 _warm(clients[w], spec)
-            runs = [0, *sizes, -1]  # -1: the largest cluster, --per-task variants a task
+            begin = time.perf_counter()
+            clients[-2] = _defaults_client(stack)  # -2: one worker with Dask's default settings, not the quiet ones
+            ups[-2] = time.perf_counter() - begin
+            _warm(clients[-2], spec)
+            clients[-1], ups[-1] = clients[sizes[-1]], ups[sizes[-1]]  # -1: the largest, --per-task variants a task
+            runs = [0, *sizes, -1, -2]
+            label = {0: "serial", **{w: f"{w} worker(s)" for w in sizes}, -2: "1 worker, Dask's default settings",
+                     -1: f"{sizes[-1]} worker(s), {args.per_task} variants a task"}  # fmt: skip
+            workers_of = {**{w: w for w in sizes}, -1: sizes[-1], -2: 1}
             walls: dict[int, list[float]] = {w: [] for w in runs}
             planning: dict[int, list[float]] = {w: [] for w in runs}
             serial = None
             for r in range(args.rounds):
                 for w in runs:
                     start = time.perf_counter()
-                    rows = (sweep(spec, workers=0) if w == 0 else sweep(spec, clients[w]) if w > 0 else
-                            sweep(spec, clients[sizes[-1]], per_task=args.per_task))  # fmt: skip
+                    rows = (sweep(spec, workers=0) if w == 0 else
+                            sweep(spec, clients[w], per_task=args.per_task if w == -1 else 1))  # fmt: skip
                     walls[w].append(time.perf_counter() - start)
                     planning[w].append(float(rows["planning_time"].mean()))
                     if serial is None:
                         serial = rows
                         assert (serial["status"] == "ok").all(), serial[["status", "reason"]]
                     assert (rows["total"].to_numpy() == serial["total"].to_numpy()).all()
-                print(f"round {r + 1}: " + ", ".join(f"{w if w > 0 else 'serial' if w == 0 else 'batched'}: "
-                                                     f"{walls[w][-1]:.2f} s" for w in walls), flush=True)  # fmt: skip
+                print(f"round {r + 1}: " + ", ".join(f"{label[w]}: {walls[w][-1]:.2f} s" for w in runs), flush=True)
             k = 2000
             start = time.perf_counter()
             clients[1].gather([clients[1].submit(_trivial, pure=False) for _ in range(k)])
@@ -123,13 +143,11 @@ def main() -> int:
         lines = [header, "|---|---|---|---|---|---|---|",
                  f"| serial (`--workers 0`) | - | {t0:.2f} | {n / t0:.2f} | 1.00 | - "
                  f"| {statistics.median(planning[0]):.3f} |"]  # fmt: skip
-        for w in [*sizes, -1]:
-            workers = w if w > 0 else sizes[-1]
+        for w in runs[1:]:
             tw = statistics.median(walls[w])
             speed = statistics.median(a / b for a, b in zip(t0s, walls[w]))
-            eff = statistics.median(a / (workers * b) for a, b in zip(t0s, walls[w]))
-            name = f"{w} worker(s)" if w > 0 else f"{workers} worker(s), {args.per_task} variants a task"
-            lines.append(f"| {name} | {ups[workers]:.1f} | {tw:.2f} | {n / tw:.2f} | {speed:.2f} | {eff:.2f} "
+            eff = statistics.median(a / (workers_of[w] * b) for a, b in zip(t0s, walls[w]))
+            lines.append(f"| {label[w]} | {ups[w]:.1f} | {tw:.2f} | {n / tw:.2f} | {speed:.2f} | {eff:.2f} "
                          f"| {statistics.median(planning[w]):.3f} |")  # fmt: skip
         overhead = statistics.median((b - a) / n for a, b in zip(t0s, walls[1]))
         share = statistics.median((b - a) / a for a, b in zip(t0s, walls[1]))  # of a variant's time, paired
