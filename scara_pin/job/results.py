@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..motion.verify import Binding
 from ..summary import Summarized
 from ..units import format_number
 from .steps import StepKind
@@ -39,30 +40,9 @@ _ROWS_SHOWN = 6
 """Rows of the table a result's summary shows at each end (its ``repr``; :meth:`JobResult.table` has them all)."""
 
 
-@dataclass(frozen=True)
-class LimitShare:
-    """A limit on a step of a job: its largest |value| / limit there and the share of the step's time at >= 99.9 %.
-
-    Attributes:
-        quantity: "velocity", "acceleration", "jerk", "torque" or "tool speed".
-        joint: the joint ("tool" for the tool speed).
-        ratio: its largest |value| / limit on the step.
-        share: the fraction of the step's time it is at >= :data:`~scara_pin.motion.jump.BINDING` of the limit.
-    """
-
-    quantity: str
-    joint: str
-    ratio: float
-    share: float
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {"quantity": self.quantity, "joint": self.joint, "ratio": self.ratio, "share": self.share}
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> LimitShare:
-        """From :meth:`to_dict`'s (``KeyError``, ``ValueError``: not one)."""
-        return cls(str(data["quantity"]), str(data["joint"]), float(data["ratio"]), float(data["share"]))
+LimitShare = Binding
+"""A limit on a step of a job: its largest |value| / limit there and the share of the step's time at >= 99.9 %
+(the jump's :class:`~scara_pin.motion.verify.Binding`, the step as its leg)."""
 
 
 @dataclass(frozen=True, eq=False, repr=False)

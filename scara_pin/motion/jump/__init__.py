@@ -99,7 +99,7 @@ from ...errors import InfeasibleError, InvalidInputError
 from ...limits import MAX_SAMPLES, check_count
 from ..payload import PayloadLike, as_payload, with_payload
 from ..trajectory import Trajectory
-from ..verify import VERIFY_RATE, jerk_vector, limits_in_force
+from ..verify import VERIFY_RATE, Binding, jerk_vector, limits_in_force
 from .bound import lower_bound
 from .cell import solve_in_cell
 from .problem import Problem, default_intervals, endpoints, given_via, holds_still, top_configuration
@@ -109,7 +109,6 @@ from .types import (
     CLEARANCE_TOL,
     STANDARD_CLEARANCE,
     STANDARD_RISE,
-    Binding,
     JumpError,
     JumpMove,
     JumpOptions,
