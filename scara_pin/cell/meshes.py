@@ -89,7 +89,6 @@ __all__ = [
     "VisualMesh",
     "check_visual_count",
     "collision_meshes",
-    "load_mesh",
     "load_meshes",
     "parse_mesh",
     "read_mesh_file",
@@ -553,19 +552,6 @@ def scaled(geometry: MeshGeometry, scale: Any) -> tuple[np.ndarray, np.ndarray]:
     s = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
     faces = geometry.faces if float(np.prod(np.sign(s))) > 0 else geometry.faces[:, ::-1].copy()
     return geometry.vertices * s, faces
-
-
-def load_mesh(path: Path, filename: str) -> MeshGeometry:
-    """The triangles of one mesh file, read under this module's rules (one file's caps; no package lookup).
-
-    Args:
-        path: the file.
-        filename: how to name it in messages (as the user wrote it).
-
-    Raises:
-        MeshProblem: refused, missing or unreadable (the message says which and why).
-    """
-    return _load(path, filename)
 
 
 @dataclass(frozen=True)
