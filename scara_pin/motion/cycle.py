@@ -523,12 +523,6 @@ def arch_move(
     return ArchMove(traj, tuple(paths), legs, ratios, payload, jv)
 
 
-def _leg_names(path: Any) -> tuple[tuple[str, ...], np.ndarray]:
-    if isinstance(path, ArchPath):
-        return path.names, path.bounds
-    return ("lift", "traverse", "descend"), np.array([0.0, 1.0])
-
-
 def _legs(
     robot: RobotModel, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
 ) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
@@ -538,15 +532,14 @@ def _legs(
     motions = [p for p in traj.pieces if isinstance(p, Motion)]
     mi = 0
     for move, path in enumerate(paths):
-        names, bounds = _leg_names(path)
         if isinstance(path, ArchPath):
             m = motions[mi]
-            cuts = [0.0, *m.law.times_at(bounds[1:-1], 80).tolist(), m.duration]
-            spans += [(names[k], move, t0 + cuts[k], t0 + cuts[k + 1]) for k in range(len(names))]
+            cuts = [0.0, *m.law.times_at(path.bounds[1:-1], 80).tolist(), m.duration]
+            spans += [(name, move, t0 + cuts[k], t0 + cuts[k + 1]) for k, name in enumerate(path.names)]
             t0 += m.duration
             mi += 1
         else:
-            for name in names:
+            for name in ("lift", "traverse", "descend"):
                 m = motions[mi]
                 spans.append((name, move, t0, t0 + m.duration))
                 t0 += m.duration
