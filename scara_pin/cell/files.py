@@ -47,6 +47,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InvalidInputError, UrdfError
 from ..limits import MAX_CELL_BYTES, MAX_CELL_OBSTACLES, check_count, read_text
@@ -337,8 +338,6 @@ def _mesh_shape(reader: _Reader, d: dict[str, Any], what: str, folder: Path | No
 def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     """The obstacles of a URDF or xacro cell: every ``<collision>`` of links joined by fixed joints."""
     import xml.etree.ElementTree as ET
-
-    import pinocchio as pin
 
     from ..description.mesh_paths import MeshProblem, mesh_file
     from ..description.packages import PackagePath, read_robot_file

@@ -25,10 +25,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 if TYPE_CHECKING:
-    import pinocchio as pin
-
     from ..model import RobotModel
 
 __all__ = ["SAMPLES", "RobotGeometry", "SelfPairs", "robot_geometry"]
@@ -88,8 +87,6 @@ def robot_geometry(robot: RobotModel) -> RobotGeometry:
     cached = _GEOMETRY.get(robot)
     if cached is not None:
         return cached
-    import pinocchio as pin
-
     from .meshes import collision_meshes
 
     gm = pin.GeometryModel(robot.collision_model)  # a copy: placeholders replaced below

@@ -56,6 +56,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from .._checks import number_text
 from ..description.mesh_paths import MeshProblem, mesh_file, resolve_mesh
@@ -388,8 +389,6 @@ def robot_size(robot: RobotModel) -> float:
 
     The yardstick of the meshes' plausibility: the links laid out end to end.
     """
-    import pinocchio as pin
-
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
     points = np.array([f.translation for f in data.oMf])

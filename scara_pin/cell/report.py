@@ -45,6 +45,7 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from .scene import describe
 
@@ -174,8 +175,6 @@ class Envelope:
 
 def reach_envelope(scene: Scene) -> Envelope:
     """The reach envelope of the robot's moving geometry, carried part included (module docstring)."""
-    import pinocchio as pin
-
     from .sweep import joint_motion
 
     robot = scene.robot

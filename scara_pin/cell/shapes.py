@@ -16,14 +16,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InvalidInputError
-
-if TYPE_CHECKING:
-    import pinocchio as pin
 
 __all__ = ["KINDS", "MAX_POSITION", "MAX_SIZE", "MIN_SIZE", "Shape", "hull", "rpy_matrix"]
 
@@ -45,8 +43,6 @@ checked: it holds the mesh, so a distance to it is never larger than to the mesh
 
 def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     """URDF's rotation of (roll, pitch, yaw): ``Rz(yaw) Ry(pitch) Rx(roll)``."""
-    import pinocchio as pin
-
     return np.asarray(pin.rpy.rpyToMatrix(float(rpy[0]), float(rpy[1]), float(rpy[2])))
 
 
@@ -123,8 +119,6 @@ class Shape:
     # ------------------------------------------------------------------ placement and geometry
     def placement(self) -> pin.SE3:
         """``frameMshape``: the shape's placement in its frame."""
-        import pinocchio as pin
-
         return pin.SE3(self.rotation, self.xyz)
 
     def grown(self, by: float) -> Shape:
@@ -153,8 +147,6 @@ class Shape:
 
     def moved(self, frameMshape: pin.SE3, what: str | None = None) -> Shape:
         """The same shape placed at ``frameMshape * self.placement()`` (e.g. a carried box put down)."""
-        import pinocchio as pin
-
         M = frameMshape * self.placement()
         rpy = np.asarray(pin.rpy.matrixToRpy(M.rotation))
         return Shape(self.kind, self.size, M.translation.copy(), rpy, self.vertices, self.faces, self.source,

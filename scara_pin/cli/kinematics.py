@@ -8,6 +8,8 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from ..errors import InfeasibleError, InvalidInputError, ParameterError
 from ..units import decimals_for, format_number
 from ._joints import check_limits, needs_wrist, q_values, read_pose
@@ -18,8 +20,6 @@ from ._robot import cell_from_args, robot_from_args
 from ._units import POSE_KINDS, Q_NAMES, Units
 
 if TYPE_CHECKING:
-    import numpy as np
-
     from .._typing import ArrayLike
     from ..robots import Robot
 
@@ -71,8 +71,6 @@ def cmd_fk(args: argparse.Namespace) -> int:
 
 def cmd_jacobian(args: argparse.Namespace) -> int:
     """The task Jacobian d(x, y, z, yaw)/dq, or Pinocchio's 6 x 4 frame Jacobian."""
-    import numpy as np
-
     units = Units.from_args(args)
     robot = robot_from_args(args, units)
     q = check_limits(robot, q_values(args.q, units), units, args.strict)
@@ -234,8 +232,6 @@ def _clear_solutions(robot: Robot, cell: Any, qs: list[Any], branches: list[str]
 
     Each refused one: its q, branch, the reason code ``COLLISION``, the closest pair and its distance [m].
     """
-    import numpy as np
-
     from ..cell import describe, scene
 
     sc = scene(robot, cell)

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..motion.verify import Binding
 from ..summary import Summarized
-from ..units import format_number
+from ..units import SI, format_number
 from .steps import StepKind
 
 if TYPE_CHECKING:
@@ -70,8 +70,6 @@ class PlacedBox(Summarized):
 
     def summary(self, units: DisplayUnits | None = None) -> str:
         """One line: the box, where and when it was left."""
-        from ..units import SI
-
         u = units or SI
         return (f"PlacedBox {self.name} at {self.at} (step {self.step}, t = {self.time:.6f} s): centre "
                 f"{u.format_vector(self.shape.xyz, 'length')} [{u.length}] in base")  # fmt: skip

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from .._urdf_checks import xacro_leftovers
 from ..description import JOINT_COUNTS
+from ..errors import InvalidInputError, UrdfError
 from .context import KNOWN_TYPES, Context, Stop, shown_path
 from .report import Finding, Severity
 
@@ -25,7 +26,6 @@ __all__ = [
 def unreadable(ctx: Context) -> None:
     """A file that cannot be read (missing, too large, not UTF-8, a device); its URDF text read otherwise."""
     from ..description.packages import PackagePath, read_robot_file
-    from ..errors import InvalidInputError, UrdfError
     from ..limits import check_input_file
 
     path = ctx.path
@@ -45,7 +45,6 @@ def unreadable(ctx: Context) -> None:
 def xacro_failed(ctx: Context) -> None:
     """A ``.xacro`` file that cannot be expanded (a missing package, an undefined property: where, when known)."""
     from ..description.xacro_sources import expand_with_sources
-    from ..errors import UrdfError
 
     path = ctx.path
     if path is None or not path.name.endswith(".xacro"):
