@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..errors import InfeasibleError, InvalidInputError, ParameterError, UrdfError
 from ..units import decimals_for, format_number
 from ._joints import check_limits, needs_wrist, q_values, read_pose
 from ._numbers import integer_type
@@ -157,8 +157,6 @@ def cmd_ik(args: argparse.Namespace) -> int:
     if args.all_turns and (numeric or near is not None):
         raise InvalidInputError("--all-turns lists every closed-form solution: not with --numeric or --near")
     if not numeric:
-        from ..errors import UrdfError
-
         try:
             _ = robot.kinematics  # extracted on first use: refused here if the model is not its kind's
         except UrdfError as exc:  # NotScaraError, NotPalletizerError
@@ -249,7 +247,6 @@ def _clear_solutions(robot: Robot, cell: Any, qs: list[Any], branches: list[str]
 
 
 def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
-    from ..errors import UrdfError
     from ..kinematics.numeric import elbow_sign, solve_numeric
 
     res = solve_numeric(robot, target, q0=near)

@@ -8,7 +8,7 @@ import logging
 import sys
 from typing import Any
 
-from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..errors import InfeasibleError, InvalidInputError, ParameterError, ScaraError
 from ..files import outputs_together
 from ..units import format_number, format_vector
 from ._joints import joint_arg, needs_wrist, read_pose
@@ -231,7 +231,6 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
 def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units, tool_speed: float | None
                ) -> float | None:  # fmt: skip
     """The jump's duration between the same configurations and limits, or None if it cannot be planned."""
-    from ..errors import ScaraError
     from ..motion.jump import STANDARD_RISE, jump_move
 
     q0, q1 = move.trajectory.q_start, move.trajectory.q_end

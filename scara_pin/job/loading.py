@@ -64,7 +64,7 @@ from typing import Any, NoReturn, TypeVar
 
 import numpy as np
 
-from ..errors import InvalidInputError, JobFileError, ParameterError
+from ..errors import InvalidInputError, JobFileError, ParameterError, YamlError
 from ..limits import (
     MAX_DOCUMENT_BYTES,
     MAX_DWELL,
@@ -229,7 +229,6 @@ def read_job(path: str | Path, overrides: Iterable[Override] = (), *, text: str 
         InvalidInputError: the file cannot be read (missing, not a regular file, over its cap, not UTF-8).
     """
     from ..description.yaml_units import load_yaml, yaml_line
-    from ..errors import YamlError
 
     path = Path(path)
     if text is None:
@@ -306,7 +305,6 @@ def read_carry(path: str | Path) -> Carry:
         InvalidInputError: the file cannot be read.
     """
     from ..description.yaml_units import load_yaml, yaml_line
-    from ..errors import YamlError
 
     path = Path(path)
     text = read_text(check_input_file(path, "carry file", MAX_JOB_BYTES), "carry file", MAX_JOB_BYTES)

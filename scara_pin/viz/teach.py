@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInputError, ParameterError, ScaraError
+from ..errors import InvalidInputError, ParameterError, ScaraError, UrdfError
 from ..motion.manual import (
     JogAxis,
     JogFrame,
@@ -619,7 +619,6 @@ def _cell_scene(robot: RobotModel, cell: Cell) -> Scene:
     that IK.
     """
     from ..cell import scene
-    from ..errors import UrdfError
 
     if robot.kind != "scara" or robot.dof != 4:
         raise InvalidInputError(f"the teach pendant's cell is for 4-joint SCARA robots for now; {robot.name!r} is a "
