@@ -50,7 +50,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInputError, UrdfError
-from ..limits import MAX_CELL_BYTES, MAX_CELL_OBSTACLES, check_count, read_text
+from ..limits import MAX_CELL_BYTES, MAX_CELL_OBSTACLES, check_count, check_input_file, read_text
 from .cell import DEFAULT_MARGIN, Cell, Obstacle, check_name
 from .shapes import KINDS, Shape
 
@@ -342,7 +342,6 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     from ..description.mesh_paths import MeshProblem, mesh_file
     from ..description.packages import PackagePath, read_robot_file
     from ..description.placeholders import placeholder_urdf
-    from ..limits import check_input_file
     from .meshes import MeshUse, MeshUseError, load_meshes, mesh_scale, scaled
 
     check_input_file(path, "cell file", MAX_CELL_BYTES)

@@ -47,6 +47,7 @@ import gzip
 import io
 import logging
 import math
+import os
 import re
 import xml.etree.ElementTree as ET
 import zipfile
@@ -595,9 +596,7 @@ def load_meshes(uses: list[MeshUse], origin: str) -> dict[Path, MeshGeometry]:
         MeshUseError: a file that cannot be read or parsed, with the first shape naming it.
         InvalidInputError: the bytes or the triangles of the cell's meshes above their caps (counted before parsing).
     """
-    import os
-
-    from ..limits import MAX_CELL_MESH_BYTES, MAX_CELL_TRIANGLES
+    from ..limits import MAX_CELL_MESH_BYTES, MAX_CELL_TRIANGLES  # here: read when called (tests lower them)
 
     first: dict[Path, MeshUse] = {}
     count: dict[Path, int] = {}

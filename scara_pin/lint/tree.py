@@ -9,7 +9,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from .._urdf_checks import xacro_leftovers
+from .._urdf_checks import second_parents, xacro_leftovers
 from ..description import JOINT_COUNTS
 from ..errors import InvalidInputError, UrdfError
 from .context import KNOWN_TYPES, Context, Stop, shown_path
@@ -168,8 +168,6 @@ def two_parents(ctx: Context) -> None:
 
     The loader's rule (``scara_pin._urdf_checks.second_parents``).
     """
-    from .._urdf_checks import second_parents
-
     order = {j.name: k for k, j in enumerate(ctx.document.joints)}
     for link, kept, other, harmful in second_parents(ctx.document.root):
         j = ctx.tree.joints.get(max(kept, other, key=lambda n: order.get(n, -1)))  # the second written

@@ -65,7 +65,7 @@ from .paths import CartesianSegment, GeometricPath, PathError, SegmentedPath, ca
 from .payload import Payload, PayloadLike, as_payload, with_payload
 from .timing import TimingOptions, limits_in_force, parameterize
 from .trajectory import Motion, Trajectory
-from .verify import Quantity, Verification, state_ratios, trajectory_jerk, verify
+from .verify import Quantity, Verification, clear_of, state_ratios, trajectory_jerk, verify
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -728,8 +728,6 @@ def standard_cycle(
         used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
         bound = _lines_bound(robot, move, a, b, rise, limits, jerk)
         if cell is not None:
-            from .verify import clear_of
-
             move = replace(move, distance=clear_of(robot, move.trajectory, cell))
     if wmin != wmin:  # the smallest manipulability along the traverse of the given placement
         q0 = move.trajectory.q_start

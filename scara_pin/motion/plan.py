@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
@@ -202,8 +202,6 @@ def plan_motion(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     plan = _plan(robot, request)
     if request.cell is None or plan.method is Method.JUMP:
         return plan
-    from dataclasses import replace
-
     from .verify import clear_of
 
     return replace(plan, clearance=clear_of(robot, plan.trajectory, request.cell))

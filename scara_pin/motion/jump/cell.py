@@ -13,7 +13,7 @@ from ...cell.sweep import clear_mask
 from ...errors import InfeasibleError
 from ..polynomial import PolynomialPiece
 from ..trajectory import Trajectory, line_optimal_duration
-from ..verify import CERTIFY_ACCELERATION, DISTANCE_TOL
+from ..verify import CERTIFY_ACCELERATION, DISTANCE_TOL, verify
 from .candidates import SECOND_WITHIN, Candidate, candidates, line_samples, score
 from .nlp import Transcription
 from .problem import ConstraintPoint, Problem
@@ -293,8 +293,6 @@ def _missed(prob: Problem, traj: Trajectory) -> DistanceRow | None:
 
     Its lowest sample, or its certificate's weakest point.
     """
-    from ..verify import verify
-
     scene = prob.scene
     if scene is None:  # pragma: no cover - in a cell only
         return None
