@@ -46,6 +46,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -406,8 +407,6 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
 
 def _primitive(geometry: Any, xyz: np.ndarray, rpy: np.ndarray, what: str) -> Shape:
     """A Shape of a coal primitive that Pinocchio built from URDF."""
-    import coal
-
     if isinstance(geometry, coal.Box):
         return Shape("box", tuple(2.0 * np.asarray(geometry.halfSide)), xyz, rpy, what=what)
     if isinstance(geometry, coal.Cylinder):

@@ -24,6 +24,7 @@ import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -94,8 +95,6 @@ def robot_geometry(robot: RobotModel) -> RobotGeometry:
     for i, g in enumerate(gm.geometryObjects):
         mesh = meshes.get(g.name)
         if mesh is not None:
-            import coal
-
             bvh = coal.BVHModelOBBRSS()
             bvh.beginModel(len(mesh.faces), len(mesh.vertices))
             bvh.addVertices(np.asarray(mesh.vertices, dtype=float))

@@ -39,6 +39,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -346,8 +347,6 @@ class Scene:
 
         The pairs with a mesh that is a surface (a bounding-volume tree) are bounded by their spheres when far.
         """
-        import coal
-
         self._gm = gm
         self._gd = gm.createData()
         _fresh_guesses(self._gd)
@@ -598,8 +597,6 @@ def _fresh_guesses(gd: Any) -> None:
     penetration 30 times too deep was seen: box against cylinder).
     """
     import warnings
-
-    import coal
 
     for req in gd.distanceRequests:
         req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess

@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -160,8 +161,6 @@ class Shape:
         holds it, so no collision is missed; a query on a hull costs microseconds where one on a tree of 199,000
         triangles cost 0.2 s).
         """
-        import coal
-
         if self.kind == "box":
             return coal.Box(*self.size)
         if self.kind == "cylinder":
@@ -267,7 +266,6 @@ def hull(points: np.ndarray) -> Any:
     that of a snapped one, so the inflated hull holds the original (a distance to it is never larger). A flat set
     (qhull refuses it; coal would crash on it) is taken as its bounding box, thickened to :data:`MIN_SIZE`.
     """
-    import coal
     from scipy.spatial import ConvexHull, QhullError
 
     points = np.asarray(points, dtype=float)

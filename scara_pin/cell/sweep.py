@@ -53,6 +53,7 @@ import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
+import coal
 import numpy as np
 
 from ..errors import ScaraError
@@ -171,8 +172,6 @@ def bounding_shapes(scene: Scene) -> BoundingShapes:
     cached = _BOUNDS.get(scene)
     if cached is not None:
         return cached
-    import coal
-
     gm = scene.geometry_model
     joint, center, radius, end0, end1, capsule, box_r = [], [], [], [], [], [], []
     half_sides = []
