@@ -135,17 +135,13 @@ def cmd_traj(args: argparse.Namespace) -> int:
 _ARCH_ONLY = ("rise", "blend", "clearance_radius", "max_height", "path")
 
 
-def _flag(name: str) -> str:
-    return "--" + name.replace("_", "-")
-
-
 def _arch_options(args: argparse.Namespace) -> None:
     """Refuse (exit 2) an option given with a motion kind it does not act on, naming the combination."""
     check_setpoint_options(args)
     if not args.arch:
         for name in _ARCH_ONLY:
             if getattr(args, name) is not None:
-                raise InvalidInputError(f"{_flag(name)} shapes an arch move: it needs --arch")
+                raise InvalidInputError(f"--{name.replace('_', '-')} shapes an arch move: it needs --arch")
         return
     if (args.path or "jump") == "jump":
         if args.blend is not None:

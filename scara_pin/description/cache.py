@@ -142,13 +142,10 @@ class DigestStore:
                 reason = "a symbolic link: never followed" if exc.errno == errno.ELOOP else exc.strerror or str(exc)
             else:
                 reason = str(exc)
-            log.warning("%s entry %s ignored (%s): %s and the entry replaced", self.what, path, reason,
-                        self._again())  # fmt: skip
+            again = "the robot is made again" if self.what == "description cache" else "it is made again"
+            log.warning("%s entry %s ignored (%s): %s and the entry replaced", self.what, path, reason, again)
             return None
         return entry
-
-    def _again(self) -> str:
-        return "the robot is made again" if self.what == "description cache" else "it is made again"
 
     def _folder(self) -> Path | None:
         """The cache folder, created with mode 0700 (narrowed to it when it is the user's); None: not usable."""

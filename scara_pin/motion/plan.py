@@ -63,10 +63,6 @@ class Method(enum.Enum):
     LINE_JERK = "straight line, jerk-limited time-optimal"
 
 
-def _optional_vector(name: str, value: object) -> np.ndarray | None:
-    return None if value is None else as_vector(name, value, None)  # one per joint (4, or 3 without a wrist)
-
-
 @dataclass(frozen=True, eq=False)
 class MotionRequest:
     """What a move should do. Exactly one start (``start_q`` or ``start_pose``) and one end.
@@ -119,7 +115,8 @@ class MotionRequest:
 
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
-            object.__setattr__(self, name, _optional_vector(name, getattr(self, name)))
+            value = getattr(self, name)  # one per joint (4, or 3 without a wrist)
+            object.__setattr__(self, name, None if value is None else as_vector(name, value, None))
         if self.payload is not None:  # a mass [kg] becomes a Payload
             from .payload import as_payload
 
