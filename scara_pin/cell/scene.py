@@ -33,6 +33,7 @@ margin and the activation distance, both far below it); nearer, coal's exact dis
 from __future__ import annotations
 
 import math
+import warnings
 import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -596,8 +597,6 @@ def _fresh_guesses(gd: Any) -> None:
     Pinocchio's requests cache it by default, and EPA started from a stale guess can stop on a wrong face (a
     penetration 30 times too deep was seen: box against cylinder).
     """
-    import warnings
-
     for req in gd.distanceRequests:
         req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
         with warnings.catch_warnings():  # the flag is deprecated, but Pinocchio still sets it

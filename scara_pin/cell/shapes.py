@@ -15,6 +15,7 @@ a surface: see :mod:`scara_pin.cell.scene`, which refuses a closed mesh that is 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -198,8 +199,6 @@ class Shape:
             return (True, True)
         found = self.__dict__.get("_closure")
         if found is None:
-            import warnings
-
             import trimesh
 
             with warnings.catch_warnings(), np.errstate(all="ignore"):  # trimesh divides by a zero volume
