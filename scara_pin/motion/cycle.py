@@ -201,17 +201,6 @@ class ArchPath(SegmentedPath, GeometricPath):
                 out[o][sel] = res[o] / width**o
         return tuple(out)
 
-    def tool_poses(self, s: np.ndarray) -> np.ndarray:
-        """(n, 4) tool poses on the path at s (from the segments' curves, not FK)."""
-        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
-        idx = np.clip(np.searchsorted(self.bounds, s, side="right") - 1, 0, len(self.segments) - 1)
-        out = np.empty((len(s), 4))
-        for k, seg in enumerate(self.segments):
-            sel = idx == k
-            if sel.any():
-                out[sel] = seg.poses((s[sel] - self.bounds[k]) / (self.bounds[k + 1] - self.bounds[k]))
-        return out
-
 
 def arch_path(
     robot: RobotModel,
