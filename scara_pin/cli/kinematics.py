@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import InfeasibleError, InvalidInputError, ParameterError, UrdfError
+from ..model import pose_from_placement
 from ..units import decimals_for, format_number
 from ._joints import check_limits, needs_wrist, q_values, read_pose
 from ._numbers import integer_type
@@ -34,8 +35,6 @@ def cmd_fk(args: argparse.Namespace) -> int:
     robot = robot_from_args(args, units)
     q = check_limits(robot, q_values(args.q, units), units, args.strict)
     M = robot.tool_placement(q)
-    from ..model import pose_from_placement
-
     pose = pose_from_placement(M)
     if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         out = {

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .._version import __version__
 from ..limits import read_bytes
 
 __all__ = ["FORMAT", "MAX_ENTRY_BYTES", "DescriptionCache", "DigestStore", "cache_folder"]
@@ -199,8 +200,6 @@ class DescriptionCache(DigestStore):
             description: Path) -> str:  # fmt: skip
         """The SHA-256 digest (hex) of everything a configured robot is made from (module docstring)."""
         import importlib.util
-
-        from .._version import __version__
 
         digest = hashlib.sha256()
 

@@ -26,6 +26,7 @@ from xml.etree.ElementTree import Element
 import numpy as np
 
 from .._checks import number_text
+from .._urdf_checks import parse_urdf_xml
 from ..errors import UrdfError
 from ..kinematics.kinds import kinematics_for
 from ..model import RobotModel
@@ -56,8 +57,6 @@ class _Quiet(logging.Filter):
 
 def parse(text: str) -> tuple[Element, dict[Element, int]]:
     """An ElementTree of the text as urdfdom reads it, with each element's line (the loader's reader)."""
-    from .._urdf_checks import parse_urdf_xml
-
     return parse_urdf_xml(text)
 
 

@@ -59,6 +59,7 @@ from ..motion.manual import (
     pose_ik,
 )
 from ..motion.points import PointSet, PosePoint, TaughtPoint, points_format, read_points, write_points
+from .scene import recorded_scene
 
 if TYPE_CHECKING:
     from ..cell import Cell, PairDistance, Scene
@@ -838,8 +839,6 @@ def _cell_words(cell: Cell) -> str:
 
 def _teach_page(robot: RobotModel, session: TeachSession, controls: bool = False) -> str:
     """The pendant page of the live teach server (no motion player; a ``teach`` section)."""
-    from .scene import recorded_scene
-
     scene, data = recorded_scene(robot, session.q, cell=session.cell)
     data["controls"] = bool(controls)
     labels = {"all": "nearest (any branch)"}
