@@ -55,11 +55,6 @@ class _Quiet(logging.Filter):
         return False
 
 
-def parse(text: str) -> tuple[Element, dict[Element, int]]:
-    """An ElementTree of the text as urdfdom reads it, with each element's line (the loader's reader)."""
-    return parse_urdf_xml(text)
-
-
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
     """URDF: R = Rz(y) Ry(p) Rx(r) (written here: the linter's walk is independent of Pinocchio)."""
     cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
@@ -243,8 +238,8 @@ class Context:
     # ------------------------------------------------------------------------------------------ the file
     @cached_property
     def parsed(self) -> tuple[Element, dict[Element, int]]:
-        """The document's tree and each element's line (:func:`parse`; the ``malformed-xml`` rule parses it)."""
-        return parse(self.text)
+        """The tree as urdfdom reads it, each element's line (the loader's reader; ``malformed-xml`` parses it)."""
+        return parse_urdf_xml(self.text)
 
     @cached_property
     def document(self) -> Document:
