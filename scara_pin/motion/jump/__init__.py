@@ -95,6 +95,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..._checks import as_positive, as_vector
+from ...cell import scene as make_scene
 from ...errors import InfeasibleError, InvalidInputError
 from ...limits import MAX_SAMPLES, check_count
 from ..payload import PayloadLike, as_payload, with_payload
@@ -221,8 +222,6 @@ def jump_move(
         raise InvalidInputError("via points are hints of the way through a cell: give the cell too")
     scene = None
     if cell is not None:
-        from ...cell import scene as make_scene
-
         scene = make_scene(robot, cell)
         scene.check(qA, "the start (pose_from)")
         scene.check(qB, "the goal (pose_to)")
