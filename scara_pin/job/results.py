@@ -19,7 +19,7 @@ job's top-level steps that reach the pallet places, from the first to the last o
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -106,9 +106,8 @@ class PlanningStats(Summarized):
                 f"from the cache{free}; {self.seconds:.3g} s")  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {"planned": self.planned, "same": self.same, "reversed": self.reversed, "cached": self.cached,
-                "free": self.free, "seconds": self.seconds}  # fmt: skip
+        """JSON-ready: the fields, by name."""
+        return asdict(self)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
