@@ -239,12 +239,10 @@ def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | Non
     xyz = _numbers(reader, d, "xyz", f"{what}: xyz", 3) if "xyz" in d else [0.0, 0.0, 0.0]
     rpy = _numbers(reader, d, "rpy", f"{what}: rpy", 3) if "rpy" in d else [0.0, 0.0, 0.0]
     try:
-        if kind == "box":
-            size = tuple(_numbers(reader, d, "size", f"{what}: size", 3))
-            return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
         if kind == "mesh":
             return _mesh_shape(reader, d, what, folder, xyz, rpy, meshes)
-        size = tuple(_number(reader, d, k, f"{what}: {k}") for k in _SHAPE_KEYS[kind])
+        size = (tuple(_numbers(reader, d, "size", f"{what}: size", 3)) if kind == "box"
+                else tuple(_number(reader, d, k, f"{what}: {k}") for k in _SHAPE_KEYS[kind]))  # fmt: skip
         return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
     except InvalidInputError as exc:
         message = str(exc)
