@@ -29,6 +29,7 @@ loads, as it does in Pinocchio.
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import math
 import re
@@ -238,10 +239,6 @@ def _lost(link: ET.Element, visuals: bool) -> str:
     return f"none of the link's {' and '.join(parts)}" if parts else "no geometry of the link (it has none)"
 
 
-def _ordinal(items: list[ET.Element], item: ET.Element) -> str:
-    return f"<{item.tag}>" if len(items) == 1 else f"<{item.tag}> #{items.index(item) + 1} of {len(items)}"
-
-
 def _inertial(root: ET.Element, origin: str) -> None:
     for link in root.findall("link"):
         inertial = link.find("inertial")  # urdfdom reads the first one only
@@ -308,7 +305,8 @@ def _geometry(root: ET.Element, origin: str) -> None:
                 if problem is None:
                     continue
                 lost = _lost(link, part == "visual")
-                raise _refuse("geometry", origin, f"{_link_where(link)} {_ordinal(items, item)}: {problem}; urdfdom "
+                ordinal = f" #{items.index(item) + 1} of {len(items)}" if len(items) > 1 else ""
+                raise _refuse("geometry", origin, f"{_link_where(link)} <{item.tag}>{ordinal}: {problem}; urdfdom "
                                                   f"would stop reading the link there, and Pinocchio would load "
                                                   f"{lost}; the toolkit refuses it")  # fmt: skip
 
@@ -635,9 +633,7 @@ def xacro_leftovers(root: ET.Element) -> tuple[bool, str, ET.Element] | None:
             substituted = el
     if not found and substituted is None:
         return None
-    counts: dict[str, int] = {}
-    for name, _ in found:
-        counts[name] = counts.get(name, 0) + 1
+    counts = collections.Counter(name for name, _ in found)
     listing = ", ".join(f"{n} <xacro:{k}>" for k, n in counts.items())
     if substituted is not None:
         attr, value = next((a, v) for a, v in substituted.attrib.items() if "${" in v or "$(" in v)

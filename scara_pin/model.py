@@ -42,6 +42,7 @@ from .urdf_rules import (
     mimic_error,
     read_tree,
     resolve_mimics,
+    zero_within,
 )
 
 if TYPE_CHECKING:
@@ -733,8 +734,6 @@ class RobotModel:
 
         q = 0, each joint whose limits exclude 0 at its nearest limit (:func:`scara_pin.urdf_rules.zero_within`).
         """
-        from .urdf_rules import zero_within
-
         return np.array([0.0 if c else zero_within(lo, hi)
                          for c, lo, hi in zip(self.continuous, self.limits.lower, self.limits.upper)])  # fmt: skip
 

@@ -8,13 +8,12 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from ..summary import Summarized
 from .chain import Group, MeasurementFrame
 
 if TYPE_CHECKING:
-    import pinocchio as pin
-
     from ..units import DisplayUnits
     from .chain import ChainModel
     from .measurements import Measurements
@@ -365,8 +364,6 @@ class CalibrationResult(Summarized):
 
 
 def _rpy(R: np.ndarray) -> np.ndarray:
-    import pinocchio as pin
-
     return np.asarray(pin.rpy.matrixToRpy(R), dtype=float)
 
 

@@ -46,10 +46,13 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import coal
 import numpy as np
+import pinocchio as pin
 
+from ..description.yaml_units import load_yaml, yaml_line
 from ..errors import InvalidInputError, UrdfError
-from ..limits import MAX_CELL_BYTES, MAX_CELL_OBSTACLES, check_count, read_text
+from ..limits import MAX_CELL_BYTES, MAX_CELL_OBSTACLES, check_count, check_input_file, read_text
 from .cell import DEFAULT_MARGIN, Cell, Obstacle, check_name
 from .shapes import KINDS, Shape
 
@@ -128,8 +131,6 @@ def parse_cell(text: str, origin: str = "cell", folder: Path | None = None) -> C
     Raises:
         InvalidInputError: malformed YAML or a bad value, naming ``origin`` and the line.
     """
-    from ..description.yaml_units import load_yaml, yaml_line
-
     reader = _Reader(origin)
     top = load_yaml(text, origin)
     if top is None:
@@ -178,8 +179,6 @@ def parse_cell(text: str, origin: str = "cell", folder: Path | None = None) -> C
 
 
 def _number(reader: _Reader, data: Any, key: Any, what: str) -> float:
-    from ..description.yaml_units import yaml_line
-
     v = data[key]
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise reader.error(yaml_line(data, key), f"{what} must be a number")
@@ -189,8 +188,6 @@ def _number(reader: _Reader, data: Any, key: Any, what: str) -> float:
 
 
 def _numbers(reader: _Reader, data: Any, key: Any, what: str, n: int) -> list[float]:
-    from ..description.yaml_units import yaml_line
-
     v = data[key]
     if not isinstance(v, list) or len(v) != n:
         raise reader.error(yaml_line(data, key), f"{what} must be a list of {n} numbers")
@@ -198,8 +195,6 @@ def _numbers(reader: _Reader, data: Any, key: Any, what: str, n: int) -> list[fl
 
 
 def _name(reader: _Reader, data: Any, key: Any, what: str) -> str:
-    from ..description.yaml_units import yaml_line
-
     try:
         return check_name(data[key], what)
     except InvalidInputError as exc:
@@ -207,8 +202,6 @@ def _name(reader: _Reader, data: Any, key: Any, what: str) -> str:
 
 
 def _obstacle(reader: _Reader, items: list[Any], i: int, folder: Path | None, meshes: _Meshes) -> Obstacle:
-    from ..description.yaml_units import yaml_line
-
     item = items[i]
     line = yaml_line(items, i)
     if not isinstance(item, dict):
@@ -226,8 +219,6 @@ def _obstacle(reader: _Reader, items: list[Any], i: int, folder: Path | None, me
 
 def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | None, meshes: _Meshes, *,
            named: bool) -> Shape:  # fmt: skip
-    from ..description.yaml_units import yaml_line
-
     d = parent[key]
     line = yaml_line(parent, key)
     if not isinstance(d, dict):
@@ -248,12 +239,10 @@ def _shape(reader: _Reader, parent: Any, key: Any, what: str, folder: Path | Non
     xyz = _numbers(reader, d, "xyz", f"{what}: xyz", 3) if "xyz" in d else [0.0, 0.0, 0.0]
     rpy = _numbers(reader, d, "rpy", f"{what}: rpy", 3) if "rpy" in d else [0.0, 0.0, 0.0]
     try:
-        if kind == "box":
-            size = tuple(_numbers(reader, d, "size", f"{what}: size", 3))
-            return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
         if kind == "mesh":
             return _mesh_shape(reader, d, what, folder, xyz, rpy, meshes)
-        size = tuple(_number(reader, d, k, f"{what}: {k}") for k in _SHAPE_KEYS[kind])
+        size = (tuple(_numbers(reader, d, "size", f"{what}: size", 3)) if kind == "box"
+                else tuple(_number(reader, d, k, f"{what}: {k}") for k in _SHAPE_KEYS[kind]))  # fmt: skip
         return Shape(kind, size, np.array(xyz), np.array(rpy), what=what)
     except InvalidInputError as exc:
         message = str(exc)
@@ -268,8 +257,6 @@ def _mesh_path(reader: _Reader, d: dict[str, Any], what: str, folder: Path | Non
     A mesh cannot leave the cell's folder: ``../outside.stl``, an absolute path elsewhere, or a link pointing out
     are refused (as a URDF cell refuses them), naming the line.
     """
-    from ..description.yaml_units import yaml_line
-
     file = d["file"]
     if not isinstance(file, str) or not file or len(file) > 4096 or "\0" in file:
         raise reader.error(yaml_line(d, "file"), f"{what}: file must be a file name")
@@ -292,7 +279,6 @@ def _meshes(reader: _Reader, top: dict[Any, Any], folder: Path | None) -> _Meshe
     times the shapes naming them, against the cell's caps; then each file parsed once. A shape that is not a
     well-formed mesh is left to the reading of its shape (its own message).
     """
-    from ..description.yaml_units import yaml_line
     from .meshes import MeshUse, MeshUseError, load_meshes
 
     items: list[tuple[Any, Any, str]] = []
@@ -319,7 +305,6 @@ def _meshes(reader: _Reader, top: dict[Any, Any], folder: Path | None) -> _Meshe
 
 def _mesh_shape(reader: _Reader, d: dict[str, Any], what: str, folder: Path | None, xyz: list[float],
                 rpy: list[float], meshes: _Meshes) -> Shape:  # fmt: skip
-    from ..description.yaml_units import yaml_line
     from .meshes import scaled
 
     file = d["file"]
@@ -338,12 +323,9 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
     """The obstacles of a URDF or xacro cell: every ``<collision>`` of links joined by fixed joints."""
     import xml.etree.ElementTree as ET
 
-    import pinocchio as pin
-
     from ..description.mesh_paths import MeshProblem, mesh_file
     from ..description.packages import PackagePath, read_robot_file
     from ..description.placeholders import placeholder_urdf
-    from ..limits import check_input_file
     from .meshes import MeshUse, MeshUseError, load_meshes, mesh_scale, scaled
 
     check_input_file(path, "cell file", MAX_CELL_BYTES)
@@ -408,8 +390,6 @@ def _urdf_cell(path: Path, package_dirs: tuple[str | Path, ...]) -> Cell:
 
 def _primitive(geometry: Any, xyz: np.ndarray, rpy: np.ndarray, what: str) -> Shape:
     """A Shape of a coal primitive that Pinocchio built from URDF."""
-    import coal
-
     if isinstance(geometry, coal.Box):
         return Shape("box", tuple(2.0 * np.asarray(geometry.halfSide)), xyz, rpy, what=what)
     if isinstance(geometry, coal.Cylinder):

@@ -24,11 +24,11 @@ import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import coal
 import numpy as np
+import pinocchio as pin
 
 if TYPE_CHECKING:
-    import pinocchio as pin
-
     from ..model import RobotModel
 
 __all__ = ["SAMPLES", "RobotGeometry", "SelfPairs", "robot_geometry"]
@@ -88,8 +88,6 @@ def robot_geometry(robot: RobotModel) -> RobotGeometry:
     cached = _GEOMETRY.get(robot)
     if cached is not None:
         return cached
-    import pinocchio as pin
-
     from .meshes import collision_meshes
 
     gm = pin.GeometryModel(robot.collision_model)  # a copy: placeholders replaced below
@@ -97,8 +95,6 @@ def robot_geometry(robot: RobotModel) -> RobotGeometry:
     for i, g in enumerate(gm.geometryObjects):
         mesh = meshes.get(g.name)
         if mesh is not None:
-            import coal
-
             bvh = coal.BVHModelOBBRSS()
             bvh.beginModel(len(mesh.faces), len(mesh.vertices))
             bvh.addVertices(np.asarray(mesh.vertices, dtype=float))

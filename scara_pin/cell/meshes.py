@@ -47,6 +47,7 @@ import gzip
 import io
 import logging
 import math
+import os
 import re
 import xml.etree.ElementTree as ET
 import zipfile
@@ -56,6 +57,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import pinocchio as pin
 
 from .._checks import number_text
 from ..description.mesh_paths import MeshProblem, mesh_file, resolve_mesh
@@ -89,7 +91,6 @@ __all__ = [
     "VisualMesh",
     "check_visual_count",
     "collision_meshes",
-    "load_mesh",
     "load_meshes",
     "parse_mesh",
     "read_mesh_file",
@@ -389,8 +390,6 @@ def robot_size(robot: RobotModel) -> float:
 
     The yardstick of the meshes' plausibility: the links laid out end to end.
     """
-    import pinocchio as pin
-
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
     points = np.array([f.translation for f in data.oMf])
@@ -555,19 +554,6 @@ def scaled(geometry: MeshGeometry, scale: Any) -> tuple[np.ndarray, np.ndarray]:
     return geometry.vertices * s, faces
 
 
-def load_mesh(path: Path, filename: str) -> MeshGeometry:
-    """The triangles of one mesh file, read under this module's rules (one file's caps; no package lookup).
-
-    Args:
-        path: the file.
-        filename: how to name it in messages (as the user wrote it).
-
-    Raises:
-        MeshProblem: refused, missing or unreadable (the message says which and why).
-    """
-    return _load(path, filename)
-
-
 @dataclass(frozen=True)
 class MeshUse:
     """One shape that names a mesh file (an obstacle, the carried part).
@@ -610,9 +596,7 @@ def load_meshes(uses: list[MeshUse], origin: str) -> dict[Path, MeshGeometry]:
         MeshUseError: a file that cannot be read or parsed, with the first shape naming it.
         InvalidInputError: the bytes or the triangles of the cell's meshes above their caps (counted before parsing).
     """
-    import os
-
-    from ..limits import MAX_CELL_MESH_BYTES, MAX_CELL_TRIANGLES
+    from ..limits import MAX_CELL_MESH_BYTES, MAX_CELL_TRIANGLES  # here: read when called (tests lower them)
 
     first: dict[Path, MeshUse] = {}
     count: dict[Path, int] = {}

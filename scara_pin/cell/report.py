@@ -44,7 +44,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
+import coal
 import numpy as np
+import pinocchio as pin
 
 from .scene import describe
 
@@ -161,8 +163,6 @@ class Envelope:
 
     def geometry(self, oMbase: Any) -> tuple[Any, Any]:
         """(coal.Cylinder, coal.Transform3s) of the envelope in the world (``oMbase``: the base frame's placement)."""
-        import coal
-
         z = self.axis
         x = np.cross(z, [1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0])
         x /= np.linalg.norm(x)
@@ -174,8 +174,6 @@ class Envelope:
 
 def reach_envelope(scene: Scene) -> Envelope:
     """The reach envelope of the robot's moving geometry, carried part included (module docstring)."""
-    import pinocchio as pin
-
     from .sweep import joint_motion
 
     robot = scene.robot
@@ -311,8 +309,6 @@ def _self_pairs(scene: Scene, configurations: Sequence[tuple[str, np.ndarray]]) 
 
 
 def _out_of_reach(scene: Scene, configurations: Sequence[tuple[str, np.ndarray]]) -> list[CellFinding]:
-    import coal
-
     env = reach_envelope(scene)
     base = scene.robot.data.oMf[scene.robot.base_id]
     cylinder, placement = env.geometry(base)
@@ -350,14 +346,10 @@ def _out_of_reach(scene: Scene, configurations: Sequence[tuple[str, np.ndarray]]
 
 
 def _transform(obj: Any) -> Any:
-    import coal
-
     return coal.Transform3s(obj.placement.rotation, obj.placement.translation)
 
 
 def _distance(g1: Any, M1: Any, g2: Any, M2: Any) -> float:
-    import coal
-
     req, res = coal.DistanceRequest(), coal.DistanceResult()
     return float(coal.distance(g1, M1, g2, M2, req, res))
 

@@ -33,21 +33,22 @@ margin and the activation distance, both far below it); nearer, coal's exact dis
 from __future__ import annotations
 
 import math
+import warnings
 import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import coal
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InvalidInputError
 from .cell import CARRIED, Cell
 from .geometry import SelfPairs, robot_geometry, sample_configurations
 
 if TYPE_CHECKING:
-    import pinocchio as pin
-
     from .._typing import ArrayLike
     from ..model import RobotModel
 
@@ -220,8 +221,6 @@ class Scene:
     margin: float = field(init=False)
 
     def __post_init__(self) -> None:
-        import pinocchio as pin
-
         gm, names, n_robot, carried = self._geometry()
         allowed = self._allowed(set(names))
         movers = list(range(n_robot)) + ([carried] if carried is not None else [])
@@ -250,8 +249,6 @@ class Scene:
 
         The robot's collision geometry, the carried part on the tool frame, the obstacles on the root.
         """
-        import pinocchio as pin
-
         robot, cell = self.robot, self.cell
         geo = robot_geometry(robot)
         gm = pin.GeometryModel(geo.model)
@@ -332,8 +329,6 @@ class Scene:
 
         Its placement is the cell's (tool frame); the depth shown is at q = 0.
         """
-        import pinocchio as pin
-
         probe = pin.GeometryModel(gm)
         probe.removeAllCollisionPairs()
         probe.addCollisionPair(pin.CollisionPair(link, carried))
@@ -353,8 +348,6 @@ class Scene:
 
         The pairs with a mesh that is a surface (a bounding-volume tree) are bounded by their spheres when far.
         """
-        import coal
-
         self._gm = gm
         self._gd = gm.createData()
         _fresh_guesses(self._gd)
@@ -377,8 +370,6 @@ class Scene:
     def _always_in_contact(self, gm: pin.GeometryModel, candidates: list[tuple[int, int]],
                            depth: float = 0.0) -> set[tuple[int, int]]:  # fmt: skip
         """The candidate pairs in contact (distance <= -``depth``) at every sampled configuration."""
-        import pinocchio as pin
-
         if not candidates:
             return set()
         probe = pin.GeometryModel(gm)
@@ -403,8 +394,6 @@ class Scene:
 
     def distances(self, q: ArrayLike) -> Distances:
         """Every checked pair's distance at ``q`` (witness points and normals in the base frame), closest first."""
-        import pinocchio as pin
-
         q = self.robot.check_q(q)
         pin.computeDistances(self.robot.model, self._data, self._gm, self._gd, self.robot.to_pinocchio_q(q))
         inv = self._oMbase.inverse()
@@ -422,8 +411,6 @@ class Scene:
 
     def distance_array(self, Q: ArrayLike, pairs: ArrayLike | None = None) -> np.ndarray:
         """(n, k) distances of pairs ``pairs`` (default: all, in the scene's order) at each row of ``Q`` [m]."""
-        import pinocchio as pin
-
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
         model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
         convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
@@ -453,8 +440,6 @@ class Scene:
         Only the pairs marked in ``candidates`` ((n, len(pairs)) bool) are asked, in order, each configuration's
         geometries placed once; rows without a candidate are not placed at all.
         """
-        import pinocchio as pin
-
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
         model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
         convert = self.robot.to_pinocchio_q if self.robot.has_continuous else None
@@ -479,8 +464,6 @@ class Scene:
         every pair's result back into Python: Pinocchio's ``computeDistances`` returns the index of the closest
         pair it computed. No pairs: distances ``inf``, indices ``-1``.
         """
-        import pinocchio as pin
-
         Q = np.atleast_2d(np.asarray(Q, dtype=float))
         dist = np.full(len(Q), math.inf)
         which = np.full(len(Q), -1, dtype=int)
@@ -519,8 +502,6 @@ class Scene:
 
     def _bounded(self, k: int) -> float:
         """Pair k's distance (placements current): its bounding spheres' beyond :data:`FAR`, else coal's."""
-        import pinocchio as pin
-
         pr = self.pairs[k]
         (ca, ra), (cb, rb) = self._spheres[pr.first], self._spheres[pr.second]
         Ma, Mb = self._gd.oMg[pr.first], self._gd.oMg[pr.second]
@@ -534,8 +515,6 @@ class Scene:
 
         See the module docstring for the formula and where it holds.
         """
-        import pinocchio as pin
-
         q = np.asarray(q, dtype=float)
         model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
         qp = self.robot.to_pinocchio_q(q) if self.robot.has_continuous else q
@@ -572,8 +551,6 @@ class Scene:
 
         In the MODEL's world frame (the root link), where :meth:`distances` gives the base frame.
         """
-        import pinocchio as pin
-
         model, data, gm, gd = self.robot.model, self._data, self._gm, self._gd
         pin.forwardKinematics(model, data, self.robot.to_pinocchio_q(q) if self.robot.has_continuous else q)
         pin.updateGeometryPlacements(model, data, gm, gd)
@@ -620,10 +597,6 @@ def _fresh_guesses(gd: Any) -> None:
     Pinocchio's requests cache it by default, and EPA started from a stale guess can stop on a wrong face (a
     penetration 30 times too deep was seen: box against cylinder).
     """
-    import warnings
-
-    import coal
-
     for req in gd.distanceRequests:
         req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
         with warnings.catch_warnings():  # the flag is deprecated, but Pinocchio still sets it

@@ -15,15 +15,15 @@ a surface: see :mod:`scara_pin.cell.scene`, which refuses a closed mesh that is 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+import coal
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InvalidInputError
-
-if TYPE_CHECKING:
-    import pinocchio as pin
 
 __all__ = ["KINDS", "MAX_POSITION", "MAX_SIZE", "MIN_SIZE", "Shape", "hull", "rpy_matrix"]
 
@@ -45,8 +45,6 @@ checked: it holds the mesh, so a distance to it is never larger than to the mesh
 
 def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     """URDF's rotation of (roll, pitch, yaw): ``Rz(yaw) Ry(pitch) Rx(roll)``."""
-    import pinocchio as pin
-
     return np.asarray(pin.rpy.rpyToMatrix(float(rpy[0]), float(rpy[1]), float(rpy[2])))
 
 
@@ -123,8 +121,6 @@ class Shape:
     # ------------------------------------------------------------------ placement and geometry
     def placement(self) -> pin.SE3:
         """``frameMshape``: the shape's placement in its frame."""
-        import pinocchio as pin
-
         return pin.SE3(self.rotation, self.xyz)
 
     def grown(self, by: float) -> Shape:
@@ -153,8 +149,6 @@ class Shape:
 
     def moved(self, frameMshape: pin.SE3, what: str | None = None) -> Shape:
         """The same shape placed at ``frameMshape * self.placement()`` (e.g. a carried box put down)."""
-        import pinocchio as pin
-
         M = frameMshape * self.placement()
         rpy = np.asarray(pin.rpy.matrixToRpy(M.rotation))
         return Shape(self.kind, self.size, M.translation.copy(), rpy, self.vertices, self.faces, self.source,
@@ -168,8 +162,6 @@ class Shape:
         holds it, so no collision is missed; a query on a hull costs microseconds where one on a tree of 199,000
         triangles cost 0.2 s).
         """
-        import coal
-
         if self.kind == "box":
             return coal.Box(*self.size)
         if self.kind == "cylinder":
@@ -207,8 +199,6 @@ class Shape:
             return (True, True)
         found = self.__dict__.get("_closure")
         if found is None:
-            import warnings
-
             import trimesh
 
             with warnings.catch_warnings(), np.errstate(all="ignore"):  # trimesh divides by a zero volume
@@ -275,7 +265,6 @@ def hull(points: np.ndarray) -> Any:
     that of a snapped one, so the inflated hull holds the original (a distance to it is never larger). A flat set
     (qhull refuses it; coal would crash on it) is taken as its bounding box, thickened to :data:`MIN_SIZE`.
     """
-    import coal
     from scipy.spatial import ConvexHull, QhullError
 
     points = np.asarray(points, dtype=float)

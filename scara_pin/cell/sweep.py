@@ -53,6 +53,7 @@ import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
+import coal
 import numpy as np
 
 from ..errors import ScaraError
@@ -71,7 +72,6 @@ __all__ = [
     "Contact",
     "JointPath",
     "clear_mask",
-    "clearance_bound",
     "pair_masks",
     "first_contact",
     "bounding_shapes",
@@ -172,8 +172,6 @@ def bounding_shapes(scene: Scene) -> BoundingShapes:
     cached = _BOUNDS.get(scene)
     if cached is not None:
         return cached
-    import coal
-
     gm = scene.geometry_model
     joint, center, radius, end0, end1, capsule, box_r = [], [], [], [], [], [], []
     half_sides = []
@@ -218,22 +216,13 @@ def clear_mask(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margi
     return np.asarray(pair_masks(scene, Q, pairs, margin, want_bound=False)[0].all(axis=1))
 
 
-def clearance_bound(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None) -> np.ndarray:
-    """(n,) a lower bound of the smallest distance of ``pairs`` (default: every checked pair) at each row of ``Q``.
-
-    The pairs' bounding capsules' distance (each capsule holds its shape): no distance query, so cheap enough for
-    many configurations; +inf without pairs.
-    """
-    return pair_masks(scene, Q, pairs, exact=False)[1].min(axis=1, initial=np.inf)  # type: ignore[no-any-return]
-
-
 def pair_masks(scene: Scene, Q: ArrayLike, pairs: list[int] | None = None, margin: float | None = None,
                exact: bool = True, want_bound: bool = True) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(closed (n, k) bool, bound (n, k)): which pair first closes each configuration, and a bound of each distance.
 
     ``closed[i, k]`` is False where pair k is the first of ``pairs`` found closer than the margin at row i (a row
     already closed is not asked again: its later pairs stay True); ``bound[i, k]`` is a lower bound of pair k's
-    distance there, its bounding capsules' (:func:`clearance_bound`).
+    distance there, its bounding capsules' (each capsule holds its shape).
 
     The joint placements are computed once for all the pairs, and only for the geometries they name (an
     obstacle's are fixed); the spheres, the capsules, then the boxes (``_boxes_apart``) spare the exact distance

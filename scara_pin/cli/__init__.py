@@ -27,6 +27,7 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from .._version import __version__
 from ..errors import ScaraError
 from ..limits import files_recorded
 from ..signals import Terminated, kept, raise_pending
@@ -61,8 +62,6 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
             ``import pinocchio``); a name that is no command builds them all, for argparse's message.
             None: every command.
     """
-    from .._version import __version__
-
     parser = Parser(
         prog="scara-pin",
         description="Kinematics of SCARA robots from one xacro/URDF description (Pinocchio inside). "

@@ -6,6 +6,9 @@ import argparse
 import json
 from typing import TYPE_CHECKING, Any
 
+from ..errors import InvalidInputError
+from ..robots import load_robot, load_urdf
+from ._numbers import parse_locks, parse_sets
 from ._options import add_cell_options
 from ._robot import cell_from_args
 
@@ -27,8 +30,6 @@ def report_with_cell(args: argparse.Namespace, report: CheckReport) -> int:
     cannot be loaded leaves the cell unchecked (its findings say why). Exit code: 2 if the URDF is unusable,
     else 4 if either report has warnings, else 0.
     """
-    from ..errors import InvalidInputError
-
     if getattr(args, "cell", None) is None and getattr(args, "carry", None) is None:
         if getattr(args, "points", None) is not None or getattr(args, "margin", None) is not None:
             raise InvalidInputError("--points and --margin of check go with --cell (or --carry)")
@@ -60,13 +61,8 @@ def _cell_report(args: argparse.Namespace) -> Any:
 
     from ..cell import scene
     from ..cell.report import check_cell
-    from ..robots import load_urdf
-    from ._numbers import parse_locks
 
     if getattr(args, "robot", None) is not None:
-        from ..robots import load_robot
-        from ._numbers import parse_sets
-
         robot = load_robot(args.robot, parse_sets(args.set), tool=args.tool, base=args.base,
                            lock=parse_locks(args.lock))  # fmt: skip
     else:

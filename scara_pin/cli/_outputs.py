@@ -7,6 +7,8 @@ import contextlib
 import logging
 from collections.abc import Sequence
 
+from ..description import config_files
+from ..errors import UnknownRobotError
 from ._robot import MAX_NAME
 
 log = logging.getLogger("scara_pin")
@@ -18,9 +20,6 @@ INPUT_OPTIONS = ("urdf", "dh", "points", "measurements", "input", "traj", "simul
 
 def input_files(args: argparse.Namespace) -> dict[str, list[str]]:
     """The files a command reads, by option: its input options, and the yaml files of a configured ``--robot``."""
-    from ..description import config_files
-    from ..errors import UnknownRobotError
-
     found = {f"--{name}": [value] for name in INPUT_OPTIONS
              if isinstance(value := getattr(args, name, None), str) and value not in ("", "-")}  # fmt: skip
     robot = getattr(args, "robot", None)

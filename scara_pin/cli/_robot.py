@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from ..errors import InvalidInputError, ParameterError
+from ..limits import check_input_file
 from ._numbers import number, parse_locks, parse_sets
 from ._options import UsageError
 from ._units import Units
@@ -33,8 +34,6 @@ def robot_from_args(args: argparse.Namespace, units: Units | None = None) -> Rob
         raise InvalidInputError(f"--robot {args.robot[:40]!r}...: not a robot name nor a folder "
                                 f"(longer than {MAX_NAME} characters or with a NUL)")  # fmt: skip
     if args.urdf is not None:  # a regular file under the size cap, or refused before it is read
-        from ..limits import check_input_file
-
         check_input_file(args.urdf, "URDF")
     robot = _load(args)
     for note in (robot.frame_note, robot.lock_note):  # the tool chosen without a tool0, another arm locked

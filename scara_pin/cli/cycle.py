@@ -7,7 +7,7 @@ import json
 import logging
 from typing import Any
 
-from ..errors import InvalidInputError, ParameterError
+from ..errors import InvalidInputError, ParameterError, ScaraError
 from ..files import outputs_together
 from ._joints import needs_wrist, read_pose
 from ._numbers import number, number_type
@@ -146,7 +146,6 @@ def cell_text(cell: Any, distance: Any, units: Units) -> str:
 
 def _jump_for_comparison(robot: Any, result: Any, common: dict[str, Any], radius: float) -> tuple[float] | None:
     """The jump cycle's time at the same placement and limits, or None if it cannot be planned."""
-    from ..errors import ScaraError
     from ..motion.cycle import CyclePath, standard_cycle
 
     kwargs = dict(common, start=result.start, direction=(result.end - result.start)[:2])

@@ -8,8 +8,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ..description import available_robots, generate_urdf, urdf_dir
 from ..errors import InvalidInputError
 from ..files import write_text_atomic
+from ..robots import load_robot
 from ._numbers import parse_locks, parse_sets
 from ._options import add_frame_options, add_robot_options
 from ._outputs import check_command_outputs
@@ -29,7 +31,6 @@ def robot_facts(name: str) -> dict[str, Any]:
     import numpy as np
 
     from ..motion.verify import static_payload
-    from ..robots import load_robot
     from ..workspace import Workspace, workspace_of
 
     robot = load_robot(name)
@@ -44,8 +45,6 @@ def robot_facts(name: str) -> dict[str, Any]:
 
 def cmd_robots(args: argparse.Namespace) -> int:
     """List the shipped robot configurations: kind, reach, stroke and the payload their effort limits hold."""
-    from ..description import available_robots, urdf_dir
-
     facts = [robot_facts(name) for name in available_robots()]
     if args.json:
         units = {"length": "m", "mass": "kg"}
@@ -72,8 +71,6 @@ def cmd_urdf(args: argparse.Namespace) -> int:
             raise InvalidInputError("--dh takes the whole robot from the table: no --robot, --set or --prefix")
         text = dh_to_urdf(Path(args.dh))
     else:
-        from ..description import generate_urdf
-
         text = generate_urdf(args.robot or "default", parse_sets(args.set), prefix=args.prefix)
     if args.output in (None, "-"):
         sys.stdout.write(text)
@@ -99,7 +96,6 @@ def cmd_check(args: argparse.Namespace) -> int:
     from ._check_cell import report_with_cell
 
     if args.robot is not None:  # a configured robot: its generated URDF (what every command loads)
-        from ..description import generate_urdf
         from ..lint import check_urdf
 
         if args.file is not None:

@@ -57,8 +57,10 @@ def cmd_job(args: argparse.Namespace) -> int:
 
             plot_job(result, args.plot, robot=robot, units=units.display)
             written["plot"] = args.plot
-        if args.html:
-            _page(result, robot, args.html, units)
+        if args.html:  # the viewer page playing the job: the poses it reaches as small frames, the cell, the boxes
+            from ..viz.job import job_page
+
+            job_page(result, robot, args.html, rate=_VIEW_RATE, units=units.display)
             written["page"] = args.html
     if args.json:
         print(json.dumps({**result.to_dict(), "outputs": written}))
@@ -121,13 +123,6 @@ def _plan(job: Any, robot: Any, cache: bool) -> Any:
 
     with tqdm(total=job.actions, desc="job", unit="step", file=sys.stderr, leave=False) as bar:
         return job.plan(robot, progress=lambda done, total: bar.update(done - bar.n), cache=cache)
-
-
-def _page(result: Any, robot: Any, path: str, units: Units) -> None:
-    """``--html``: the viewer page playing the job: the poses it reaches as small frames, the cell, the boxes."""
-    from ..viz.job import job_page
-
-    job_page(result, robot, path, rate=_VIEW_RATE, units=units.display)
 
 
 def register(sub: Any) -> None:

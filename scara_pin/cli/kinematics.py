@@ -8,7 +8,10 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-from ..errors import InfeasibleError, InvalidInputError, ParameterError
+import numpy as np
+
+from ..errors import InfeasibleError, InvalidInputError, ParameterError, UrdfError
+from ..model import pose_from_placement
 from ..units import decimals_for, format_number
 from ._joints import check_limits, needs_wrist, q_values, read_pose
 from ._numbers import integer_type
@@ -18,8 +21,6 @@ from ._robot import cell_from_args, robot_from_args
 from ._units import POSE_KINDS, Q_NAMES, Units
 
 if TYPE_CHECKING:
-    import numpy as np
-
     from .._typing import ArrayLike
     from ..robots import Robot
 
@@ -34,8 +35,6 @@ def cmd_fk(args: argparse.Namespace) -> int:
     robot = robot_from_args(args, units)
     q = check_limits(robot, q_values(args.q, units), units, args.strict)
     M = robot.tool_placement(q)
-    from ..model import pose_from_placement
-
     pose = pose_from_placement(M)
     if args.json:  # always SI (docs/cli.md: "--json output is always SI")
         out = {
@@ -71,8 +70,6 @@ def cmd_fk(args: argparse.Namespace) -> int:
 
 def cmd_jacobian(args: argparse.Namespace) -> int:
     """The task Jacobian d(x, y, z, yaw)/dq, or Pinocchio's 6 x 4 frame Jacobian."""
-    import numpy as np
-
     units = Units.from_args(args)
     robot = robot_from_args(args, units)
     q = check_limits(robot, q_values(args.q, units), units, args.strict)
@@ -159,8 +156,6 @@ def cmd_ik(args: argparse.Namespace) -> int:
     if args.all_turns and (numeric or near is not None):
         raise InvalidInputError("--all-turns lists every closed-form solution: not with --numeric or --near")
     if not numeric:
-        from ..errors import UrdfError
-
         try:
             _ = robot.kinematics  # extracted on first use: refused here if the model is not its kind's
         except UrdfError as exc:  # NotScaraError, NotPalletizerError
@@ -234,8 +229,6 @@ def _clear_solutions(robot: Robot, cell: Any, qs: list[Any], branches: list[str]
 
     Each refused one: its q, branch, the reason code ``COLLISION``, the closest pair and its distance [m].
     """
-    import numpy as np
-
     from ..cell import describe, scene
 
     sc = scene(robot, cell)
@@ -253,7 +246,6 @@ def _clear_solutions(robot: Robot, cell: Any, qs: list[Any], branches: list[str]
 
 
 def _ik_numeric(robot: Robot, target: Sequence[float], near: np.ndarray | None) -> tuple[str, str, list, list]:
-    from ..errors import UrdfError
     from ..kinematics.numeric import elbow_sign, solve_numeric
 
     res = solve_numeric(robot, target, q0=near)

@@ -8,7 +8,7 @@ import logging
 import sys
 from typing import Any
 
-from ..errors import InfeasibleError, InvalidInputError, ParameterError
+from ..errors import InfeasibleError, InvalidInputError, ParameterError, ScaraError
 from ..files import outputs_together
 from ..units import format_number, format_vector
 from ._joints import joint_arg, needs_wrist, read_pose
@@ -135,17 +135,13 @@ def cmd_traj(args: argparse.Namespace) -> int:
 _ARCH_ONLY = ("rise", "blend", "clearance_radius", "max_height", "path")
 
 
-def _flag(name: str) -> str:
-    return "--" + name.replace("_", "-")
-
-
 def _arch_options(args: argparse.Namespace) -> None:
     """Refuse (exit 2) an option given with a motion kind it does not act on, naming the combination."""
     check_setpoint_options(args)
     if not args.arch:
         for name in _ARCH_ONLY:
             if getattr(args, name) is not None:
-                raise InvalidInputError(f"{_flag(name)} shapes an arch move: it needs --arch")
+                raise InvalidInputError(f"--{name.replace('_', '-')} shapes an arch move: it needs --arch")
         return
     if (args.path or "jump") == "jump":
         if args.blend is not None:
@@ -231,7 +227,6 @@ def _print_arch(args: argparse.Namespace, robot: Any, move: Any, units: Units, m
 def _jump_time(robot: Any, move: Any, args: argparse.Namespace, units: Units, tool_speed: float | None
                ) -> float | None:  # fmt: skip
     """The jump's duration between the same configurations and limits, or None if it cannot be planned."""
-    from ..errors import ScaraError
     from ..motion.jump import STANDARD_RISE, jump_move
 
     q0, q1 = move.trajectory.q_start, move.trajectory.q_end

@@ -33,7 +33,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from ..errors import DescriptionError, ParameterError, UnknownRobotError
+from ..errors import DescriptionError, InvalidInputError, ParameterError, UnknownRobotError, YamlError
+from ..units import number_text
 
 __all__ = [
     "JOINT_COUNTS",
@@ -289,8 +290,6 @@ def _check_finite(name: str, value: object) -> None:
 def _to_float(name: str, raw: object) -> float:
     """A finite float from a number or the text of one (the grammar of :data:`scara_pin.units.NUMBER_TEXT`)."""
     if isinstance(raw, str):
-        from ..units import number_text
-
         value = number_text(raw)
         if math.isnan(value):
             if raw.strip().lower().lstrip("+-") in ("nan", "inf", "infinity"):
@@ -313,7 +312,6 @@ def _flatten(tree: object, prefix: str, out: dict[str, object]) -> None:
 
 
 def _read_yaml_text(path: Path) -> str:
-    from ..errors import InvalidInputError
     from ..limits import check_input_file, read_text
 
     try:
@@ -332,7 +330,6 @@ def _config_texts(folder: Path) -> dict[str, str]:
 
 def _read_config(folder: Path, texts: Mapping[str, str] | None = None) -> tuple[str, dict[str, float]]:
     """(kind, flat values) of a config folder (or of its files' ``texts``); the kind is kinematics.yaml's ``kind:``."""
-    from ..errors import YamlError
     from .yaml_units import load_yaml
 
     texts = _config_texts(folder) if texts is None else texts

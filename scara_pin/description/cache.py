@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .._version import __version__
 from ..limits import read_bytes
 
 __all__ = ["FORMAT", "MAX_ENTRY_BYTES", "DescriptionCache", "DigestStore", "cache_folder"]
@@ -142,13 +143,10 @@ class DigestStore:
                 reason = "a symbolic link: never followed" if exc.errno == errno.ELOOP else exc.strerror or str(exc)
             else:
                 reason = str(exc)
-            log.warning("%s entry %s ignored (%s): %s and the entry replaced", self.what, path, reason,
-                        self._again())  # fmt: skip
+            again = "the robot is made again" if self.what == "description cache" else "it is made again"
+            log.warning("%s entry %s ignored (%s): %s and the entry replaced", self.what, path, reason, again)
             return None
         return entry
-
-    def _again(self) -> str:
-        return "the robot is made again" if self.what == "description cache" else "it is made again"
 
     def _folder(self) -> Path | None:
         """The cache folder, created with mode 0700 (narrowed to it when it is the user's); None: not usable."""
@@ -202,8 +200,6 @@ class DescriptionCache(DigestStore):
             description: Path) -> str:  # fmt: skip
         """The SHA-256 digest (hex) of everything a configured robot is made from (module docstring)."""
         import importlib.util
-
-        from .._version import __version__
 
         digest = hashlib.sha256()
 

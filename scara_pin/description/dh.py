@@ -49,7 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
-from ..errors import ParameterError
+from ..errors import InvalidInputError, ParameterError, YamlError
 
 __all__ = [
     "CONVENTIONS",
@@ -178,7 +178,6 @@ def load_dh_table(path: str | Path) -> DHTable:
     """
     path = Path(path)
     origin = str(path)
-    from ..errors import InvalidInputError, YamlError
     from ..limits import read_text
     from .yaml_units import load_yaml
 

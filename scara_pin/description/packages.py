@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
-from ..errors import InvalidInputError, UrdfError
+from ..errors import InvalidInputError, UrdfError, YamlError
 from ..limits import (
     MAX_DOCUMENT_BYTES,
     MAX_PACKAGE_XML_BYTES,
@@ -401,7 +401,6 @@ def _check_yaml(data: bytes, file: object) -> None:
 
     xacro parses it again (its values, its tags); an invalid file is left to xacro's own error.
     """
-    from ..errors import YamlError
     from .yaml_units import load_yaml
 
     try:

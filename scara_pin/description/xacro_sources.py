@@ -16,6 +16,7 @@ The tag's value is a number: nothing of the user's reaches xacro's evaluation th
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -95,8 +96,6 @@ def _tagging_parser(top: Path, table: list[tuple[Path, int]], failed: list[int])
     And its ``eval_all`` by one that records, when an evaluation fails, the innermost tagged element being
     evaluated (its index in ``table``, or -1) in ``failed``.
     """
-    import os
-
     import xacro
 
     original, original_eval = xacro.parse, xacro.eval_all

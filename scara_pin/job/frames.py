@@ -19,14 +19,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InvalidInputError
-
-if TYPE_CHECKING:
-    import pinocchio as pin
 
 __all__ = ["BASE", "WORLD", "Frame", "FrameTree"]
 
@@ -135,8 +133,6 @@ class FrameTree:
 
     def base_M_world(self) -> pin.SE3:
         """``baseMworld``: the world's placement in the robot's base frame (moves the cell's obstacles)."""
-        import pinocchio as pin
-
         c, s = math.cos(self.base.yaw), math.sin(self.base.yaw)
         R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
         return pin.SE3(R, np.array(self.base.xyz)).inverse()

@@ -64,7 +64,8 @@ from typing import Any, NoReturn, TypeVar
 
 import numpy as np
 
-from ..errors import InvalidInputError, JobFileError, ParameterError
+from ..description.yaml_units import Tagged, load_yaml, yaml_line
+from ..errors import InvalidInputError, JobFileError, ParameterError, YamlError
 from ..limits import (
     MAX_DOCUMENT_BYTES,
     MAX_DWELL,
@@ -142,8 +143,6 @@ class _At:
 
     def child(self, key: str | int, name: str | None = None) -> _At:
         """The value at ``key`` of this mapping (or index of this list), with its line (the shared loader's)."""
-        from ..description.yaml_units import yaml_line
-
         label = name if name is not None else (f"{self.name}[{key}]" if isinstance(key, int) else str(key))
         origin = self.origin or self.placed.get(id(self.value), {}).get(key)
         line = yaml_line(self.value, key)
@@ -159,8 +158,6 @@ class _At:
         return self._scaled("angle", rule, what)
 
     def _scaled(self, kind: str, rule: Callable[[float], bool], what: str) -> float:
-        from ..description.yaml_units import Tagged
-
         scale = self.units.scale(kind)
         if isinstance(self.value, Tagged) or scale == 1.0:
             return self.number(rule, what, "m" if kind == "length" else "rad")
@@ -228,9 +225,6 @@ def read_job(path: str | Path, overrides: Iterable[Override] = (), *, text: str 
         JobFileError: the file, the line (or the override) and the reason of the first problem (exit 2).
         InvalidInputError: the file cannot be read (missing, not a regular file, over its cap, not UTF-8).
     """
-    from ..description.yaml_units import load_yaml, yaml_line
-    from ..errors import YamlError
-
     path = Path(path)
     if text is None:
         text = read_text(check_input_file(path, "job file", MAX_JOB_BYTES), "job file", MAX_JOB_BYTES)
@@ -305,9 +299,6 @@ def read_carry(path: str | Path) -> Carry:
         JobFileError: no carry, or one the job would refuse (the file and the line).
         InvalidInputError: the file cannot be read.
     """
-    from ..description.yaml_units import load_yaml, yaml_line
-    from ..errors import YamlError
-
     path = Path(path)
     text = read_text(check_input_file(path, "carry file", MAX_JOB_BYTES), "carry file", MAX_JOB_BYTES)
     try:

@@ -19,12 +19,13 @@ job's top-level steps that reach the pallet places, from the first to the last o
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..motion.verify import Binding
 from ..summary import Summarized
-from ..units import format_number
+from ..units import SI, format_number
 from .steps import StepKind
 
 if TYPE_CHECKING:
@@ -39,30 +40,9 @@ _ROWS_SHOWN = 6
 """Rows of the table a result's summary shows at each end (its ``repr``; :meth:`JobResult.table` has them all)."""
 
 
-@dataclass(frozen=True)
-class LimitShare:
-    """A limit on a step of a job: its largest |value| / limit there and the share of the step's time at >= 99.9 %.
-
-    Attributes:
-        quantity: "velocity", "acceleration", "jerk", "torque" or "tool speed".
-        joint: the joint ("tool" for the tool speed).
-        ratio: its largest |value| / limit on the step.
-        share: the fraction of the step's time it is at >= :data:`~scara_pin.motion.jump.BINDING` of the limit.
-    """
-
-    quantity: str
-    joint: str
-    ratio: float
-    share: float
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {"quantity": self.quantity, "joint": self.joint, "ratio": self.ratio, "share": self.share}
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> LimitShare:
-        """From :meth:`to_dict`'s (``KeyError``, ``ValueError``: not one)."""
-        return cls(str(data["quantity"]), str(data["joint"]), float(data["ratio"]), float(data["share"]))
+LimitShare = Binding
+"""A limit on a step of a job: its largest |value| / limit there and the share of the step's time at >= 99.9 %
+(the jump's :class:`~scara_pin.motion.verify.Binding`, the step as its leg)."""
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -90,8 +70,6 @@ class PlacedBox(Summarized):
 
     def summary(self, units: DisplayUnits | None = None) -> str:
         """One line: the box, where and when it was left."""
-        from ..units import SI
-
         u = units or SI
         return (f"PlacedBox {self.name} at {self.at} (step {self.step}, t = {self.time:.6f} s): centre "
                 f"{u.format_vector(self.shape.xyz, 'length')} [{u.length}] in base")  # fmt: skip
@@ -128,9 +106,8 @@ class PlanningStats(Summarized):
                 f"from the cache{free}; {self.seconds:.3g} s")  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {"planned": self.planned, "same": self.same, "reversed": self.reversed, "cached": self.cached,
-                "free": self.free, "seconds": self.seconds}  # fmt: skip
+        """JSON-ready: the fields, by name."""
+        return asdict(self)
 
 
 @dataclass(frozen=True, eq=False, repr=False)

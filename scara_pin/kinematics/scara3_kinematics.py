@@ -12,12 +12,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._checks import as_vector
 from ..errors import InvalidInputError, ParameterError
 from ..ik_results import BatchIKResult, IKResult
 from . import scara
 from .polish import polish_batch, row_solver, solve_refined
 from .scara_batch import solve_batch
-from .targets import nearest_q
+from .targets import check_magnitude, nearest_q
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -51,9 +52,6 @@ class Scara3Kinematics(ScaraKinematics):
     # ------------------------------------------------------------------------- 3 <-> 4 joint values
     def _target4(self, target: Any) -> tuple[float, float, float, float]:
         """(x, y, z, yaw0) of a 3-value target: the virtual wrist absorbs the yaw."""
-        from .._checks import as_vector
-        from .targets import check_magnitude
-
         size = np.size(target) if not hasattr(target, "homogeneous") else 16
         if size != 3:
             raise InvalidInputError(
@@ -68,8 +66,6 @@ class Scara3Kinematics(ScaraKinematics):
     def _ref4(reference: ArrayLike | None) -> np.ndarray | None:
         if reference is None:
             return None
-        from .._checks import as_vector
-
         ref = np.asarray(reference, dtype=float)
         if ref.ndim == 2:
             if ref.shape[1] != 3:
@@ -101,8 +97,6 @@ class Scara3Kinematics(ScaraKinematics):
         """The solution nearest ``reference`` (3 values; weighted joint space); NoSolutionError if none."""
         if self.robot is not None:
             return nearest_q(self.solve(target, branch=branch, reference=reference), reference, weights, branch, 3)
-        from .._checks import as_vector
-
         w = np.append(np.ones(3) if weights is None else as_vector("weights", weights, 3), 0.0)  # the wrist: nothing
         q = scara.solve_nearest(self.geometry, self._target4(target), self._ref4(reference), weights=w, branch=branch)
         return q[:3].copy()

@@ -23,7 +23,7 @@ from ..model import pose_from_placement
 from . import scara
 from .polish import polish_batch, row_solver, seed_geometry, solve_refined
 from .scara_batch import solve_batch
-from .targets import nearest_q
+from .targets import nearest_q, parse_target, placement_matrix
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -67,8 +67,6 @@ class ScaraKinematics:
         """:func:`scara_pin.kinematics.scara.solve` (refined on the model when its axes are near-parallel)."""
         if self.robot is None:
             return scara.solve(self.geometry, target, branch=branch, reference=reference, all_turns=all_turns)
-        from .targets import parse_target, placement_matrix
-
         geo = self.geometry
         x, y, z, alpha, tilt = parse_target(target, geo.yaw0, geo.R0)
         rotation = None

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from .._checks import MAGNITUDE_MAX, as_floats, as_vector
-from ..errors import NoSolutionError, ParameterError
+from ..errors import InvalidInputError, NoSolutionError, ParameterError
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -123,8 +123,6 @@ def batch_inputs(targets: object, reference: object, branch: str, branches: tupl
         ParameterError: a shape, or a value that is not finite or out of range.
         InvalidInputError: an unknown branch.
     """
-    from ..errors import InvalidInputError
-
     T = as_floats("targets", targets, "must be an (N, 4) array of x, y, z, yaw")
     if T.ndim != 2 or T.shape[1] != 4:
         raise ParameterError("targets", f"array of shape {T.shape}", "must have shape (N, 4): x, y, z, yaw")

@@ -26,12 +26,15 @@ from xml.etree.ElementTree import Element
 import numpy as np
 
 from .._checks import number_text
-from ..urdf_rules import MOVABLE, FrameChoice, JointEdge, Mimic, resolve_mimics
+from .._urdf_checks import parse_urdf_xml
+from ..errors import UrdfError
+from ..kinematics.kinds import kinematics_for
+from ..model import RobotModel
+from ..urdf_rules import MOVABLE, FrameChoice, JointEdge, Mimic, locked_joints, mimic_error, resolve_mimics, zero_within
 from .report import Finding, Severity
 
 if TYPE_CHECKING:
     from ..description.xacro_sources import SourceMap
-    from ..model import RobotModel
 
 __all__ = ["KNOWN_TYPES", "SAMPLES", "Context", "LintJoint", "Stop", "rpy_matrix", "shown_path"]
 
@@ -50,13 +53,6 @@ class _Quiet(logging.Filter):
 
     def filter(self, record: logging.LogRecord) -> bool:
         return False
-
-
-def parse(text: str) -> tuple[Element, dict[Element, int]]:
-    """An ElementTree of the text as urdfdom reads it, with each element's line (the loader's reader)."""
-    from .._urdf_checks import parse_urdf_xml
-
-    return parse_urdf_xml(text)
 
 
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
@@ -242,8 +238,8 @@ class Context:
     # ------------------------------------------------------------------------------------------ the file
     @cached_property
     def parsed(self) -> tuple[Element, dict[Element, int]]:
-        """The document's tree and each element's line (:func:`parse`; the ``malformed-xml`` rule parses it)."""
-        return parse(self.text)
+        """The tree as urdfdom reads it, each element's line (the loader's reader; ``malformed-xml`` parses it)."""
+        return parse_urdf_xml(self.text)
 
     @cached_property
     def document(self) -> Document:
@@ -325,9 +321,6 @@ class Context:
         A mimic Pinocchio cannot build (``Mimic.unbuildable``) is the loader's error unless its source is locked
         (then it is locked with it; read once the frames are chosen).
         """
-        from ..errors import UrdfError
-        from ..urdf_rules import locked_joints, mimic_error
-
         try:
             resolved = resolve_mimics(self.edges, self.source)
         except UrdfError as exc:
@@ -395,8 +388,6 @@ class Context:
         ``rpy``: (a joint, the rpy its origin takes instead of the file's). Geared joints follow their free
         joint (:attr:`mimics`); locked ones sit at their ``--lock`` value, else 0 (or their nearest limit).
         """
-        from ..urdf_rules import zero_within
-
         index = {j.name: i for i, j in enumerate(self.chain.joints)}
         resolved = self.mimics[0]
 
@@ -436,10 +427,6 @@ class Context:
     @cached_property
     def loaded(self) -> tuple[RobotModel | None, Exception | None]:
         """(the robot as the toolkit loads it, None) or (None, the UrdfError saying why it cannot)."""
-        from ..errors import UrdfError
-        from ..kinematics.kinds import kinematics_for
-        from ..model import RobotModel
-
         quiet = _Quiet()  # the loader's warnings are findings here already (xacro-ignored): not logged twice
         logging.getLogger("scara_pin").addFilter(quiet)
         try:
@@ -459,8 +446,6 @@ class Context:
     @cached_property
     def kinematics(self) -> tuple[Any, Exception | None]:
         """(the robot's kinematics, None) or (None, the closed form's refusal: NotScaraError, NotPalletizerError)."""
-        from ..errors import UrdfError
-
         robot = self.robot
         if robot is None:
             return None, None

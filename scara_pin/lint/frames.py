@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from ..errors import UrdfError
 from ..kinematics.scara_geometry import NEAR_PARALLEL_TOL, WRIST_TILT_MAX  # beyond: tilted (the wrist: up to the max)
 from ..urdf_rules import TOOL_NAMES, choose_frames
 from .context import SAMPLES, Context, LintJoint, Stop
@@ -38,8 +39,6 @@ OFFSET_RANGE = 10.0
 
 def frame_missing(ctx: Context) -> None:
     """``--tool``/``--base`` names no link, or a base that moves: the loader's frames (choose_frames)."""
-    from ..errors import UrdfError
-
     try:
         ctx.chosen = choose_frames(list(ctx.tree.links), ctx.edges, tool=ctx.tool_asked, base=ctx.base_asked,
                                    origin=ctx.source)  # fmt: skip

@@ -6,9 +6,11 @@ Each rule is a function of the :class:`~scara_pin.lint.context.Context`; its cod
 
 from __future__ import annotations
 
+import copy
 import math
 
 from .._checks import number_text
+from .._urdf_checks import urdfdom_ignores
 from .context import Context
 from .report import Severity
 
@@ -91,10 +93,6 @@ def mesh_path(ctx: Context) -> None:
 
 def colour_ignored(ctx: Context) -> None:
     """Colours urdfdom cannot read and ignores (``rgb=``, a malformed ``rgba``): the loader's rule, said once."""
-    import copy
-
-    from .._urdf_checks import urdfdom_ignores
-
     ignored = urdfdom_ignores(copy.deepcopy(ctx.parsed[0]))
     if ignored:
         ctx.add(Severity.WARNING, "colour-ignored", f"colours URDF cannot read, ignored by urdfdom and the toolkit "

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pinocchio as pin
 
 from .context import Context
 from .report import Severity
@@ -86,8 +87,6 @@ def near_parallel(ctx: Context) -> None:
 
 def effort_limit(ctx: Context) -> None:
     """An effort limit that stops torque-limited timing: 0 (a placeholder), or below the static load somewhere."""
-    import pinocchio as pin
-
     robot = ctx.robot
     if robot is None:
         return

@@ -9,8 +9,9 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from .._urdf_checks import xacro_leftovers
+from .._urdf_checks import second_parents, xacro_leftovers
 from ..description import JOINT_COUNTS
+from ..errors import InvalidInputError, UrdfError
 from .context import KNOWN_TYPES, Context, Stop, shown_path
 from .report import Finding, Severity
 
@@ -25,7 +26,6 @@ __all__ = [
 def unreadable(ctx: Context) -> None:
     """A file that cannot be read (missing, too large, not UTF-8, a device); its URDF text read otherwise."""
     from ..description.packages import PackagePath, read_robot_file
-    from ..errors import InvalidInputError, UrdfError
     from ..limits import check_input_file
 
     path = ctx.path
@@ -45,7 +45,6 @@ def unreadable(ctx: Context) -> None:
 def xacro_failed(ctx: Context) -> None:
     """A ``.xacro`` file that cannot be expanded (a missing package, an undefined property: where, when known)."""
     from ..description.xacro_sources import expand_with_sources
-    from ..errors import UrdfError
 
     path = ctx.path
     if path is None or not path.name.endswith(".xacro"):
@@ -169,8 +168,6 @@ def two_parents(ctx: Context) -> None:
 
     The loader's rule (``scara_pin._urdf_checks.second_parents``).
     """
-    from .._urdf_checks import second_parents
-
     order = {j.name: k for k, j in enumerate(ctx.document.joints)}
     for link, kept, other, harmful in second_parents(ctx.document.root):
         j = ctx.tree.joints.get(max(kept, other, key=lambda n: order.get(n, -1)))  # the second written

@@ -65,7 +65,7 @@ from .paths import CartesianSegment, GeometricPath, PathError, SegmentedPath, ca
 from .payload import Payload, PayloadLike, as_payload, with_payload
 from .timing import TimingOptions, limits_in_force, parameterize
 from .trajectory import Motion, Trajectory
-from .verify import Quantity, Verification, state_ratios, trajectory_jerk, verify
+from .verify import Quantity, Verification, clear_of, state_ratios, trajectory_jerk, verify
 
 if TYPE_CHECKING:
     from .._typing import ArrayLike
@@ -200,17 +200,6 @@ class ArchPath(SegmentedPath, GeometricPath):
             for o in range(order + 1):
                 out[o][sel] = res[o] / width**o
         return tuple(out)
-
-    def tool_poses(self, s: np.ndarray) -> np.ndarray:
-        """(n, 4) tool poses on the path at s (from the segments' curves, not FK)."""
-        s = np.clip(np.asarray(s, dtype=float).ravel(), 0.0, 1.0)
-        idx = np.clip(np.searchsorted(self.bounds, s, side="right") - 1, 0, len(self.segments) - 1)
-        out = np.empty((len(s), 4))
-        for k, seg in enumerate(self.segments):
-            sel = idx == k
-            if sel.any():
-                out[sel] = seg.poses((s[sel] - self.bounds[k]) / (self.bounds[k + 1] - self.bounds[k]))
-        return out
 
 
 def arch_path(
@@ -523,12 +512,6 @@ def arch_move(
     return ArchMove(traj, tuple(paths), legs, ratios, payload, jv)
 
 
-def _leg_names(path: Any) -> tuple[tuple[str, ...], np.ndarray]:
-    if isinstance(path, ArchPath):
-        return path.names, path.bounds
-    return ("lift", "traverse", "descend"), np.array([0.0, 1.0])
-
-
 def _legs(
     robot: RobotModel, traj: Trajectory, paths: list[Any], lim: Any, jerk: np.ndarray | None, rate: float = 1000.0
 ) -> tuple[tuple[Leg, ...], dict[str, float | None]]:
@@ -538,15 +521,14 @@ def _legs(
     motions = [p for p in traj.pieces if isinstance(p, Motion)]
     mi = 0
     for move, path in enumerate(paths):
-        names, bounds = _leg_names(path)
         if isinstance(path, ArchPath):
             m = motions[mi]
-            cuts = [0.0, *m.law.times_at(bounds[1:-1], 80).tolist(), m.duration]
-            spans += [(names[k], move, t0 + cuts[k], t0 + cuts[k + 1]) for k in range(len(names))]
+            cuts = [0.0, *m.law.times_at(path.bounds[1:-1], 80).tolist(), m.duration]
+            spans += [(name, move, t0 + cuts[k], t0 + cuts[k + 1]) for k, name in enumerate(path.names)]
             t0 += m.duration
             mi += 1
         else:
-            for name in names:
+            for name in ("lift", "traverse", "descend"):
                 m = motions[mi]
                 spans.append((name, move, t0, t0 + m.duration))
                 t0 += m.duration
@@ -735,8 +717,6 @@ def standard_cycle(
         used = 0.0 if blend == 0.0 else min(math.inf if blend is None else blend, rise, span / 2.0)
         bound = _lines_bound(robot, move, a, b, rise, limits, jerk)
         if cell is not None:
-            from .verify import clear_of
-
             move = replace(move, distance=clear_of(robot, move.trajectory, cell))
     if wmin != wmin:  # the smallest manipulability along the traverse of the given placement
         q0 = move.trajectory.q_start

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
@@ -61,10 +61,6 @@ class Method(enum.Enum):
     ARCH = "straight-leg arch (lift, traverse, descend, blended), time-optimal (TOPP-RA)"
     JOINT_JERK = "joint path, jerk-limited time-optimal"
     LINE_JERK = "straight line, jerk-limited time-optimal"
-
-
-def _optional_vector(name: str, value: object) -> np.ndarray | None:
-    return None if value is None else as_vector(name, value, None)  # one per joint (4, or 3 without a wrist)
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,7 +115,8 @@ class MotionRequest:
 
     def __post_init__(self) -> None:
         for name in ("start_q", "end_q", "start_pose", "end_pose"):
-            object.__setattr__(self, name, _optional_vector(name, getattr(self, name)))
+            value = getattr(self, name)  # one per joint (4, or 3 without a wrist)
+            object.__setattr__(self, name, None if value is None else as_vector(name, value, None))
         if self.payload is not None:  # a mass [kg] becomes a Payload
             from .payload import as_payload
 
@@ -202,8 +199,6 @@ def plan_motion(robot: RobotModel, request: MotionRequest) -> MotionPlan:
     plan = _plan(robot, request)
     if request.cell is None or plan.method is Method.JUMP:
         return plan
-    from dataclasses import replace
-
     from .verify import clear_of
 
     return replace(plan, clearance=clear_of(robot, plan.trajectory, request.cell))

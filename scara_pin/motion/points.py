@@ -64,7 +64,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInputError, brief
+from ..errors import InfeasibleError, InvalidInputError, ParameterError, brief
 from ..limits import MAX_POINTS, MAX_POINTS_BYTES, check_input_file, read_text
 from ..units import number_text
 
@@ -201,8 +201,6 @@ class PosePoint:
             InvalidInputError: a hand that is not one of the robot's branches.
             InfeasibleError: the pose out of reach on that branch, or no wrist angle of that turn within the limits.
         """
-        from ..errors import InfeasibleError
-
         branches = tuple(robot.kinematics.branches)
         if self.hand not in branches:
             raise InvalidInputError(f"point {self.name}: hand {self.hand} is not a branch of robot {robot.name!r} "
@@ -320,8 +318,6 @@ class PointSet:
         Raises:
             InvalidInputError: naming the point and what differs.
         """
-        from ..errors import ParameterError
-
         branches = tuple(robot.kinematics.branches)
         for p in self.points:
             if isinstance(p, PosePoint):

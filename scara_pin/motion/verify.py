@@ -79,6 +79,7 @@ __all__ = [
     "REST_TOL",
     "TOLERANCE",
     "VERIFY_RATE",
+    "Binding",
     "Clearance",
     "JointStates",
     "LimitViolation",
@@ -166,6 +167,32 @@ class Worst:
         """JSON-ready."""
         return {"ratio": self.ratio, "time": self.time,
                 "joint": None if self.joint is None else self.names[self.joint]}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Binding:
+    """A limit that binds on a leg of a jump, or on a step of a job (its ``LimitShare``).
+
+    Attributes:
+        quantity: "velocity", "acceleration", "jerk", "torque" or "tool speed".
+        joint: the joint ("tool" for the tool speed).
+        ratio: its largest |value| / limit on the leg.
+        share: the fraction of the leg's time it is at >= :data:`~scara_pin.motion.jump.BINDING` of the limit.
+    """
+
+    quantity: str
+    joint: str
+    ratio: float
+    share: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {"quantity": self.quantity, "joint": self.joint, "ratio": self.ratio, "share": self.share}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Binding:
+        """From :meth:`to_dict`'s (``KeyError``, ``ValueError``: not one)."""
+        return cls(str(data["quantity"]), str(data["joint"]), float(data["ratio"]), float(data["share"]))
 
 
 @dataclass(frozen=True)

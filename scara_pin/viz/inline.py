@@ -24,6 +24,7 @@ from ..errors import ParameterError
 from ..files import write_text_atomic
 from ..limits import MAX_FRAMES, check_count
 from ..summary import Summarized
+from .meshcat import static_html
 from .scene import DEFAULT_FPS
 
 if TYPE_CHECKING:
@@ -125,8 +126,6 @@ def show(
     Raises:
         ParameterError: a ``q`` that is not ``robot.dof`` finite numbers, or a height outside 100..4000.
     """
-    from .meshcat import static_html
-
     if isinstance(height, bool) or not isinstance(height, int) or not 100 <= height <= 4000:
         raise ParameterError("height", height, "must be a whole number of pixels within [100, 4000]")
     times = qs = None

@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InvalidInputError, ParameterError, ScaraError
+from ..errors import InvalidInputError, ParameterError, ScaraError, UrdfError
 from ..motion.manual import (
     JogAxis,
     JogFrame,
@@ -59,6 +59,7 @@ from ..motion.manual import (
     pose_ik,
 )
 from ..motion.points import PointSet, PosePoint, TaughtPoint, points_format, read_points, write_points
+from .scene import recorded_scene
 
 if TYPE_CHECKING:
     from ..cell import Cell, PairDistance, Scene
@@ -619,7 +620,6 @@ def _cell_scene(robot: RobotModel, cell: Cell) -> Scene:
     that IK.
     """
     from ..cell import scene
-    from ..errors import UrdfError
 
     if robot.kind != "scara" or robot.dof != 4:
         raise InvalidInputError(f"the teach pendant's cell is for 4-joint SCARA robots for now; {robot.name!r} is a "
@@ -839,8 +839,6 @@ def _cell_words(cell: Cell) -> str:
 
 def _teach_page(robot: RobotModel, session: TeachSession, controls: bool = False) -> str:
     """The pendant page of the live teach server (no motion player; a ``teach`` section)."""
-    from .scene import recorded_scene
-
     scene, data = recorded_scene(robot, session.q, cell=session.cell)
     data["controls"] = bool(controls)
     labels = {"all": "nearest (any branch)"}

@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import InvalidInputError, ParameterError
 from ..limits import MAX_WORKSPACE_GRID, check_count
 from ..units import SI, DisplayUnits
-from .scara import Workspace, workspace
+from .scara import Workspace, plot_workspace, workspace
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -246,7 +246,6 @@ def plot_free_region(
     from matplotlib.patches import Patch
 
     from ..files import finish
-    from .scara import plot_workspace
 
     fig = plot_workspace(region.workspace, None, units=units, robot_name=robot_name, arm=False)
     ax = fig.axes[0]

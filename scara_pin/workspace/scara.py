@@ -603,10 +603,6 @@ def wrist_tilt_note(geo: ScaraGeometry) -> str | None:
             "a fixed-yaw region of the tool point is not given")  # fmt: skip
 
 
-def _deg(v: float) -> str:
-    return f"{math.degrees(v):.6g} deg"
-
-
 def _labels(geo: ScaraGeometry) -> dict[Role, tuple[tuple[Limit, str], int]]:
     """Each candidate role's (Limit, description) and rank: the joint limit it is, named in q (not angle) terms.
 
@@ -619,8 +615,8 @@ def _labels(geo: ScaraGeometry) -> dict[Role, tuple[tuple[Limit, str], int]]:
                                     (rb, (Role.SECOND_LO, Role.SECOND_HI), (Limit.J2_LOWER, Limit.J2_UPPER), n1)):
         for role, lower_q in zip(roles, (geo.signs[j] > 0, geo.signs[j] < 0), strict=True):
             limit = limits[0] if lower_q else limits[1]
-            q = geo.lower[j] if lower_q else geo.upper[j]
-            text = f"{geo.names[j]} at its {'lower' if lower_q else 'upper'} limit {_deg(q)}, {other} sweeping"
+            deg = math.degrees(geo.lower[j] if lower_q else geo.upper[j])
+            text = f"{geo.names[j]} at its {'lower' if lower_q else 'upper'} limit {deg:.6g} deg, {other} sweeping"
             out[role] = ((limit, text), _PRIORITY[limit])
     out[Role.STRETCHED] = ((Limit.OUTER, f"outer: arm stretched ({n2} at elbow angle 0), {n1} sweeping"),
                            _PRIORITY[Limit.OUTER])

@@ -95,11 +95,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..._checks import as_positive, as_vector
+from ...cell import scene as make_scene
 from ...errors import InfeasibleError, InvalidInputError
 from ...limits import MAX_SAMPLES, check_count
 from ..payload import PayloadLike, as_payload, with_payload
 from ..trajectory import Trajectory
-from ..verify import VERIFY_RATE, jerk_vector, limits_in_force
+from ..verify import VERIFY_RATE, Binding, jerk_vector, limits_in_force
 from .bound import lower_bound
 from .cell import solve_in_cell
 from .problem import Problem, default_intervals, endpoints, given_via, holds_still, top_configuration
@@ -109,7 +110,6 @@ from .types import (
     CLEARANCE_TOL,
     STANDARD_CLEARANCE,
     STANDARD_RISE,
-    Binding,
     JumpError,
     JumpMove,
     JumpOptions,
@@ -222,8 +222,6 @@ def jump_move(
         raise InvalidInputError("via points are hints of the way through a cell: give the cell too")
     scene = None
     if cell is not None:
-        from ...cell import scene as make_scene
-
         scene = make_scene(robot, cell)
         scene.check(qA, "the start (pose_from)")
         scene.check(qB, "the goal (pose_to)")

@@ -9,11 +9,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...cell import describe
 from ...cell.sweep import clear_mask
 from ...errors import InfeasibleError
 from ..polynomial import PolynomialPiece
 from ..trajectory import Trajectory, line_optimal_duration
-from ..verify import CERTIFY_ACCELERATION, DISTANCE_TOL
+from ..verify import CERTIFY_ACCELERATION, DISTANCE_TOL, verify
 from .candidates import SECOND_WITHIN, Candidate, candidates, line_samples, score
 from .nlp import Transcription
 from .problem import ConstraintPoint, Problem
@@ -36,8 +37,6 @@ def closest(scene: Scene, Q: np.ndarray) -> tuple[int, PairDistance | None]:
 
 def blocking(scene: Scene, piece: PolynomialPiece) -> str:
     """Which pair comes closest in ``piece`` and where, in words (for a failure message)."""
-    from ...cell import describe
-
     n = len(piece.breaks) - 1
     h = np.diff(piece.breaks)
     k = np.repeat(np.arange(n), 4)
@@ -51,11 +50,8 @@ def blocking(scene: Scene, piece: PolynomialPiece) -> str:
 
 def where_blocked(scene: Scene, cand: Candidate, velocity: np.ndarray, acceleration: np.ndarray) -> str:
     """What blocks a warm start's joint lines most, where and when (the lines timed from rest to rest), in words."""
-    from ...cell import describe
-
     Q = line_samples(cand.waypoints)
-    i = int(np.argmin(scene.minimum_array(Q)))
-    found = scene.distances(Q[i]).closest
+    i, found = closest(scene, Q)
     if found is None:  # pragma: no cover - a scene without pairs blocks nothing
         return f"{cand.way}: clear"
     per_line = len(Q) // (len(cand.waypoints) - 1)
@@ -293,8 +289,6 @@ def _missed(prob: Problem, traj: Trajectory) -> DistanceRow | None:
 
     Its lowest sample, or its certificate's weakest point.
     """
-    from ..verify import verify
-
     scene = prob.scene
     if scene is None:  # pragma: no cover - in a cell only
         return None

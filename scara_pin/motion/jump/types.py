@@ -19,7 +19,7 @@ from ..trajectory import Trajectory
 if TYPE_CHECKING:
     from ...cell import Cell
     from ...units import DisplayUnits
-    from ..verify import Clearance
+    from ..verify import Binding, Clearance
 
 STANDARD_RISE = 0.025
 """[m] the vertical stroke of the standard cycle, and the default rise of a jump."""
@@ -140,27 +140,6 @@ class LowerBound:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {"duration": self.duration, "joint": self.joint, "reason": self.reason}
-
-
-@dataclass(frozen=True)
-class Binding:
-    """A limit that binds on a leg.
-
-    Attributes:
-        quantity: "velocity", "acceleration", "jerk", "torque" or "tool speed".
-        joint: the joint ("tool" for the tool speed).
-        ratio: its largest |value| / limit on the leg.
-        share: the fraction of the leg's time it is at >= :data:`BINDING` of the limit.
-    """
-
-    quantity: str
-    joint: str
-    ratio: float
-    share: float
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready."""
-        return {"quantity": self.quantity, "joint": self.joint, "ratio": self.ratio, "share": self.share}
 
 
 @dataclass(frozen=True, kw_only=True)

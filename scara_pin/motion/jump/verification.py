@@ -15,6 +15,7 @@ from ..verify import (
     ENDPOINT_TOL,
     TOLERANCE,
     VERIFY_RATE,
+    Binding,
     Clearance,
     LimitViolation,
     limits_in_force,
@@ -23,7 +24,7 @@ from ..verify import (
 )
 from .problem import Problem
 from .refine import extrema
-from .types import BINDING, CLEARANCE_TOL, Binding, JumpError, Leg, Phase
+from .types import BINDING, CLEARANCE_TOL, JumpError, Leg, Phase
 
 _QUANTITIES = ("velocity", "acceleration", "jerk", "torque", "tool speed")
 
