@@ -466,7 +466,14 @@ def test_ctrl_c_while_the_outputs_are_written_leaves_none_of_them(
 
     monkeypatch.setattr(files, "write_text_atomic", interrupted)
     outs = [tmp_path / n for n in ("t.csv", "t.png", "t.html")]
-    code = main(["job", str(job), "--out", str(outs[0]), "--plot", str(outs[1]), "--html", str(outs[2])])
+    # Ctrl-C as a terminal sends it to a command in the foreground: a suite started as a background job (a script's
+    # `make test &`) ignores SIGINT, its workers may inherit that, and then the signal sent above would never arrive
+    # (tests/sigint.py says the same for child processes)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        code = main(["job", str(job), "--out", str(outs[0]), "--plot", str(outs[1]), "--html", str(outs[2])])
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert code == 130, capsys.readouterr().err
     assert seen and seen[-1].endswith("t.html")  # the page was being written, after the two others
     assert [p.name for p in outs if p.exists()] == []
