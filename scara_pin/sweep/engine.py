@@ -162,9 +162,7 @@ def _on_cluster(recipe: Recipe, variants: list[Variant], store: ResultStore, cli
         batch = next(todo, None)
         if batch is None:
             return False
-        key = f"sweep-{batch[0].key}-{run}"
-        future = (client.submit(run_variant, recipe, batch[0], key=key, pure=False) if per_task == 1 else
-                  client.submit(run_batch, recipe, batch, key=key, pure=False))  # fmt: skip
+        future = client.submit(run_batch, recipe, batch, key=f"sweep-{batch[0].key}-{run}", pure=False)
         of[str(future.key)] = batch
         flying.add(future)
         return True
@@ -179,7 +177,6 @@ def _on_cluster(recipe: Recipe, variants: list[Variant], store: ResultStore, cli
             batch = of.pop(str(future.key))
             try:
                 rows = future.result()
-                rows = [rows] if per_task == 1 else rows
             except Exception as exc:  # the task never raises: its workers died (KilledWorker), a lost connection
                 reason = f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:2000]
                 rows = [{**dict(v.values), "variant": v.index, "key": v.key, "status": "failed", "reason": reason,
