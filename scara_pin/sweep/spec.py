@@ -261,7 +261,8 @@ def load_spec(path: str | Path) -> SweepSpec:
     robots = {n: _recipe(n, path.parent, acceleration, fail) for n in names}
     shared = {"format": FORMAT, "planner": planner_digest(), "job": _sha(job_text.encode()),
               "files": _files(job, skip=checked)}  # a varied file is in its own variants' keys (below)
-    files = {_file_key(key, value): _sha(json.dumps(_files(Job.load(job_path, {key: value}, text=job_text))).encode())
+    files = {_file_key(key, value): _files(Job.load(job_path, {key: value}, text=job_text),
+                                           skip=[k for k in _FILE_KEYS if k != key]).get(key, "")
              for key in checked if key in _FILE_KEYS and isinstance(checked[key], list)
              for value in checked[key]}  # fmt: skip
     spec = SweepSpec(path=path, job=job_path, job_text=job_text, vary=checked, samples=samples, seed=seed or 0,
