@@ -112,8 +112,9 @@ def time_limit(seconds: float | None) -> Iterator[None]:
     None: no limit of its own; an outer limit that ends sooner stays in force.
     """
     outer = getattr(_limit, "at", None)
-    if seconds is not None and (outer is None or time.perf_counter() + seconds < outer[0]):
-        _limit.at = (time.perf_counter() + seconds, seconds)
+    at = None if seconds is None else time.perf_counter() + seconds
+    if at is not None and (outer is None or at < outer[0]):
+        _limit.at = (at, seconds)
     try:
         yield
     finally:
